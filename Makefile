@@ -1,0 +1,36 @@
+# The README's two commands are `make sweep` and `make test`; every target builds .venv first.
+PYTHON ?= python3
+VENV   ?= .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.installed-stamp
+WORKERS ?= 2
+
+.PHONY: all venv test sweep figures bench lint clean
+
+all: test
+
+$(STAMP): pyproject.toml
+	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e ".[dev,dist]"
+	@touch $(STAMP)
+
+venv: $(STAMP)
+
+test: $(STAMP)
+	$(PY) -m pytest -q
+
+sweep: $(STAMP)
+	$(PY) -m cell sweep scenarios/table_7_1.yaml --out build/sweep --workers $(WORKERS) --report reports
+
+figures: $(STAMP)
+	MPLBACKEND=Agg $(PY) -m cell figures --out reports/figures
+
+bench: $(STAMP)
+	$(PY) -m cell bench --out reports/bench.json
+
+lint: $(STAMP)
+	$(PY) -m ruff check cell tests
+
+clean:
+	rm -rf $(VENV) build .pytest_cache .hypothesis

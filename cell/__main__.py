@@ -1,0 +1,7 @@
+"""``python -m cell``: the same as the ``cell`` command."""
+
+import sys
+
+from cell.cli import main
+
+sys.exit(main())

@@ -1,0 +1,136 @@
+"""The ``cell`` command: ``cell path | run | sweep | figures | mintime | bench``.
+
+Each subcommand is a thin shell: it reads its input, calls the package, and
+writes its output whole or not at all.  Any :class:`~cell.errors.CellError` is
+reported as one line on stderr with exit code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+from typing import Any
+
+import yaml
+
+from cell import __version__
+from cell.errors import CellError, ScenarioError
+
+#: subcommand -> "module:function" taking the parsed arguments.
+HANDLERS = {
+    "path": "cell.cli:cmd_path",
+    "run": "cell.simulation:cmd_run",
+    "sweep": "cell.sweep:cmd_sweep",
+    "figures": "cell.figures:cmd_figures",
+    "mintime": "cell.mintime.cli:cmd_mintime",
+    "bench": "cell.bench:cmd_bench",
+}
+
+
+def parse_sets(pairs: Sequence[str] | None) -> dict[str, Any]:
+    """``--set key=value`` pairs as dotted overrides; values are read as YAML."""
+    out: dict[str, Any] = {}
+    for pair in pairs or ():
+        key, sep, value = pair.partition("=")
+        if not sep or not key:
+            raise ScenarioError("--set", pair, pair, "expected KEY=VALUE, e.g. run.parts=100")
+        out[key.strip()] = yaml.safe_load(value)
+    return out
+
+
+def _scenario_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("scenario", help="scenario YAML file (see scenarios/)")
+    p.add_argument("--set", dest="sets", action="append", metavar="KEY=VALUE",
+                   help="override a scenario value, e.g. --set run.parts=100 (repeatable)")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="cell",
+        description="Simulate King's (1984) robotic transfer station.")
+    parser.add_argument("--version", action="version", version=f"cell {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    p = sub.add_parser("path", help="write the joint-step table of the transfer path (CSV)",
+                       description="Solve the transfer path once (thesis §4.2, eq. 6.7) and "
+                                   "write one row per path point: coordinates, joint angles, "
+                                   "motor steps, move length, load and LO/TD events.")
+    _scenario_args(p)
+    p.add_argument("--out", required=True, help="CSV file to write")
+
+    p = sub.add_parser("run", help="simulate one scenario; write parts.csv and summary.csv",
+                       description="Run the cell in simulated time under the scenario's policy.")
+    _scenario_args(p)
+    p.add_argument("--out", required=True, help="directory for parts.csv and summary.csv")
+
+    p = sub.add_parser("sweep", help="replicated sweep over scenario keys (Table 7.1)",
+                       description="Run a grid of scenarios with replications; write "
+                                   "replications.csv and, with --report, Table 7.1.")
+    p.add_argument("sweep", help="sweep YAML file (see scenarios/table_7_1.yaml)")
+    p.add_argument("--out", required=True, help="directory for results")
+    p.add_argument("--workers", type=int, default=None,
+                   help="local worker processes (default: number of cores)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run on a dask.distributed cluster at ADDRESS")
+    p.add_argument("--resume", action="store_true", help="run only what is missing in --out")
+    p.add_argument("--report", default=None, metavar="DIR",
+                   help="also write table_7_1.csv and table_7_1.md into DIR")
+
+    p = sub.add_parser("figures", help="regenerate the thesis's figures as PNG",
+                       description="Write reports/figures/figNN_<slug>.png for Fig. 8-30.")
+    p.add_argument("--out", default="reports/figures", help="directory for the PNGs")
+    p.add_argument("--scenario", default="scenarios/baseline.yaml", help="scenario to draw")
+
+    p = sub.add_parser("mintime", help="minimum-time motion along the path (Shin & McKay)",
+                       description="Phase-plane minimum-time parameterisation of R II and "
+                                   "R IV; writes FILE.csv and FILE.json.")
+    _scenario_args(p)
+    p.add_argument("--out", required=True, help="output stem: FILE.csv and FILE.json")
+
+    p = sub.add_parser("bench", help="measure simulation and planner speed",
+                       description="Benchmarks; writes a JSON of the figures.")
+    p.add_argument("--out", default="reports/bench.json", help="JSON file to write")
+    return parser
+
+
+def cmd_path(args: argparse.Namespace) -> int:
+    from cell.scenario import load_scenario
+    from cell.steptable import StepTable
+
+    scenario = load_scenario(args.scenario, parse_sets(args.sets))
+    table = StepTable.from_scenario(scenario)
+    table.write_csv(args.out)
+    n = table.path.n_points
+    print(f"wrote {args.out}: {n} points, {n - 1} moves; R IV {table.regime_length('R4'):.4f} in")
+    return 0
+
+
+def _handler(command: str) -> Any:
+    module, _, func = HANDLERS[command].partition(":")
+    try:
+        return getattr(importlib.import_module(module), func)
+    except (ImportError, AttributeError):
+        return None
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    handler = _handler(args.command)
+    if handler is None:
+        print(f"cell: error: '{args.command}' is not built yet", file=sys.stderr)
+        return 2
+    try:
+        return int(handler(args) or 0)
+    except CellError as exc:
+        print(f"cell: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("cell: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,176 @@
+"""MICROBOT kinematics (thesis §3, §6.1; corrections in SPEC §2).
+
+Forward kinematics is the product of the Denavit-Hartenberg A matrices
+(eq. 3.1-3.7, Table 3.1), vectorised over any number of configurations.  The
+inverse is the closed form of SPEC §2 (the scan's eq. 3.26-3.31 are garbled).
+The cell's placement Z (eq. 6.1), the hand E (eq. 6.2), the part P and grasp PG
+(eq. 6.3-6.5) give the arm's target T5 = Z⁻¹ P PG E⁻¹ (eq. 6.7).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from cell.errors import UnreachableError
+from cell.scenario import Scenario
+from cell.transforms import Frame, inverse, rot, trans
+
+JOINTS = ("theta1", "theta2", "theta3", "theta4", "theta5")
+JOINT_NAMES = ("base", "shoulder", "elbow", "wrist pitch", "wrist roll")
+
+#: Twist α and whether the link length a is L2/L3, per link (Table 3.1); d = 0 for all.
+DH_ALPHA = np.radians([90.0, 0.0, 0.0, -90.0, 0.0])
+
+
+@dataclass(frozen=True)
+class Arm:
+    """The arm's geometry: link lengths and joint ranges (radians)."""
+
+    l2: float = 7.0
+    l3: float = 7.0
+    limits: NDArray[np.float64] = field(default_factory=lambda: np.radians(
+        [[-90.0, 90.0], [-35.0, 144.0], [-149.0, 0.0], [-180.0, 0.0], [-180.0, 180.0]]))
+    """(5, 2) lower and upper bounds, Table 3.1 in the DH convention of SPEC §2."""
+
+    @classmethod
+    def from_scenario(cls, s: Scenario) -> Arm:
+        return cls(s.robot.l2_in, s.robot.l3_in,
+                   np.radians(np.array(s.robot.joint_limits_deg.as_array(), dtype=float)))
+
+    @property
+    def link_a(self) -> NDArray[np.float64]:
+        return np.array([0.0, self.l2, self.l3, 0.0, 0.0])
+
+
+def a_matrix(theta: ArrayLike, d: float, a: float, alpha: float) -> Frame:
+    """A = Rot(z, θ) Trans(0, 0, d) Trans(a, 0, 0) Rot(x, α) (eq. 3.1-3.2)."""
+    theta = np.asarray(theta, dtype=float)
+    c, s = np.cos(theta), np.sin(theta)
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    out = np.zeros(theta.shape + (4, 4))
+    out[..., 0, :] = np.stack([c, -s * ca, s * sa, a * c], axis=-1)
+    out[..., 1, :] = np.stack([s, c * ca, -c * sa, a * s], axis=-1)
+    out[..., 2, 1], out[..., 2, 2], out[..., 2, 3] = sa, ca, d
+    out[..., 3, 3] = 1.0
+    return out
+
+
+def forward(q: ArrayLike, arm: Arm = Arm()) -> Frame:
+    """T5 = A1 A2 A3 A4 A5 (eq. 3.13-3.15) for configurations ``q`` of shape (..., 5)."""
+    q = np.asarray(q, dtype=float)
+    t = a_matrix(q[..., 0], 0.0, 0.0, DH_ALPHA[0])
+    for i in range(1, 5):
+        t = t @ a_matrix(q[..., i], 0.0, arm.link_a[i], DH_ALPHA[i])
+    return t
+
+
+def _wrap_from(angle: NDArray[np.float64], lo: float) -> NDArray[np.float64]:
+    """Angle brought into [lo, lo + 2π)."""
+    return lo + np.mod(angle - lo, 2 * np.pi)
+
+
+def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *, labels: list[str] | None = None,
+                       check_limits: bool = True) -> NDArray[np.float64]:
+    """Joint angles (..., 5) for target frames T5 (..., 4, 4), SPEC §2 closed form.
+
+    The elbow-down branch (θ3 ≤ 0) of Table 3.1's ranges is taken; θ1 is the
+    solution inside the base's range.  A pose out of reach (|C3| > 1) or with a
+    joint outside its range raises :class:`UnreachableError` naming the pose
+    (``labels[i]`` if given) and the joint.  Nothing is clamped.
+    """
+    t = np.asarray(t5, dtype=float)
+    shape = t.shape[:-2]
+    t = t.reshape(-1, 4, 4)
+    n, o, a, p = t[:, :3, 0], t[:, :3, 1], t[:, :3, 2], t[:, :3, 3]
+    lim = arm.limits
+
+    th1 = np.arctan2(p[:, 1], p[:, 0])
+    # The wrist may sit behind the base axis (θ2 > 90°): then the other atan2 branch.
+    th1 = np.where((th1 > lim[0, 1] + 1e-12) | (th1 < lim[0, 0] - 1e-12),
+                   np.arctan2(-p[:, 1], -p[:, 0]), th1)
+    c1, s1 = np.cos(th1), np.sin(th1)
+    th234 = np.arctan2(-(c1 * a[:, 0] + s1 * a[:, 1]), a[:, 2])
+    th5 = np.arctan2(c1 * n[:, 1] - s1 * n[:, 0], c1 * o[:, 1] - s1 * o[:, 0])
+
+    r = c1 * p[:, 0] + s1 * p[:, 1]
+    z = p[:, 2]
+    c3 = (r**2 + z**2 - arm.l2**2 - arm.l3**2) / (2 * arm.l2 * arm.l3)
+    reach_bad = np.abs(c3) > 1.0 + 1e-12
+    c3 = np.clip(c3, -1.0, 1.0)
+    s3 = -np.sqrt(1.0 - c3**2)
+    th3 = np.arctan2(s3, c3)
+    k1 = arm.l2 + arm.l3 * c3
+    th2 = np.arctan2(k1 * z - arm.l3 * s3 * r, k1 * r + arm.l3 * s3 * z)
+    th4 = th234 - th2 - th3
+
+    q = np.stack([th1, th2, th3, th4, th5], axis=-1)
+    q[:, 3] = _wrap_from(q[:, 3], lim[3, 0] - 1e-9)
+    q[:, 4] = _wrap_from(q[:, 4], lim[4, 0] - 1e-9)
+
+    def name(i: int) -> str:
+        if labels is not None:
+            return labels[i]
+        return "pose at p = (" + ", ".join(f"{v:.4f}" for v in p[i]) + ") in the robot frame"
+
+    if reach_bad.any():
+        i = int(np.flatnonzero(reach_bad)[0])
+        dist = float(np.hypot(r[i], z[i]))
+        raise UnreachableError(
+            f"{name(i)} is out of reach: the wrist would be {dist:.4f} in from the shoulder, "
+            f"the arm reaches {abs(arm.l2 - arm.l3):.4f} to {arm.l2 + arm.l3:.4f} in", i)
+    if check_limits:
+        tol = 1e-9
+        outside = (q < lim[:, 0] - tol) | (q > lim[:, 1] + tol)
+        if outside.any():
+            i, j = (int(v) for v in np.argwhere(outside)[0])
+            lo, hi = np.degrees(lim[j])
+            raise UnreachableError(
+                f"{name(i)} needs {JOINTS[j]} ({JOINT_NAMES[j]}) = {np.degrees(q[i, j]):.3f}°, "
+                f"outside its range [{lo:g}°, {hi:g}°]", i)
+    return q.reshape(shape + (5,))
+
+
+# ----------------------------------------------------------------------------- the cell's frames
+def placement(s: Scenario) -> Frame:
+    """Z = Trans(base x, base y, shoulder height) · Rot(z, yaw) (eq. 6.1)."""
+    bx, by, bz = s.cell.robot_base_in
+    return trans(bx, by, bz + s.cell.shoulder_height_in) @ rot("z", np.radians(s.cell.robot_yaw_deg))
+
+
+def hand_length(opening_in: ArrayLike, s: Scenario) -> NDArray[np.float64]:
+    """w11 = L1 + √(L2² - (G - G0)²/2), the hand length at finger opening G (eq. 6.2)."""
+    h = s.robot.hand
+    g = np.asarray(opening_in, dtype=float)
+    return h.l1_in + np.sqrt(h.l2_in**2 - (g - h.g0_in) ** 2 / 2)
+
+
+def hand(opening_in: ArrayLike, s: Scenario) -> Frame:
+    """E = Trans(0, 0, w11): the tool centre along the approach vector (eq. 6.2)."""
+    w = hand_length(opening_in, s)
+    return trans(np.zeros_like(w), 0.0, w)
+
+
+def part_frame(xyz_in: ArrayLike, phi_rad: ArrayLike) -> Frame:
+    """P = Trans(XG, YG, ZG) · Rot(z, φ): φ = 0 in R I, 90° in R III (eq. 6.3, 6.5)."""
+    xyz = np.asarray(xyz_in, dtype=float)
+    return trans(xyz[..., 0], xyz[..., 1], xyz[..., 2]) @ rot("z", phi_rad)
+
+
+#: PG: approach along the part's -z, orientation along its -y (eq. 6.4).
+GRASP: Frame = rot("x", np.pi)
+
+
+def arm_target(xyz_in: ArrayLike, phi_rad: ArrayLike, opening_in: ArrayLike,
+               s: Scenario) -> Frame:
+    """T5 = Z⁻¹ P PG E⁻¹ for tool-centre points in the global frame (eq. 6.6-6.7)."""
+    return inverse(placement(s)) @ part_frame(xyz_in, phi_rad) @ GRASP @ inverse(
+        hand(opening_in, s))
+
+
+def tool_centre(q: ArrayLike, opening_in: ArrayLike, s: Scenario) -> NDArray[np.float64]:
+    """Global tool-centre point Z T5 E for joint angles q (eq. 6.6)."""
+    t = placement(s) @ forward(q, Arm.from_scenario(s)) @ hand(opening_in, s)
+    return t[..., :3, 3]
