@@ -24,6 +24,10 @@ JOINT_NAMES = ("base", "shoulder", "elbow", "wrist pitch", "wrist roll")
 #: Twist α and whether the link length a is L2/L3, per link (Table 3.1); d = 0 for all.
 DH_ALPHA = np.radians([90.0, 0.0, 0.0, -90.0, 0.0])
 
+#: Round-off allowed at a joint limit (rad): near the stretched-elbow singularity
+#: the closed form recovers angles only to about √eps.  Not a clamp.
+LIMIT_TOL_RAD = 1e-7
+
 
 @dataclass(frozen=True)
 class Arm:
@@ -107,8 +111,8 @@ def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *, labels: list[str] | N
     th4 = th234 - th2 - th3
 
     q = np.stack([th1, th2, th3, th4, th5], axis=-1)
-    q[:, 3] = _wrap_from(q[:, 3], lim[3, 0] - 1e-9)
-    q[:, 4] = _wrap_from(q[:, 4], lim[4, 0] - 1e-9)
+    q[:, 3] = _wrap_from(q[:, 3], lim[3, 0] - LIMIT_TOL_RAD)
+    q[:, 4] = _wrap_from(q[:, 4], lim[4, 0] - LIMIT_TOL_RAD)
 
     def name(i: int) -> str:
         if labels is not None:
@@ -122,7 +126,7 @@ def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *, labels: list[str] | N
             f"{name(i)} is out of reach: the wrist would be {dist:.4f} in from the shoulder, "
             f"the arm reaches {abs(arm.l2 - arm.l3):.4f} to {arm.l2 + arm.l3:.4f} in", i)
     if check_limits:
-        tol = 1e-9
+        tol = LIMIT_TOL_RAD
         outside = (q < lim[:, 0] - tol) | (q > lim[:, 1] + tol)
         if outside.any():
             i, j = (int(v) for v in np.argwhere(outside)[0])

@@ -145,24 +145,31 @@ def build_path(s: Scenario) -> TransferPath:
                                labels=labels)
     except UnreachableError as exc:
         i = exc.index
-        key, value = _blame(s, i, regime[i], lo, td, xyz[i])
+        key, value = _blame(s, i, regime[i], xyz[i])
         raise ScenarioError(s.source, key, value, str(exc)) from None
     return TransferPath(xyz, regime, phi, opening, load, q, lo, td)
 
 
-def _blame(s: Scenario, i: int, regime: int, lo: int, td: int,
-           point: NDArray) -> tuple[str, object]:
+def _blame(s: Scenario, i: int, regime: int, point: NDArray) -> tuple[str, object]:
     """The scenario key whose point lies nearest an unreachable path point."""
     p = s.path
+    lo_xyz = _along(p.bot_in, p.f_in, p.lo_from_bot_in, p.pick_height_in)
+    td_xyz = _along(p.g_in, p.eot_in, p.td_from_g_in, p.place_height_in)
     candidates = {
-        1: [("path.bot_in", p.bot_in), ("path.f_in", p.f_in)],
+        1: [("path.bot_in", p.bot_in), ("path.f_in", p.f_in),
+            ("path.pick_height_in", lo_xyz)],
         2: [("path.f_in", p.f_in), ("path.g_in", p.g_in)],
-        3: [("path.g_in", p.g_in), ("path.eot_in", p.eot_in)],
+        3: [("path.g_in", p.g_in), ("path.eot_in", p.eot_in),
+            ("path.place_height_in", td_xyz)],
         4: [("path.eot_in", p.eot_in), ("path.bot_in", p.bot_in)],
     }[int(regime)]
-    if i == lo:
-        return "path.pick_height_in", p.pick_height_in
-    if i == td:
-        return "path.place_height_in", p.place_height_in
-    key, value = min(candidates, key=lambda kv: float(np.linalg.norm(np.subtract(kv[1], point))))
-    return key, list(value)
+    key, _ = min(candidates,
+                     key=lambda kv: float(np.linalg.norm(np.subtract(kv[1], point))))
+    value = s.get(key)
+    return key, list(value) if isinstance(value, tuple) else value
+
+
+def _along(start: tuple, end: tuple, distance: float, z: float) -> NDArray:
+    a, b = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+    xy = a[:2] + (b[:2] - a[:2]) * distance / np.linalg.norm(b - a)
+    return np.array([xy[0], xy[1], z])

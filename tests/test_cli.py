@@ -1,0 +1,87 @@
+"""The command line: subcommands, `cell path`, and hostile input."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from cell.cli import build_parser, main
+
+SUBCOMMANDS = ["path", "run", "sweep", "figures", "mintime", "bench"]
+
+
+def test_help_lists_the_subcommands():
+    out = subprocess.run([sys.executable, "-m", "cell", "--help"], capture_output=True,
+                         text=True, check=True).stdout
+    for name in SUBCOMMANDS:
+        assert name in out
+
+
+def test_installed_cell_command():
+    exe = Path(sys.executable).parent / "cell"
+    assert exe.exists(), "the `cell` console script is installed with the package"
+    out = subprocess.run([str(exe), "--help"], capture_output=True, text=True, check=True).stdout
+    assert all(name in out for name in SUBCOMMANDS)
+
+
+def test_parser_knows_every_subcommand():
+    parser = build_parser()
+    for name in SUBCOMMANDS:
+        assert parser.parse_args([name, "x", "--out", "y"] if name in ("path", "run", "mintime")
+                                 else [name, "x", "--out", "y"] if name == "sweep"
+                                 else [name]).command == name
+
+
+def test_cell_path_writes_the_thesis_table(tmp_path):
+    """Issue 2 must-show: 460 rows, angles in range, R IV 35.54 in and 1125π base steps,
+    9.9855 s at the nominal rate and 7.489 s at the maximum."""
+    out = tmp_path / "steps.csv"
+    assert main(["path", "scenarios/baseline.yaml", "--out", str(out)]) == 0
+    df = pd.read_csv(out, keep_default_na=False)
+    assert len(df) == 460
+    ranges = {1: (-90, 90), 2: (-35, 144), 3: (-149, 0), 4: (-180, 0), 5: (-180, 180)}
+    for j, (lo, hi) in ranges.items():
+        col = df[f"theta{j}_deg"]
+        assert col.between(lo - 1e-9, hi + 1e-9).all(), j
+    r4 = df[df.regime == "R4"]
+    assert r4.move_in.sum() == pytest.approx(35.54, abs=0.01)
+    assert abs(r4.steps1.sum()) == pytest.approx(1125 * np.pi, rel=0.01)
+    # base-limited R IV: steps over the base's rate at no load (thesis §6.1 linear model)
+    base_max = 0.419488 * 1125  # steps/s, robot.motors in scenarios/baseline.yaml
+    assert (r4.steps1.abs() / (0.75 * base_max)).sum() == pytest.approx(9.9855, rel=0.005)
+    assert (r4.steps1.abs() / base_max).sum() == pytest.approx(7.489, rel=0.005)
+    assert set(df.event) == {"", "LO", "TD"}
+
+
+def _run(args, tmp_path):
+    return subprocess.run([sys.executable, "-m", "cell", *args], capture_output=True, text=True,
+                          cwd=Path.cwd())
+
+
+@pytest.mark.parametrize("yaml_text,needle", [
+    ("robot:\n  motrs: {}\n", "robot.motrs"),
+    ("run:\n  parts: ten\n", "run.parts"),
+    ("path:\n  bot_in: [-26.0, 0.0, 3.0]\n", "path.bot_in"),
+    ("belts:\n  input_nominal_in_s: -1\n", "belts.input_nominal_in_s"),
+])
+def test_hostile_scenario_one_line_exit_2_no_file(tmp_path, yaml_text, needle):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml_text)
+    out = tmp_path / "out" / "steps.csv"
+    res = _run(["path", str(bad), "--out", str(out)], tmp_path)
+    assert res.returncode == 2
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and str(bad) in lines[0] and needle in lines[0]
+    assert not out.exists()
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
+
+
+def test_set_overrides_from_the_command_line(tmp_path):
+    out = tmp_path / "steps.csv"
+    assert main(["path", "scenarios/baseline.yaml", "--set", "path.moves.R4=100",
+                 "--out", str(out)]) == 0
+    assert len(pd.read_csv(out)) == 410
+    assert main(["path", "scenarios/baseline.yaml", "--set", "nonsense", "--out", str(out)]) == 2

@@ -1,0 +1,134 @@
+"""Scenario files: defaults, overrides, and one clear line for every bad input."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+import yaml
+
+from cell.errors import ScenarioError
+from cell.scenario import (
+    WEIBULL_SHAPE,
+    default_scenario,
+    from_dict,
+    known_key,
+    load_scenario,
+    to_dict,
+)
+
+
+def test_baseline_yaml_is_the_thesis_defaults():
+    """scenarios/baseline.yaml spells out every default: file and code cannot drift apart."""
+    base = load_scenario("scenarios/baseline.yaml")
+    defaults = default_scenario()
+    for f in dataclasses.fields(base):
+        if f.name in ("source", "name", "description"):
+            continue
+        a, b = to_dict(getattr(base, f.name)), to_dict(getattr(defaults, f.name))
+        assert a == pytest.approx(b, rel=1e-9) if isinstance(a, float) else a == b or \
+            _close(a, b), f.name
+
+
+def _close(a, b):
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(_close(a[k], b[k]) for k in a)
+    if isinstance(a, list):
+        return len(a) == len(b) and all(_close(x, y) for x, y in zip(a, b))
+    if isinstance(a, float):
+        return abs(a - b) <= 1e-9 * max(1, abs(b))
+    return a == b
+
+
+def test_weibull_shape_is_eq_6_9():
+    assert WEIBULL_SHAPE == pytest.approx(4.9068, abs=1e-4)
+    assert default_scenario().arrivals.params["c"] == WEIBULL_SHAPE
+
+
+def test_overrides_are_validated():
+    s = default_scenario().with_overrides({"run.parts": 10, "belts.input_nominal_in_s": 2.5})
+    assert s.run.parts == 10 and s.belts.input_nominal_in_s == 2.5
+    with pytest.raises(ScenarioError, match=r"run\.parts = 0: must be at least 1"):
+        default_scenario().with_overrides({"run.parts": 0})
+
+
+def test_known_key():
+    assert known_key("controller.ideal_cycle_s")
+    assert known_key("robot.motors.nominal_fraction")
+    assert not known_key("controller.cycle")
+    assert not known_key("run.parts.x")
+    assert not known_key("source")
+
+
+BAD = [
+    ({"pth": 1}, "pth", "unknown key"),
+    ({"robot": {"motors": {"stepz_per_rad": 1}}}, "robot.motors.stepz_per_rad", "unknown key"),
+    ({"run": {"parts": "many"}}, "run.parts", "whole number"),
+    ({"run": {"parts": 2.5}}, "run.parts", "whole number"),
+    ({"run": {"parts": 0}}, "run.parts", "at least 1"),
+    ({"run": {"parts": -5}}, "run.parts", "at least 1"),
+    ({"belts": {"input_nominal_in_s": -3.0}}, "belts.input_nominal_in_s", "greater than 0"),
+    ({"belts": {"output_nominal_in_s": 0}}, "belts.output_nominal_in_s", "greater than 0"),
+    ({"belts": {"input_nominal_in_s": True}}, "belts.input_nominal_in_s", "must be a number"),
+    ({"belts": {"input_nominal_in_s": ".nan"}}, "belts.input_nominal_in_s", "must be a number"),
+    ({"robot": {"motors": {"steps_per_rad": [1, 2, 3]}}}, "robot.motors.steps_per_rad",
+     "exactly 5"),
+    ({"robot": {"motors": {"nominal_fraction": 1.5}}}, "robot.motors.nominal_fraction",
+     "at most 1"),
+    ({"robot": {"timing": "fast"}}, "robot.timing", "one of"),
+    ({"controller": {"policy": "random"}}, "controller.policy", "one of"),
+    ({"arrivals": {"distribution": "no_such_dist"}}, "arrivals.distribution", "scipy.stats"),
+    ({"arrivals": {"distribution": "poisson"}}, "arrivals.distribution", "continuous"),
+    ({"arrivals": {"distribution": "norm", "params": {"mu": 3}}}, "arrivals.params",
+     "not accepted"),
+    ({"arrivals": {"distribution": "norm", "params": {"loc": 20, "scale": 1}}},
+     "arrivals.params", "non-negative"),
+    ({"arrivals": {"trace_csv": "missing.csv"}}, "arrivals.trace_csv", "no such file"),
+    ({"path": {"lo_from_bot_in": 9.0}}, "path.lo_from_bot_in", "inside the input window"),
+    ({"robot": {"hand": {"open_in": 5.0}}}, "robot.hand.open_in", "linkage"),
+    ({"path": "x"}, "path", "mapping"),
+]
+
+
+@pytest.mark.parametrize("raw,key,why", BAD, ids=[b[1] + ":" + b[2] for b in BAD])
+def test_bad_values_name_file_key_and_value(tmp_path, raw, key, why):
+    f = tmp_path / "bad.yaml"
+    f.write_text(yaml.safe_dump(raw) if not isinstance(raw, str) else raw)
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(f)
+    msg = str(info.value)
+    assert msg.startswith(f"{f}: {key} = "), msg
+    assert why in msg and "\n" not in msg
+
+
+def test_trace_with_negative_time(tmp_path):
+    (tmp_path / "trace.csv").write_text("interarrival_s\n20.0\n-1.5\n21.0\n")
+    f = tmp_path / "s.yaml"
+    f.write_text("arrivals:\n  trace_csv: trace.csv\n")
+    with pytest.raises(ScenarioError, match=r"trace_csv = .*row 2 .*-1.5.*positive"):
+        load_scenario(f)
+
+
+def test_trace_resolves_beside_the_scenario(tmp_path):
+    (tmp_path / "trace.csv").write_text("interarrival_s\n20.0\n21.0\n")
+    f = tmp_path / "s.yaml"
+    f.write_text("arrivals:\n  trace_csv: trace.csv\n")
+    assert load_scenario(f).arrivals.trace_csv == "trace.csv"
+
+
+def test_unreachable_path_point_is_a_scenario_error():
+    from cell.path import build_path
+
+    s = from_dict({"path": {"bot_in": [-26.0, 0.0, 3.0]}}, "x.yaml")
+    with pytest.raises(ScenarioError, match=r"x.yaml: path.bot_in = \[-26.0, 0.0, 3.0\]: "
+                                            r"path point 0 .*out of reach"):
+        build_path(s)
+    s = from_dict({"path": {"pick_height_in": 14.0}}, "y.yaml")
+    with pytest.raises(ScenarioError, match=r"y.yaml: path.pick_height_in = 14.0: .*theta"):
+        build_path(s)
+
+
+def test_distribution_by_name_and_params():
+    s = from_dict({"arrivals": {"distribution": "gamma",
+                                "params": {"a": 4.0, "loc": 18.0, "scale": 1.0}}})
+    assert s.arrivals.distribution == "gamma"
+    assert np.isclose(s.arrivals.params["a"], 4.0)
