@@ -1,0 +1,95 @@
+"""The thesis's figures, regenerated from this model: ``cell figures`` (issue 5).
+
+Writes ``figNN_<slug>.png`` for Fig. 8, 9, 12-30 of the thesis's list of
+illustrations, each titled with its number and caption.  Fig. 8-21 need only the
+path and the motors; Fig. 22-30 run the simulation (adaptive and non-adaptive,
+the six robot cycles of Table 7.1).
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable, Iterable
+from pathlib import Path
+
+from cell.figures import arrivals, layout, motion
+from cell.figures.style import style
+from cell.scenario import Scenario, load_scenario
+from cell.steptable import StepTable
+
+#: Figure number -> file stem, as written into the output folder.
+FILES: dict[int, str] = {
+    8: "fig08_working_environment",
+    9: "fig09_path_definition",
+    12: "fig12_hand_length",
+    13: "fig13_weibull_pdf",
+    14: "fig14_weibull_cdf",
+    15: "fig15_coordinates_vs_time",
+    16: "fig16_joint_angles_vs_time",
+    17: "fig17_theta1_rates",
+    18: "fig18_theta2_rates",
+    19: "fig19_theta3_rates",
+    20: "fig20_theta4_rates",
+    21: "fig21_theta5_rates",
+    22: "fig22_tip_velocity",
+    23: "fig23_delivery_interval_lumped",
+    24: "fig24_delivery_interval_running",
+    25: "fig25_ip_22_5872",
+    26: "fig26_ip_22_0000",
+    27: "fig27_ip_21_5000",
+    28: "fig28_ip_21_0000",
+    29: "fig29_ip_20_5000",
+    30: "fig30_ip_20_0907",
+}
+
+
+def make_figures(scenario: Scenario, out: str | Path, *, parts: int | None = None,
+                 only: Iterable[int] | None = None,
+                 progress: Callable[[Path], None] | None = None) -> list[Path]:
+    """Draw the figures of ``scenario`` into ``out``; return the files written.
+
+    ``parts`` overrides ``run.parts`` (fewer parts draw faster); ``only`` limits
+    the figure numbers drawn.
+    """
+    out = Path(out)
+    if parts is not None:
+        scenario = scenario.with_overrides({"run.parts": parts})
+    wanted = set(FILES) if only is None else set(only)
+    path = {n: out / f"{FILES[n]}.png" for n in FILES}
+    written: list[Path] = []
+
+    def done(p: Path) -> None:
+        written.append(p)
+        if progress:
+            progress(p)
+
+    with style():
+        table = StepTable.from_scenario(scenario)
+        if 8 in wanted:
+            done(layout.fig08_working_environment(scenario, table, path[8]))
+        if 9 in wanted:
+            done(layout.fig09_path(scenario, table, path[9]))
+        if 12 in wanted:
+            done(layout.fig12_hand_length(scenario, path[12]))
+        if wanted & {13, 14}:
+            x = arrivals.draws(scenario, scenario.run.parts)
+            if 13 in wanted:
+                done(arrivals.fig13_pdf(scenario, x, path[13]))
+            if 14 in wanted:
+                done(arrivals.fig14_cdf(scenario, x, path[14]))
+        tl = motion.nominal_timeline(table, scenario)
+        if 15 in wanted:
+            done(motion.fig15_coordinates(table, tl, path[15]))
+        if 16 in wanted:
+            done(motion.fig16_joint_angles(table, tl, path[16]))
+        for joint in range(5):
+            if 17 + joint in wanted:
+                done(motion.fig_joint_rate(table, tl, scenario, joint, path[17 + joint]))
+    return written
+
+
+def cmd_figures(args: argparse.Namespace) -> int:
+    """``cell figures [--out DIR] [--scenario FILE]``."""
+    scenario = load_scenario(args.scenario)
+    make_figures(scenario, args.out, progress=lambda p: print(f"wrote {p}"))
+    return 0
