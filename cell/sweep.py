@@ -261,8 +261,17 @@ def simulate_summary(scenario: Scenario, seed: np.random.SeedSequence) -> Mappin
 
 def run_task(replicate: Replicate, scenario: Scenario,
              seeds: Sequence[np.random.SeedSequence]) -> list[dict[str, Any]]:
-    """Run one batch (in a worker): each stream's summary as a plain dict."""
-    return [{k: _plain(v) for k, v in replicate(scenario, s).items()} for s in seeds]
+    """Run one batch (in a worker): each stream's summary as a plain dict.
+
+    Each replication gets a fresh copy of its stream, so a replication that
+    spawns from it cannot change what the next point or policy sees.
+    """
+    return [{k: _plain(v) for k, v in replicate(scenario, _fresh(s)).items()} for s in seeds]
+
+
+def _fresh(seed: np.random.SeedSequence) -> np.random.SeedSequence:
+    return np.random.SeedSequence(seed.entropy, spawn_key=seed.spawn_key,
+                                  pool_size=seed.pool_size)
 
 
 def _plain(value: Any) -> Any:

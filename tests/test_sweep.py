@@ -281,3 +281,16 @@ def test_cli_report_refuses_a_sweep_that_is_not_table_7_1(tmp_path, capsys):
                  "--report", str(tmp_path / "rep")])
     assert code == 2 and "belts.output_nominal_in_s" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def spawning(scenario, seed) -> dict:
+    """A replication that spawns from its stream (which mutates the SeedSequence)."""
+    return {"u": np.random.default_rng(seed.spawn(1)[0]).random()}
+
+
+def test_a_replication_that_spawns_cannot_break_common_random_numbers(tmp_path):
+    sweep = load_sweep(write_sweep(tmp_path, batch=6))
+    frame = run_sweep(sweep, tmp_path / "o", workers=1, replicate=spawning,
+                      progress=False).replications
+    per_point = frame.pivot(index="replication", columns=["policy", "point"], values="u")
+    assert (per_point.nunique(axis=1) == 1).all()
