@@ -29,6 +29,7 @@ T = Σ 2Δs / (ṡ_i + ṡ_{i+1}), the formula SPEC §9 fixes for comparisons.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -283,7 +284,7 @@ def plan(rows: PathRows, sdot_start: float = 0.0, sdot_end: float = 0.0) -> Prof
                                     "no acceleration to keep moving along the path")
             u1 = _umax(ups[i + 1], xp, sq(xp))
             x1 = min(x0 + d * (u0 + u1), cap)
-        if x1 < cap:
+        if x1 < cap * (1.0 - 1e-9):
             phase[i] = 1
         else:
             phase[i] = 0 if cap >= mvc_l[i + 1] * (1 - 1e-9) else -1
@@ -305,7 +306,31 @@ def _switches(s: Array, phase: NDArray[np.int8]) -> list[float]:
     change = np.flatnonzero(np.diff(phase) != 0) + 1
     starts = np.concatenate([[0], change])
     lengths = np.diff(np.concatenate([starts, [len(phase)]]))
-    keep = starts[(lengths > 1) | (starts == 0)]
+    keep = starts[(lengths > 1) | (starts == 0) | (starts == len(phase) - 1)]
     vals = phase[keep]
     out = [float(s[k]) for j, k in enumerate(keep) if j > 0 and vals[j] != vals[j - 1]]
     return out
+
+
+def torque_rows(s: ArrayLike, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike, rnea: Callable,
+                tau_max: ArrayLike, *, viscous: ArrayLike | None = None,
+                line_slope: ArrayLike | None = None) -> PathRows:
+    """The paper's reduced dynamics (eq. 11b) as rows, one per joint.
+
+    ``rnea(q, qd, qdd, friction=False, gravity=...)`` is the rigid-body inverse
+    dynamics.  M = J q' (a), Q = J q'' + c(q', q') (b), R = K q' plus the
+    torque-speed line's slope τ_s/ω_f times q' (e), S = g(q) (c); bounded by
+    ±τ_max.
+    """
+    q, dq, ddq = (np.asarray(v, float) for v in (q, dq, ddq))
+    zero = np.zeros_like(q)
+    a = rnea(q, zero, dq, friction=False, gravity=False)
+    b = rnea(q, dq, ddq, friction=False, gravity=False)
+    c = rnea(q, zero, zero, friction=False, gravity=True)
+    e = np.zeros_like(q)
+    if viscous is not None:
+        e = e + np.asarray(viscous, float) * dq
+    if line_slope is not None:
+        e = e + np.asarray(line_slope, float) * dq
+    t = np.broadcast_to(np.asarray(tau_max, float), q.shape)
+    return PathRows(np.asarray(s, float), a, b, e, c, -t, t.copy())

@@ -1,0 +1,242 @@
+"""The robot: regime times from the joint-step table, and its SimPy process.
+
+A regime's time for a tip velocity v is Σ max(ℓ/v, t_min) over its moves
+(thesis §6.1): each move takes its length over the velocity unless its slowest
+joint's maximum step rate makes it longer.  That total is piecewise linear in
+u = 1/v, so :class:`Segment` stores it once as sorted breakpoints and answers
+"time for this velocity" and "velocity for this time" with one bisection each,
+with no per-move work while the simulation runs.
+
+The tracking regimes (R I, R III) are timed against the belt, not along the
+path: a move's "length" there is the belt's travel during it (the path divides
+the belt equally, §4.2), so at belt speed v the robot keeps up with the part
+unless a joint cannot.  Before LO (and before TD) the robot must keep up; the
+grasp (release) move that ends at LO (TD) changes the hand's length (eq. 6.2)
+and may take longer than the belt's pace; after LO (TD) the hand is off the belt
+and the move times are only floored by the motors (§4.3 c).
+"""
+
+from __future__ import annotations
+
+import bisect
+import functools
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import simpy
+from numpy.typing import ArrayLike
+
+from cell.errors import CellError, InfeasibleError
+from cell.scenario import Scenario
+
+
+class Segment:
+    """Times of a run of moves, t(u) = Σ max(ℓ_k u, t_min_k) with u = 1/v.
+
+    Built once from per-move lengths and minimum times; afterwards each query is
+    a scalar bisection (microseconds), as the simulation needs.
+    """
+
+    __slots__ = ("length_in", "floor_s", "_ub", "_lfree", "_tfix", "_tbreak")
+
+    def __init__(self, lengths_in: ArrayLike, min_times_s: ArrayLike):
+        ell = np.asarray(lengths_in, dtype=float)
+        tmin = np.asarray(min_times_s, dtype=float)
+        if ell.shape != tmin.shape or np.any(ell < 0) or np.any(tmin < 0):
+            raise ValueError("lengths and minimum times must be matching non-negative arrays")
+        self.length_in = float(ell.sum())
+        """Total length (path or belt travel) of the moves."""
+        self.floor_s = float(tmin.sum())
+        """Shortest possible time: every move at its slowest joint's maximum rate."""
+        moving = ell > 0
+        # Zero-length moves always take their t_min; the others have a breakpoint:
+        # move k is motor-limited while u < t_min_k / ℓ_k.
+        fixed = float(tmin[~moving].sum())
+        ell, tmin = ell[moving], tmin[moving]
+        ub = tmin / ell
+        order = np.argsort(ub, kind="stable")
+        ub, ls, ts = ub[order], ell[order], tmin[order]
+        # With u in [ub[j-1], ub[j]) moves 0..j-1 are free (time ℓ u), j.. limited.
+        self._ub: list[float] = ub.tolist()
+        self._lfree: list[float] = np.concatenate([[0.0], np.cumsum(ls)]).tolist()
+        self._tfix: list[float] = (fixed + np.concatenate(
+            [np.cumsum(ts[::-1])[::-1], [0.0]])).tolist()
+        # t at each breakpoint, increasing: inverts t(u) by bisection.
+        self._tbreak: list[float] = [self._tfix[j] + self._lfree[j] * u
+                                     for j, u in enumerate(self._ub)]
+
+    def time(self, velocity: float) -> float:
+        """Σ max(ℓ/v, t_min): the moves' time at tip (or belt) velocity v > 0."""
+        u = 1.0 / velocity
+        j = bisect.bisect_right(self._ub, u)
+        return self._tfix[j] + self._lfree[j] * u
+
+    def velocity(self, time_s: float) -> float:
+        """The velocity v whose moves take exactly ``time_s`` (inverse of :meth:`time`)."""
+        if time_s < self.floor_s * (1 - 1e-12):
+            raise InfeasibleError(f"{time_s:.4f} s is below the motors' minimum "
+                                  f"of {self.floor_s:.4f} s")
+        j = bisect.bisect_left(self._tbreak, time_s)
+        if self._lfree[j] <= 0:
+            return float("inf")
+        return self._lfree[j] / (time_s - self._tfix[j])
+
+    def max_tracking_velocity(self) -> float:
+        """Fastest velocity at which no move is motor-limited (min ℓ/t_min)."""
+        return 1.0 / self._ub[-1] if self._ub else float("inf")
+
+
+@dataclass(frozen=True)
+class RobotTiming:
+    """Everything the controllers need about the robot's speed, built once per scenario.
+
+    Belt-tracking segments are in belt travel (in); R II and R IV in path length.
+    Motor floors are at the peak rates (the motors can always give them, §7.2);
+    ``r4_nominal_s`` is R IV with the base at its nominal 75 % (thesis 9.9855 s).
+    """
+
+    r1_pre: Segment
+    """B → LO, belt travel; the grasp move ending at LO included."""
+    r1_post: Segment
+    """LO → F, belt travel (hand off the belt: motors only)."""
+    r2: Segment
+    r3_pre: Segment
+    """G → TD, output belt travel; the release move ending at TD included."""
+    r3_post: Segment
+    """TD → K."""
+    r4: Segment
+    r4_nominal_s: float
+    """R IV at the nominal motor rates (the thesis's 9.9855 s; SPEC §4)."""
+    input_track_max_in_s: float
+    """Fastest input belt the robot can follow before LO (grasp move excluded)."""
+    output_track_max_in_s: float
+    """Fastest output belt the robot can follow before TD (release move excluded)."""
+    r1_length_in: float
+    r3_length_in: float
+    r2_min_s: float
+    r4_min_s: float
+    """Fastest R II / R IV: constant peak rates (§6.1) or the minimum-time planner."""
+
+    def r1_time(self, v: float) -> tuple[float, float]:
+        """(B → LO, LO → F) times tracking an input belt at v."""
+        return self.r1_pre.time(v), self.r1_post.time(v)
+
+    def r3_time(self, u: float) -> tuple[float, float]:
+        """(G → TD, TD → K) times tracking an output belt at u."""
+        return self.r3_pre.time(u), self.r3_post.time(u)
+
+
+def _belt_steps(xyz: np.ndarray, rows: np.ndarray, start: Sequence[float],
+                end: Sequence[float]) -> np.ndarray:
+    """Belt travel of each move: its displacement along the belt direction start → end."""
+    d = np.subtract(end, start)[:2]
+    d = d / np.linalg.norm(d)
+    disp = np.diff(xyz[:, :2], axis=0, prepend=xyz[:1, :2]) @ d
+    return np.abs(disp[rows])
+
+
+def build_timing(s: Scenario) -> RobotTiming:
+    """Solve the path once and reduce it to the regime segments (thesis §6.1)."""
+    from cell.steptable import StepTable
+
+    t = StepTable.from_scenario(s)
+    p = t.path
+    xyz, tp = p.xyz_in, t.peak_min_times
+    idx = np.arange(p.n_points)
+    r1, r2, r3, r4 = (np.flatnonzero(t.regime_rows(r)) for r in ("R1", "R2", "R3", "R4"))
+    pre1, post1 = r1[r1 <= p.lo], r1[r1 > p.lo]
+    pre3, post3 = r3[r3 <= p.td], r3[r3 > p.td]
+    bx1 = _belt_steps(xyz, idx, s.path.bot_in, s.path.f_in)
+    bx3 = _belt_steps(xyz, idx, s.path.g_in, s.path.eot_in)
+    track1 = Segment(bx1[pre1[:-1]], tp[pre1[:-1]])
+    track3 = Segment(bx3[pre3[:-1]], tp[pre3[:-1]])
+    r2seg = Segment(t.move_in[r2], tp[r2])
+    r4seg = Segment(t.move_in[r4], tp[r4])
+    r2_min, r4_min = r2seg.floor_s, r4seg.floor_s
+    if s.robot.timing == "minimum-time":
+        try:
+            from cell.mintime import fastest_regime_times
+        except ImportError:
+            raise CellError("robot.timing = 'minimum-time' needs the minimum-time planner "
+                            "(cell.mintime.fastest_regime_times), which is not available; "
+                            "use robot.timing: constant-rate") from None
+        fastest = fastest_regime_times(s)
+        r2_min, r4_min = max(r2_min, float(fastest["R2"])), max(r4_min, float(fastest["R4"]))
+    return RobotTiming(
+        r1_pre=Segment(bx1[pre1], tp[pre1]), r1_post=Segment(bx1[post1], tp[post1]),
+        r2=r2seg,
+        r3_pre=Segment(bx3[pre3], tp[pre3]), r3_post=Segment(bx3[post3], tp[post3]),
+        r4=r4seg,
+        r4_nominal_s=t.regime_min_time("R4", nominal=True),
+        input_track_max_in_s=track1.max_tracking_velocity(),
+        output_track_max_in_s=track3.max_tracking_velocity(),
+        r1_length_in=t.regime_length("R1"), r3_length_in=t.regime_length("R3"),
+        r2_min_s=r2_min, r4_min_s=r4_min)
+
+
+@functools.lru_cache(maxsize=16)
+def _cached_timing(cell: Any, path: Any, part: Any, robot: Any, mintime: Any) -> RobotTiming:
+    return build_timing(Scenario(cell=cell, path=path, part=part, robot=robot, mintime=mintime))
+
+
+def robot_timing(s: Scenario) -> RobotTiming:
+    """:func:`build_timing`, cached on the sections that shape the path and the motors.
+
+    A sweep's replications (and both policies) share one solved path per process.
+    """
+    if s.robot.timing == "minimum-time":  # the planner may read files next to the scenario
+        return build_timing(s)
+    return _cached_timing(s.cell, s.path, s.part, s.robot, s.mintime)
+
+
+# --------------------------------------------------------------------------- process
+@dataclass(frozen=True)
+class Order:
+    """One transfer cycle as the controller sends it (step 6.1): regime times, s."""
+
+    part: Any
+    to_lo_s: float
+    """B → LO (R I up to lift-off)."""
+    lo_to_td_s: float
+    """LO → F → G → TD."""
+    td_to_bot_s: float
+    """TD → K → B (rest of R III and R IV)."""
+
+
+class Robot:
+    """The arm as a SimPy process: takes an :class:`Order`, runs it, hands the part over.
+
+    ``lo`` and ``td`` are the current cycle's lift-off and touch-down events (any
+    process may wait on them); ``free_at_s`` is when it will be back at B.  One
+    timeout per leg: a regime's moves are summed, never simulated one by one.
+    """
+
+    def __init__(self, env: simpy.Environment, output: simpy.Store, log: Any):
+        self.env = env
+        self.log = log
+        """Where lift-off and touch-down instants are written (``pick_s``, ``touchdown_s``)."""
+        self.orders: simpy.Store = simpy.Store(env)
+        """Cycles to run, from the controller."""
+        self.output = output
+        """Where parts are set down (the output conveyor's store)."""
+        self.free_at_s = 0.0
+        """When the robot is (or will be) back at B, ready for a part."""
+        self.lo: simpy.Event | None = None
+        self.td: simpy.Event | None = None
+        self.process = env.process(self.run())
+
+    def run(self):  # noqa: ANN201 (SimPy generator)
+        env, log = self.env, self.log
+        while True:
+            order: Order = yield self.orders.get()
+            part = order.part
+            self.lo = env.timeout(order.to_lo_s)
+            yield self.lo
+            log.pick_s[part] = env.now
+            self.td = env.timeout(order.lo_to_td_s)
+            yield self.td
+            log.touchdown_s[part] = env.now
+            self.output.put(part)
+            yield env.timeout(order.td_to_bot_s)
