@@ -217,10 +217,17 @@ class MinTime:
     """Minimum-time planner settings (Shin & McKay 1983; SPEC §9)."""
 
     grid_points: int = _num(460, lo=3)
+    """Grid points per regime (R II, R IV), s scaled to [0, 1]; 460 as the thesis's path."""
+    rate_fraction: float = _num(1.0, lo=0.0, hi=1.0, lo_open=True)
+    """Joint velocity bounds = the motors' step rates at the regime's load (§6.1) times
+    this: 1.0 is the peak, as in the thesis's minimum feasible cycle (§7.2)."""
+    acceleration_bounds: bool = True
+    """Apply ``qddot_max_rad_s2``; switch off when the dynamic model is to set the
+    accelerations alone."""
     qddot_max_rad_s2: Five = _num((2.0, 2.0, 4.0, 8.0, 8.0), lo=0.0, lo_open=True)
-    """Joint acceleration bounds; assumed, see scenarios/microbot_dynamics.yaml."""
+    """Joint acceleration bounds; ASSUMED (a stepper indexer's ramp; the thesis has none)."""
     dynamics_file: str | None = None
-    """YAML of the rigid-body model; empty means velocity and acceleration bounds only."""
+    """YAML of the rigid-body model (relative to the scenario file); empty: no torque bounds."""
 
 
 # --------------------------------------------------------------------------- scenario
