@@ -171,6 +171,12 @@ class Belts:
     spacing_tol_in: float = _num(0.25, lo=0.0)
     input_max_in_s: float = _num(12.0, lo=0.0, lo_open=True)
     """Fastest the input belt may run; assumed (§6.2 a gives belts infinite range)."""
+    output_max_in_s: float = _num(12.0, lo=0.0, lo_open=True)
+    """Fastest the output belt may run; assumed, as the input's."""
+    input_length_in: float | None = _num(None, lo=0.0, lo_open=True)
+    """Feeder drop point to B; the thesis gives none.  Empty: two nominal cycles of
+    belt travel (2 × 3.0 × 22.5872 = 135.52 in), so the next part is usually on the
+    belt when the controller looks ahead (§5.2)."""
 
 
 # --------------------------------------------------------------------------- arrivals
