@@ -124,22 +124,19 @@ class Plan(NamedTuple):
     r3_pre: float
     r3_post: float
     r4: float
+    input_speed: float
+    """Input belt while R I tracks the part (the belt's speed when it reached B)."""
     input_after_lo: float
     """Input belt from LO until the cycle ends (steps 3.1/3.2)."""
     input_next: float
     """Input belt after the cycle (step 6.3): the next part's R I tracking speed."""
     output_to_g: float
     """Output belt until the robot reaches G (step 5.0)."""
+    to_g: float
+    """TTSOT counted from the start of this cycle: R I + R II (step 5.0)."""
+    cycle: float
+    """The robot's motion time for the whole cycle B → B."""
     note: str
-
-    @property
-    def cycle(self) -> float:
-        return self.r1_pre + self.r1_post + self.r2 + self.r3_pre + self.r3_post + self.r4
-
-    @property
-    def to_g(self) -> float:
-        """TTSOT counted from the start of this cycle: R I + R II."""
-        return self.r1_pre + self.r1_post + self.r2
 
 
 def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
@@ -197,7 +194,8 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
         if not OUTPUT_MIN_IN_S <= u <= k.output_max:
             u = min(max(u, OUTPUT_MIN_IN_S), k.output_max)
             notes.append("output belt at its limit: spacing off")
-    return Plan(r1a, r1b, r2, r3a, r3b, r4, w, v_next, u, "; ".join(notes))
+    return Plan(r1a, r1b, r2, r3a, r3b, r4, v, w, v_next, u, r1a + r1b + r2, cycle,
+                "; ".join(notes))
 
 
 def fixed_plan(k: CellConstants, ideal_cycle_s: float, file: object = None) -> Plan:
@@ -212,22 +210,28 @@ def fixed_plan(k: CellConstants, ideal_cycle_s: float, file: object = None) -> P
                             f"{t.r4_min_s:.4f} s at its peak rate: the shortest cycle is "
                             f"{shortest:.4f} s")
     r4 = max(r4, t.r4_min_s)
+    to_g = k.r1_pre_nom + k.r1_post_nom + k.r2_nom
     return Plan(k.r1_pre_nom, k.r1_post_nom, k.r2_nom, k.r3_pre_nom, k.r3_post_nom, r4,
-                k.v_nom, k.v_nom, k.u_nom, "")
+                k.v_nom, k.v_nom, k.v_nom, k.u_nom, to_g,
+                to_g + k.r3_pre_nom + k.r3_post_nom + r4, "")
 
 
 class Log:
-    """Per-part facts gathered during a run (lists indexed by part number)."""
+    """Per-part facts gathered during a run (lists indexed by part number).
 
-    FIELDS = ("at_bot_s", "pick_s", "touchdown_s", "motion_cycle_s", "thesis_interval_s",
-              "input_speed_in_s", "output_speed_in_s", "v_r1_in_s", "v_r2_in_s",
-              "v_r3_in_s", "v_r4_in_s", "r4_s")
+    The controller stores each caught part's :class:`Plan` and the thesis's step
+    6.2 interval; the robot its lift-off and touch-down instants.  Columns are
+    built from these once, after the run.
+    """
 
     def __init__(self, n: int):
         nan = float("nan")
-        for name in self.FIELDS:
-            setattr(self, name, [nan] * n)
-        self.picked = [False] * n
+        self.at_bot_s = [nan] * n
+        self.pick_s = [nan] * n
+        self.touchdown_s = [nan] * n
+        self.plan: list[Plan | None] = [None] * n
+        self.thesis_interval_s = [nan] * n
+        """Step 6.2: motion time to TD plus the previous cycle's residual."""
         self.note = [""] * n
 
 
@@ -245,10 +249,8 @@ class Controller:
         self.fed_s = feeder_fed_s
         self.n = n_parts
         self.conveyor, self.output, self.robot, self.log = conveyor, output, robot, log
-        t = k.timing
         self.residual_s = k.r3_post_nom + k.r4_nom
         """The previous cycle's TD → K and R IV (step 5.0, 6.2); nominal before the first."""
-        self._len = (t.r1_length_in, t.r2.length_in, t.r3_length_in, t.r4.length_in)
         self.process = env.process(self.run())
 
     def next_part(self, i: int, now: float, lag: float, v: float) -> tuple[float, float] | None:
@@ -269,41 +271,28 @@ class Controller:
 
     def run(self):  # noqa: ANN201 (SimPy generator)
         env, log, k, robot = self.env, self.log, self.k, self.robot
-        l1, l2, l3, l4 = self._len
+        conveyor, output = self.conveyor, self.output
+        r1_pre_time = k.timing.r1_pre.time
         while True:
-            i = yield self.conveyor.at_bot.get()
+            i = yield conveyor.at_bot.get()
             now = env.now
             log.at_bot_s[i] = now
             if robot.free_at_s > now + EPS_S:
                 log.note[i] = "reached B while the robot was busy: fell off at F"
                 continue
             if self.adaptive:
-                v = self.conveyor.belt.speed(now + EPS_S)
-                lag = k.timing.r1_pre.time(v)
-                plan = adaptive_plan(k, v, self.next_part(i, now, lag, v),
-                                     self.output.gap_now())
-                self.conveyor.replan(((now + lag, plan.input_after_lo),
-                                      (now + plan.cycle, plan.input_next)))
-                self.output.replan(((now, plan.output_to_g),
-                                    (now + plan.to_g, k.u_nom)))
+                v = conveyor.belt.speed(now + EPS_S)
+                lag = r1_pre_time(v)
+                plan = adaptive_plan(k, v, self.next_part(i, now, lag, v), output.gap_now())
+                conveyor.replan(now + lag, plan.input_after_lo, now + plan.cycle,
+                                plan.input_next)
+                output.replan(now, plan.output_to_g, now + plan.to_g, k.u_nom)
                 log.note[i] = plan.note
             else:
                 plan = self.fixed
-                v = k.v_nom
-            cycle = plan.cycle
-            r1 = plan.r1_pre + plan.r1_post
-            r3 = plan.r3_pre + plan.r3_post
-            log.picked[i] = True
-            log.motion_cycle_s[i] = cycle
+            log.plan[i] = plan
             log.thesis_interval_s[i] = plan.to_g + plan.r3_pre + self.residual_s
             self.residual_s = plan.r3_post + plan.r4
-            log.input_speed_in_s[i] = v
-            log.output_speed_in_s[i] = plan.output_to_g
-            log.v_r1_in_s[i] = l1 / r1
-            log.v_r2_in_s[i] = l2 / plan.r2
-            log.v_r3_in_s[i] = l3 / r3
-            log.v_r4_in_s[i] = l4 / plan.r4
-            log.r4_s[i] = plan.r4
-            robot.free_at_s = now + cycle
-            robot.orders.put(Order(i, plan.r1_pre, plan.r1_post + plan.r2 + plan.r3_pre,
+            robot.free_at_s = now + plan.cycle
+            robot.orders.put(Order(i, plan.r1_pre, plan.to_g - plan.r1_pre + plan.r3_pre,
                                    plan.r3_post + plan.r4))

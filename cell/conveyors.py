@@ -12,9 +12,10 @@ wakes when a part reaches B, or when a new plan moves that instant.
 from __future__ import annotations
 
 import bisect
-from collections.abc import Iterable
 
 import simpy
+
+from cell.mailbox import Mailbox
 
 #: Two instants closer than this are the same instant (float rounding of planned times).
 EPS_S = 1e-6
@@ -44,27 +45,25 @@ class Belt:
         k = max(bisect.bisect_right(self._x, x) - 1, 0)
         return self._t[k] + (x - self._x[k]) / self._v[k]
 
-    def plan(self, changes: Iterable[tuple[float, float]]) -> None:
-        """Replace the schedule after the first change's instant with ``changes``.
+    def plan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
+        """From instant t1 run at v1 (and from t2 > t1 at v2), dropping later plans.
 
-        ``changes`` are (instant, speed) pairs in increasing time; planned changes
-        later than the first are dropped (a new plan supersedes the old one).
+        A new plan supersedes whatever was planned after t1 (the controller
+        replans every cycle); a change within EPS_S of the last one replaces it.
         """
-        changes = list(changes)
-        t0 = changes[0][0]
-        k = bisect.bisect_right(self._t, t0 + EPS_S)
-        del self._t[k:], self._x[k:], self._v[k:]
-        for t, v in changes:
-            if v <= 0:
+        ts, xs, vs = self._t, self._x, self._v
+        k = bisect.bisect_right(ts, t1 + EPS_S)
+        if k < len(ts):
+            del ts[k:], xs[k:], vs[k:]
+        for t, v in ((t1, v1),) if t2 is None else ((t1, v1), (t2, v2)):
+            if not v > 0:
                 raise ValueError(f"belt speed must be positive, got {v!r}")
-            x = self.travel(t)
-            if t <= self._t[-1]:
-                t = self._t[-1]
-                self._v[-1] = v
+            if t <= ts[-1]:
+                vs[-1] = v
             else:
-                self._t.append(t)
-                self._x.append(x)
-                self._v.append(v)
+                xs.append(xs[-1] + vs[-1] * (t - ts[-1]))
+                ts.append(t)
+                vs.append(v)
 
     def history(self) -> list[tuple[float, float]]:
         """(instant, speed) of every speed change, for plots and checks."""
@@ -85,9 +84,9 @@ class InputConveyor:
         self.belt = Belt(speed_in_s)
         self.length_in = length_in
         """Feeder drop point to B (in)."""
-        self.loaded: simpy.Store = simpy.Store(env)
+        self.loaded: Mailbox = Mailbox(env)
         """Parts dropped on the belt by the feeder (part numbers)."""
-        self.at_bot: simpy.Store = simpy.Store(env)
+        self.at_bot: Mailbox = Mailbox(env)
         """Parts as they reach B."""
         self.x_fed: list[float] = [float("nan")] * n_parts
         """Belt travel at the instant each part was dropped on."""
@@ -103,9 +102,14 @@ class InputConveyor:
         """When a dropped part reaches B under the current schedule."""
         return self.belt.time_at(self.x_fed[part] + self.length_in)
 
-    def replan(self, changes: Iterable[tuple[float, float]]) -> None:
-        """New speed plan from the controller; re-times the part on its way to B."""
-        self.belt.plan(changes)
+    def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
+        """New speed plan from the controller (see :meth:`Belt.plan`).
+
+        The controller plans when a part reaches B, before this process times the
+        next part (same-instant events run in order); should a plan ever arrive
+        while a part is being timed, the process is interrupted and re-times it.
+        """
+        self.belt.plan(t1, v1, t2, v2)
         if self._timing:
             self.process.interrupt()
 
@@ -135,7 +139,7 @@ class OutputConveyor:
     def __init__(self, env: simpy.Environment, speed_in_s: float, n_parts: int):
         self.env = env
         self.belt = Belt(speed_in_s)
-        self.placed: simpy.Store = simpy.Store(env)
+        self.placed: Mailbox = Mailbox(env)
         """Parts set down by the robot."""
         self.spacing_in: list[float] = [float("nan")] * n_parts
         self.last_td_x: float | None = None
@@ -148,8 +152,8 @@ class OutputConveyor:
             return None
         return self.belt.travel(self.env.now) - self.last_td_x
 
-    def replan(self, changes: Iterable[tuple[float, float]]) -> None:
-        self.belt.plan(changes)
+    def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
+        self.belt.plan(t1, v1, t2, v2)
 
     def run(self):  # noqa: ANN201 (SimPy generator)
         while True:

@@ -29,6 +29,7 @@ import simpy
 from numpy.typing import ArrayLike
 
 from cell.errors import CellError, InfeasibleError
+from cell.mailbox import Mailbox
 from cell.scenario import Scenario
 
 
@@ -210,17 +211,19 @@ class Robot:
 
     ``lo`` and ``td`` are the current cycle's lift-off and touch-down events (any
     process may wait on them); ``free_at_s`` is when it will be back at B.  One
-    timeout per leg: a regime's moves are summed, never simulated one by one.
+    timeout per leg up to TD: a regime's moves are summed, never simulated one by
+    one.  The way back (TD → K → B) needs no event: the controller sends no order
+    before ``free_at_s``, and the robot starts the next one when it comes.
     """
 
-    def __init__(self, env: simpy.Environment, output: simpy.Store, log: Any):
+    def __init__(self, env: simpy.Environment, output: Mailbox, log: Any):
         self.env = env
         self.log = log
         """Where lift-off and touch-down instants are written (``pick_s``, ``touchdown_s``)."""
-        self.orders: simpy.Store = simpy.Store(env)
+        self.orders: Mailbox = Mailbox(env)
         """Cycles to run, from the controller."""
         self.output = output
-        """Where parts are set down (the output conveyor's store)."""
+        """Where parts are set down (the output conveyor's mailbox)."""
         self.free_at_s = 0.0
         """When the robot is (or will be) back at B, ready for a part."""
         self.lo: simpy.Event | None = None
@@ -228,15 +231,15 @@ class Robot:
         self.process = env.process(self.run())
 
     def run(self):  # noqa: ANN201 (SimPy generator)
-        env, log = self.env, self.log
+        env, log, timeout = self.env, self.log, self.env.timeout
+        pick_s, touchdown_s, put = log.pick_s, log.touchdown_s, self.output.put
         while True:
             order: Order = yield self.orders.get()
             part = order.part
-            self.lo = env.timeout(order.to_lo_s)
-            yield self.lo
-            log.pick_s[part] = env.now
-            self.td = env.timeout(order.lo_to_td_s)
-            yield self.td
-            log.touchdown_s[part] = env.now
-            self.output.put(part)
-            yield env.timeout(order.td_to_bot_s)
+            self.lo = lo = timeout(order.to_lo_s)
+            yield lo
+            pick_s[part] = env.now
+            self.td = td = timeout(order.lo_to_td_s)
+            yield td
+            touchdown_s[part] = env.now
+            put(part)

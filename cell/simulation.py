@@ -24,7 +24,7 @@ import pandas as pd
 import simpy
 
 from cell import accounting
-from cell.controller import Controller, Log, constants, fixed_plan
+from cell.controller import Controller, Log, Plan, constants, fixed_plan
 from cell.conveyors import InputConveyor, OutputConveyor
 from cell.feeder import Feeder, interarrival_times
 from cell.robot import Robot, robot_timing
@@ -105,7 +105,12 @@ def _tables(s: Scenario, seed: Any, ideal: float, adaptive: bool, k: Any, fixed:
             t: np.ndarray, feeder: Feeder, log: Log, output: OutputConveyor, end_s: float
             ) -> tuple[pd.DataFrame, dict[str, Any]]:
     n = s.run.parts
-    picked = np.array(log.picked)
+    picked = np.array([p is not None for p in log.plan])
+    nan_plan = (math.nan,) * len(Plan._fields[:-1])
+    plans = np.array([p[:-1] if p is not None else nan_plan for p in log.plan], dtype=float)
+    col = {name: plans[:, j] for j, name in enumerate(Plan._fields[:-1])}
+    r1, r3 = col["r1_pre"] + col["r1_post"], col["r3_pre"] + col["r3_post"]
+    tm = k.timing
     td = np.array(log.touchdown_s)
     t_next = t[1:]
     wall = accounting.wallclock(t_next, td)
@@ -132,24 +137,24 @@ def _tables(s: Scenario, seed: Any, ideal: float, adaptive: bool, k: Any, fixed:
         "pick_s": log.pick_s,
         "touchdown_s": td,
         "delivery_interval_s": wall.interval_s,
-        "motion_cycle_s": log.motion_cycle_s,
+        "motion_cycle_s": col["cycle"],
         "thesis_interval_s": thesis_interval,
         "ip_wallclock": wall.ip,
         "ip_thesis": ip_thesis,
-        "input_speed_in_s": log.input_speed_in_s,
-        "output_speed_in_s": log.output_speed_in_s,
+        "input_speed_in_s": col["input_speed"],
+        "output_speed_in_s": col["output_to_g"],
         "spacing_in": spacing,
-        "v_r1_in_s": log.v_r1_in_s,
-        "v_r2_in_s": log.v_r2_in_s,
-        "v_r3_in_s": log.v_r3_in_s,
-        "v_r4_in_s": log.v_r4_in_s,
+        "v_r1_in_s": tm.r1_length_in / r1,
+        "v_r2_in_s": tm.r2.length_in / col["r2"],
+        "v_r3_in_s": tm.r3_length_in / r3,
+        "v_r4_in_s": tm.r4.length_in / col["r4"],
         "note": log.note,
     }, columns=PART_COLUMNS)
 
     delivered = int(np.isfinite(td).sum())
     missed = int((~picked).sum())
     sp = spacing[np.isfinite(spacing)]
-    r4 = np.array(log.r4_s)[picked]
+    r4 = col["r4"][picked]
     length_r4 = k.timing.r4.length_in
     if adaptive:
         cycle_pct = 100.0 * (actual_thesis - k.cycle_nom) / k.cycle_nom
@@ -157,8 +162,7 @@ def _tables(s: Scenario, seed: Any, ideal: float, adaptive: bool, k: Any, fixed:
     else:
         cycle_pct = 100.0 * (actual_thesis - ideal) / ideal
         r4_s = fixed.r4
-    vin = np.array(log.input_speed_in_s)[picked]
-    vout = np.array(log.output_speed_in_s)[picked]
+    vout = col["output_to_g"][picked]
     summary = {
         "scenario": s.name,
         "policy": s.controller.policy,
@@ -189,7 +193,6 @@ def _tables(s: Scenario, seed: Any, ideal: float, adaptive: bool, k: Any, fixed:
         "thesis_slack_s": math.nan if adaptive else accounting.THESIS_SLACK_S,
         "sim_end_s": end_s,
     }
-    del vin
     return parts, summary
 
 
