@@ -114,9 +114,9 @@ class InputConveyor:
             self.process.interrupt()
 
     def run(self):  # noqa: ANN201 (SimPy generator)
-        env = self.env
+        env, loaded = self.env, self.loaded
         while True:
-            part = yield self.loaded.get()
+            part = yield loaded.get()
             while True:
                 self._timing = True
                 try:
@@ -126,6 +126,8 @@ class InputConveyor:
                     continue
                 finally:
                     self._timing = False
+            # The controller takes the part (and may replan the belt) before this
+            # process's next get() is served: same-instant events run in order.
             self.at_bot.put(part)
 
 

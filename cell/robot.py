@@ -22,7 +22,7 @@ import bisect
 import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import simpy
@@ -193,8 +193,7 @@ def robot_timing(s: Scenario) -> RobotTiming:
 
 
 # --------------------------------------------------------------------------- process
-@dataclass(frozen=True)
-class Order:
+class Order(NamedTuple):
     """One transfer cycle as the controller sends it (step 6.1): regime times, s."""
 
     part: Any
