@@ -178,18 +178,21 @@ def build_timing(s: Scenario) -> RobotTiming:
 
 
 @functools.lru_cache(maxsize=16)
-def _cached_timing(cell: Any, path: Any, part: Any, robot: Any, mintime: Any) -> RobotTiming:
-    return build_timing(Scenario(cell=cell, path=path, part=part, robot=robot, mintime=mintime))
+def _cached_timing(cell: Any, path: Any, part: Any, robot: Any, mintime: Any,
+                   source: str) -> RobotTiming:
+    return build_timing(Scenario(cell=cell, path=path, part=part, robot=robot,
+                                 mintime=mintime, source=source))
 
 
 def robot_timing(s: Scenario) -> RobotTiming:
     """:func:`build_timing`, cached on the sections that shape the path and the motors.
 
     A sweep's replications (and both policies) share one solved path per process.
+    With the minimum-time planner the scenario's file is part of the key (the
+    planner may read a dynamics file beside it).
     """
-    if s.robot.timing == "minimum-time":  # the planner may read files next to the scenario
-        return build_timing(s)
-    return _cached_timing(s.cell, s.path, s.part, s.robot, s.mintime)
+    source = s.source if s.robot.timing == "minimum-time" else ""
+    return _cached_timing(s.cell, s.path, s.part, s.robot, s.mintime, source)
 
 
 # --------------------------------------------------------------------------- process

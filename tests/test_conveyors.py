@@ -1,0 +1,51 @@
+"""Belts as speed schedules (cell.conveyors): travel is the integral of speed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from cell.conveyors import Belt
+
+
+def test_travel_integrates_piecewise_speeds():
+    b = Belt(3.0)
+    b.plan(10.0, 6.0, 20.0, 1.5)
+    assert b.travel(10.0) == pytest.approx(30.0)
+    assert b.travel(15.0) == pytest.approx(60.0)
+    assert b.travel(30.0) == pytest.approx(30.0 + 60.0 + 15.0)
+    assert b.speed(12.0) == 6.0 and b.speed(25.0) == 1.5
+
+
+def test_new_plan_supersedes_later_changes():
+    b = Belt(3.0)
+    b.plan(10.0, 6.0, 20.0, 1.5)
+    b.plan(15.0, 2.0)                   # replans from 15 s: the change at 20 s is gone
+    assert b.speed(25.0) == 2.0
+    assert b.travel(25.0) == pytest.approx(30.0 + 30.0 + 20.0)
+
+
+def test_speed_must_be_positive():
+    with pytest.raises(ValueError):
+        Belt(3.0).plan(1.0, 0.0)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(st.floats(0.1, 50.0), st.floats(0.05, 12.0)), min_size=1,
+                max_size=8),
+       st.floats(0.0, 400.0))
+def test_time_at_inverts_travel(changes, t):
+    b = Belt(3.0)
+    now = 0.0
+    for dt, v in changes:
+        now += dt
+        b.plan(now, v)
+    # brute-force integral of the schedule
+    knots = [0.0] + list(np.cumsum([dt for dt, _ in changes]))
+    speeds = [3.0] + [v for _, v in changes]
+    x = sum(s * (min(t, hi) - lo) for lo, hi, s in zip(knots, knots[1:] + [np.inf], speeds)
+            if t > lo)
+    assert b.travel(t) == pytest.approx(x, rel=1e-9, abs=1e-9)
+    assert b.time_at(b.travel(t)) == pytest.approx(t, rel=1e-9, abs=1e-7)

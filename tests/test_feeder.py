@@ -1,0 +1,66 @@
+"""The parts supply (cell.feeder): eq. 6.9, scipy's moments, traces, common random numbers."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.stats
+
+from cell.feeder import FEEDER_STREAM, interarrival_times, stream
+from cell.scenario import Arrivals, default_scenario
+
+WEIBULL = scipy.stats.weibull_min(1 / 0.2038, loc=17.6019, scale=5.4342)
+
+
+def test_default_is_eq_6_9_by_inverse_cdf():
+    n, seed = 1000, 11
+    t = interarrival_times(Arrivals(), n, seed)
+    u = stream(seed, FEEDER_STREAM).random(n)
+    eq_6_9 = 17.6019 + 5.4342 * (-np.log(1.0 - u)) ** 0.2038
+    np.testing.assert_allclose(t, eq_6_9, rtol=1e-9)
+
+
+def test_weibull_moments_match_scipy_and_spec():
+    t = interarrival_times(Arrivals(), 40_000, 3)
+    mean, sd = WEIBULL.mean(), WEIBULL.std()
+    assert mean == pytest.approx(22.586, abs=1e-3)     # SPEC §5 (thesis quotes 22.5872)
+    assert sd == pytest.approx(1.16, abs=5e-3)
+    assert abs(t.mean() - mean) < 4 * sd / np.sqrt(t.size)
+    assert t.std() == pytest.approx(sd, rel=0.03)
+    assert t.min() >= 17.6019                          # the location parameter
+
+
+def test_any_scipy_distribution_by_name():
+    a = Arrivals(distribution="gamma", params={"a": 9.0, "loc": 10.0, "scale": 1.4})
+    t = interarrival_times(a, 40_000, 5)
+    ref = scipy.stats.gamma(9.0, loc=10.0, scale=1.4)
+    assert abs(t.mean() - ref.mean()) < 4 * ref.std() / np.sqrt(t.size)
+
+
+def test_seed_sequence_is_not_consumed():
+    root = np.random.SeedSequence(1234)
+    a = interarrival_times(Arrivals(), 50, root)
+    b = interarrival_times(Arrivals(), 50, root)
+    np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(a, interarrival_times(Arrivals(), 50, 1234))
+    assert not np.array_equal(a, interarrival_times(Arrivals(), 50, 1235))
+    child = root.spawn(2)[1]
+    assert not np.array_equal(a, interarrival_times(Arrivals(), 50, child))
+
+
+def test_trace_is_replayed_in_order_and_repeats(tmp_path):
+    (tmp_path / "trace.csv").write_text("interarrival_s\n20.5\n23.25\n21.0\n")
+    a = Arrivals(trace_csv="trace.csv")
+    t = interarrival_times(a, 7, 99, tmp_path)
+    assert t.tolist() == [20.5, 23.25, 21.0, 20.5, 23.25, 21.0, 20.5]
+
+
+def test_both_policies_see_the_same_parts():
+    from cell.simulation import simulate
+
+    s = default_scenario().with_overrides({"run.parts": 60})
+    seed = np.random.SeedSequence(77)
+    a = simulate(s, seed=seed).parts
+    b = simulate(s.with_overrides({"controller.policy": "non-adaptive"}), seed=seed).parts
+    np.testing.assert_array_equal(a["interarrival_s"], b["interarrival_s"])
+    np.testing.assert_array_equal(a["arrival_s"], b["arrival_s"])
