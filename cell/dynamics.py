@@ -88,6 +88,14 @@ def load_dynamics(path: str | Path, file_for_errors: object = None,
     return build(DynamicsModel, raw, path)
 
 
+def _cross(a: Array, b: Array) -> Array:
+    """a × b over the last axis (np.cross is slow on small arrays)."""
+    a, b = np.asarray(a), np.asarray(b)
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+
+
 @dataclass(frozen=True)
 class Chain:
     """The numeric chain for one payload: DH lengths, link masses, COMs, inertias, drives."""
@@ -129,16 +137,16 @@ class Chain:
             Rt = np.swapaxes(R[:, i], -1, -2)
             z[:, 2] = qd[:, i]
             wz = w + z
-            wd_ = wd + np.cross(w, z)
+            wd_ = wd + _cross(w, z)
             wd_[:, 2] += qdd[:, i]
             w = np.einsum("nij,nj->ni", Rt, wz)
             wd = np.einsum("nij,nj->ni", Rt, wd_)
-            vd = (np.einsum("nij,nj->ni", Rt, vd) + np.cross(wd, pstar[i])
-                  + np.cross(w, np.cross(w, pstar[i])))
-            vc = vd + np.cross(wd, self.com[i]) + np.cross(w, np.cross(w, self.com[i]))
+            vd = (np.einsum("nij,nj->ni", Rt, vd) + _cross(wd, pstar[i])
+                  + _cross(w, _cross(w, pstar[i])))
+            vc = vd + _cross(wd, self.com[i]) + _cross(w, _cross(w, self.com[i]))
             F.append(self.mass[i] * vc)
             Iw = w @ self.inertia[i].T
-            N.append(wd @ self.inertia[i].T + np.cross(w, Iw))
+            N.append(wd @ self.inertia[i].T + _cross(w, Iw))
         tau = np.zeros((n, 5))
         f = np.zeros((n, 3))
         m = np.zeros((n, 3))
@@ -146,8 +154,8 @@ class Chain:
             if i < 4:
                 Rn = R[:, i + 1]
                 f = np.einsum("nij,nj->ni", Rn, f)
-                m = np.einsum("nij,nj->ni", Rn, m) + np.cross(pstar[i], f)
-            m = m + np.cross(pstar[i] + self.com[i], F[i]) + N[i]
+                m = np.einsum("nij,nj->ni", Rn, m) + _cross(pstar[i], f)
+            m = m + _cross(pstar[i] + self.com[i], F[i]) + N[i]
             f = f + F[i]
             tau[:, i] = np.einsum("ni,ni->n", m, R[:, i, 2, :])   # joint axis z_{i-1} in frame i
         tau += self.rotor * qdd

@@ -1,0 +1,90 @@
+"""The planner on the cell's R II and R IV, ``fastest_regime_times`` and ``cell mintime``."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pandas as pd
+import pytest
+
+from cell.cli import main
+from cell.mintime import fastest_regime_times
+from cell.mintime.regimes import _CACHE
+from cell.scenario import load_scenario
+
+KIN = "scenarios/mintime_kinematic.yaml"
+BASE = "scenarios/baseline.yaml"
+BASE_RATE = 0.419488          # rad/s, robot.motors (calibrated, SPEC §4)
+
+
+def test_r4_kinematic_is_the_base_trapezoid():
+    """R IV is 180° of base (SPEC §3) at the base's peak no-load rate ω, |q̈| ≤ a:
+    T = π/ω + ω/a, the closed form of a trapezoid."""
+    s = load_scenario(KIN)
+    a = s.mintime.qddot_max_rad_s2[0]
+    assert fastest_regime_times(s)["R4"] == pytest.approx(math.pi / BASE_RATE + BASE_RATE / a,
+                                                          rel=1e-4)
+
+
+def test_velocity_bounds_alone_give_the_thesis_constant_rate_time():
+    """With (almost) unbounded acceleration the planner's R IV is the constant-rate time of
+    Table 7.1's minimum cycle, π/ω = 7.4890 s (SPEC §4, derived).  On a grid of n points the
+    start and stop each take one step at half speed: T = π/ω · (n + 1)/(n − 1)."""
+    n = 4000
+    s = load_scenario(KIN, {"mintime.qddot_max_rad_s2": [1e4] * 5, "mintime.grid_points": n})
+    t = fastest_regime_times(s)["R4"]
+    assert math.pi / BASE_RATE == pytest.approx(7.4890, abs=2e-4)
+    assert t == pytest.approx(math.pi / BASE_RATE * (n + 1) / (n - 1), rel=1e-5)
+
+
+def test_dynamic_model_is_never_faster_than_the_velocity_bound():
+    t = fastest_regime_times(load_scenario(BASE))
+    assert t["R4"] >= math.pi / BASE_RATE
+    assert t["R4"] < math.pi / BASE_RATE * 1.01
+
+
+def test_times_are_cached_per_scenario():
+    s = load_scenario(KIN)
+    first = fastest_regime_times(s)
+    n = len(_CACHE)
+    again = fastest_regime_times(s.with_overrides({"run.parts": 3}))   # irrelevant to the planner
+    assert again == first and len(_CACHE) == n
+    other = fastest_regime_times(s.with_overrides({"mintime.qddot_max_rad_s2": [1.0] * 5}))
+    assert other["R4"] > first["R4"] and len(_CACHE) == n + 1
+
+
+@pytest.mark.parametrize("scenario,torque", [(KIN, False), (BASE, True)])
+def test_cli_writes_csv_and_json(tmp_path, scenario, torque):
+    out = tmp_path / "mt"
+    assert main(["mintime", scenario, "--out", str(out)]) == 0
+    doc = json.loads((tmp_path / "mt.json").read_text())
+    assert set(doc["regimes"]) == {"R2", "R4"}
+    assert doc["limits"]["torque"] is torque
+    assert len(doc["limits"]["qdot_max_rad_s"]) == 5 and len(doc["limits"]["qddot_max_rad_s2"]) == 5
+    frame = pd.read_csv(tmp_path / "mt.csv")
+    assert list(frame.columns) == ["regime", "s", "theta1_rad", "theta2_rad", "theta3_rad",
+                                   "theta4_rad", "theta5_rad", "sdot", "sdot_limit"]
+    assert (frame.groupby("regime").size() == 460).all()
+    assert (frame["sdot"] <= frame["sdot_limit"] * (1 + 1e-9)).all()
+    # The CSV's own profile gives the JSON's time: T = Σ 2Δs/(ṡ_i + ṡ_{i+1}).
+    for r, g in frame.groupby("regime"):
+        sd, s = g["sdot"].to_numpy(), g["s"].to_numpy()
+        t = (2 * (s[1:] - s[:-1]) / (sd[1:] + sd[:-1])).sum()
+        assert t == pytest.approx(doc["regimes"][r]["time_s"], rel=1e-8)
+
+
+def test_cli_bad_dynamics_file_is_one_line_and_no_output(tmp_path, capsys):
+    out = tmp_path / "mt"
+    code = main(["mintime", BASE, "--set", "mintime.dynamics_file=missing.yaml", "--out", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "\n" not in err
+    assert "mintime.dynamics_file" in err and "missing.yaml" in err and "baseline.yaml" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_no_bounds_at_all_is_refused(tmp_path, capsys):
+    code = main(["mintime", KIN, "--set", "mintime.acceleration_bounds=false",
+                 "--out", str(tmp_path / "x")])
+    assert code == 2 and "infinite acceleration" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
