@@ -1,0 +1,127 @@
+"""The policies' decisions (cell.controller) against thesis §5.3, §6.3 and Table 7.1."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from cell.controller import adaptive_plan, constants, fixed_plan
+from cell.errors import ScenarioError
+from cell.robot import robot_timing
+from cell.scenario import default_scenario
+
+#: Table 7.1: ideal cycle -> Vavg R IV (in/s).
+VAVG_R4 = {22.5872: 3.5594, 22.0: 3.7818, 21.5: 3.9943, 21.0: 4.2321, 20.5: 4.5000,
+           20.0907: 4.7459}
+
+
+@pytest.fixture(scope="module")
+def k():
+    s = default_scenario()
+    return constants(s, robot_timing(s))
+
+
+@pytest.mark.parametrize("ideal", sorted(VAVG_R4))
+def test_fixed_cycle_shortens_r4_only_as_in_table_7_1(k, ideal):
+    plan = fixed_plan(k, ideal)
+    assert plan.cycle == pytest.approx(ideal, abs=5e-4)
+    assert plan.r4 >= k.timing.r4_min_s
+    assert k.timing.r4.length_in / plan.r4 == pytest.approx(VAVG_R4[ideal], abs=1.5e-3)
+    assert (plan.r1_pre, plan.r2, plan.r3_pre) == (k.r1_pre_nom, k.r2_nom, k.r3_pre_nom)
+
+
+def test_nominal_regimes_add_up_to_the_ideal_cycle(k):
+    assert k.r1_nom + k.r2_nom + k.r3_pre_nom + k.r3_post_nom + k.r4_nom == \
+        pytest.approx(22.5872, abs=1e-9)
+    # SPEC §6 derives R II = 5.9350 s from an R I of exactly 8/3 s; the motor floor
+    # after LO lengthens R I a little and R II gives that back.
+    assert k.r2_nom == pytest.approx(5.9350, abs=0.1)
+    assert k.r2_nom < 5.9350
+
+
+def test_a_cycle_shorter_than_the_base_allows_is_an_error(k):
+    with pytest.raises(ScenarioError, match="controller.ideal_cycle_s"):
+        fixed_plan(k, 20.0)
+
+
+def test_on_time_part_keeps_everything_nominal(k):
+    # next part exactly one nominal cycle away at the nominal belt speed
+    lag = k.timing.r1_pre.time(3.0)
+    b = (k.cycle_nom - lag) * 3.0
+    gap = 45.0 - 2.0 * (k.r1_nom + k.r2_nom) - 2.0 * k.r3_pre_nom
+    plan = adaptive_plan(k, 3.0, (lag, b), gap)
+    assert plan.cycle == pytest.approx(k.cycle_nom)
+    assert plan.input_after_lo == pytest.approx(3.0)
+    assert plan.output_to_g == pytest.approx(2.0)
+    assert plan.note == ""
+
+
+def test_late_part_speeds_the_input_belt_after_the_lag(k):
+    lag = k.timing.r1_pre.time(3.0)
+    b = (k.cycle_nom + 1.5 - lag) * 3.0          # 1.5 s late at the current speed
+    plan = adaptive_plan(k, 3.0, (lag, b), None)
+    assert plan.cycle == pytest.approx(k.cycle_nom)
+    assert plan.input_after_lo > 3.0
+    assert lag + b / plan.input_after_lo == pytest.approx(plan.cycle)   # at B as robot returns
+    assert plan.input_next == pytest.approx((plan.input_after_lo + 3.0) / 2)  # step 6.3
+
+
+def test_early_part_is_made_up_in_r4_first(k):
+    lag = k.timing.r1_pre.time(3.0)
+    b = (k.cycle_nom - 1.0 - lag) * 3.0          # 1 s early
+    plan = adaptive_plan(k, 3.0, (lag, b), None)
+    assert plan.r4 == pytest.approx(k.r4_nom - 1.0)
+    assert plan.input_after_lo == 3.0
+    assert plan.cycle == pytest.approx(lag + b / 3.0)
+
+
+def test_very_early_part_uses_the_base_maximum_then_slows_the_belt(k):
+    lag = k.timing.r1_pre.time(3.0)
+    b = (k.cycle_nom - 4.0 - lag) * 3.0          # 4 s early: more than R IV can give
+    plan = adaptive_plan(k, 3.0, (lag, b), None)
+    assert plan.r4 == pytest.approx(k.timing.r4_min_s)
+    assert plan.input_after_lo < 3.0
+    assert lag + b / plan.input_after_lo == pytest.approx(plan.cycle)
+    assert plan.input_next == plan.input_after_lo     # 6.3: below nominal, left alone
+
+
+def test_fast_input_belt_gives_its_time_to_r2(k):
+    v = 4.0
+    plan = adaptive_plan(k, v, None, None)
+    r1 = plan.r1_pre + plan.r1_post
+    assert r1 < k.r1_nom
+    assert plan.r2 == pytest.approx(k.r2_nom + (k.r1_nom - r1))   # step 2.1
+    assert plan.cycle == pytest.approx(k.cycle_nom)
+
+
+def test_output_speed_is_the_average_of_the_spacing_limits(k):
+    gap = 20.0
+    plan = adaptive_plan(k, 3.0, None, gap)
+    ttsot = plan.to_g
+    lo = (44.75 - gap - 2.0 * plan.r3_pre) / ttsot          # step 5.0
+    hi = (45.25 - gap - 2.0 * plan.r3_pre) / ttsot
+    assert plan.output_to_g == pytest.approx((lo + hi) / 2)
+    assert gap + plan.output_to_g * ttsot + 2.0 * plan.r3_pre == pytest.approx(45.0)
+
+
+@settings(max_examples=150, deadline=None)
+@given(v=st.floats(0.3, 4.3), a=st.floats(0.0, 40.0), b=st.floats(0.01, 200.0),
+       gap=st.one_of(st.none(), st.floats(0.0, 60.0)))
+def test_plans_never_ask_more_than_the_motors_and_belts_can_do(k, v, a, b, gap):
+    v = min(v, k.timing.input_track_max_in_s)
+    plan = adaptive_plan(k, v, (a, b), gap)
+    t = k.timing
+    assert plan.r1_pre >= t.r1_pre.floor_s - 1e-12
+    assert plan.r1_post >= t.r1_post.floor_s - 1e-12
+    assert plan.r2 >= t.r2_min_s - 1e-12
+    assert plan.r4 >= t.r4_min_s - 1e-12
+    assert 0 < plan.input_after_lo <= k.input_max
+    assert 0 < plan.input_next <= t.input_track_max_in_s
+    assert 0 < plan.output_to_g <= k.output_max
+    assert math.isfinite(plan.cycle) and plan.cycle > 0
+    if "output belt" not in plan.note and gap is not None:
+        spacing = gap + plan.output_to_g * plan.to_g + k.u_nom * plan.r3_pre
+        assert spacing == pytest.approx(45.0, abs=1e-9)
