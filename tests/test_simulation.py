@@ -1,0 +1,171 @@
+"""Whole runs (cell.simulation, ``cell run``): SPEC §7-8 facts, invariants, hostile input."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from cell.cli import main
+from cell.scenario import default_scenario, load_scenario
+from cell.simulation import PART_COLUMNS, SUMMARY_COLUMNS, simulate
+
+ROOT = Path(__file__).resolve().parents[1]
+BASELINE = ROOT / "scenarios" / "baseline.yaml"
+NON_ADAPTIVE = ROOT / "scenarios" / "non_adaptive.yaml"
+
+
+@pytest.fixture(scope="module")
+def adaptive():
+    return simulate(load_scenario(BASELINE))
+
+
+@pytest.fixture(scope="module")
+def fixed():
+    return simulate(load_scenario(NON_ADAPTIVE))
+
+
+def test_issue_columns_are_present(adaptive):
+    required_parts = ["part", "arrival_s", "interarrival_s", "picked", "missed", "pick_s",
+                      "touchdown_s", "delivery_interval_s", "motion_cycle_s", "ip_wallclock",
+                      "ip_thesis", "input_speed_in_s", "output_speed_in_s", "spacing_in",
+                      "v_r1_in_s", "v_r2_in_s", "v_r3_in_s", "v_r4_in_s"]
+    required_summary = ["policy", "ideal_cycle_s", "parts_arrived", "parts_delivered",
+                        "parts_missed", "actual_cycle_wallclock_s", "actual_cycle_thesis_s",
+                        "parts_per_hr_wallclock", "parts_per_hr_thesis", "vavg_r4_in_s",
+                        "ip_wallclock", "ip_thesis", "spacing_min_in", "spacing_max_in"]
+    assert set(required_parts) <= set(adaptive.parts.columns) == set(PART_COLUMNS)
+    assert set(required_summary) <= set(adaptive.summary) == set(SUMMARY_COLUMNS)
+    assert len(adaptive.parts) == 500
+
+
+def test_adaptive_baseline_loses_nothing_and_spaces_parts_45_in(adaptive):
+    p, s = adaptive.parts, adaptive.summary
+    assert s["parts_missed"] == 0 and s["parts_delivered"] == 500           # §7.2
+    sp = p["spacing_in"].dropna()
+    assert len(sp) == 499
+    assert ((sp - 45.0).abs() <= 0.25).all()                                # §4.3 f
+    # every delivered part was picked after it reached B and set down after
+    assert (p["pick_s"] > p["at_bot_s"]).all() and (p["touchdown_s"] > p["pick_s"]).all()
+    # the thesis's accounting lands near its published figures (printed, not equal)
+    assert 0.95 < s["ip_thesis"] < 1.05
+    assert abs(s["cycle_vs_nominal_pct"]) < 5
+
+
+def test_adaptive_never_exceeds_motor_or_belt_limits(adaptive):
+    s = load_scenario(BASELINE)
+    from cell.robot import robot_timing
+
+    t = robot_timing(s)
+    p = adaptive.parts
+    assert (p["v_r4_in_s"] <= t.r4.length_in / t.r4_min_s + 1e-9).all()
+    assert (p["v_r2_in_s"] <= t.r2.length_in / t.r2_min_s + 1e-9).all()
+    assert (p["input_speed_in_s"] <= t.input_track_max_in_s + 1e-9).all()
+    speeds = [v for _, v in adaptive.belts["input"]]
+    assert 0 < min(speeds) and max(speeds) <= s.belts.input_max_in_s
+    out = [v for _, v in adaptive.belts["output"]]
+    assert 0 < min(out) and max(out) <= s.belts.output_max_in_s
+    # robot cycles never overlap: each starts after the previous one ended
+    start = p["at_bot_s"].to_numpy()
+    assert (start[1:] >= start[:-1] + p["motion_cycle_s"].to_numpy()[:-1] - 1e-6).all()
+
+
+def test_non_adaptive_loses_what_the_physics_says(fixed):
+    p, s = fixed.parts, fixed.summary
+    # conservation: arrived = delivered + lost + at most one in the cell
+    assert s["parts_arrived"] == 500
+    assert 0 <= s["parts_arrived"] - s["parts_delivered"] - s["parts_missed"] <= 1
+    # lost iff the part reached B before the robot was back (§6.3)
+    free_at = 0.0
+    for at_bot, picked, cycle in zip(p["at_bot_s"], p["picked"], p["motion_cycle_s"]):
+        assert picked == (at_bot >= free_at - 1e-6)
+        if picked:
+            free_at = at_bot + cycle
+    np.testing.assert_allclose(p.loc[p.picked, "motion_cycle_s"], 22.5872, atol=1e-9)
+    # the thesis's bookkeeping is computed from the same draws beside it
+    assert s["parts_missed_thesis"] == int(p["missed_thesis"].sum())
+    assert s["parts_missed_thesis"] > s["parts_missed"]
+
+
+def test_non_adaptive_loss_rate_matches_spec_8():
+    s = load_scenario(NON_ADAPTIVE)
+    lost = [simulate(s, seed=seed).summary["parts_missed"] for seed in range(12)]
+    assert np.mean(lost) == pytest.approx(162, abs=10)        # SPEC §8: about 162 of 500
+    shortest = s.with_overrides({"controller.ideal_cycle_s": 20.0907})
+    lost = [simulate(shortest, seed=seed).summary["parts_missed"] for seed in range(12)]
+    assert np.mean(lost) == pytest.approx(10, abs=4)          # SPEC §8: about 10
+
+
+def test_conservation_over_seeds_and_cycles():
+    base = default_scenario().with_overrides({"run.parts": 120})
+    for policy in ("adaptive", "non-adaptive"):
+        for seed in range(4):
+            r = simulate(base.with_overrides({"controller.policy": policy}), seed=seed).summary
+            assert 0 <= r["parts_arrived"] - r["parts_delivered"] - r["parts_missed"] <= 1
+
+
+def test_same_seed_gives_byte_identical_csvs(tmp_path, capsys):
+    for out in ("a", "b"):
+        assert main(["run", str(BASELINE), "--set", "run.parts=80", "--out",
+                     str(tmp_path / out)]) == 0
+    for name in ("parts.csv", "summary.csv"):
+        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes()
+    text = capsys.readouterr().out
+    assert "1.0214" in text and "2.1 %" in text        # the thesis's figures printed beside
+    frame = pd.read_csv(tmp_path / "a" / "parts.csv")
+    assert list(frame.columns) == PART_COLUMNS and len(frame) == 80
+
+
+def test_other_seed_other_parts(tmp_path):
+    s = default_scenario().with_overrides({"run.parts": 30})
+    a = simulate(s, seed=1).parts["interarrival_s"]
+    b = simulate(s, seed=2).parts["interarrival_s"]
+    assert not np.array_equal(a, b)
+
+
+def _hostile(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "hostile.yaml"
+    path.write_text(text)
+    return path
+
+
+HOSTILE = {
+    "unknown key": ("belts:\n  speed_in_s: 3.0\n", "belts.speed_in_s", "3.0"),
+    "wrong type": ("run:\n  parts: many\n", "run.parts", "'many'"),
+    "negative speed": ("belts:\n  input_nominal_in_s: -3.0\n", "belts.input_nominal_in_s",
+                       "-3.0"),
+    "zero speed": ("belts:\n  output_nominal_in_s: 0\n", "belts.output_nominal_in_s", "0"),
+    "no parts": ("run:\n  parts: 0\n", "run.parts", "0"),
+    "no such distribution": ("arrivals:\n  distribution: weibull_maxx\n",
+                             "arrivals.distribution", "weibull_maxx"),
+    "missing trace": ("arrivals:\n  trace_csv: nowhere.csv\n", "arrivals.trace_csv",
+                      "nowhere.csv"),
+    "negative trace": ("arrivals:\n  trace_csv: trace.csv\n", "arrivals.trace_csv",
+                       "trace.csv"),
+    "cycle too short": ("controller:\n  policy: non-adaptive\n  ideal_cycle_s: 19.5\n",
+                        "controller.ideal_cycle_s", "19.5"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(HOSTILE))
+def test_hostile_scenario_one_line_exit_2_nothing_written(tmp_path, capsys, case):
+    text, key, value = HOSTILE[case]
+    (tmp_path / "trace.csv").write_text("interarrival_s\n22.0\n-4.0\n21.0\n")
+    path = _hostile(tmp_path, text)
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert str(path) in err and key in err and value in err
+    assert not out.exists()
+
+
+def test_hostile_override_on_the_command_line(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["run", str(BASELINE), "--set", "belts.input_max_in_s=0",
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "belts.input_max_in_s" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
