@@ -6,8 +6,14 @@ import numpy as np
 import pytest
 import scipy.stats
 
-from cell.accounting import (THESIS_SLACK_S, parts_per_hr, thesis_adaptive,
-                             thesis_non_adaptive, thesis_non_adaptive_held, wallclock)
+from cell.accounting import (
+    THESIS_SLACK_S,
+    parts_per_hr,
+    thesis_adaptive,
+    thesis_non_adaptive,
+    thesis_non_adaptive_held,
+    wallclock,
+)
 
 #: Table 7.1 (thesis §7.2) with SPEC §8's figures for the reconstruction held at
 #: the thesis's own miss counts: (ideal cycle, missed, actual cycle, IP, SPEC actual, SPEC IP).
