@@ -104,13 +104,24 @@ def acceleration_rows(s: ArrayLike, dq: ArrayLike, ddq: ArrayLike,
 
 # --------------------------------------------------------------------------- limit curve
 def _halves(rows: PathRows) -> tuple[Array, Array, Array, Array]:
-    """Each row as two one-sided bounds α u ≤ β0 + β1 ṡ + β2 ṡ²; tiny α set to 0."""
+    """Each row as two one-sided bounds α u ≤ β0 + β1 ṡ + β2 ṡ².
+
+    α counts as zero (a zero-inertia point) when it is below ``ZERO_INERTIA`` of
+    the row's largest |α| along the path plus its own β's size: a joint that
+    does not move (q' at round-off) then bounds ṡ only, never u.  Halves whose
+    α is zero and whose β cannot bind (β0 > 0, no ṡ terms) are dropped.
+    """
     alpha = np.hstack([rows.a, -rows.a])
     b0 = np.hstack([rows.hi - rows.c, rows.c - rows.lo])
     b1 = np.hstack([-rows.e, rows.e])
     b2 = np.hstack([-rows.b, rows.b])
-    scale = np.max(np.abs(alpha), axis=0, keepdims=True) if len(alpha) else alpha
-    alpha = np.where(np.abs(alpha) <= ZERO_INERTIA * scale, 0.0, alpha)
+    if alpha.shape[1]:
+        tol = ZERO_INERTIA * (np.max(np.abs(alpha), axis=0) + np.abs(b0) + np.abs(b1) + np.abs(b2))
+        alpha = np.where(np.abs(alpha) <= tol, 0.0, alpha)
+        idle = (alpha == 0) & (b0 > 0) & (np.abs(b1) <= ZERO_INERTIA * b0) \
+            & (np.abs(b2) <= ZERO_INERTIA * b0)
+        keep = ~idle.all(axis=0)
+        alpha, b0, b1, b2 = alpha[:, keep], b0[:, keep], b1[:, keep], b2[:, keep]
     return alpha, b0, b1, b2
 
 
@@ -151,11 +162,23 @@ def velocity_limit(rows: PathRows) -> Array:
         limit = np.minimum(limit, r.min(axis=1))
     # Every upper bound (α_p > 0) against every lower bound (α_n < 0):
     # U_p ≥ L_n  ⇔  α_p β_n − α_n β_p ≥ 0, a quadratic in ṡ.
-    ap, an = np.where(pos, alpha, 0.0)[:, :, None], np.where(neg, alpha, 0.0)[:, None, :]
-    valid = pos[:, :, None] & neg[:, None, :]
-    coef = [ap * bn[:, None, :] - an * bp[:, :, None] for bp, bn in ((b0, b0), (b1, b1), (b2, b2))]
+    cp, cn = pos.any(axis=0), neg.any(axis=0)
+    if not (cp.any() and cn.any()):
+        return limit
+    ap = np.where(pos, alpha, 0.0)[:, cp, None]
+    an = np.where(neg, alpha, 0.0)[:, None, cn]
+    valid = pos[:, cp, None] & neg[:, None, cn]
+    coef = [ap * bn[:, None, cn] - an * bp[:, cp, None] for bp, bn in ((b0, b0), (b1, b1), (b2, b2))]
     c0 = np.where(valid, coef[0], 1.0)
-    r = _first_loss(c0, np.where(valid, coef[1], 0.0), np.where(valid, coef[2], 0.0))
+    if not np.any(b1):
+        # No ṡ terms: the pair is linear in x = ṡ², lost beyond x = −c0/c2 when c2 < 0.
+        c2 = np.where(valid, coef[2], 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x = np.where(c2 < 0, -c0 / c2, np.inf)
+        x = np.where(c0 < -1e-12 * (np.abs(c0) + np.abs(c2)), 0.0, x)
+        r = np.sqrt(np.maximum(x, 0.0))
+    else:
+        r = _first_loss(c0, np.where(valid, coef[1], 0.0), np.where(valid, coef[2], 0.0))
     limit = np.minimum(limit, r.reshape(n, -1).min(axis=1))
     return limit
 

@@ -1,0 +1,99 @@
+"""Planner speed against toppra on the transfer path (issue 6; merged into
+reports/bench.json by ``cell bench``).
+
+Input: the joint paths of R II and R IV from the step table, their peak
+velocity bounds and the acceleration bounds of ``scenarios/mintime_kinematic.yaml``
+(velocity + acceleration: toppra's fastest, Cython, case).  Both planners start
+from the same waypoints, build their own spline and constraints on the same
+uniform grid, and return ṡ on it; the time of the best of several runs, in ms.
+The torque case (baseline dynamic model, 460 points) is reported beside it.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _best_ms(fn: Callable[[], object], repeat: int) -> float:
+    best = np.inf
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return 1e3 * best
+
+
+def benchmarks(repeat: int = 5) -> dict[str, float]:
+    from scipy.interpolate import CubicSpline
+
+    from cell.dynamics import chain, load_dynamics
+    from cell.mintime.planner import PathRows, acceleration_rows, plan, torque_rows, velocity_rows
+    from cell.mintime.reference import toppra_profile
+    from cell.mintime.regimes import FREE_REGIMES, regime_path, regime_rows
+    from cell.scenario import load_scenario
+    from cell.steptable import StepTable
+
+    kin = load_scenario(ROOT / "scenarios" / "mintime_kinematic.yaml")
+    table = StepTable.from_scenario(kin)
+    paths = [regime_path(table, r, kin) for r in FREE_REGIMES]
+    amax = np.asarray(kin.mintime.qddot_max_rad_s2)
+    vmax = {rp.regime: regime_rows(kin, rp, 3)[3].qdot_max_rad_s for rp in paths}
+
+    def ours(n: int) -> list[float]:
+        s = np.linspace(0.0, 1.0, n)
+        out = []
+        for rp in paths:
+            sp = CubicSpline(rp.s_way, rp.q_way)
+            dq, ddq = sp(s, 1), sp(s, 2)
+            rows = PathRows.join(velocity_rows(s, dq, vmax[rp.regime]),
+                                 acceleration_rows(s, dq, ddq, amax))
+            out.append(plan(rows).time_s)
+        return out
+
+    def theirs(n: int) -> list[float]:
+        s = np.linspace(0.0, 1.0, n)
+        return [toppra_profile(rp.s_way, rp.q_way, s, qdot_max=vmax[rp.regime], qddot_max=amax)[1]
+                for rp in paths]
+
+    out: dict[str, float] = {}
+    for n in (460, 2000):
+        a, b = ours(n), theirs(n)
+        out[f"mintime_ms_{n}"] = _best_ms(lambda: ours(n), repeat)       # noqa: B023
+        out[f"toppra_ms_{n}"] = _best_ms(lambda: theirs(n), repeat)      # noqa: B023
+        out[f"mintime_vs_toppra_time_rel_{n}"] = float(max(abs(x - y) / y for x, y in zip(a, b)))
+
+    # Torque (baseline dynamic model) on R IV at 460 points: toppra calls the same inverse
+    # dynamics once per grid point and coefficient, the planner batches it.
+    base = load_scenario(ROOT / "scenarios" / "baseline.yaml")
+    model = load_dynamics(base.base_dir / base.mintime.dynamics_file)
+    r4 = next(rp for rp in paths if rp.regime == "R4")
+    ch = chain(model, base.robot.l2_in, base.robot.l3_in, r4.load_oz, r4.tcp_in)
+    tau = np.asarray(model.drives.stall_torque_nm)
+    s = np.linspace(0.0, 1.0, 460)
+
+    def ours_tau() -> float:
+        sp = CubicSpline(r4.s_way, r4.q_way)
+        q, dq, ddq = sp(s), sp(s, 1), sp(s, 2)
+        return plan(PathRows.join(velocity_rows(s, dq, vmax["R4"]),
+                                  torque_rows(s, q, dq, ddq, ch.rnea, tau))).time_s
+
+    def theirs_tau() -> float:
+        return toppra_profile(r4.s_way, r4.q_way, s, qdot_max=vmax["R4"],
+                              inv_dyn=lambda q, qd, qdd: ch.rnea(q, qd, qdd, friction=False),
+                              tau_max=tau)[1]
+
+    out["mintime_torque_ms_460"] = _best_ms(ours_tau, 3)
+    out["toppra_torque_ms_460"] = _best_ms(theirs_tau, 1)
+    return {k: round(v, 3) if "ms" in k else v for k, v in out.items()}
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import json
+
+    print(json.dumps(benchmarks(), indent=2))
