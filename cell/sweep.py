@@ -35,7 +35,10 @@ import hashlib
 import itertools
 import json
 import os
+import signal
 import sys
+import threading
+import time
 import typing
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -331,7 +334,21 @@ def _open_executor(workers: int, scheduler: str | None) -> tuple[cf.Executor | N
         return client.get_executor(pure=False), client
     if workers <= 1:
         return None, None
-    return cf.ProcessPoolExecutor(max_workers=workers), None
+    return cf.ProcessPoolExecutor(max_workers=workers, initializer=_worker_init,
+                                  initargs=(os.getpid(),)), None
+
+
+def _worker_init(parent: int) -> None:
+    """In each local worker: leave Ctrl-C to the sweep, and exit if the sweep dies
+    (even by kill -9), so no orphan keeps running."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(0.5)
+        os._exit(1)
+
+    threading.Thread(target=watch, daemon=True, name="watch-sweep").start()
 
 
 def _run_tasks(sweep: Sweep, todo: Sequence[Task], replicate: Replicate,
@@ -449,8 +466,23 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     return Outcome(pd.read_csv(out / "replications.csv"), len(todo), len(tasks) - len(todo))
 
 
+def _interrupt(signum: int, frame: Any) -> None:
+    raise KeyboardInterrupt
+
+
 def cmd_sweep(args: argparse.Namespace) -> int:
     """``cell sweep SWEEP --out DIR [--workers N] [--scheduler ADDR] [--resume] [--report DIR]``."""
+    if threading.current_thread() is not threading.main_thread():
+        return _sweep_command(args)
+    # kill (SIGTERM) stops like Ctrl-C: pending tasks cancelled, finished ones kept.
+    previous = signal.signal(signal.SIGTERM, _interrupt)
+    try:
+        return _sweep_command(args)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _sweep_command(args: argparse.Namespace) -> int:
     sweep = load_sweep(args.sweep)
     if args.report:
         from cell.report import check_table_7_1

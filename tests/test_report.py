@@ -152,10 +152,13 @@ def _synthetic(thesis_missed: float, wall_missed: float) -> pd.DataFrame:
 def test_reading_follows_the_direction_of_the_numbers():
     more = " ".join(reading(_synthetic(200.0, 160.0), 500))
     same = " ".join(reading(_synthetic(200.0, 200.0), 500))
+    fewer = " ".join(reading(_synthetic(5.0, 10.0), 500))
     assert "loses 200.0 of 500 parts on average against 160.0" in more
-    assert "cannot come twice running" in more and "lose the same parts" not in more
-    assert "lose the same parts" in same and "cannot come twice running" not in same
+    assert "cannot come twice running" in more and "same number" not in more
+    assert "same number of parts" in same and "twice running" not in same
+    assert "loses fewer than the wall clock" in fewer and "twice running" not in fewer
     assert "2.00–2.00 times lower" in more  # 0.8 / 0.4
+    assert "+66.7%" in more  # actual cycle 50 s against 30 s
 
 
 def test_write_table_7_1_writes_both_files(tmp_path):
