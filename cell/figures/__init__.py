@@ -12,7 +12,7 @@ import argparse
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
-from cell.figures import arrivals, layout, motion
+from cell.figures import arrivals, layout, motion, runs
 from cell.figures.style import style
 from cell.scenario import Scenario, load_scenario
 from cell.steptable import StepTable
@@ -85,6 +85,17 @@ def make_figures(scenario: Scenario, out: str | Path, *, parts: int | None = Non
         for joint in range(5):
             if 17 + joint in wanted:
                 done(motion.fig_joint_rate(table, tl, scenario, joint, path[17 + joint]))
+        if wanted & set(range(22, 31)):
+            sims = runs.simulate_runs(scenario)
+            if 22 in wanted:
+                done(runs.fig22_tip_velocity(sims, table, scenario, path[22]))
+            if 23 in wanted:
+                done(runs.fig23_lumped(sims, scenario, path[23]))
+            if 24 in wanted:
+                done(runs.fig24_running(sims, scenario, path[24]))
+            for number, cycle in zip(range(25, 31), runs.TABLE_7_1_CYCLES, strict=True):
+                if number in wanted:
+                    done(runs.fig_ip(sims, cycle, number, path[number]))
     return written
 
 

@@ -18,9 +18,11 @@ def distribution(s: Scenario) -> scipy.stats.rv_continuous:
 
 
 def draws(s: Scenario, n: int) -> NDArray[np.float64]:
-    """n inter-arrival times by inverse cdf of u ~ U(0, 1), as the thesis draws them (eq. 6.9)."""
-    u = np.random.default_rng(s.run.seed).random(n)
-    return distribution(s).ppf(u)
+    """The first n inter-arrival times the simulation feeds (inverse cdf, eq. 6.9;
+    the feeder's own stream of ``run.seed``)."""
+    from cell.feeder import interarrival_times
+
+    return interarrival_times(s.arrivals, n, s.run.seed, s.base_dir)
 
 
 def _params_note(s: Scenario, x: NDArray[np.float64]) -> str:
@@ -41,7 +43,7 @@ def fig13_pdf(s: Scenario, x: NDArray[np.float64], out: Path) -> Path:
     d = distribution(s)
     t = _grid(s, x)
     ax.hist(x, bins=30, density=True, color="#9ecae1", edgecolor="white",
-            label=f"{x.size} drawn inter-arrival times")
+            label=f"the {x.size} inter-arrival times of the run (seed {s.run.seed})")
     ax.plot(t, d.pdf(t), color="black", label="pdf (eq. 6.8)")
     ax.axvline(d.mean(), color="#d62728", ls="--", lw=1.2, label=f"mean {d.mean():.4f} s")
     ax.axvline(s.arrivals.params.get("loc", np.nan), color="0.4", ls=":", lw=1.2,
@@ -59,7 +61,7 @@ def fig14_cdf(s: Scenario, x: NDArray[np.float64], out: Path) -> Path:
     t = _grid(s, x)
     xs = np.sort(x)
     ax.step(xs, np.arange(1, xs.size + 1) / xs.size, where="post", color="#6baed6", lw=2.2,
-            label=f"empirical cdf of {x.size} draws")
+            label=f"empirical cdf of the run's {x.size} draws")
     ax.plot(t, d.cdf(t), color="black", lw=1.3, label="cdf F(T)")
     u = 0.5
     tu = float(d.ppf(u))

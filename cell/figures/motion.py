@@ -2,11 +2,12 @@
 
 The path is timed at its nominal regime velocities (SPEC §6): R I and R III
 locked to their belts (each move takes its advance along the belt over the belt
-speed), R II at the tip velocity that makes it last the nominal
-22.5872 - 8/3 - 4 - 9.9855 = 5.935 s, and R IV at the base's nominal rate.
-No move is ever shorter than its motors allow (§6.1): after LO the loaded
-shoulder cannot quite keep up with the 3 in/s belt (§4.3 c), so R I takes a
-little longer than 8/3 s.
+speed), R IV at the base's nominal rate and R II the rest of the 22.5872 s
+ideal cycle.  No move is ever shorter than its motors allow (§6.1): after LO
+the loaded shoulder cannot quite keep up with the 3 in/s belt (§4.3 c), so R I
+takes 2.729 s rather than 8/3 s and R II 5.868 s rather than the thesis's
+5.935 s, as in the simulation.  The same spreading of segment times over moves
+draws one simulated transfer in Fig. 22.
 """
 
 from __future__ import annotations
@@ -17,53 +18,80 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from cell.figures.style import LIMIT_COLOUR, mark_events, new_figure, save, shade_regimes
+from cell.figures.style import LIMIT_COLOUR, REGIME_LABELS, mark_events, new_figure, save, shade_regimes
 from cell.kinematics import JOINT_NAMES
 from cell.motors import max_rates, move_times, velocity_for_time
 from cell.scenario import Scenario
 from cell.steptable import StepTable
 
-#: Nominal R IV time of the thesis (§5.3 step 3.2); R II gets what is left of the cycle.
-R4_NOMINAL_S = 9.9855
+#: The six pieces of a transfer whose times a cycle plan fixes (simulation's Plan).
+SEGMENTS = ("r1_pre", "r1_post", "r2", "r3_pre", "r3_post", "r4")
 
 
 @dataclass(frozen=True)
 class Timeline:
-    """A transfer timed at nominal velocities."""
+    """A transfer timed move by move."""
 
     t_s: NDArray[np.float64]
     """(N,) time at each path point, 0 at B."""
     dt_s: NDArray[np.float64]
     """(N,) duration of the move arriving at each point (row 0: 0)."""
-    r2_velocity_in_s: float
-    regime_s: dict[int, float]
-    """Duration of each regime, 1..4."""
+    segment_s: dict[str, float]
+    """Duration of each of :data:`SEGMENTS`."""
+
+    @property
+    def regime_s(self) -> dict[int, float]:
+        g = self.segment_s
+        return {1: g["r1_pre"] + g["r1_post"], 2: g["r2"], 3: g["r3_pre"] + g["r3_post"],
+                4: g["r4"]}
+
+
+def segment_rows(table: StepTable) -> dict[str, NDArray[np.bool_]]:
+    """Moves of each segment: R I and R III split at LO and TD (the move onto LO/TD before)."""
+    idx = np.arange(table.path.n_points)
+    lo, td = table.path.lo, table.path.td
+    r1, r3 = table.regime_rows(1), table.regime_rows(3)
+    return {"r1_pre": r1 & (idx <= lo), "r1_post": r1 & (idx > lo), "r2": table.regime_rows(2),
+            "r3_pre": r3 & (idx <= td), "r3_post": r3 & (idx > td), "r4": table.regime_rows(4)}
+
+
+def move_lengths(table: StepTable) -> NDArray[np.float64]:
+    """What a move's velocity is measured on (§6.1): belt travel while tracking
+    (the path divides the belt equally, §4.2), path length in R II and R IV."""
+    p = table.path
+    along = np.concatenate([[0.0], np.linalg.norm(np.diff(p.xyz_in[:, :2], axis=0), axis=1)])
+    tracking = table.regime_rows(1) | table.regime_rows(3)
+    return np.where(tracking, along, table.move_in)
+
+
+def timeline(table: StepTable, segment_s: dict[str, float]) -> Timeline:
+    """Spread each segment's time over its moves: one velocity per segment, every
+    move max(ℓ/v, t_min) at the motors' peak rates (§6.1)."""
+    ell = move_lengths(table)
+    floor = table.peak_min_times
+    dt = np.zeros(table.path.n_points)
+    for name, rows in segment_rows(table).items():
+        total = max(float(segment_s[name]), float(floor[rows].sum()))
+        v = velocity_for_time(ell[rows], floor[rows], total)
+        dt[rows] = move_times(ell[rows], floor[rows], v)
+    return Timeline(np.cumsum(dt), dt, {k: float(segment_s[k]) for k in SEGMENTS})
 
 
 def nominal_timeline(table: StepTable, s: Scenario) -> Timeline:
-    """Time every move of one transfer at the nominal regime velocities (§6.1, SPEC §6).
-
-    Tracking moves take (advance along the belt) / (belt speed) but never less
-    than the motors' peak-rate floor; R II runs at the tip velocity that gives
-    the leftover nominal time; R IV at the nominal (75 %) motor rates.
-    """
-    p = table.path
-    along = np.concatenate([[0.0], np.linalg.norm(np.diff(p.xyz_in[:, :2], axis=0), axis=1)])
-    dt = np.zeros(p.n_points)
-    for reg, belt in ((1, s.belts.input_nominal_in_s), (3, s.belts.output_nominal_in_s)):
-        m = table.regime_rows(reg)
-        dt[m] = move_times(along[m], table.peak_min_times[m], belt)
-    m4 = table.regime_rows(4)
-    dt[m4] = table.nominal_min_times[m4]
-    window_in = np.linalg.norm(np.subtract(s.path.f_in, s.path.bot_in))
-    window_out = np.linalg.norm(np.subtract(s.path.eot_in, s.path.g_in))
-    r2_time = (s.controller.nominal_cycle_s - window_in / s.belts.input_nominal_in_s
-               - window_out / s.belts.output_nominal_in_s - R4_NOMINAL_S)
-    m2 = table.regime_rows(2)
-    v2 = velocity_for_time(table.move_in[m2], table.nominal_min_times[m2], r2_time)
-    dt[m2] = move_times(table.move_in[m2], table.nominal_min_times[m2], v2)
-    regime_s = {r: float(dt[table.regime_rows(r)].sum()) for r in (1, 2, 3, 4)}
-    return Timeline(np.cumsum(dt), dt, v2, regime_s)
+    """One transfer at the nominal velocities (SPEC §6): R I and R III locked to
+    their belts at nominal speed, R IV at the nominal (75 %) motor rates, and R II
+    the rest of the ideal cycle (the thesis's 22.5872 - 8/3 - 4 - 9.9855 = 5.935 s
+    if R I took exactly 8/3 s)."""
+    ell, floor, rows = move_lengths(table), table.peak_min_times, segment_rows(table)
+    seg: dict[str, float] = {}
+    for name, belt in (("r1_pre", s.belts.input_nominal_in_s),
+                       ("r1_post", s.belts.input_nominal_in_s),
+                       ("r3_pre", s.belts.output_nominal_in_s),
+                       ("r3_post", s.belts.output_nominal_in_s)):
+        seg[name] = float(move_times(ell[rows[name]], floor[rows[name]], belt).sum())
+    seg["r4"] = float(table.nominal_min_times[rows["r4"]].sum())
+    seg["r2"] = s.controller.nominal_cycle_s - sum(seg.values())
+    return timeline(table, seg)
 
 
 def _events(table: StepTable, tl: Timeline) -> dict[str, float]:
@@ -71,7 +99,7 @@ def _events(table: StepTable, tl: Timeline) -> dict[str, float]:
 
 
 def _regime_note(tl: Timeline) -> str:
-    parts = ", ".join(f"R{'I' * r if r < 4 else 'IV'} {tl.regime_s[r]:.3f} s" for r in (1, 2, 3, 4))
+    parts = ", ".join(f"{REGIME_LABELS[r]} {tl.regime_s[r]:.3f} s" for r in (1, 2, 3, 4))
     return f"one transfer at nominal velocities: {parts}; cycle {tl.t_s[-1]:.3f} s"
 
 
