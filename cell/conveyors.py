@@ -55,15 +55,21 @@ class Belt:
         k = bisect.bisect_right(ts, t1 + EPS_S)
         if k < len(ts):
             del ts[k:], xs[k:], vs[k:]
-        for t, v in ((t1, v1),) if t2 is None else ((t1, v1), (t2, v2)):
-            if not v > 0:
-                raise ValueError(f"belt speed must be positive, got {v!r}")
-            if t <= ts[-1]:
-                vs[-1] = v
+        if not v1 > 0 or (t2 is not None and not v2 > 0):
+            raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}")
+        if t1 <= ts[-1]:
+            vs[-1] = v1
+        else:
+            xs.append(xs[-1] + vs[-1] * (t1 - ts[-1]))
+            ts.append(t1)
+            vs.append(v1)
+        if t2 is not None:
+            if t2 <= ts[-1]:
+                vs[-1] = v2
             else:
-                xs.append(xs[-1] + vs[-1] * (t - ts[-1]))
-                ts.append(t)
-                vs.append(v)
+                xs.append(xs[-1] + vs[-1] * (t2 - ts[-1]))
+                ts.append(t2)
+                vs.append(v2)
 
     def history(self) -> list[tuple[float, float]]:
         """(instant, speed) of every speed change, for plots and checks."""

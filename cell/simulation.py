@@ -43,7 +43,8 @@ SUMMARY_COLUMNS = [
     "parts_missed", "parts_in_cell", "parts_missed_thesis", "actual_cycle_wallclock_s",
     "actual_cycle_thesis_s", "parts_per_hr_wallclock", "parts_per_hr_thesis",
     "vavg_r4_in_s", "ip_wallclock", "ip_thesis", "cycle_vs_nominal_pct",
-    "spacing_min_in", "spacing_max_in", "spacing_outside_tol", "input_speed_max_in_s",
+    "spacing_min_in", "spacing_max_in", "spacing_outside_tol", "parts_noted",
+    "input_speed_max_in_s",
     "output_speed_min_in_s", "output_speed_max_in_s", "r1_nominal_s", "r2_nominal_s",
     "r4_s", "thesis_slack_s", "sim_end_s"]
 
@@ -184,6 +185,7 @@ def _tables(s: Scenario, seed: Any, ideal: float, adaptive: bool, k: Any, fixed:
         "spacing_min_in": float(sp.min()) if sp.size else math.nan,
         "spacing_max_in": float(sp.max()) if sp.size else math.nan,
         "spacing_outside_tol": int(np.sum(np.abs(sp - k.spacing) > k.tol + 1e-9)),
+        "parts_noted": int(sum(1 for note in log.note if note)),
         "input_speed_max_in_s": float(max(v for _, v in feeder.conveyor.belt.history())),
         "output_speed_min_in_s": float(vout.min()) if vout.size else math.nan,
         "output_speed_max_in_s": float(vout.max()) if vout.size else math.nan,
@@ -231,6 +233,7 @@ def format_summary(summary: dict[str, Any]) -> str:
         f"{summary['spacing_min_in']:.3f} / {summary['spacing_max_in']:.3f}", "{}",
         "45.00 ± 0.25")
     add("spacings outside tolerance", summary["spacing_outside_tol"], "{:d}")
+    add("parts with a note (limits hit, lost)", summary["parts_noted"], "{:d}")
     width = max(len(label) for label, _ in rows)
     return "\n".join(f"{label:<{width}}  {text}" for label, text in rows)
 

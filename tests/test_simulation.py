@@ -169,3 +169,32 @@ def test_hostile_override_on_the_command_line(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "belts.input_max_in_s" in err and len(err.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_minimum_time_robot_takes_its_fastest_r4_from_the_planner():
+    pytest.importorskip("cell.mintime")
+    from cell.mintime import fastest_regime_times
+
+    s = default_scenario().with_overrides({"robot.timing": "minimum-time", "run.parts": 60})
+    fastest = fastest_regime_times(s)
+    r = simulate(s)
+    t_r4 = r.parts["v_r4_in_s"].rdiv(35.5424)          # R IV times (SPEC §3 length)
+    assert (t_r4 >= fastest["R4"] - 1e-3).all()
+    fixed = s.with_overrides({"controller.policy": "non-adaptive",
+                              "controller.ideal_cycle_s": 22.5872 - (9.9855 - fastest["R4"])
+                              - 0.01})
+    from cell.errors import ScenarioError
+    with pytest.raises(ScenarioError, match="controller.ideal_cycle_s"):
+        simulate(fixed)
+
+
+def test_minimum_time_without_the_planner_is_a_clear_error(monkeypatch):
+    import sys
+
+    from cell.errors import CellError
+    from cell.robot import build_timing
+
+    monkeypatch.setitem(sys.modules, "cell.mintime", None)
+    s = default_scenario().with_overrides({"robot.timing": "minimum-time"})
+    with pytest.raises(CellError, match="minimum-time"):
+        build_timing(s)
