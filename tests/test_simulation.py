@@ -7,6 +7,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from cell.cli import main
 from cell.scenario import default_scenario, load_scenario
@@ -198,3 +200,24 @@ def test_minimum_time_without_the_planner_is_a_clear_error(monkeypatch):
     s = default_scenario().with_overrides({"robot.timing": "minimum-time"})
     with pytest.raises(CellError, match="minimum-time"):
         build_timing(s)
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), policy=st.sampled_from(["adaptive", "non-adaptive"]),
+       ideal=st.floats(20.1, 24.0), input_max=st.floats(3.0, 12.0))
+def test_invariants_hold_for_any_seed(seed, policy, ideal, input_max):
+    s = default_scenario().with_overrides({
+        "run.parts": 40, "controller.policy": policy, "belts.input_max_in_s": input_max,
+        "controller.ideal_cycle_s": ideal if policy == "non-adaptive" else None})
+    r = simulate(s, seed=seed)
+    p, sm = r.parts, r.summary
+    assert 0 <= sm["parts_arrived"] - sm["parts_delivered"] - sm["parts_missed"] <= 1
+    done = p[p.picked]
+    assert (done["pick_s"] >= done["at_bot_s"]).all()
+    assert (done["touchdown_s"] > done["pick_s"]).all()
+    assert (p["missed"] == ~p["picked"]).all()
+    if policy == "adaptive":
+        clean = p["note"].fillna("").str.contains("output belt") == False  # noqa: E712
+        sp = p.loc[clean, "spacing_in"].dropna()
+        assert ((sp - 45.0).abs() <= 0.25 + 1e-9).all()
+        assert max(v for _, v in r.belts["input"]) <= input_max + 1e-12
