@@ -72,10 +72,8 @@ class CellConstants:
     r4_nom: float
     r2_nom: float
     """R II's share of the ideal cycle: what the other regimes leave of it (SPEC §6)."""
-
-    @property
-    def r1_nom(self) -> float:
-        return self.r1_pre_nom + self.r1_post_nom
+    r1_nom: float
+    """R I at the nominal input belt: 8/3 s at belt pace plus the motor floor after LO."""
 
 
 def constants(s: Scenario, timing: RobotTiming) -> CellConstants:
@@ -112,7 +110,7 @@ def constants(s: Scenario, timing: RobotTiming) -> CellConstants:
         cycle_nom=c.nominal_cycle_s, input_max=min(b.input_max_in_s, 1e9),
         output_max=b.output_max_in_s, spacing=b.spacing_in, tol=b.spacing_tol_in,
         input_length=length, r1_pre_nom=r1a, r1_post_nom=r1b, r3_pre_nom=r3a,
-        r3_post_nom=r3b, r4_nom=r4, r2_nom=r2)
+        r3_post_nom=r3b, r4_nom=r4, r2_nom=r2, r1_nom=r1a + r1b)
 
 
 class Plan(NamedTuple):

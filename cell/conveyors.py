@@ -120,18 +120,18 @@ class InputConveyor:
             self.process.interrupt()
 
     def run(self):  # noqa: ANN201 (SimPy generator)
-        env, loaded = self.env, self.loaded
+        env, get, timeout = self.env, self.loaded.get, self.env.timeout
+        time_at, x_fed, length = self.belt.time_at, self.x_fed, self.length_in
         while True:
-            part = yield loaded.get()
+            part = yield get()
+            self._timing = True
             while True:
-                self._timing = True
                 try:
-                    yield env.timeout(max(self.time_at_bot(part) - env.now, 0.0))
+                    yield timeout(max(time_at(x_fed[part] + length) - env.now, 0.0))
                     break
-                except simpy.Interrupt:
-                    continue
-                finally:
-                    self._timing = False
+                except simpy.Interrupt:  # the plan changed: re-time the part
+                    pass
+            self._timing = False
             # The controller takes the part (and may replan the belt) before this
             # process's next get() is served: same-instant events run in order.
             self.at_bot.put(part)

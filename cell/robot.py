@@ -235,13 +235,14 @@ class Robot:
     def run(self):  # noqa: ANN201 (SimPy generator)
         env, log, timeout = self.env, self.log, self.env.timeout
         pick_s, touchdown_s, put = log.pick_s, log.touchdown_s, self.output.put
+        get = self.orders.get
         while True:
-            order: Order = yield self.orders.get()
-            part = order.part
-            self.lo = lo = timeout(order.to_lo_s)
-            yield lo
-            pick_s[part] = env.now
-            self.td = td = timeout(order.lo_to_td_s)
+            order: Order = yield get()
+            part, to_lo, to_td = order.part, order.to_lo_s, order.to_lo_s + order.lo_to_td_s
+            # LO is an event others may wait on; the robot itself moves on to TD.
+            self.lo = timeout(to_lo)
+            pick_s[part] = env.now + to_lo
+            self.td = td = timeout(to_td)
             yield td
             touchdown_s[part] = env.now
             put(part)
