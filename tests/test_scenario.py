@@ -17,16 +17,19 @@ from cell.scenario import (
 )
 
 
-#: Keys naming files: resolved beside the scenario, so they cannot be built-in defaults.
-FILE_KEYS = {("mintime", "dynamics_file")}
+#: The planner's model switch.  A file is resolved beside its scenario, so the built-in
+#: defaults cannot name one: they plan with velocity and acceleration bounds, while
+#: baseline.yaml names the dynamic model and lets it set the accelerations alone.
+MODEL_SWITCH = {("mintime", "dynamics_file"): ("microbot_dynamics.yaml", None),
+                ("mintime", "acceleration_bounds"): (False, True)}
 
 
 def test_baseline_yaml_is_the_thesis_defaults():
     """scenarios/baseline.yaml spells out every default: file and code cannot drift apart."""
     base = to_dict(load_scenario("scenarios/baseline.yaml"))
     defaults = to_dict(default_scenario())
-    for section, key in FILE_KEYS:
-        assert base[section].pop(key) and defaults[section].pop(key) is None
+    for (section, key), (in_file, default) in MODEL_SWITCH.items():
+        assert (base[section].pop(key), defaults[section].pop(key)) == (in_file, default)
     for name in ("name", "description"):
         base.pop(name), defaults.pop(name)
     for section in base:
