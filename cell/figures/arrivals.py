@@ -42,7 +42,7 @@ def fig13_pdf(s: Scenario, x: NDArray[np.float64], out: Path) -> Path:
     fig, ax = new_figure(13, "Weibull pdf of the Inter-arrival Times")
     d = distribution(s)
     t = _grid(s, x)
-    ax.hist(x, bins=30, density=True, color="#9ecae1", edgecolor="white",
+    heights, _, _ = ax.hist(x, bins=30, density=True, color="#9ecae1", edgecolor="white",
             label=f"the {x.size} inter-arrival times of the run (seed {s.run.seed})")
     ax.plot(t, d.pdf(t), color="black", label="pdf (eq. 6.8)")
     ax.axvline(d.mean(), color="#d62728", ls="--", lw=1.2, label=f"mean {d.mean():.4f} s")
@@ -50,6 +50,7 @@ def fig13_pdf(s: Scenario, x: NDArray[np.float64], out: Path) -> Path:
                label=f"location {s.arrivals.params.get('loc', np.nan):g} s")
     ax.set_xlabel("inter-arrival time T (s)")
     ax.set_ylabel("probability density (1/s)")
+    ax.set_ylim(0, 1.45 * max(float(heights.max()), float(d.pdf(t).max())))
     ax.legend(loc="upper left")
     ax.set_title(_params_note(s, x), loc="left", fontsize=8.5)
     return save(fig, out)
