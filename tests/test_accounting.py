@@ -94,3 +94,14 @@ def test_thesis_adaptive_is_next_arrival_over_motion_time():
     assert np.isnan(r.ip[1])
     assert r.actual_cycle_s == pytest.approx(21.75)
     assert r.mean_ip == pytest.approx((23.0 / 22.5 + 1.0) / 2)
+
+
+def test_counting_arrivals_from_each_pickup_gives_the_thesis_adaptive_figures():
+    from cell.accounting import thesis_adaptive_memoryless
+
+    t = WEIBULL.ppf(np.random.default_rng(5).random(400_000))
+    shortest = 22.5872 - (9.9855 - 7.4890)            # Table 7.1's minimum cycle, 20.0907
+    r = thesis_adaptive_memoryless(t, 22.5872, shortest)
+    assert r.mean_ip == pytest.approx(1.0214, abs=3e-3)                      # §7.2
+    assert 100 * (22.5872 - r.actual_cycle_s) / 22.5872 == pytest.approx(2.1, abs=0.15)
+    assert thesis_adaptive_memoryless([22.5872], 22.5872, shortest).mean_ip == 1.0
