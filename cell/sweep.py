@@ -24,7 +24,10 @@ worker processes, or on a dask.distributed cluster through its
 concurrent.futures executor; each finished task is written at once, atomically,
 to ``OUT/tasks/``, so ``--resume`` runs only the tasks that are missing.
 ``OUT/replications.csv`` is always assembled from those files in a fixed order,
-so it is byte-identical however the sweep was run.
+so it is byte-identical however the sweep was run.  Its columns: ``policy``,
+``point`` (index of the grid point within its policy), one column per varied key
+(empty where a policy does not vary it), ``replication``, then the run's summary
+(``cell.simulation``'s summary.csv columns).  ``--workers 1`` runs in this process.
 """
 
 from __future__ import annotations
