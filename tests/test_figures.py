@@ -99,3 +99,10 @@ def test_bad_scenario_is_one_line_and_writes_nothing(tmp_path: Path, capsys) -> 
     err = capsys.readouterr().err.strip()
     assert "input_nominal_in_s" in err and len(err.splitlines()) == 1
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_out_that_is_a_file_is_one_line(tmp_path: Path, capsys) -> None:
+    blocker = tmp_path / "figs"
+    blocker.write_text("not a folder")
+    assert main(["figures", "--out", str(blocker / "sub")]) == 2
+    assert capsys.readouterr().err.count("\n") == 1

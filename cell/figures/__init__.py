@@ -12,6 +12,7 @@ import argparse
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
+from cell.errors import CellError
 from cell.figures import arrivals, layout, motion, runs
 from cell.figures.style import style
 from cell.scenario import Scenario, load_scenario
@@ -102,5 +103,8 @@ def make_figures(scenario: Scenario, out: str | Path, *, parts: int | None = Non
 def cmd_figures(args: argparse.Namespace) -> int:
     """``cell figures [--out DIR] [--scenario FILE]``."""
     scenario = load_scenario(args.scenario)
-    make_figures(scenario, args.out, progress=lambda p: print(f"wrote {p}"))
+    try:
+        make_figures(scenario, args.out, progress=lambda p: print(f"wrote {p}"))
+    except OSError as exc:
+        raise CellError(f"cannot write figures into {args.out}: {exc.strerror or exc}") from None
     return 0
