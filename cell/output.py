@@ -11,6 +11,15 @@ from pathlib import Path
 
 import pandas as pd
 
+def _file_mode() -> int:
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
+#: The mode an ordinary new file gets (0644 under the usual umask).
+_FILE_MODE = _file_mode()
+
 #: Digits kept in CSV floats: enough to round-trip, identical on every run.
 FLOAT_FORMAT = "%.10g"
 
@@ -25,6 +34,7 @@ def atomic_path(target: str | Path) -> Iterator[Path]:
     tmp_path = Path(tmp)
     try:
         yield tmp_path
+        tmp_path.chmod(_FILE_MODE)  # mkstemp makes 0600; outputs are for everyone to read
         os.replace(tmp_path, target)
     finally:
         tmp_path.unlink(missing_ok=True)

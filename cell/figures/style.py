@@ -72,7 +72,6 @@ def save(fig: Figure, path: str | Path) -> Path:
     path = Path(path)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", dpi=DPI)
-        tmp.chmod(0o644)  # mkstemp makes 0600; a report is for everyone to read
     return path
 
 
