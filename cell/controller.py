@@ -138,7 +138,7 @@ class Plan(NamedTuple):
 
 
 def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
-                  gap_in: float | None) -> Plan:
+                  gap_in: float | None, lag: float | None = None) -> Plan:
     """Thesis §5.3 steps 2.0-6.3 for one part (pure).
 
     ``v``: input belt speed now (R I tracks it).  ``nxt = (a, b)``: the next part
@@ -146,11 +146,13 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
     (a = the lag B → LO and b = its pseudo-distance then, or, for a part not yet
     on the belt, a = time until the feeder drops it and b = the belt's length);
     None if no part is coming.  ``gap_in``: how far the last part set down has
-    travelled on the output belt (None before the first).
+    travelled on the output belt (None before the first).  ``lag``: B → LO at v,
+    if the caller has it already.
     """
     t = k.timing
     notes = []
-    r1a, r1b = t.r1_pre.time(v), t.r1_post.time(v)
+    r1a = t.r1_pre.time(v) if lag is None else lag
+    r1b = t.r1_post.time(v)
     # 2.1-2.3: R I's difference from nominal goes to R II.
     r2 = k.r2_nom + (k.r1_nom - r1a - r1b)
     if r2 < t.r2_min_s:
@@ -269,28 +271,30 @@ class Controller:
 
     def run(self):  # noqa: ANN201 (SimPy generator)
         env, log, k, robot = self.env, self.log, self.k, self.robot
-        conveyor, output = self.conveyor, self.output
-        r1_pre_time = k.timing.r1_pre.time
+        conveyor, output, adaptive, u_nom = self.conveyor, self.output, self.adaptive, k.u_nom
+        r1_pre_time, speed, next_part = k.timing.r1_pre.time, conveyor.belt.speed, self.next_part
+        replan_in, replan_out, put = conveyor.replan, output.replan, robot.orders.put
+        get, at_bot_s, plans, thesis_s = conveyor.at_bot.get, log.at_bot_s, log.plan, \
+            log.thesis_interval_s
         while True:
-            i = yield conveyor.at_bot.get()
+            i = yield get()
             now = env.now
-            log.at_bot_s[i] = now
+            at_bot_s[i] = now
             if robot.free_at_s > now + EPS_S:
                 log.note[i] = "reached B while the robot was busy: fell off at F"
                 continue
-            if self.adaptive:
-                v = conveyor.belt.speed(now + EPS_S)
+            if adaptive:
+                v = speed(now + EPS_S)
                 lag = r1_pre_time(v)
-                plan = adaptive_plan(k, v, self.next_part(i, now, lag, v), output.gap_now())
-                conveyor.replan(now + lag, plan.input_after_lo, now + plan.cycle,
-                                plan.input_next)
-                output.replan(now, plan.output_to_g, now + plan.to_g, k.u_nom)
+                plan = adaptive_plan(k, v, next_part(i, now, lag, v), output.gap_now(), lag)
+                replan_in(now + lag, plan.input_after_lo, now + plan.cycle, plan.input_next)
+                replan_out(now, plan.output_to_g, now + plan.to_g, u_nom)
                 log.note[i] = plan.note
             else:
                 plan = self.fixed
-            log.plan[i] = plan
-            log.thesis_interval_s[i] = plan.to_g + plan.r3_pre + self.residual_s
+            plans[i] = plan
+            thesis_s[i] = plan.to_g + plan.r3_pre + self.residual_s
             self.residual_s = plan.r3_post + plan.r4
             robot.free_at_s = now + plan.cycle
-            robot.orders.put(Order(i, plan.r1_pre, plan.to_g - plan.r1_pre + plan.r3_pre,
-                                   plan.r3_post + plan.r4))
+            put(Order(i, plan.r1_pre, plan.to_g - plan.r1_pre + plan.r3_pre,
+                      plan.r3_post + plan.r4))

@@ -71,6 +71,10 @@ class Belt:
                 ts.append(t2)
                 vs.append(v2)
 
+    def max_speed(self) -> float:
+        """The fastest the belt has been (or is planned to be)."""
+        return float(max(self._v))
+
     def history(self) -> list[tuple[float, float]]:
         """(instant, speed) of every speed change, for plots and checks."""
         return list(zip(self._t, self._v))

@@ -140,11 +140,11 @@ def _tables(s: Scenario, seed: Any, ideal: float, adaptive: bool, k: Any, fixed:
         "part": np.arange(1, n + 1),
         "arrival_s": np.array(feeder.fed_s[:n]),
         "interarrival_s": t[:n],
-        "at_bot_s": log.at_bot_s,
+        "at_bot_s": np.array(log.at_bot_s),
         "picked": picked,
         "missed": ~picked,
         "missed_thesis": missed_thesis,
-        "pick_s": log.pick_s,
+        "pick_s": np.array(log.pick_s),
         "touchdown_s": td,
         "delivery_interval_s": wall.interval_s,
         "motion_cycle_s": col["cycle"],
@@ -158,7 +158,7 @@ def _tables(s: Scenario, seed: Any, ideal: float, adaptive: bool, k: Any, fixed:
         "v_r2_in_s": tm.r2.length_in / col["r2"],
         "v_r3_in_s": tm.r3_length_in / r3,
         "v_r4_in_s": tm.r4.length_in / col["r4"],
-        "note": log.note,
+        "note": np.array(log.note, dtype=object),
     }, columns=PART_COLUMNS)
 
     delivered = int(np.isfinite(td).sum())
@@ -202,7 +202,7 @@ def _tables(s: Scenario, seed: Any, ideal: float, adaptive: bool, k: Any, fixed:
         "spacing_max_in": float(sp.max()) if sp.size else math.nan,
         "spacing_outside_tol": int(np.sum(np.abs(sp - k.spacing) > k.tol + 1e-9)),
         "parts_noted": int(sum(1 for note in log.note if note)),
-        "input_speed_max_in_s": float(max(v for _, v in feeder.conveyor.belt.history())),
+        "input_speed_max_in_s": feeder.conveyor.belt.max_speed(),
         "output_speed_min_in_s": float(vout.min()) if vout.size else math.nan,
         "output_speed_max_in_s": float(vout.max()) if vout.size else math.nan,
         "r1_nominal_s": k.r1_nom,
