@@ -82,6 +82,8 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Write reports/figures/figNN_<slug>.png for Fig. 8-30.")
     p.add_argument("--out", default="reports/figures", help="directory for the PNGs")
     p.add_argument("--scenario", default="scenarios/baseline.yaml", help="scenario to draw")
+    p.add_argument("--set", dest="sets", action="append", metavar="KEY=VALUE",
+                   help="override a scenario value (repeatable)")
 
     p = sub.add_parser("mintime", help="minimum-time motion along the path (Shin & McKay)",
                        description="Phase-plane minimum-time parameterisation of R II and "

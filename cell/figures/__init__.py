@@ -102,7 +102,9 @@ def make_figures(scenario: Scenario, out: str | Path, *, parts: int | None = Non
 
 def cmd_figures(args: argparse.Namespace) -> int:
     """``cell figures [--out DIR] [--scenario FILE]``."""
-    scenario = load_scenario(args.scenario)
+    from cell.cli import parse_sets
+
+    scenario = load_scenario(args.scenario, parse_sets(getattr(args, "sets", None)))
     try:
         make_figures(scenario, args.out, progress=lambda p: print(f"wrote {p}"))
     except OSError as exc:
