@@ -322,3 +322,10 @@ def test_real_simulation_both_policies_see_the_same_parts(tmp_path):
     # ... and replication r carries the same stream label at every point (CRN)
     seeds = frame.pivot(index="replication", columns=["policy", "point"], values="seed")
     assert (seeds.nunique(axis=1) == 1).all()
+
+
+def test_zero_workers_is_one_clear_error_and_no_output(tmp_path, capsys):
+    code = main(["sweep", str(write_sweep(tmp_path)), "--out", str(tmp_path / "o"),
+                 "--workers", "0"])
+    assert code == 2 and "--workers 0" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
