@@ -25,6 +25,7 @@ sweep: $(STAMP)
 
 figures: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m cell figures --out reports/figures
+	$(PY) -m cell.mintime.report
 
 bench: $(STAMP)
 	$(PY) -m cell bench --out reports/bench.json

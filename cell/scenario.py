@@ -135,8 +135,8 @@ class Motors:
 
     steps_per_rad: Five = _num((1125.0, 1125.0, 672.0, 241.0, 241.0), lo=0.0, lo_open=True)
     """TeachMover half-steps per radian: base, shoulder, elbow, pitch, roll."""
-    max_rate_no_load_rad_s: Five = _num((0.419488, 0.36, 0.82, 2.02, 2.02), lo=0.0, lo_open=True)
-    """TeachMover no-load speeds, except the base: CALIBRATED to 0.419488 rad/s
+    max_rate_no_load_rad_s: Five = _num((0.4194527, 0.36, 0.82, 2.02, 2.02), lo=0.0, lo_open=True)
+    """TeachMover no-load speeds, except the base: CALIBRATED to 0.4194527 rad/s
     (TeachMover 0.42) so that R IV at the nominal 75 % takes the thesis's 9.9855 s."""
     max_rate_full_load_rad_s: Five = _num((0.37, 0.15, 0.23, 1.31, 1.31), lo=0.0, lo_open=True)
     """TeachMover speeds carrying the full load (1 lb)."""

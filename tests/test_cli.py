@@ -50,7 +50,7 @@ def test_cell_path_writes_the_thesis_table(tmp_path):
     assert r4.move_in.sum() == pytest.approx(35.54, abs=0.01)
     assert abs(r4.steps1.sum()) == pytest.approx(1125 * np.pi, rel=0.01)
     # base-limited R IV: steps over the base's rate at no load (thesis §6.1 linear model)
-    base_max = 0.419488 * 1125  # steps/s, robot.motors in scenarios/baseline.yaml
+    base_max = 0.4194527 * 1125  # steps/s, robot.motors in scenarios/baseline.yaml
     assert (r4.steps1.abs() / (0.75 * base_max)).sum() == pytest.approx(9.9855, rel=0.005)
     assert (r4.steps1.abs() / base_max).sum() == pytest.approx(7.489, rel=0.005)
     assert set(df.event) == {"", "LO", "TD"}
