@@ -170,3 +170,21 @@ def test_write_table_7_1_writes_both_files(tmp_path):
     back = pd.read_csv(paths[0])
     assert list(back.columns) == COLUMNS
     assert back.loc[back["accounting"] == "wallclock", "thesis"].isna().all()
+
+
+def test_memoryless_reading_follows_the_numbers():
+    """The adaptive reading says whether the memoryless IP holds the published 1.0214."""
+    import numpy as np
+    import pandas as pd
+
+    from cell.report import _memoryless
+
+    rng = np.random.default_rng(0)
+    near = pd.DataFrame({"policy": "adaptive", "ip_thesis_memoryless": 1.0214 + rng.normal(0, 1e-3, 200),
+                         "cycle_vs_nominal_memoryless_pct": -2.0})
+    far = near.assign(ip_thesis_memoryless=1.0 + rng.normal(0, 1e-3, 200))
+    assert "1.0214 is inside" in _memoryless(near, 1.0214)[0]
+    assert "reproduces the published IP" in _memoryless(near, 1.0214)[0]
+    assert "is outside" in _memoryless(far, 1.0214)[0]
+    assert "does not reproduce" in _memoryless(far, 1.0214)[0]
+    assert _memoryless(near.drop(columns="ip_thesis_memoryless"), 1.0214) == []
