@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pandas as pd
 
+
 def _file_mode() -> int:
     umask = os.umask(0)
     os.umask(umask)

@@ -1,6 +1,5 @@
 """Scenario files: defaults, overrides, and one clear line for every bad input."""
 
-import dataclasses
 
 import numpy as np
 import pytest
@@ -15,7 +14,6 @@ from cell.scenario import (
     load_scenario,
     to_dict,
 )
-
 
 #: The planner's model switch.  A file is resolved beside its scenario, so the built-in
 #: defaults cannot name one: they plan with velocity and acceleration bounds, while
