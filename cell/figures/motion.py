@@ -5,7 +5,7 @@ locked to their belts (each move takes its advance along the belt over the belt
 speed), R IV at the base's nominal rate and R II the rest of the 22.5872 s
 ideal cycle.  No move is ever shorter than its motors allow (§6.1): after LO
 the loaded shoulder cannot quite keep up with the 3 in/s belt (§4.3 c), so R I
-takes 2.729 s rather than 8/3 s and R II 5.868 s rather than the thesis's
+takes 2.729 s rather than 8/3 s and R II 5.867 s rather than the thesis's
 5.935 s, as in the simulation.  The same spreading of segment times over moves
 draws one simulated transfer in Fig. 22.
 """
