@@ -25,6 +25,7 @@ import numpy as np
 import pandas as pd
 import scipy.stats
 
+from cell import thesis
 from cell.errors import CellError
 from cell.output import write_csv, write_text
 
@@ -39,20 +40,9 @@ MEASURES = ("actual_cycle_s", "parts_missed", "parts_per_hr", "vavg_r4_in_s", "i
 CONFIDENCE = 0.95
 VARIED_KEY = "controller.ideal_cycle_s"
 
-#: Table 7.1 (thesis §7.2, SPEC §8), non-adaptive: ideal cycle ->
-#: (actual cycle s, parts missed, parts/hr, Vavg R IV in/s, IP).
-THESIS_TABLE_7_1: dict[float, tuple[float, float, float, float, float]] = {
-    22.5872: (54.1660, 206, 66.4624, 3.5594, 0.3901),
-    22.0000: (35.6057, 113, 101.1074, 3.7818, 0.4388),
-    21.5000: (29.0548, 64, 123.9039, 3.9943, 0.4655),
-    21.0000: (25.8622, 35, 139.1995, 4.2321, 0.4817),
-    20.5000: (23.8200, 14, 151.1336, 4.5000, 0.4933),
-    20.0907: (23.0209, 5, 156.3796, 4.7459, 0.4984),
-}
-#: The adaptive run (§7.2): IP averaged 1.0214, no parts lost.
-THESIS_ADAPTIVE = {"ip": 1.0214, "parts_missed": 0.0}
-#: §7.2's text: "206 of 500 parts ... a 41.2 % reduction in throughput".
-THESIS_TEXT_CUT = 0.412
+THESIS_TABLE_7_1 = thesis.TABLE_7_1
+THESIS_ADAPTIVE = {"ip": thesis.ADAPTIVE_IP, "parts_missed": float(thesis.ADAPTIVE_PARTS_MISSED)}
+THESIS_TEXT_CUT = thesis.TEXT_THROUGHPUT_CUT
 
 LABELS = {"actual_cycle_s": "actual cycle (s)", "parts_missed": "parts missed",
           "parts_per_hr": "parts/hr", "vavg_r4_in_s": "Vavg R IV (in/s)", "ip": "IP"}

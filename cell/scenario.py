@@ -471,11 +471,11 @@ def read_trace(path: Path, file: object = None) -> Any:
     return times
 
 
-def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) -> Scenario:
-    """Read and validate a scenario file; dotted ``overrides`` replace its values."""
+def read_yaml_mapping(path: str | Path, what: str = "scenario") -> dict[str, Any]:
+    """A YAML file's top-level mapping (an empty file is an empty mapping)."""
     path = Path(path)
     if not path.is_file():
-        raise ScenarioError(path, "(file)", str(path), "no such scenario file")
+        raise ScenarioError(path, "(file)", str(path), f"no such {what} file")
     try:
         raw = yaml.safe_load(path.read_text())
     except yaml.YAMLError as exc:
@@ -483,6 +483,12 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
     raw = {} if raw is None else raw
     if not isinstance(raw, dict):
         raise ScenarioError(path, "(top level)", raw, "must be a mapping of keys")
+    return raw
+
+
+def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) -> Scenario:
+    """Read and validate a scenario file; dotted ``overrides`` replace its values."""
+    raw = read_yaml_mapping(path)
     for key, value in (overrides or {}).items():
         set_dotted(raw, key, value, path)
     return from_dict(raw, path, source=str(path))

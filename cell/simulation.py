@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 import simpy
 
-from cell import accounting
+from cell import accounting, thesis
 from cell.controller import Controller, Log, Plan, constants, fixed_plan
 from cell.conveyors import InputConveyor, OutputConveyor
 from cell.feeder import Feeder, interarrival_times
@@ -49,17 +49,9 @@ SUMMARY_COLUMNS = [
     "r4_s", "thesis_slack_s", "sim_end_s"]
 
 #: The thesis's published figures (§7.2) printed beside ours.
-THESIS_ADAPTIVE_IP = 1.0214
-THESIS_ADAPTIVE_CYCLE_PCT = 2.1
-#: Table 7.1 (§7.2): ideal cycle -> (actual cycle, parts missed, parts/hr, Vavg R IV, IP).
-TABLE_7_1 = {
-    22.5872: (54.1660, 206, 66.4624, 3.5594, 0.3901),
-    22.0: (35.6057, 113, 101.1074, 3.7818, 0.4388),
-    21.5: (29.0548, 64, 123.9039, 3.9943, 0.4655),
-    21.0: (25.8622, 35, 139.1995, 4.2321, 0.4817),
-    20.5: (23.8200, 14, 151.1336, 4.5000, 0.4933),
-    20.0907: (23.0209, 5, 156.3796, 4.7459, 0.4984),
-}
+THESIS_ADAPTIVE_IP = thesis.ADAPTIVE_IP
+THESIS_ADAPTIVE_CYCLE_PCT = thesis.ADAPTIVE_CYCLE_PCT
+TABLE_7_1 = thesis.TABLE_7_1
 
 
 @dataclass

@@ -50,11 +50,17 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-import yaml
 
 from cell.errors import CellError, ScenarioError
 from cell.output import write_csv, write_text
-from cell.scenario import Controller, Scenario, known_key, load_scenario, to_dict
+from cell.scenario import (
+    Controller,
+    Scenario,
+    known_key,
+    load_scenario,
+    read_yaml_mapping,
+    to_dict,
+)
 
 #: A replication: (scenario, stream) -> the run's summary row.
 Replicate = Callable[[Scenario, np.random.SeedSequence], Mapping[str, Any]]
@@ -190,14 +196,7 @@ def _whole(raw: Mapping[str, Any], key: str, default: Any, lo: int, file: object
 def load_sweep(path: str | Path) -> Sweep:
     """Read and validate a sweep file; every grid point's scenario is built and checked."""
     path = Path(path)
-    if not path.is_file():
-        raise ScenarioError(path, "(file)", str(path), "no such sweep file")
-    try:
-        raw = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise ScenarioError(path, "(file)", str(path), f"not valid YAML: {exc}") from None
-    if not isinstance(raw, dict):
-        raise ScenarioError(path, "(top level)", raw, "must be a mapping of keys")
+    raw = read_yaml_mapping(path, "sweep")
     for key in raw:
         if key not in SWEEP_KEYS:
             raise ScenarioError(path, str(key), raw[key],

@@ -28,9 +28,8 @@ from cell.figures.style import (
 )
 from cell.scenario import Scenario
 from cell.steptable import StepTable
+from cell.thesis import TABLE_7_1_CYCLES
 
-#: Table 7.1, column 1: the non-adaptive robot's cycle, shortened in R IV (s).
-TABLE_7_1_CYCLES = (22.5872, 22.0, 21.5, 21.0, 20.5, 20.0907)
 #: Parts per lot of Fig. 23's lumped averages (§7.2).
 LOT = 10
 
