@@ -211,7 +211,9 @@ def format_summary(summary: dict[str, Any]) -> str:
     """The summary as a two-column table, with the thesis's figures where it has them."""
     adaptive = summary["policy"] == "adaptive"
     row = None if adaptive else TABLE_7_1.get(round(summary["ideal_cycle_s"], 4))
-    actual, missed, per_hr, vavg, ip = (f"{x}" for x in row) if row else ("",) * 5
+    # the published figures as printed: four decimals, whole parts
+    actual, missed, per_hr, vavg, ip = ((f"{x:.4f}" if isinstance(x, float) else f"{x}")
+                                        for x in row) if row else ("",) * 5
     rows: list[tuple[str, str]] = []
 
     def add(label: str, value: Any, fmt: str = "{:.4f}", thesis: str = "") -> None:
