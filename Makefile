@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-stamp
 WORKERS ?= 2
 
-.PHONY: all venv test sweep figures bench lint clean
+.PHONY: all venv test sweep sweep-mintime figures bench lint clean
 
 all: test
 
@@ -22,6 +22,9 @@ test: $(STAMP)
 
 sweep: $(STAMP)
 	$(PY) -m cell sweep scenarios/table_7_1.yaml --out build/sweep --workers $(WORKERS) --report reports
+
+sweep-mintime: $(STAMP)
+	$(PY) -m cell sweep scenarios/table_7_1_mintime.yaml --out build/sweep_mintime --workers $(WORKERS) --report reports/mintime
 
 figures: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m cell figures --out reports/figures
