@@ -13,6 +13,8 @@ regime's time for a velocity is one numpy sum.
 
 from __future__ import annotations
 
+import bisect
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -52,29 +54,65 @@ def move_times(lengths_in: ArrayLike, min_times_s: ArrayLike,
 def velocity_for_time(lengths_in: ArrayLike, min_times_s: ArrayLike, time_s: float) -> float:
     """The tip velocity v whose moves Σ max(ℓ/v, t_min) take exactly ``time_s``.
 
-    The total is convex, piecewise linear and increasing in u = 1/v, so the
-    answer is exact: sort the moves by the u at which their motor stops
-    limiting them and find the piece that holds ``time_s``.  Raises
-    :class:`InfeasibleError` if ``time_s`` is below the motors' minimum.
+    Raises :class:`InfeasibleError` if ``time_s`` is below the motors' minimum.
+    See :class:`Segment`, which keeps the breakpoints for repeated queries.
     """
-    ell = np.asarray(lengths_in, dtype=float)
-    tmin = np.asarray(min_times_s, dtype=float)
-    floor = float(tmin.sum())
-    if time_s < floor * (1 - 1e-12):
-        raise InfeasibleError(f"{time_s:.4f} s is below the motors' minimum of {floor:.4f} s")
-    moving = ell > 0
-    if not moving.any():
+    if not np.any(np.asarray(lengths_in, dtype=float) > 0):
         raise InfeasibleError("a regime with no length has no tip velocity")
-    # For u below u_i = tmin_i/ℓ_i move i is motor-limited (time tmin_i).
-    u_break = np.where(moving, tmin / np.where(moving, ell, 1.0), np.inf)
-    order = np.argsort(u_break)
-    ub, l_sorted, t_sorted = u_break[order], ell[order], tmin[order]
-    # With u in [ub[j-1], ub[j]) moves 0..j-1 run at ℓ u, the rest at tmin.
-    ell_free = np.concatenate([[0.0], np.cumsum(l_sorted)])
-    t_fixed = np.concatenate([[0.0], np.cumsum(t_sorted[::-1])])[::-1]
-    u = (time_s - t_fixed) / np.where(ell_free > 0, ell_free, np.nan)
-    lo = np.concatenate([[0.0], ub])
-    hi = np.concatenate([ub, [np.inf]])
-    ok = (u >= lo - 1e-15) & (u <= hi + 1e-15) & np.isfinite(u) & (u > 0)
-    j = int(np.flatnonzero(ok)[-1]) if ok.any() else len(ub)
-    return float(1.0 / u[j])
+    return Segment(lengths_in, min_times_s).velocity(time_s)
+
+
+class Segment:
+    """Times of a run of moves, t(u) = Σ max(ℓ_k u, t_min_k) with u = 1/v.
+
+    Built once from per-move lengths and minimum times; afterwards each query is
+    a scalar bisection (microseconds), as the simulation needs.
+    """
+
+    __slots__ = ("length_in", "floor_s", "_ub", "_lfree", "_tfix", "_tbreak")
+
+    def __init__(self, lengths_in: ArrayLike, min_times_s: ArrayLike):
+        ell = np.asarray(lengths_in, dtype=float)
+        tmin = np.asarray(min_times_s, dtype=float)
+        if ell.shape != tmin.shape or np.any(ell < 0) or np.any(tmin < 0):
+            raise ValueError("lengths and minimum times must be matching non-negative arrays")
+        self.length_in = float(ell.sum())
+        """Total length (path or belt travel) of the moves."""
+        self.floor_s = float(tmin.sum())
+        """Shortest possible time: every move at its slowest joint's maximum rate."""
+        moving = ell > 0
+        # Zero-length moves always take their t_min; the others have a breakpoint:
+        # move k is motor-limited while u < t_min_k / ℓ_k.
+        fixed = float(tmin[~moving].sum())
+        ell, tmin = ell[moving], tmin[moving]
+        ub = tmin / ell
+        order = np.argsort(ub, kind="stable")
+        ub, ls, ts = ub[order], ell[order], tmin[order]
+        # With u in [ub[j-1], ub[j]) moves 0..j-1 are free (time ℓ u), j.. limited.
+        self._ub: list[float] = ub.tolist()
+        self._lfree: list[float] = np.concatenate([[0.0], np.cumsum(ls)]).tolist()
+        self._tfix: list[float] = (fixed + np.concatenate(
+            [np.cumsum(ts[::-1])[::-1], [0.0]])).tolist()
+        # t at each breakpoint, increasing: inverts t(u) by bisection.
+        self._tbreak: list[float] = [self._tfix[j] + self._lfree[j] * u
+                                     for j, u in enumerate(self._ub)]
+
+    def time(self, velocity: float) -> float:
+        """Σ max(ℓ/v, t_min): the moves' time at tip (or belt) velocity v > 0."""
+        u = 1.0 / velocity
+        j = bisect.bisect_right(self._ub, u)
+        return self._tfix[j] + self._lfree[j] * u
+
+    def velocity(self, time_s: float) -> float:
+        """The velocity v whose moves take exactly ``time_s`` (inverse of :meth:`time`)."""
+        if time_s < self.floor_s * (1 - 1e-12):
+            raise InfeasibleError(f"{time_s:.4f} s is below the motors' minimum "
+                                  f"of {self.floor_s:.4f} s")
+        j = bisect.bisect_left(self._tbreak, time_s)
+        if self._lfree[j] <= 0:
+            return float("inf")
+        return self._lfree[j] / (time_s - self._tfix[j])
+
+    def max_tracking_velocity(self) -> float:
+        """Fastest velocity at which no move is motor-limited (min ℓ/t_min)."""
+        return 1.0 / self._ub[-1] if self._ub else float("inf")

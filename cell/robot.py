@@ -18,7 +18,6 @@ and the move times are only floored by the motors (§4.3 c).
 
 from __future__ import annotations
 
-import bisect
 import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -26,67 +25,11 @@ from typing import Any, NamedTuple
 
 import numpy as np
 import simpy
-from numpy.typing import ArrayLike
 
-from cell.errors import CellError, InfeasibleError
+from cell.errors import CellError
 from cell.mailbox import Mailbox
+from cell.motors import Segment
 from cell.scenario import Scenario
-
-
-class Segment:
-    """Times of a run of moves, t(u) = Σ max(ℓ_k u, t_min_k) with u = 1/v.
-
-    Built once from per-move lengths and minimum times; afterwards each query is
-    a scalar bisection (microseconds), as the simulation needs.
-    """
-
-    __slots__ = ("length_in", "floor_s", "_ub", "_lfree", "_tfix", "_tbreak")
-
-    def __init__(self, lengths_in: ArrayLike, min_times_s: ArrayLike):
-        ell = np.asarray(lengths_in, dtype=float)
-        tmin = np.asarray(min_times_s, dtype=float)
-        if ell.shape != tmin.shape or np.any(ell < 0) or np.any(tmin < 0):
-            raise ValueError("lengths and minimum times must be matching non-negative arrays")
-        self.length_in = float(ell.sum())
-        """Total length (path or belt travel) of the moves."""
-        self.floor_s = float(tmin.sum())
-        """Shortest possible time: every move at its slowest joint's maximum rate."""
-        moving = ell > 0
-        # Zero-length moves always take their t_min; the others have a breakpoint:
-        # move k is motor-limited while u < t_min_k / ℓ_k.
-        fixed = float(tmin[~moving].sum())
-        ell, tmin = ell[moving], tmin[moving]
-        ub = tmin / ell
-        order = np.argsort(ub, kind="stable")
-        ub, ls, ts = ub[order], ell[order], tmin[order]
-        # With u in [ub[j-1], ub[j]) moves 0..j-1 are free (time ℓ u), j.. limited.
-        self._ub: list[float] = ub.tolist()
-        self._lfree: list[float] = np.concatenate([[0.0], np.cumsum(ls)]).tolist()
-        self._tfix: list[float] = (fixed + np.concatenate(
-            [np.cumsum(ts[::-1])[::-1], [0.0]])).tolist()
-        # t at each breakpoint, increasing: inverts t(u) by bisection.
-        self._tbreak: list[float] = [self._tfix[j] + self._lfree[j] * u
-                                     for j, u in enumerate(self._ub)]
-
-    def time(self, velocity: float) -> float:
-        """Σ max(ℓ/v, t_min): the moves' time at tip (or belt) velocity v > 0."""
-        u = 1.0 / velocity
-        j = bisect.bisect_right(self._ub, u)
-        return self._tfix[j] + self._lfree[j] * u
-
-    def velocity(self, time_s: float) -> float:
-        """The velocity v whose moves take exactly ``time_s`` (inverse of :meth:`time`)."""
-        if time_s < self.floor_s * (1 - 1e-12):
-            raise InfeasibleError(f"{time_s:.4f} s is below the motors' minimum "
-                                  f"of {self.floor_s:.4f} s")
-        j = bisect.bisect_left(self._tbreak, time_s)
-        if self._lfree[j] <= 0:
-            return float("inf")
-        return self._lfree[j] / (time_s - self._tfix[j])
-
-    def max_tracking_velocity(self) -> float:
-        """Fastest velocity at which no move is motor-limited (min ℓ/t_min)."""
-        return 1.0 / self._ub[-1] if self._ub else float("inf")
 
 
 @dataclass(frozen=True)
