@@ -19,7 +19,6 @@ and the move times are only floored by the motors (§4.3 c).
 from __future__ import annotations
 
 import functools
-from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -72,32 +71,21 @@ class RobotTiming:
         return self.r3_pre.time(u), self.r3_post.time(u)
 
 
-def _belt_steps(xyz: np.ndarray, rows: np.ndarray, start: Sequence[float],
-                end: Sequence[float]) -> np.ndarray:
-    """Belt travel of each move: its displacement along the belt direction start → end."""
-    d = np.subtract(end, start)[:2]
-    d = d / np.linalg.norm(d)
-    disp = np.diff(xyz[:, :2], axis=0, prepend=xyz[:1, :2]) @ d
-    return np.abs(disp[rows])
-
-
 def build_timing(s: Scenario) -> RobotTiming:
     """Solve the path once and reduce it to the regime segments (thesis §6.1)."""
     from cell.steptable import StepTable
 
     t = StepTable.from_scenario(s)
-    p = t.path
-    xyz, tp = p.xyz_in, t.peak_min_times
-    idx = np.arange(p.n_points)
-    r1, r2, r3, r4 = (np.flatnonzero(t.regime_rows(r)) for r in ("R1", "R2", "R3", "R4"))
-    pre1, post1 = r1[r1 <= p.lo], r1[r1 > p.lo]
-    pre3, post3 = r3[r3 <= p.td], r3[r3 > p.td]
-    bx1 = _belt_steps(xyz, idx, s.path.bot_in, s.path.f_in)
-    bx3 = _belt_steps(xyz, idx, s.path.g_in, s.path.eot_in)
-    track1 = Segment(bx1[pre1[:-1]], tp[pre1[:-1]])
-    track3 = Segment(bx3[pre3[:-1]], tp[pre3[:-1]])
-    r2seg = Segment(t.move_in[r2], tp[r2])
-    r4seg = Segment(t.move_in[r4], tp[r4])
+    ell, tp = t.velocity_lengths, t.peak_min_times
+    rows = {name: np.flatnonzero(mask) for name, mask in t.segment_rows().items()}
+
+    def segment(name: str, drop_last: bool = False) -> Segment:
+        r = rows[name][:-1] if drop_last else rows[name]
+        return Segment(ell[r], tp[r])
+
+    # what the robot can follow on a belt: the grasp / release move excluded
+    track1, track3 = segment("r1_pre", drop_last=True), segment("r3_pre", drop_last=True)
+    r2seg, r4seg = segment("r2"), segment("r4")
     r2_min, r4_min = r2seg.floor_s, r4seg.floor_s
     if s.robot.timing == "minimum-time":
         try:
@@ -109,10 +97,8 @@ def build_timing(s: Scenario) -> RobotTiming:
         fastest = fastest_regime_times(s)
         r2_min, r4_min = max(r2_min, float(fastest["R2"])), max(r4_min, float(fastest["R4"]))
     return RobotTiming(
-        r1_pre=Segment(bx1[pre1], tp[pre1]), r1_post=Segment(bx1[post1], tp[post1]),
-        r2=r2seg,
-        r3_pre=Segment(bx3[pre3], tp[pre3]), r3_post=Segment(bx3[post3], tp[post3]),
-        r4=r4seg,
+        r1_pre=segment("r1_pre"), r1_post=segment("r1_post"), r2=r2seg,
+        r3_pre=segment("r3_pre"), r3_post=segment("r3_post"), r4=r4seg,
         r4_nominal_s=t.regime_min_time("R4", nominal=True),
         input_track_max_in_s=track1.max_tracking_velocity(),
         output_track_max_in_s=track3.max_tracking_velocity(),

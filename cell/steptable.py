@@ -21,6 +21,10 @@ from cell.motors import max_rates, min_move_times
 from cell.path import REGIMES, TransferPath, build_path
 from cell.scenario import Motors, Scenario
 
+#: The stretches of a cycle whose times a plan fixes: R I and R III split at LO
+#: and TD (the grasp / release move ends the first half).
+SEGMENTS = ("r1_pre", "r1_post", "r2", "r3_pre", "r3_post", "r4")
+
 COLUMNS = ["point", "regime", "x_in", "y_in", "z_in",
            "theta1_deg", "theta2_deg", "theta3_deg", "theta4_deg", "theta5_deg",
            "steps1", "steps2", "steps3", "steps4", "steps5", "move_in", "load_oz", "event"]
@@ -67,6 +71,30 @@ class StepTable:
     @cached_property
     def nominal_min_times(self) -> NDArray[np.float64]:
         return self.min_times(self.motors.nominal_fraction)
+
+    def segment_rows(self) -> dict[str, NDArray[np.bool_]]:
+        """Masks of the moves of each of :data:`SEGMENTS`."""
+        idx = np.arange(self.path.n_points)
+        lo, td = self.path.lo, self.path.td
+        r1, r3 = self.regime_rows(1), self.regime_rows(3)
+        return {"r1_pre": r1 & (idx <= lo), "r1_post": r1 & (idx > lo),
+                "r2": self.regime_rows(2), "r3_pre": r3 & (idx <= td),
+                "r3_post": r3 & (idx > td), "r4": self.regime_rows(4)}
+
+    @cached_property
+    def velocity_lengths(self) -> NDArray[np.float64]:
+        """(N,) what each move's velocity is measured on (§6.1): the belt's travel while
+        tracking (R I along B → F, R III along G → K; the path divides the belt
+        equally, §4.2), the path length in R II and R IV."""
+        xyz = self.path.xyz_in
+        out = self.move_in.copy()
+        for regime in (1, 3):
+            rows = self.regime_rows(regime)
+            ends = np.flatnonzero(rows)
+            start, end = xyz[ends[0] - 1, :2], xyz[ends[-1], :2]
+            direction = (end - start) / np.linalg.norm(end - start)
+            out[rows] = np.abs(np.diff(xyz[:, :2], axis=0)[rows[1:]] @ direction)
+        return out
 
     def regime_length(self, regime: int | str) -> float:
         return float(self.move_in[self.regime_rows(regime)].sum())

@@ -22,10 +22,7 @@ from cell.figures.style import LIMIT_COLOUR, REGIME_LABELS, mark_events, new_fig
 from cell.kinematics import JOINT_NAMES
 from cell.motors import max_rates, move_times, velocity_for_time
 from cell.scenario import Scenario
-from cell.steptable import StepTable
-
-#: The six pieces of a transfer whose times a cycle plan fixes (simulation's Plan).
-SEGMENTS = ("r1_pre", "r1_post", "r2", "r3_pre", "r3_post", "r4")
+from cell.steptable import SEGMENTS, StepTable
 
 
 @dataclass(frozen=True)
@@ -46,31 +43,13 @@ class Timeline:
                 4: g["r4"]}
 
 
-def segment_rows(table: StepTable) -> dict[str, NDArray[np.bool_]]:
-    """Moves of each segment: R I and R III split at LO and TD (the move onto LO/TD before)."""
-    idx = np.arange(table.path.n_points)
-    lo, td = table.path.lo, table.path.td
-    r1, r3 = table.regime_rows(1), table.regime_rows(3)
-    return {"r1_pre": r1 & (idx <= lo), "r1_post": r1 & (idx > lo), "r2": table.regime_rows(2),
-            "r3_pre": r3 & (idx <= td), "r3_post": r3 & (idx > td), "r4": table.regime_rows(4)}
-
-
-def move_lengths(table: StepTable) -> NDArray[np.float64]:
-    """What a move's velocity is measured on (§6.1): belt travel while tracking
-    (the path divides the belt equally, §4.2), path length in R II and R IV."""
-    p = table.path
-    along = np.concatenate([[0.0], np.linalg.norm(np.diff(p.xyz_in[:, :2], axis=0), axis=1)])
-    tracking = table.regime_rows(1) | table.regime_rows(3)
-    return np.where(tracking, along, table.move_in)
-
-
 def timeline(table: StepTable, segment_s: dict[str, float]) -> Timeline:
     """Spread each segment's time over its moves: one velocity per segment, every
     move max(ℓ/v, t_min) at the motors' peak rates (§6.1)."""
-    ell = move_lengths(table)
+    ell = table.velocity_lengths
     floor = table.peak_min_times
     dt = np.zeros(table.path.n_points)
-    for name, rows in segment_rows(table).items():
+    for name, rows in table.segment_rows().items():
         total = max(float(segment_s[name]), float(floor[rows].sum()))
         v = velocity_for_time(ell[rows], floor[rows], total)
         dt[rows] = move_times(ell[rows], floor[rows], v)
@@ -78,20 +57,16 @@ def timeline(table: StepTable, segment_s: dict[str, float]) -> Timeline:
 
 
 def nominal_timeline(table: StepTable, s: Scenario) -> Timeline:
-    """One transfer at the nominal velocities (SPEC §6): R I and R III locked to
-    their belts at nominal speed, R IV at the nominal (75 %) motor rates, and R II
-    the rest of the ideal cycle (the thesis's 22.5872 - 8/3 - 4 - 9.9855 = 5.935 s
-    if R I took exactly 8/3 s)."""
-    ell, floor, rows = move_lengths(table), table.peak_min_times, segment_rows(table)
-    seg: dict[str, float] = {}
-    for name, belt in (("r1_pre", s.belts.input_nominal_in_s),
-                       ("r1_post", s.belts.input_nominal_in_s),
-                       ("r3_pre", s.belts.output_nominal_in_s),
-                       ("r3_post", s.belts.output_nominal_in_s)):
-        seg[name] = float(move_times(ell[rows[name]], floor[rows[name]], belt).sum())
-    seg["r4"] = float(table.nominal_min_times[rows["r4"]].sum())
-    seg["r2"] = s.controller.nominal_cycle_s - sum(seg.values())
-    return timeline(table, seg)
+    """One transfer at the nominal velocities, as the controllers plan it (SPEC §6):
+    R I and R III locked to their belts at nominal speed, R IV at the nominal (75 %)
+    motor rates, and R II the rest of the ideal cycle (the thesis's
+    22.5872 - 8/3 - 4 - 9.9855 = 5.935 s if R I took exactly 8/3 s)."""
+    from cell.controller import constants
+    from cell.robot import robot_timing
+
+    k = constants(s, robot_timing(s))
+    return timeline(table, {"r1_pre": k.r1_pre_nom, "r1_post": k.r1_post_nom, "r2": k.r2_nom,
+                            "r3_pre": k.r3_pre_nom, "r3_post": k.r3_post_nom, "r4": k.r4_nom})
 
 
 def _events(table: StepTable, tl: Timeline) -> dict[str, float]:

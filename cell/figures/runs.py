@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from cell.figures.motion import SEGMENTS, Timeline, timeline
+from cell.figures.motion import Timeline, timeline
 from cell.figures.style import (
     IDEAL_COLOUR,
     POLICY_COLOURS,
@@ -27,7 +27,7 @@ from cell.figures.style import (
     shade_regimes,
 )
 from cell.scenario import Scenario
-from cell.steptable import StepTable
+from cell.steptable import SEGMENTS, StepTable
 from cell.thesis import TABLE_7_1_CYCLES
 
 #: Parts per lot of Fig. 23's lumped averages (§7.2).
