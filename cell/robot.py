@@ -94,7 +94,7 @@ def build_timing(s: Scenario) -> RobotTiming:
             raise CellError("robot.timing = 'minimum-time' needs the minimum-time planner "
                             "(cell.mintime.fastest_regime_times), which is not available; "
                             "use robot.timing: constant-rate") from None
-        fastest = fastest_regime_times(s)
+        fastest = fastest_regime_times(s, t)
         r2_min, r4_min = max(r2_min, float(fastest["R2"])), max(r4_min, float(fastest["R4"]))
     return RobotTiming(
         r1_pre=segment("r1_pre"), r1_post=segment("r1_post"), r2=r2seg,

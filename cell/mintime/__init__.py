@@ -11,12 +11,16 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # pragma: no cover
     from cell.scenario import Scenario
+    from cell.steptable import StepTable
 
 __all__ = ["fastest_regime_times"]
 
 
-def fastest_regime_times(scenario: Scenario) -> dict[str, float]:
-    """{"R2": seconds, "R4": seconds}: the planner's rest-to-rest times (cached per scenario)."""
+def fastest_regime_times(scenario: Scenario, table: StepTable | None = None) -> dict[str, float]:
+    """{"R2": seconds, "R4": seconds}: the planner's rest-to-rest times (cached per scenario).
+
+    ``table``: the scenario's solved path, if the caller has it already.
+    """
     from .regimes import fastest_regime_times as _f
 
-    return _f(scenario)
+    return _f(scenario, table)

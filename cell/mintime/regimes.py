@@ -134,15 +134,16 @@ def _key(scenario: Scenario) -> str:
     return json.dumps([str(scenario.base_dir.resolve()), keep], sort_keys=True, default=str)
 
 
-def fastest_regime_times(scenario: Scenario) -> dict[str, float]:
+def fastest_regime_times(scenario: Scenario, table: StepTable | None = None) -> dict[str, float]:
     """{"R2": s, "R4": s}: the minimum-time traversal of each free regime, rest to rest.
 
     Cached per scenario (only the settings that change the answer count), so a
-    simulation calls the planner once, not per part.
+    simulation calls the planner once, not per part.  ``table``: the scenario's
+    solved path, if the caller has it (saves solving it again).
     """
     key = _key(scenario)
     if key not in _CACHE:
-        res = plan_regimes(scenario)
+        res = plan_regimes(scenario, table)
         _CACHE[key] = {r: res[r].profile.time_s for r in FREE_REGIMES}
     return dict(_CACHE[key])
 
