@@ -12,6 +12,7 @@ Keys are written dotted when overridden, as in a sweep file:
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import types
 import typing
@@ -447,27 +448,41 @@ def _cross_checks(s: Scenario, file: object) -> None:
 
 
 def read_trace(path: Path, file: object = None) -> Any:
-    """Inter-arrival times from a CSV trace: one column ``interarrival_s``, all > 0."""
+    """Inter-arrival times from a CSV trace: one column ``interarrival_s``, all > 0.
+
+    Parsed once per version of the file (path, size, modification time), so a
+    sweep's replications do not read it again.  The array is read-only.
+    """
+    if not path.is_file():
+        raise ScenarioError(file or path, "arrivals.trace_csv", str(path), "no such file")
+    st = path.stat()
+    times = _parse_trace(str(path.resolve()), st.st_size, st.st_mtime_ns)
+    if isinstance(times, str):
+        raise ScenarioError(file or path, "arrivals.trace_csv", str(path), times)
+    return times
+
+
+@functools.lru_cache(maxsize=32)
+def _parse_trace(path: str, size: int, mtime_ns: int) -> Any:
+    """The trace's times, or why they cannot be used (a message)."""
     import numpy as np
     import pandas as pd
 
-    key = "arrivals.trace_csv"
-    if not path.is_file():
-        raise ScenarioError(file or path, key, str(path), "no such file")
+    del size, mtime_ns  # part of the cache key only
     try:
         frame = pd.read_csv(path)
     except Exception as exc:  # pandas raises many kinds
-        raise ScenarioError(file or path, key, str(path), f"not a readable CSV: {exc}") from None
+        return f"not a readable CSV: {exc}"
     if "interarrival_s" not in frame.columns:
-        raise ScenarioError(file or path, key, str(path), "needs a column named interarrival_s")
+        return "needs a column named interarrival_s"
     times = pd.to_numeric(frame["interarrival_s"], errors="coerce").to_numpy(dtype=float)
     bad = np.flatnonzero(~np.isfinite(times) | (times <= 0))
     if bad.size:
-        raise ScenarioError(file or path, key, str(path),
-                            f"row {bad[0] + 1} has inter-arrival time "
-                            f"{frame['interarrival_s'].iloc[bad[0]]!r}; times must be positive")
+        return (f"row {bad[0] + 1} has inter-arrival time "
+                f"{frame['interarrival_s'].iloc[bad[0]]!r}; times must be positive")
     if times.size == 0:
-        raise ScenarioError(file or path, key, str(path), "has no inter-arrival times")
+        return "has no inter-arrival times"
+    times.setflags(write=False)
     return times
 
 
