@@ -479,7 +479,7 @@ def _parse_trace(path: str, size: int, mtime_ns: int) -> Any:
     bad = np.flatnonzero(~np.isfinite(times) | (times <= 0))
     if bad.size:
         return (f"row {bad[0] + 1} has inter-arrival time "
-                f"{frame['interarrival_s'].iloc[bad[0]]!r}; times must be positive")
+                f"{frame['interarrival_s'].iloc[bad[0]]}; times must be positive")
     if times.size == 0:
         return "has no inter-arrival times"
     times.setflags(write=False)
