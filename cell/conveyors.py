@@ -57,19 +57,19 @@ class Belt:
             del ts[k:], xs[k:], vs[k:]
         if not v1 > 0 or (t2 is not None and not v2 > 0):
             raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}")
-        if t1 <= ts[-1]:
-            vs[-1] = v1
-        else:
-            xs.append(xs[-1] + vs[-1] * (t1 - ts[-1]))
-            ts.append(t1)
-            vs.append(v1)
+        self._append(t1, v1)
         if t2 is not None:
-            if t2 <= ts[-1]:
-                vs[-1] = v2
-            else:
-                xs.append(xs[-1] + vs[-1] * (t2 - ts[-1]))
-                ts.append(t2)
-                vs.append(v2)
+            self._append(t2, v2)
+
+    def _append(self, t: float, v: float) -> None:
+        """Run at v from t on (t at or before the last change: that change's speed is v)."""
+        ts, xs, vs = self._t, self._x, self._v
+        if t <= ts[-1]:
+            vs[-1] = v
+        else:
+            xs.append(xs[-1] + vs[-1] * (t - ts[-1]))
+            ts.append(t)
+            vs.append(v)
 
     def max_speed(self) -> float:
         """The fastest the belt has been (or is planned to be)."""
