@@ -110,20 +110,15 @@ def cmd_path(args: argparse.Namespace) -> int:
 
 
 def _handler(command: str) -> Any:
+    """The subcommand's function, imported only when it runs (keeps ``--help`` fast)."""
     module, _, func = HANDLERS[command].partition(":")
-    try:
-        return getattr(importlib.import_module(module), func)
-    except (ImportError, AttributeError):
-        return None
+    return getattr(importlib.import_module(module), func)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     handler = _handler(args.command)
-    if handler is None:
-        print(f"cell: error: '{args.command}' is not built yet", file=sys.stderr)
-        return 2
     try:
         return int(handler(args) or 0)
     except CellError as exc:

@@ -85,3 +85,11 @@ def test_set_overrides_from_the_command_line(tmp_path):
                  "--out", str(out)]) == 0
     assert len(pd.read_csv(out)) == 410
     assert main(["path", "scenarios/baseline.yaml", "--set", "nonsense", "--out", str(out)]) == 2
+
+
+def test_every_subcommand_has_its_handler():
+    from cell.cli import HANDLERS, _handler
+
+    assert set(HANDLERS) == set(SUBCOMMANDS)
+    for name in SUBCOMMANDS:
+        assert callable(_handler(name)), name
