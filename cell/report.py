@@ -25,7 +25,7 @@ import numpy as np
 import pandas as pd
 import scipy.stats
 
-from cell import thesis
+from cell import thesis as published
 from cell.errors import CellError
 from cell.output import write_csv, write_text
 
@@ -40,9 +40,9 @@ MEASURES = ("actual_cycle_s", "parts_missed", "parts_per_hr", "vavg_r4_in_s", "i
 CONFIDENCE = 0.95
 VARIED_KEY = "controller.ideal_cycle_s"
 
-THESIS_TABLE_7_1 = thesis.TABLE_7_1
-THESIS_ADAPTIVE = {"ip": thesis.ADAPTIVE_IP, "parts_missed": float(thesis.ADAPTIVE_PARTS_MISSED)}
-THESIS_TEXT_CUT = thesis.TEXT_THROUGHPUT_CUT
+#: The adaptive run's published figures by measure (§7.2).
+THESIS_ADAPTIVE = {"ip": published.ADAPTIVE_IP,
+                   "parts_missed": float(published.ADAPTIVE_PARTS_MISSED)}
 
 LABELS = {"actual_cycle_s": "actual cycle (s)", "parts_missed": "parts missed",
           "parts_per_hr": "parts/hr", "vavg_r4_in_s": "Vavg R IV (in/s)", "ip": "IP"}
@@ -96,7 +96,7 @@ def thesis_value(policy: str, cycle: float, accounting: str, measure: str) -> fl
         return math.nan
     if policy == "adaptive":
         return THESIS_ADAPTIVE.get(measure, math.nan)
-    for c, row in THESIS_TABLE_7_1.items():
+    for c, row in published.TABLE_7_1.items():
         if abs(c - cycle) < 5e-5:
             return float(row[MEASURES.index(measure)])
     return math.nan
@@ -283,14 +283,14 @@ def _reading_non_adaptive(table: pd.DataFrame, cycles: list[float],
     ideal_pph = 3600 / top
     cut_t = 1 - mean[top, "thesis", "parts_per_hr"] / ideal_pph
     cut_w = 1 - mean[top, "wallclock", "parts_per_hr"] / ideal_pph
-    thesis_row = THESIS_TABLE_7_1.get(round(top, 4))
+    thesis_row = published.TABLE_7_1.get(round(top, 4))
     if thesis_row and parts:
         out.append(
             f"Throughput at {top:.4f} s: the thesis's accounting gives "
             f"{mean[top, 'thesis', 'parts_per_hr']:.1f} parts/hr, {cut_t:.0%} below the "
             f"{ideal_pph:.1f}/hr of the ideal cycle (the thesis's table: "
             f"{1 - thesis_row[2] / ideal_pph:.0%}), while {tm / parts:.1%} of the parts are lost "
-            f"(the thesis's text: {THESIS_TEXT_CUT:.1%}, 206 of 500): the table's parts/hr and "
+            f"(the thesis's text: {published.TEXT_THROUGHPUT_CUT:.1%}, 206 of 500): the table's parts/hr and "
             f"the text's throughput cut measure different things. On the wall clock the cut is "
             f"{cut_w:.0%}.")
     return out
@@ -307,20 +307,20 @@ def _reading_adaptive(table: pd.DataFrame,
     ip_t, ip_w = m("thesis", "ip"), m("wallclock", "ip")
     lost_t, lost_w = m("thesis", "parts_missed"), m("wallclock", "parts_missed")
     cyc_t, cyc_w = m("thesis", "actual_cycle_s"), m("wallclock", "actual_cycle_s")
-    published = THESIS_ADAPTIVE["ip"]
-    where = ("inside" if inside(published, ip_t["run_p2_5"], ip_t["run_p97_5"], "ip")
+    ip_published = THESIS_ADAPTIVE["ip"]
+    where = ("inside" if inside(ip_published, ip_t["run_p2_5"], ip_t["run_p97_5"], "ip")
              else "outside")
     text = [f"**Adaptive.** In the thesis's accounting the IP averages {ip_t['mean']:.4f} "
             f"(single runs {ip_t['run_p2_5']:.4f}–{ip_t['run_p97_5']:.4f}): the published "
-            f"{published:.4f} is {where} that range."]
+            f"{ip_published:.4f} is {where} that range."]
     if all(math.isfinite(v) for v in (cyc_t["mean"], cyc_w["mean"], ip_w["mean"])):
         text.append(
             f"Its time between deliveries is the robot's motion time (step 6.2), "
             f"{cyc_t['mean']:.2f} s, {cyc_t['mean'] / cycle - 1:+.2%} against the {cycle:.4f} s "
-            f"requested; the published IP implies a motion time {1 / published - 1:+.1%} "
+            f"requested; the published IP implies a motion time {1 / ip_published - 1:+.1%} "
             f"against the arrival interval. On the wall clock the cycle is {cyc_w['mean']:.2f} s "
             f"({cyc_w['mean'] / cycle - 1:+.2%}) and the IP {ip_w['mean']:.4f}.")
-    text += _memoryless(replications, published)
+    text += _memoryless(replications, ip_published)
     text.append(
         f"Parts lost: {lost_w['mean']:.2f} per run on average "
         f"(95 % of runs {lost_w['run_p2_5']:.0f}–{lost_w['run_p97_5']:.0f}; the thesis: none)"
@@ -329,7 +329,7 @@ def _reading_adaptive(table: pd.DataFrame,
     return [" ".join(text)]
 
 
-def _memoryless(replications: pd.DataFrame | None, published: float) -> list[str]:
+def _memoryless(replications: pd.DataFrame | None, ip_published: float) -> list[str]:
     """The simulation's reading with each next arrival counted from the current pick-up."""
     cols = ("ip_thesis_memoryless", "cycle_vs_nominal_memoryless_pct")
     if replications is None or not all(c in replications for c in cols):
@@ -339,10 +339,10 @@ def _memoryless(replications: pd.DataFrame | None, published: float) -> list[str
     if ip.empty or not np.isfinite(ip).all():
         return []
     lo, hi = np.percentile(ip, [2.5, 97.5])
-    where = "inside" if lo <= published <= hi else "outside"
+    where = "inside" if lo <= ip_published <= hi else "outside"
     return [f"Counted instead with each next arrival measured from the current pick-up, so that "
             f"a late part's lateness is not carried to the parts behind it, the IP is "
-            f"{ip.mean():.4f} (single runs {lo:.4f}–{hi:.4f}; the published {published:.4f} "
+            f"{ip.mean():.4f} (single runs {lo:.4f}–{hi:.4f}; the published {ip_published:.4f} "
             f"is {where}) and the motion cycle {pct.mean():+.1f} % against the requested "
             f"(the thesis: within 2.1 %)"
             + (": this reading reproduces the published IP, which suggests it is how the "
@@ -377,9 +377,9 @@ def markdown(table: pd.DataFrame, sweep: Sweep, replications: pd.DataFrame | Non
         lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
         ad = table[table["policy"] == "adaptive"]
         cycle = float(ad["ideal_cycle_s"].iloc[0])
-        published = [_fmt(thesis_value("adaptive", cycle, "thesis", m), m,
+        published_cells = [_fmt(thesis_value("adaptive", cycle, "thesis", m), m,
                           0 if m == "parts_missed" else 4) for m in MEASURES]
-        lines.append("| thesis (published) | " + " | ".join(published) + " |")
+        lines.append("| thesis (published) | " + " | ".join(published_cells) + " |")
         for accounting in ACCOUNTINGS:
             cells = [_ours(_get(table, "adaptive", cycle, accounting, m), m) for m in MEASURES]
             lines.append(f"| ours, {accounting} | " + " | ".join(cells) + " |")

@@ -23,7 +23,8 @@ import numpy as np
 import pandas as pd
 import simpy
 
-from cell import accounting, thesis
+from cell import accounting
+from cell import thesis as published
 from cell.controller import Controller, Log, Plan, constants, fixed_plan
 from cell.conveyors import InputConveyor, OutputConveyor
 from cell.feeder import Feeder, interarrival_times
@@ -48,10 +49,6 @@ SUMMARY_COLUMNS = [
     "input_speed_max_in_s", "output_speed_min_in_s", "output_speed_max_in_s", "r1_nominal_s", "r2_nominal_s",
     "r4_s", "thesis_slack_s", "sim_end_s"]
 
-#: The thesis's published figures (§7.2) printed beside ours.
-THESIS_ADAPTIVE_IP = thesis.ADAPTIVE_IP
-THESIS_ADAPTIVE_CYCLE_PCT = thesis.ADAPTIVE_CYCLE_PCT
-TABLE_7_1 = thesis.TABLE_7_1
 
 
 @dataclass
@@ -210,7 +207,7 @@ def _tables(s: Scenario, seed: Any, ideal: float, adaptive: bool, k: Any, fixed:
 def format_summary(summary: dict[str, Any]) -> str:
     """The summary as a two-column table, with the thesis's figures where it has them."""
     adaptive = summary["policy"] == "adaptive"
-    row = None if adaptive else TABLE_7_1.get(round(summary["ideal_cycle_s"], 4))
+    row = None if adaptive else published.TABLE_7_1.get(round(summary["ideal_cycle_s"], 4))
     # the published figures as printed: four decimals, whole parts
     actual, missed, per_hr, vavg, ip = ((f"{x:.4f}" if isinstance(x, float) else f"{x}")
                                         for x in row) if row else ("",) * 5
@@ -238,14 +235,14 @@ def format_summary(summary: dict[str, Any]) -> str:
         vavg)
     add("IP, wall-clock", summary["ip_wallclock"])
     add("IP, thesis's accounting", summary["ip_thesis"], "{:.4f}",
-        f"{THESIS_ADAPTIVE_IP}" if adaptive else ip)
+        f"{published.ADAPTIVE_IP}" if adaptive else ip)
     if adaptive:
         add("mean cycle (step 6.2) vs 22.5872 s, %", summary["cycle_vs_nominal_pct"],
-            "{:+.2f}", f"within {THESIS_ADAPTIVE_CYCLE_PCT} %")
+            "{:+.2f}", f"within {published.ADAPTIVE_CYCLE_PCT} %")
         add("IP, arrivals counted from each pick-up", summary["ip_thesis_memoryless"],
-            "{:.4f}", f"{THESIS_ADAPTIVE_IP}")
+            "{:.4f}", f"{published.ADAPTIVE_IP}")
         add("mean cycle, same reading, %", summary["cycle_vs_nominal_memoryless_pct"],
-            "{:+.2f}", f"within {THESIS_ADAPTIVE_CYCLE_PCT} %")
+            "{:+.2f}", f"within {published.ADAPTIVE_CYCLE_PCT} %")
     add("spacing min / max, in",
         f"{summary['spacing_min_in']:.3f} / {summary['spacing_max_in']:.3f}", "{}",
         "45.00 ± 0.25")
