@@ -4,26 +4,21 @@ Measured in one run: simulated parts per second for a 500-part adaptive and a
 500-part non-adaptive run (best of several, the path already solved, as in a
 sweep), and a bare SimPy process doing ``yield env.timeout(1)`` in a loop
 (events per second) for scale.  The planner's figures from
-``cell.mintime.bench.benchmarks()`` are merged in when that module exists.
+``cell.mintime.bench.benchmarks()`` are merged in by ``cell bench``.
 """
 
 from __future__ import annotations
 
-import argparse
-import importlib
-import json
-import platform
 import time
 from pathlib import Path
 from typing import Any
 
 import simpy
 
-from cell.output import write_text
 from cell.scenario import Scenario, default_scenario, load_scenario
 from cell.simulation import simulate
 
-#: The speed the issue asks of both policies (simulated parts per second).
+#: The speed asked of both policies (simulated parts per second).
 TARGET_PARTS_PER_S = 20_000
 
 
@@ -70,26 +65,3 @@ def benchmarks(scenario_file: str | Path = "scenarios/baseline.yaml") -> dict[st
         "parts_per_s_non_adaptive": parts_per_second(fixed),
         "simpy_timeouts_per_s": simpy_timeouts_per_second(),
     }
-
-
-def cmd_bench(args: argparse.Namespace) -> int:
-    """``cell bench --out reports/bench.json``."""
-    results: dict[str, Any] = benchmarks()
-    try:
-        planner = importlib.import_module("cell.mintime.bench")
-    except ImportError:
-        planner = None
-    if planner is not None and hasattr(planner, "benchmarks"):
-        results.update(planner.benchmarks())
-    results["machine"] = f"{platform.machine()} {platform.python_implementation()} " \
-                         f"{platform.python_version()}"
-    for key, value in results.items():
-        shown = f"{value:,.0f}" if isinstance(value, float) and value >= 100 else \
-            (f"{value:.3f}" if isinstance(value, float) else str(value))
-        print(f"{key:<28} {shown}")
-    for key in ("parts_per_s_adaptive", "parts_per_s_non_adaptive"):
-        if results[key] < TARGET_PARTS_PER_S:
-            print(f"note: {key} is below the target of {TARGET_PARTS_PER_S:,} parts/s")
-    write_text(json.dumps(results, indent=2, sort_keys=True) + "\n", args.out)
-    print(f"wrote {args.out}")
-    return 0

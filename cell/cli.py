@@ -1,7 +1,7 @@
 """The ``cell`` command: ``cell path | run | sweep | figures | mintime | bench``.
 
-Each subcommand is a thin shell: it reads its input, calls the package, and
-writes its output whole or not at all.  Any :class:`~cell.errors.CellError` is
+Each subcommand is a thin shell in :mod:`cell.commands`: it reads its input,
+calls the package, and writes its output whole or not at all.  Any :class:`~cell.errors.CellError` is
 reported as one line on stderr with exit code 2.
 """
 
@@ -13,31 +13,12 @@ import sys
 from collections.abc import Sequence
 from typing import Any
 
-import yaml
-
 from cell import __version__
-from cell.errors import CellError, ScenarioError
+from cell.errors import CellError
 
-#: subcommand -> "module:function" taking the parsed arguments.
-HANDLERS = {
-    "path": "cell.cli:cmd_path",
-    "run": "cell.simulation:cmd_run",
-    "sweep": "cell.sweep:cmd_sweep",
-    "figures": "cell.figures:cmd_figures",
-    "mintime": "cell.mintime.cli:cmd_mintime",
-    "bench": "cell.bench:cmd_bench",
-}
-
-
-def parse_sets(pairs: Sequence[str] | None) -> dict[str, Any]:
-    """``--set key=value`` pairs as dotted overrides; values are read as YAML."""
-    out: dict[str, Any] = {}
-    for pair in pairs or ():
-        key, sep, value = pair.partition("=")
-        if not sep or not key:
-            raise ScenarioError("--set", pair, pair, "expected KEY=VALUE, e.g. run.parts=100")
-        out[key.strip()] = yaml.safe_load(value)
-    return out
+#: subcommand -> the module under ``cell.commands`` whose ``main(args)`` runs it.
+HANDLERS = {name: f"cell.commands.{name}" for name in
+            ("path", "run", "sweep", "figures", "mintime", "bench")}
 
 
 def _scenario_args(p: argparse.ArgumentParser) -> None:
@@ -97,22 +78,9 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def cmd_path(args: argparse.Namespace) -> int:
-    from cell.scenario import load_scenario
-    from cell.steptable import StepTable
-
-    scenario = load_scenario(args.scenario, parse_sets(args.sets))
-    table = StepTable.from_scenario(scenario)
-    table.write_csv(args.out)
-    n = table.path.n_points
-    print(f"wrote {args.out}: {n} points, {n - 1} moves; R IV {table.regime_length('R4'):.4f} in")
-    return 0
-
-
 def _handler(command: str) -> Any:
     """The subcommand's function, imported only when it runs (keeps ``--help`` fast)."""
-    module, _, func = HANDLERS[command].partition(":")
-    return getattr(importlib.import_module(module), func)
+    return importlib.import_module(HANDLERS[command]).main
 
 
 def main(argv: Sequence[str] | None = None) -> int:

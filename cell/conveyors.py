@@ -12,6 +12,8 @@ wakes when a part reaches B, or when a new plan moves that instant.
 from __future__ import annotations
 
 import bisect
+from collections.abc import Callable
+from typing import Any
 
 import simpy
 
@@ -21,22 +23,37 @@ from cell.mailbox import Mailbox
 EPS_S = 1e-6
 
 
-class Belt:
-    """A belt's speed schedule and travel X(t) (inches since t = 0)."""
+def speed_at(instants: list[float], speeds: list[float], t: float) -> float:
+    """A piecewise-constant schedule's speed at t: the last change at or before t."""
+    return speeds[max(bisect.bisect_right(instants, t) - 1, 0)]
 
-    def __init__(self, speed_in_s: float):
+
+class Belt:
+    """A belt's speed schedule and travel X(t) (inches since t = 0).
+
+    Only the schedule from the present on is kept: a change whose successor has
+    started is final and is handed to ``on_change`` (e.g. a ``belts.csv``
+    writer) and dropped, so a long run keeps a few entries, not its history.
+    """
+
+    def __init__(self, speed_in_s: float,
+                 on_change: Callable[[float, float], Any] | None = None):
         self._t: list[float] = [0.0]
         """Instants at which a speed starts."""
         self._x: list[float] = [0.0]
         """Travel at those instants."""
         self._v: list[float] = [speed_in_s]
         """Speed from each instant on (the last one holds for ever)."""
+        self.on_change = on_change
+        """Told (instant, speed) of every change once it is final."""
+        self.max_speed_in_s = speed_in_s
+        """The fastest of the settled speeds (of all of them once closed)."""
 
     def speed(self, t: float) -> float:
-        return self._v[bisect.bisect_right(self._t, t) - 1]
+        return speed_at(self._t, self._v, t)
 
     def travel(self, t: float) -> float:
-        """X(t): inches the belt has moved by time t (t ≥ 0)."""
+        """X(t): inches the belt has moved by time t (t ≥ the last settled change)."""
         k = bisect.bisect_right(self._t, t) - 1
         return self._x[k] + self._v[k] * (t - self._t[k])
 
@@ -46,20 +63,38 @@ class Belt:
         return self._t[k] + (x - self._x[k]) / self._v[k]
 
     def plan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
-        """From instant t1 run at v1 (and from t2 > t1 at v2), dropping later plans.
+        """From instant t1 (now or later) run at v1, and from t2 > t1 at v2, dropping
+        later plans.
 
         A new plan supersedes whatever was planned after t1 (the controller
         replans every cycle); a change within EPS_S of the last one replaces it.
+        Changes before ``t1`` whose successors have started are settled.
         """
+        if not v1 > 0 or (t2 is not None and not v2 > 0):
+            raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}")
         ts, xs, vs = self._t, self._x, self._v
         k = bisect.bisect_right(ts, t1 + EPS_S)
         if k < len(ts):
             del ts[k:], xs[k:], vs[k:]
-        if not v1 > 0 or (t2 is not None and not v2 > 0):
-            raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}")
+        self._settle(t1)
         self._append(t1, v1)
         if t2 is not None:
             self._append(t2, v2)
+
+    def _settle(self, now: float) -> None:
+        ts, xs, vs = self._t, self._x, self._v
+        n = bisect.bisect_right(ts, now) - 1
+        if n > 0:
+            self._emit(n)
+            del ts[:n], xs[:n], vs[:n]
+
+    def _emit(self, n: int) -> None:
+        top = max(self._v[:n])
+        if top > self.max_speed_in_s:
+            self.max_speed_in_s = top
+        if self.on_change is not None:
+            for t, v in zip(self._t[:n], self._v[:n]):
+                self.on_change(t, v)
 
     def _append(self, t: float, v: float) -> None:
         """Run at v from t on (t at or before the last change: that change's speed is v)."""
@@ -71,13 +106,10 @@ class Belt:
             ts.append(t)
             vs.append(v)
 
-    def max_speed(self) -> float:
-        """The fastest the belt has been (or is planned to be)."""
-        return float(max(self._v))
-
-    def history(self) -> list[tuple[float, float]]:
-        """(instant, speed) of every speed change, for plots and checks."""
-        return list(zip(self._t, self._v))
+    def close(self) -> None:
+        """Hand every change still held (planned ones included) to ``on_change``."""
+        self._emit(len(self._t))
+        del self._t[:], self._x[:], self._v[:]
 
 
 class InputConveyor:
@@ -89,28 +121,24 @@ class InputConveyor:
     """
 
     def __init__(self, env: simpy.Environment, speed_in_s: float, length_in: float,
-                 n_parts: int):
+                 on_change: Callable[[float, float], Any] | None = None):
         self.env = env
-        self.belt = Belt(speed_in_s)
+        self.belt = Belt(speed_in_s, on_change)
         self.length_in = length_in
         """Feeder drop point to B (in)."""
         self.loaded: Mailbox = Mailbox(env)
-        """Parts dropped on the belt by the feeder (part numbers)."""
+        """Parts dropped on the belt by the feeder (their records)."""
         self.at_bot: Mailbox = Mailbox(env)
         """Parts as they reach B."""
-        self.x_fed: list[float] = [float("nan")] * n_parts
-        """Belt travel at the instant each part was dropped on."""
+        self.x_fed: dict[int, float] = {}
+        """Belt travel at the instant each part on the belt was dropped (by index)."""
         self._timing = False
         self.process = env.process(self.run())
 
-    def drop(self, part: int) -> None:
-        """The feeder puts a part on the belt now."""
-        self.x_fed[part] = self.belt.travel(self.env.now)
+    def drop(self, part: Any) -> None:
+        """The feeder puts a part (its record) on the belt now."""
+        self.x_fed[part.part - 1] = self.belt.travel(self.env.now)
         self.loaded.put(part)
-
-    def time_at_bot(self, part: int) -> float:
-        """When a dropped part reaches B under the current schedule."""
-        return self.belt.time_at(self.x_fed[part] + self.length_in)
 
     def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
         """New speed plan from the controller (see :meth:`Belt.plan`).
@@ -128,14 +156,17 @@ class InputConveyor:
         time_at, x_fed, length = self.belt.time_at, self.x_fed, self.length_in
         while True:
             part = yield get()
+            x_at_bot = x_fed[part.part - 1] + length
             self._timing = True
             while True:
                 try:
-                    yield timeout(max(time_at(x_fed[part] + length) - env.now, 0.0))
+                    yield timeout(max(time_at(x_at_bot) - env.now, 0.0))
                     break
                 except simpy.Interrupt:  # the plan changed: re-time the part
                     pass
             self._timing = False
+            del x_fed[part.part - 1]
+            part.at_bot_s = env.now
             # The controller takes the part (and may replan the belt) before this
             # process's next get() is served: same-instant events run in order.
             self.at_bot.put(part)
@@ -145,17 +176,22 @@ class OutputConveyor:
     """Takes parts from the robot at TD and records their spacing (thesis §4.3 f).
 
     Spacing of a part = the output belt's travel between the previous part's
-    touch-down and its own: the distance between the two on the belt.
+    touch-down and its own: the distance between the two on the belt.  Each part
+    set down is handed on to ``delivered`` (the run's log).
     """
 
-    def __init__(self, env: simpy.Environment, speed_in_s: float, n_parts: int):
+    def __init__(self, env: simpy.Environment, speed_in_s: float,
+                 delivered: Callable[[Any], Any],
+                 on_change: Callable[[float, float], Any] | None = None):
         self.env = env
-        self.belt = Belt(speed_in_s)
+        self.belt = Belt(speed_in_s, on_change)
         self.placed: Mailbox = Mailbox(env)
         """Parts set down by the robot."""
-        self.spacing_in: list[float] = [float("nan")] * n_parts
+        self.delivered = delivered
         self.last_td_x: float | None = None
         """Belt travel at the last touch-down (None before the first)."""
+        self.last_td_s: float | None = None
+        """Instant of the last touch-down (None before the first)."""
         self.process = env.process(self.run())
 
     def gap_now(self) -> float | None:
@@ -168,9 +204,13 @@ class OutputConveyor:
         self.belt.plan(t1, v1, t2, v2)
 
     def run(self):  # noqa: ANN201 (SimPy generator)
+        env, get, travel, delivered = self.env, self.placed.get, self.belt.travel, self.delivered
         while True:
-            part = yield self.placed.get()
-            x = self.belt.travel(self.env.now)
+            part = yield get()
+            td = part.touchdown_s
+            x = travel(env.now)
             if self.last_td_x is not None:
-                self.spacing_in[part] = x - self.last_td_x
-            self.last_td_x = x
+                part.spacing_in = x - self.last_td_x
+                part.delivery_interval_s = td - self.last_td_s
+            self.last_td_x, self.last_td_s = x, td
+            delivered(part)

@@ -16,20 +16,18 @@ rate (``robot.motors``): the thesis's linear rate-against-load model (§6.1).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from functools import lru_cache
-from pathlib import Path
+from dataclasses import dataclass, field
 
 import numpy as np
-import yaml
 from numpy.typing import ArrayLike, NDArray
 
-from cell.errors import ScenarioError
+from cell.errors import InfeasibleError
 from cell.kinematics import DH_ALPHA
-from cell.scenario import Five, Point, _num, _sub, build
 
 Array = NDArray[np.float64]
-Points5 = tuple[Point, Point, Point, Point, Point]
+Five = tuple[float, float, float, float, float]
+Xyz = tuple[float, float, float]
+Points5 = tuple[Xyz, Xyz, Xyz, Xyz, Xyz]
 
 IN = 0.0254
 """Metres per inch."""
@@ -41,12 +39,12 @@ OZ = 0.028349523125
 class Links:
     """Mass properties of links 1-5, each in its own DH frame (frame i at the far end of link i)."""
 
-    mass_kg: Five = _num((1.6, 0.30, 0.25, 0.10, 0.20), lo=0.0)
+    mass_kg: Five = (1.6, 0.30, 0.25, 0.10, 0.20)
     com_m: Points5 = ((0.0, -0.03, 0.0), (-0.0889, 0.0, 0.0), (-0.0889, 0.0, 0.0),
                       (0.0, 0.0, 0.0), (0.0, 0.0, 0.03))
     """Centre of mass of each link in its own frame."""
-    inertia_kg_m2: Points5 = _num(((4e-3, 6e-3, 4e-3), (5e-5, 8e-4, 8e-4), (4e-5, 6.6e-4, 6.6e-4),
-                                   (1e-5, 1e-5, 1e-5), (6e-5, 6e-5, 3e-5)), lo=0.0)
+    inertia_kg_m2: Points5 = ((4e-3, 6e-3, 4e-3), (5e-5, 8e-4, 8e-4), (4e-5, 6.6e-4, 6.6e-4),
+                              (1e-5, 1e-5, 1e-5), (6e-5, 6e-5, 3e-5))
     """Principal moments (Ixx, Iyy, Izz) about the centre of mass, along the frame's axes."""
 
 
@@ -54,38 +52,25 @@ class Links:
 class Drives:
     """Stepper drives as seen at the joints."""
 
-    gear_ratio: Five = _num((73.6, 73.6, 44.0, 15.8, 15.8), lo=0.0, lo_open=True)
+    gear_ratio: Five = (73.6, 73.6, 44.0, 15.8, 15.8)
     """Motor radians per joint radian."""
-    rotor_inertia_kg_m2: Five = _num((5e-7,) * 5, lo=0.0)
+    rotor_inertia_kg_m2: Five = (5e-7,) * 5  # type: ignore[assignment]
     """Motor rotor inertia (motor side); the joint sees ratio² times this."""
-    stall_torque_nm: Five = _num((3.1, 3.4, 1.66, 1.14, 1.14), lo=0.0, lo_open=True)
+    stall_torque_nm: Five = (3.1, 3.4, 1.66, 1.14, 1.14)
     """τ_s, joint side: torque at zero speed of the torque-speed line."""
-    viscous_nm_s_rad: Five = _num((0.37, 0.47, 0.10, 0.028, 0.028), lo=0.0)
+    viscous_nm_s_rad: Five = (0.37, 0.47, 0.10, 0.028, 0.028)
     """K, joint side."""
 
 
 @dataclass(frozen=True)
 class DynamicsModel:
-    """The file ``microbot_dynamics.yaml``."""
+    """The arm's rigid-body model: links, drives and gravity (a ``microbot_dynamics.yaml``)."""
 
     name: str = "microbot"
     description: str = ""
-    gravity_m_s2: float = _num(9.80665, lo=0.0)
-    links: Links = _sub(Links)
-    drives: Drives = _sub(Drives)
-
-
-def load_dynamics(path: str | Path, file_for_errors: object = None,
-                  key: str = "mintime.dynamics_file") -> DynamicsModel:
-    """Read and validate a dynamics YAML (errors name the file, key and value)."""
-    path = Path(path)
-    if not path.is_file():
-        raise ScenarioError(file_for_errors or path, key, str(path), "no such dynamics file")
-    try:
-        raw = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise ScenarioError(path, "(file)", str(path), f"not valid YAML: {exc}") from None
-    return build(DynamicsModel, raw, path)
+    gravity_m_s2: float = 9.80665
+    links: Links = field(default_factory=Links)
+    drives: Drives = field(default_factory=Drives)
 
 
 def _cross(a: Array, b: Array) -> Array:
@@ -203,11 +188,7 @@ def free_speed(model: DynamicsModel, no_load_rad_s: ArrayLike) -> Array:
     spare = 1.0 - k * w0 / tau_s
     if np.any(spare <= 0):
         j = int(np.flatnonzero(spare <= 0)[0])
-        raise ScenarioError("dynamics", f"drives.viscous_nm_s_rad[{j}]", float(k[j]),
-                            "friction at the no-load rate exceeds the stall torque")
+        err = InfeasibleError(f"drive {j + 1}: friction at the no-load rate exceeds the stall torque")
+        err.joint = j  # type: ignore[attr-defined]
+        raise err
     return w0 / spare
-
-
-@lru_cache(maxsize=8)
-def _cached(path: str) -> DynamicsModel:
-    return load_dynamics(path)

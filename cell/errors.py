@@ -25,13 +25,18 @@ class UnreachableError(CellError, ValueError):
     """A pose is out of the arm's reach or outside a joint's range.
 
     ``index`` is the position of the first bad pose in the batch given to the
-    inverse kinematics.
+    inverse kinematics; ``joint`` the joint (0-4) outside its range, or None when
+    the pose is out of reach altogether.
     """
 
-    def __init__(self, message: str, index: int = 0):
-        self.index = index
+    def __init__(self, message: str, index: int = 0, joint: int | None = None):
+        self.index, self.joint = index, joint
         super().__init__(message)
 
 
 class InfeasibleError(CellError, ValueError):
     """A requested timing asks more than the motors can give."""
+
+
+class NoMotionError(CellError):
+    """No admissible motion along a path under the given bounds (the planner)."""

@@ -9,13 +9,13 @@ The cell's placement Z (eq. 6.1), the hand E (eq. 6.2), the part P and grasp PG
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from cell.errors import UnreachableError
-from cell.scenario import Scenario
 from cell.transforms import Frame, inverse, rot, trans
 
 JOINTS = ("theta1", "theta2", "theta3", "theta4", "theta5")
@@ -31,22 +31,46 @@ LIMIT_TOL_RAD = 1e-7
 
 @dataclass(frozen=True)
 class Arm:
-    """The arm's geometry: link lengths and joint ranges (radians)."""
+    """The arm's geometry: link lengths (in) and joint ranges (radians, Table 3.1)."""
 
     l2: float = 7.0
     l3: float = 7.0
-    limits: NDArray[np.float64] = field(default_factory=lambda: np.radians(
-        [[-90.0, 90.0], [-35.0, 144.0], [-149.0, 0.0], [-180.0, 0.0], [-180.0, 180.0]]))
-    """(5, 2) lower and upper bounds, Table 3.1 in the DH convention of SPEC §2."""
+    limits: tuple[tuple[float, float], ...] = tuple(
+        (float(lo), float(hi)) for lo, hi in np.radians(
+            [[-90.0, 90.0], [-35.0, 144.0], [-149.0, 0.0], [-180.0, 0.0], [-180.0, 180.0]]))
+    """(5, 2) lower and upper bounds in the DH convention of docs/model.md."""
 
-    @classmethod
-    def from_scenario(cls, s: Scenario) -> Arm:
-        return cls(s.robot.l2_in, s.robot.l3_in,
-                   np.radians(np.array(s.robot.joint_limits_deg.as_array(), dtype=float)))
+    @property
+    def limits_rad(self) -> NDArray[np.float64]:
+        return np.asarray(self.limits, dtype=float)
 
     @property
     def link_a(self) -> NDArray[np.float64]:
         return np.array([0.0, self.l2, self.l3, 0.0, 0.0])
+
+
+@dataclass(frozen=True)
+class Hand:
+    """The hand of eq. 6.2: w11 = L1 + √(L2² − (G − G0)²/2) at finger opening G (in)."""
+
+    l1: float = 1.884
+    l2: float = 1.700
+    g0: float = 1.520
+    open_in: float = 2.5
+    """Finger opening with no part (assumed)."""
+
+
+@dataclass(frozen=True)
+class Placement:
+    """Where the robot stands: Z = Trans(base + shoulder height) · Rot(z, yaw) (eq. 6.1)."""
+
+    base_in: tuple[float, float, float] = (-8.0, 8.0, 0.0)
+    shoulder_height_in: float = 7.68
+    yaw_rad: float = float(np.radians(-45.0))
+
+    def frame(self) -> Frame:
+        bx, by, bz = self.base_in
+        return trans(bx, by, bz + self.shoulder_height_in) @ rot("z", self.yaw_rad)
 
 
 def a_matrix(theta: ArrayLike, d: float, a: float, alpha: float) -> Frame:
@@ -76,20 +100,22 @@ def _wrap_from(angle: NDArray[np.float64], lo: float) -> NDArray[np.float64]:
     return lo + np.mod(angle - lo, 2 * np.pi)
 
 
-def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *, labels: list[str] | None = None,
+def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *,
+                       label: Callable[[int], str] | None = None,
                        check_limits: bool = True) -> NDArray[np.float64]:
-    """Joint angles (..., 5) for target frames T5 (..., 4, 4), SPEC §2 closed form.
+    """Joint angles (..., 5) for target frames T5 (..., 4, 4), in closed form
+    (docs/sources.md: eq. 3.26-3.31 as scanned are garbled).
 
     The elbow-down branch (θ3 ≤ 0) of Table 3.1's ranges is taken; θ1 is the
     solution inside the base's range.  A pose out of reach (|C3| > 1) or with a
     joint outside its range raises :class:`UnreachableError` naming the pose
-    (``labels[i]`` if given) and the joint.  Nothing is clamped.
+    (``label(i)`` if given) and the joint.  Nothing is clamped.
     """
     t = np.asarray(t5, dtype=float)
     shape = t.shape[:-2]
     t = t.reshape(-1, 4, 4)
     n, o, a, p = t[:, :3, 0], t[:, :3, 1], t[:, :3, 2], t[:, :3, 3]
-    lim = arm.limits
+    lim = arm.limits_rad
 
     th1 = np.arctan2(p[:, 1], p[:, 0])
     # The wrist may sit behind the base axis (θ2 > 90°): then the other atan2 branch.
@@ -115,8 +141,8 @@ def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *, labels: list[str] | N
     q[:, 4] = _wrap_from(q[:, 4], lim[4, 0] - LIMIT_TOL_RAD)
 
     def name(i: int) -> str:
-        if labels is not None:
-            return labels[i]
+        if label is not None:
+            return label(i)
         return "pose at p = (" + ", ".join(f"{v:.4f}" for v in p[i]) + ") in the robot frame"
 
     if reach_bad.any():
@@ -124,7 +150,7 @@ def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *, labels: list[str] | N
         dist = float(np.hypot(r[i], z[i]))
         raise UnreachableError(
             f"{name(i)} is out of reach: the wrist would be {dist:.4f} in from the shoulder, "
-            f"the arm reaches {abs(arm.l2 - arm.l3):.4f} to {arm.l2 + arm.l3:.4f} in", i)
+            f"the arm reaches {abs(arm.l2 - arm.l3):.4f} to {arm.l2 + arm.l3:.4f} in", i, None)
     if check_limits:
         tol = LIMIT_TOL_RAD
         outside = (q < lim[:, 0] - tol) | (q > lim[:, 1] + tol)
@@ -133,27 +159,20 @@ def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *, labels: list[str] | N
             lo, hi = np.degrees(lim[j])
             raise UnreachableError(
                 f"{name(i)} needs {JOINTS[j]} ({JOINT_NAMES[j]}) = {np.degrees(q[i, j]):.3f}°, "
-                f"outside its range [{lo:g}°, {hi:g}°]", i)
+                f"outside its range [{lo:g}°, {hi:g}°]", i, j)
     return q.reshape(shape + (5,))
 
 
 # ----------------------------------------------------------------------------- the cell's frames
-def placement(s: Scenario) -> Frame:
-    """Z = Trans(base x, base y, shoulder height) · Rot(z, yaw) (eq. 6.1)."""
-    bx, by, bz = s.cell.robot_base_in
-    return trans(bx, by, bz + s.cell.shoulder_height_in) @ rot("z", np.radians(s.cell.robot_yaw_deg))
-
-
-def hand_length(opening_in: ArrayLike, s: Scenario) -> NDArray[np.float64]:
+def hand_length(opening_in: ArrayLike, hand: Hand = Hand()) -> NDArray[np.float64]:
     """w11 = L1 + √(L2² - (G - G0)²/2), the hand length at finger opening G (eq. 6.2)."""
-    h = s.robot.hand
     g = np.asarray(opening_in, dtype=float)
-    return h.l1_in + np.sqrt(h.l2_in**2 - (g - h.g0_in) ** 2 / 2)
+    return hand.l1 + np.sqrt(hand.l2**2 - (g - hand.g0) ** 2 / 2)
 
 
-def hand(opening_in: ArrayLike, s: Scenario) -> Frame:
+def hand_frame(opening_in: ArrayLike, hand: Hand = Hand()) -> Frame:
     """E = Trans(0, 0, w11): the tool centre along the approach vector (eq. 6.2)."""
-    w = hand_length(opening_in, s)
+    w = hand_length(opening_in, hand)
     return trans(np.zeros_like(w), 0.0, w)
 
 
@@ -168,13 +187,14 @@ GRASP: Frame = rot("x", np.pi)
 
 
 def arm_target(xyz_in: ArrayLike, phi_rad: ArrayLike, opening_in: ArrayLike,
-               s: Scenario) -> Frame:
+               placement: Placement = Placement(), hand: Hand = Hand()) -> Frame:
     """T5 = Z⁻¹ P PG E⁻¹ for tool-centre points in the global frame (eq. 6.6-6.7)."""
-    return inverse(placement(s)) @ part_frame(xyz_in, phi_rad) @ GRASP @ inverse(
-        hand(opening_in, s))
+    return inverse(placement.frame()) @ part_frame(xyz_in, phi_rad) @ GRASP @ inverse(
+        hand_frame(opening_in, hand))
 
 
-def tool_centre(q: ArrayLike, opening_in: ArrayLike, s: Scenario) -> NDArray[np.float64]:
+def tool_centre(q: ArrayLike, opening_in: ArrayLike, placement: Placement = Placement(),
+                arm: Arm = Arm(), hand: Hand = Hand()) -> NDArray[np.float64]:
     """Global tool-centre point Z T5 E for joint angles q (eq. 6.6)."""
-    t = placement(s) @ forward(q, Arm.from_scenario(s)) @ hand(opening_in, s)
+    t = placement.frame() @ forward(q, arm) @ hand_frame(opening_in, hand)
     return t[..., :3, 3]

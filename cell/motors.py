@@ -14,12 +14,27 @@ regime's time for a velocity is one numpy sum.
 from __future__ import annotations
 
 import bisect
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from cell.errors import InfeasibleError
-from cell.scenario import Motors
+
+Five = tuple[float, float, float, float, float]
+
+
+@dataclass(frozen=True)
+class Motors:
+    """The five stepper drives (§6.1): base, shoulder, elbow, wrist pitch, wrist roll."""
+
+    steps_per_rad: Five = (1125.0, 1125.0, 672.0, 241.0, 241.0)
+    """Motor (half-)steps per radian of joint motion."""
+    max_rate_no_load_rad_s: Five = (0.4194527, 0.36, 0.82, 2.02, 2.02)
+    max_rate_full_load_rad_s: Five = (0.37, 0.15, 0.23, 1.31, 1.31)
+    full_load_oz: float = 16.0
+    nominal_fraction: float = 0.75
+    """Nominal operation at 75 % of rated output, peak on request (§7.2)."""
 
 
 def max_rates(load_oz: ArrayLike, motors: Motors, fraction: float = 1.0) -> NDArray[np.float64]:

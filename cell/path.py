@@ -22,11 +22,45 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
-from cell.errors import ScenarioError, UnreachableError
-from cell.kinematics import Arm, arm_target, inverse_kinematics
-from cell.scenario import Scenario
+from cell.kinematics import Arm, Hand, Placement, arm_target, inverse_kinematics
 
 REGIMES = ("R1", "R2", "R3", "R4")
+
+Xyz = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class Route:
+    """The points the path runs through and how it is divided (§4.2, Fig. 9)."""
+
+    bot_in: Xyz = (-16.0, 0.0, 3.0)
+    """B: beginning of tracking on the input belt."""
+    f_in: Xyz = (-8.0, 0.0, 3.0)
+    """F: end of input tracking."""
+    g_in: Xyz = (0.0, 8.0, 3.0)
+    """G: beginning of output tracking."""
+    eot_in: Xyz = (0.0, 16.0, 3.0)
+    """K: end of tracking on the output belt."""
+    pick_height_in: float = 1.0
+    place_height_in: float = 1.0
+    lo_from_bot_in: float = 4.0
+    td_from_g_in: float = 4.0
+    moves: tuple[int, int, int, int] = (96, 117, 96, 150)
+    """Moves in R I .. R IV."""
+
+
+@dataclass(frozen=True)
+class CellGeometry:
+    """Everything the path's shape and joint angles depend on (hashable: a cache key)."""
+
+    route: Route = Route()
+    placement: Placement = Placement()
+    arm: Arm = Arm()
+    hand: Hand = Hand()
+    part_size_in: float = 2.0
+    """The finger opening while a part is held (§6.2 f)."""
+    part_weight_oz: float = 4.0
+    """The load carried from LO to TD (§6.2 f)."""
 
 
 @dataclass(frozen=True)
@@ -108,68 +142,40 @@ def _arc(start: NDArray, end: NDArray, centre_xy: NDArray, yaw: float,
     return np.column_stack([centre_xy[0] + rad * np.cos(ang), centre_xy[1] + rad * np.sin(ang), z])
 
 
-def build_path(s: Scenario) -> TransferPath:
-    """The path of scenario ``s`` with its joint angles (eq. 6.7 at every point).
+def build_path(g: CellGeometry = CellGeometry()) -> TransferPath:
+    """The path through ``g.route`` with its joint angles (eq. 6.7 at every point).
 
-    Raises :class:`ScenarioError` naming the scenario key nearest the first
-    point that is out of reach or needs a joint outside its range.
+    Raises :class:`~cell.errors.UnreachableError` for the first point out of
+    reach or needing a joint outside its range; its ``index`` is that point.
     """
-    p = s.path
-    m = p.moves
-    b, f, g, k = (np.asarray(v, dtype=float) for v in (p.bot_in, p.f_in, p.g_in, p.eot_in))
-    centre = np.asarray(s.cell.robot_base_in[:2], dtype=float)
-    yaw = np.radians(s.cell.robot_yaw_deg)
+    p = g.route
+    m1, m2, m3, m4 = p.moves
+    b, f, gp, k = (np.asarray(v, dtype=float) for v in (p.bot_in, p.f_in, p.g_in, p.eot_in))
+    centre = np.asarray(g.placement.base_in[:2], dtype=float)
+    yaw = g.placement.yaw_rad
 
-    r1, lo_local = _dip(b, f, p.lo_from_bot_in, p.pick_height_in, m.R1)
-    r2 = _arc(f, g, centre, yaw, m.R2)
-    r3, td_local = _dip(g, k, p.td_from_g_in, p.place_height_in, m.R3)
-    r4 = _arc(k, b, centre, yaw, m.R4)
+    r1, lo_local = _dip(b, f, p.lo_from_bot_in, p.pick_height_in, m1)
+    r2 = _arc(f, gp, centre, yaw, m2)
+    r3, td_local = _dip(gp, k, p.td_from_g_in, p.place_height_in, m3)
+    r4 = _arc(k, b, centre, yaw, m4)
     xyz = np.vstack([r1, r2[1:], r3[1:], r4[1:]])
-    regime = np.concatenate([np.full(m.R1 + 1, 1), np.full(m.R2, 2), np.full(m.R3, 3),
-                             np.full(m.R4, 4)])
+    regime = np.concatenate([np.full(m1 + 1, 1), np.full(m2, 2), np.full(m3, 3),
+                             np.full(m4, 4)])
     lo = lo_local
-    g_idx = m.R1 + m.R2
-    td = g_idx + td_local
+    td = m1 + m2 + td_local
     quarter = np.pi / 2
-    phi = np.concatenate([np.zeros(m.R1 + 1), np.linspace(0, quarter, m.R2 + 1)[1:],
-                          np.full(m.R3, quarter), np.linspace(quarter, 0, m.R4 + 1)[1:]])
+    phi = np.concatenate([np.zeros(m1 + 1), np.linspace(0, quarter, m2 + 1)[1:],
+                          np.full(m3, quarter), np.linspace(quarter, 0, m4 + 1)[1:]])
     idx = np.arange(len(regime))
     holding = (idx >= lo) & (idx <= td)
-    opening = np.where(holding, s.part.size_in, s.robot.hand.open_in)
-    load = np.where((idx > lo) & (idx <= td), s.part.weight_oz, 0.0)
+    opening = np.where(holding, g.part_size_in, g.hand.open_in)
+    load = np.where((idx > lo) & (idx <= td), g.part_weight_oz, 0.0)
 
-    labels = [f"path point {i} ({REGIMES[regime[i] - 1]}) at "
-              f"({xyz[i, 0]:.3f}, {xyz[i, 1]:.3f}, {xyz[i, 2]:.3f})" for i in range(len(idx))]
-    try:
-        q = inverse_kinematics(arm_target(xyz, phi, opening, s), Arm.from_scenario(s),
-                               labels=labels)
-    except UnreachableError as exc:
-        i = exc.index
-        key, value = _blame(s, i, regime[i], xyz[i])
-        raise ScenarioError(s.source, key, value, str(exc)) from None
+    def label(i: int) -> str:
+        return (f"path point {i} ({REGIMES[regime[i] - 1]}) at "
+                f"({xyz[i, 0]:.3f}, {xyz[i, 1]:.3f}, {xyz[i, 2]:.3f})")
+
+    q = inverse_kinematics(arm_target(xyz, phi, opening, g.placement, g.hand), g.arm,
+                           label=label)
     return TransferPath(xyz, regime, phi, opening, load, q, lo, td)
 
-
-def _blame(s: Scenario, i: int, regime: int, point: NDArray) -> tuple[str, object]:
-    """The scenario key whose point lies nearest an unreachable path point."""
-    p = s.path
-    lo_xyz = _along(p.bot_in, p.f_in, p.lo_from_bot_in, p.pick_height_in)
-    td_xyz = _along(p.g_in, p.eot_in, p.td_from_g_in, p.place_height_in)
-    candidates = {
-        1: [("path.bot_in", p.bot_in), ("path.f_in", p.f_in),
-            ("path.pick_height_in", lo_xyz)],
-        2: [("path.f_in", p.f_in), ("path.g_in", p.g_in)],
-        3: [("path.g_in", p.g_in), ("path.eot_in", p.eot_in),
-            ("path.place_height_in", td_xyz)],
-        4: [("path.eot_in", p.eot_in), ("path.bot_in", p.bot_in)],
-    }[int(regime)]
-    key, _ = min(candidates,
-                     key=lambda kv: float(np.linalg.norm(np.subtract(kv[1], point))))
-    value = s.get(key)
-    return key, list(value) if isinstance(value, tuple) else value
-
-
-def _along(start: tuple, end: tuple, distance: float, z: float) -> NDArray:
-    a, b = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
-    xy = a[:2] + (b[:2] - a[:2]) * distance / np.linalg.norm(b - a)
-    return np.array([xy[0], xy[1], z])

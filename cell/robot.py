@@ -18,17 +18,16 @@ and the move times are only floored by the motors (§4.3 c).
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 import numpy as np
 import simpy
 
-from cell.errors import CellError
+from cell.conveyors import EPS_S
 from cell.mailbox import Mailbox
 from cell.motors import Segment
-from cell.scenario import Scenario
+from cell.steptable import StepTable
 
 
 @dataclass(frozen=True)
@@ -71,11 +70,12 @@ class RobotTiming:
         return self.r3_pre.time(u), self.r3_post.time(u)
 
 
-def build_timing(s: Scenario) -> RobotTiming:
-    """Solve the path once and reduce it to the regime segments (thesis §6.1)."""
-    from cell.steptable import StepTable
+def build_timing(t: StepTable, fastest: dict[str, float] | None = None) -> RobotTiming:
+    """Reduce a solved path to the regime segments (thesis §6.1).
 
-    t = StepTable.from_scenario(s)
+    ``fastest``: the planner's rest-to-rest R II and R IV times, which floor the
+    constant-rate ones (``robot.timing: minimum-time``); None for the thesis's model.
+    """
     ell, tp = t.velocity_lengths, t.peak_min_times
     rows = {name: np.flatnonzero(mask) for name, mask in t.segment_rows().items()}
 
@@ -87,14 +87,7 @@ def build_timing(s: Scenario) -> RobotTiming:
     track1, track3 = segment("r1_pre", drop_last=True), segment("r3_pre", drop_last=True)
     r2seg, r4seg = segment("r2"), segment("r4")
     r2_min, r4_min = r2seg.floor_s, r4seg.floor_s
-    if s.robot.timing == "minimum-time":
-        try:
-            from cell.mintime import fastest_regime_times
-        except ImportError:
-            raise CellError("robot.timing = 'minimum-time' needs the minimum-time planner "
-                            "(cell.mintime.fastest_regime_times), which is not available; "
-                            "use robot.timing: constant-rate") from None
-        fastest = fastest_regime_times(s, t)
+    if fastest is not None:
         r2_min, r4_min = max(r2_min, float(fastest["R2"])), max(r4_min, float(fastest["R4"]))
     return RobotTiming(
         r1_pre=segment("r1_pre"), r1_post=segment("r1_post"), r2=r2seg,
@@ -106,72 +99,54 @@ def build_timing(s: Scenario) -> RobotTiming:
         r2_min_s=r2_min, r4_min_s=r4_min)
 
 
-@functools.lru_cache(maxsize=16)
-def _cached_timing(cell: Any, path: Any, part: Any, robot: Any, mintime: Any,
-                   source: str) -> RobotTiming:
-    return build_timing(Scenario(cell=cell, path=path, part=part, robot=robot,
-                                 mintime=mintime, source=source))
-
-
-def robot_timing(s: Scenario) -> RobotTiming:
-    """:func:`build_timing`, cached on the sections that shape the path and the motors.
-
-    A sweep's replications (and both policies) share one solved path per process.
-    With the minimum-time planner the scenario's file is part of the key (the
-    planner may read a dynamics file beside it).
-    """
-    source = s.source if s.robot.timing == "minimum-time" else ""
-    return _cached_timing(s.cell, s.path, s.part, s.robot, s.mintime, source)
-
-
 # --------------------------------------------------------------------------- process
 class Order(NamedTuple):
-    """One transfer cycle as the controller sends it (step 6.1): regime times, s."""
+    """One transfer cycle as the controller sends it (step 6.1), times from now (s)."""
 
     part: Any
+    """The part's record; the robot writes its lift-off and touch-down instants."""
     to_lo_s: float
     """B → LO (R I up to lift-off)."""
-    lo_to_td_s: float
-    """LO → F → G → TD."""
-    td_to_bot_s: float
-    """TD → K → B (rest of R III and R IV)."""
+    to_td_s: float
+    """B → TD (R I, R II and R III up to touch-down)."""
+    cycle_s: float
+    """B → B: the whole cycle; the robot is free again this long after starting."""
 
 
 class Robot:
-    """The arm as a SimPy process: takes an :class:`Order`, runs it, hands the part over.
+    """The arm as a SimPy process: told an :class:`Order`, runs it, hands the part over.
 
-    ``lo`` and ``td`` are the current cycle's lift-off and touch-down events (any
-    process may wait on them); ``free_at_s`` is when it will be back at B.  One
-    timeout per leg up to TD: a regime's moves are summed, never simulated one by
-    one.  The way back (TD → K → B) needs no event: the controller sends no order
-    before ``free_at_s``, and the robot starts the next one when it comes.
+    The robot owns its state: ``free_at_s``, when it will be back at B, is set the
+    moment it is told an order.  One timeout per order (B to TD): a regime's moves
+    are summed, never simulated one by one; lift-off is written when the order is
+    taken, and the way back (TD → K → B) needs no event, since no order comes
+    before ``free_at_s``.
     """
 
-    def __init__(self, env: simpy.Environment, output: Mailbox, log: Any):
+    def __init__(self, env: simpy.Environment, output: Mailbox):
         self.env = env
-        self.log = log
-        """Where lift-off and touch-down instants are written (``pick_s``, ``touchdown_s``)."""
         self.orders: Mailbox = Mailbox(env)
         """Cycles to run, from the controller."""
         self.output = output
         """Where parts are set down (the output conveyor's mailbox)."""
         self.free_at_s = 0.0
         """When the robot is (or will be) back at B, ready for a part."""
-        self.lo: simpy.Event | None = None
-        self.td: simpy.Event | None = None
         self.process = env.process(self.run())
 
+    def is_free(self, now: float) -> bool:
+        return self.free_at_s <= now + EPS_S
+
+    def order(self, order: Order) -> None:
+        """Start a cycle now (the robot must be free)."""
+        self.free_at_s = self.env.now + order.cycle_s
+        self.orders.put(order)
+
     def run(self):  # noqa: ANN201 (SimPy generator)
-        env, log, timeout = self.env, self.log, self.env.timeout
-        pick_s, touchdown_s, put = log.pick_s, log.touchdown_s, self.output.put
-        get = self.orders.get
+        env, timeout, put, get = self.env, self.env.timeout, self.output.put, self.orders.get
         while True:
             order: Order = yield get()
-            part, to_lo, to_td = order.part, order.to_lo_s, order.to_lo_s + order.lo_to_td_s
-            # LO is an event others may wait on; the robot itself moves on to TD.
-            self.lo = timeout(to_lo)
-            pick_s[part] = env.now + to_lo
-            self.td = td = timeout(to_td)
-            yield td
-            touchdown_s[part] = env.now
+            part = order.part
+            part.pick_s = env.now + order.to_lo_s
+            yield timeout(order.to_td_s)
+            part.touchdown_s = env.now
             put(part)

@@ -1,76 +1,89 @@
-"""Scenario files: read, validate and fill in the thesis's defaults.
+"""Scenario files: the schema, its defaults (the thesis's cell) and validation.
 
-A scenario is a YAML mapping whose sections mirror the dataclasses below.  Any
-key left out takes the thesis's value (source in the comment beside it).  A bad
-key or value raises :class:`~cell.errors.ScenarioError` naming the file, the
-dotted key and the value, before anything is computed or written.
+A scenario is a YAML mapping whose sections mirror the models below; a key left
+out takes the thesis's value (source beside it).  The schema is a set of
+pydantic models: they validate types and bounds, document every key (the
+attribute docstrings) and give the JSON Schema that editors use for scenario
+files (``cell schema``).  Every failure becomes one
+:class:`~cell.errors.ScenarioError` line naming the file, the dotted key and
+the value.  Checks that need the robot's maths (a point out of reach, a cycle
+the motors cannot make) are made where the cell is assembled
+(:mod:`cell.assembly`), with the same kind of message.
 
-Keys are written dotted when overridden, as in a sweep file:
-``controller.ideal_cycle_s``, ``robot.motors.nominal_fraction``.
+Magnitudes are bounded so that no input can exhaust the machine or overflow:
+lengths and coordinates within 1,000 in, belt speeds up to 1,000 in/s, times up
+to 10⁶ s, at most 10,000 moves per regime, 10⁷ parts per run, 10⁵ planner grid
+points, and seeds below 2¹²⁸.
 """
 
 from __future__ import annotations
 
-import dataclasses
-import functools
 import math
-import types
-import typing
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields, is_dataclass
 from pathlib import Path
-from typing import Any, Literal, Union
+from typing import Annotated, Any, Literal
 
-import yaml
+from pydantic import BaseModel, Field, PrivateAttr, ValidationError, field_validator
 
+from cell import registry
 from cell.errors import ScenarioError
+from cell.overrides import apply_overrides, merge
+from cell.settings import Section, error_from_validation, model_at
 
-Point = tuple[float, float, float]
-Five = tuple[float, float, float, float, float]
-
-
-def _num(default: Any, *, lo: float | None = None, hi: float | None = None,
-         lo_open: bool = False, doc: str = "") -> Any:
-    """A numeric field with bounds (checked elementwise for tuples)."""
-    meta = {"lo": lo, "hi": hi, "lo_open": lo_open, "doc": doc}
-    if isinstance(default, (dict, list)):
-        raise TypeError("use a tuple or a factory for mutable defaults")
-    return field(default=default, metadata=meta)
+MAX_LENGTH_IN = 1000.0
+MAX_SPEED_IN_S = 1000.0
+MAX_TIME_S = 1e6
+MAX_PARTS = 10_000_000
+MAX_MOVES = 10_000
+MAX_GRID_POINTS = 100_000
+MAX_SEED = 2**128
 
 
-def _sub(cls: type) -> Any:
-    return field(default_factory=cls)
+def _num(default: Any = None, *, gt: float | None = None, ge: float | None = None,
+         le: float | None = None) -> Any:
+    """A finite number field (ints accepted, booleans and text refused) with bounds."""
+    return Field(default, strict=True, allow_inf_nan=False, gt=gt, ge=ge, le=le)
+
+
+Coord = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=-MAX_LENGTH_IN,
+                               le=MAX_LENGTH_IN)]
+Point = tuple[Coord, Coord, Coord]
+Positive = Annotated[float, Field(strict=True, allow_inf_nan=False, gt=0.0, le=1e9)]
+NonNegative = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=0.0, le=1e9)]
+Five = tuple[Positive, Positive, Positive, Positive, Positive]
+Angle = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=-360.0, le=360.0)]
+Range = tuple[Angle, Angle]
 
 
 # --------------------------------------------------------------------------- cell
-@dataclass(frozen=True)
-class CellLayout:
+class LayoutSettings(Section):
     """Where the robot stands (thesis §4.1, §6.1, eq. 6.1)."""
 
     robot_base_in: Point = (-8.0, 8.0, 0.0)
     """Base axis on the table, global frame (§4.1)."""
-    shoulder_height_in: float = _num(7.68, lo=0.0, lo_open=True)
+    shoulder_height_in: float = _num(7.68, gt=0.0, le=MAX_LENGTH_IN)
     """Shoulder above the table (§6.1)."""
-    robot_yaw_deg: float = -45.0
+    robot_yaw_deg: float = _num(-45.0, ge=-360.0, le=360.0)
     """Robot frame = global rotated about z by this (eq. 6.1)."""
-    belt_width_in: float = _num(8.0, lo=0.0, lo_open=True)
+    belt_width_in: float = _num(8.0, gt=0.0, le=MAX_LENGTH_IN)
     """Both conveyors (§4.1); used for drawings only."""
 
 
 # --------------------------------------------------------------------------- path
-@dataclass(frozen=True)
-class Moves:
+class MoveSettings(Section):
     """Moves per regime; 459 in all, 460 points (§4.2)."""
 
-    R1: int = _num(96, lo=2)
-    R2: int = _num(117, lo=1)
-    R3: int = _num(96, lo=2)
-    R4: int = _num(150, lo=1)
-    """150 equal chords reproduce the R IV length 35.5424 in (SPEC §3, derived)."""
+    R1: int = Field(96, strict=True, ge=2, le=MAX_MOVES)
+    """Divisions along the input belt, B → F."""
+    R2: int = Field(117, strict=True, ge=1, le=MAX_MOVES)
+    """Divisions of the F → G arc."""
+    R3: int = Field(96, strict=True, ge=2, le=MAX_MOVES)
+    """Divisions along the output belt, G → K."""
+    R4: int = Field(150, strict=True, ge=1, le=MAX_MOVES)
+    """150 equal chords reproduce the R IV length 35.5424 in that Table 7.1's Vavg implies."""
 
 
-@dataclass(frozen=True)
-class PathSpec:
+class PathSettings(Section):
     """The transfer path B → F → G → K → B (thesis §4.2, Fig. 9)."""
 
     bot_in: Point = (-16.0, 0.0, 3.0)
@@ -81,184 +94,205 @@ class PathSpec:
     """G, beginning of output tracking (§4.2)."""
     eot_in: Point = (0.0, 16.0, 3.0)
     """K, end of tracking on the output belt (§4.2)."""
-    pick_height_in: float = _num(1.0, lo=0.0, lo_open=True)
+    pick_height_in: float = _num(1.0, gt=0.0, le=MAX_LENGTH_IN)
     """Tool-centre height at lift-off LO: the cube's centre (§4.2, §6.2 f)."""
-    place_height_in: float = _num(1.0, lo=0.0, lo_open=True)
+    place_height_in: float = _num(1.0, gt=0.0, le=MAX_LENGTH_IN)
     """Tool-centre height at touch-down TD (§4.2)."""
-    lo_from_bot_in: float = _num(4.0, lo=0.0, lo_open=True)
-    """Distance B → LO; the thesis does not place LO, SPEC §3 reads it as mid-window."""
-    td_from_g_in: float = _num(4.0, lo=0.0, lo_open=True)
-    """Distance G → TD (SPEC §3: mid-window)."""
-    moves: Moves = _sub(Moves)
+    lo_from_bot_in: float = _num(4.0, gt=0.0, le=MAX_LENGTH_IN)
+    """Distance B → LO; the thesis does not place LO: mid-window (docs/model.md)."""
+    td_from_g_in: float = _num(4.0, gt=0.0, le=MAX_LENGTH_IN)
+    """Distance G → TD: mid-window, as LO."""
+    moves: MoveSettings = MoveSettings()
 
 
 # --------------------------------------------------------------------------- part
-@dataclass(frozen=True)
-class Part:
+class PartSettings(Section):
     """The parts: oriented cubes (thesis §6.2 c, f)."""
 
-    size_in: float = _num(2.0, lo=0.0, lo_open=True)
+    size_in: float = _num(2.0, gt=0.0, le=MAX_LENGTH_IN)
     """Cube edge; also the finger opening while holding it (§6.2 f)."""
-    weight_oz: float = _num(4.0, lo=0.0)
+    weight_oz: float = _num(4.0, ge=0.0, le=1e6)
     """Load carried from LO to TD (§6.2 f)."""
 
 
 # --------------------------------------------------------------------------- robot
-@dataclass(frozen=True)
-class JointLimits:
-    """Joint ranges in the DH convention of Table 3.1 (SPEC §2)."""
+class JointLimitSettings(Section):
+    """Joint ranges (degrees) in the DH convention of Table 3.1 (docs/model.md)."""
 
-    theta1: tuple[float, float] = (-90.0, 90.0)
-    theta2: tuple[float, float] = (-35.0, 144.0)
-    theta3: tuple[float, float] = (-149.0, 0.0)
-    theta4: tuple[float, float] = (-180.0, 0.0)
-    """The thesis's ±90° about the in-line pose, which is θ4 = -90° here (SPEC §2)."""
-    theta5: tuple[float, float] = (-180.0, 180.0)
+    theta1: Range = (-90.0, 90.0)
+    """Base ±90°."""
+    theta2: Range = (-35.0, 144.0)
+    """Shoulder +144° / -35°."""
+    theta3: Range = (-149.0, 0.0)
+    """Elbow 0° / -149°."""
+    theta4: Range = (-180.0, 0.0)
+    """Wrist pitch: the thesis's ±90° about the in-line pose, which is θ4 = -90° here."""
+    theta5: Range = (-180.0, 180.0)
+    """Wrist roll ±180°."""
 
-    def as_array(self) -> list[tuple[float, float]]:
+    def as_list(self) -> list[tuple[float, float]]:
         return [self.theta1, self.theta2, self.theta3, self.theta4, self.theta5]
 
 
-@dataclass(frozen=True)
-class Hand:
-    """Hand length against finger opening, eq. 6.2 (corrected in SPEC §2)."""
+class HandSettings(Section):
+    """Hand length against finger opening G, eq. 6.2 (corrected: docs/sources.md)."""
 
-    l1_in: float = _num(1.884, lo=0.0)
-    l2_in: float = _num(1.700, lo=0.0, lo_open=True)
-    g0_in: float = _num(1.520, lo=0.0)
-    open_in: float = _num(2.5, lo=0.0, lo_open=True)
-    """Finger opening with no part; assumed (the thesis gives no figure)."""
+    l1_in: float = _num(1.884, ge=0.0, le=MAX_LENGTH_IN)
+    """L1 of w11 = L1 + √(L2² − (G − G0)²/2)."""
+    l2_in: float = _num(1.700, gt=0.0, le=MAX_LENGTH_IN)
+    """L2 of eq. 6.2."""
+    g0_in: float = _num(1.520, ge=0.0, le=MAX_LENGTH_IN)
+    """G0 of eq. 6.2."""
+    open_in: float = _num(2.5, gt=0.0, le=MAX_LENGTH_IN)
+    """Finger opening with no part; ASSUMED (the thesis gives no figure)."""
 
 
-@dataclass(frozen=True)
-class Motors:
-    """Stepper drives (thesis §6.1, SPEC §4)."""
+class MotorSettings(Section):
+    """Stepper drives (thesis §6.1): rates linear in the load, 75 % nominal."""
 
-    steps_per_rad: Five = _num((1125.0, 1125.0, 672.0, 241.0, 241.0), lo=0.0, lo_open=True)
+    steps_per_rad: Five = (1125.0, 1125.0, 672.0, 241.0, 241.0)
     """TeachMover half-steps per radian: base, shoulder, elbow, pitch, roll."""
-    max_rate_no_load_rad_s: Five = _num((0.4194527, 0.36, 0.82, 2.02, 2.02), lo=0.0, lo_open=True)
+    max_rate_no_load_rad_s: Five = (0.4194527, 0.36, 0.82, 2.02, 2.02)
     """TeachMover no-load speeds, except the base: CALIBRATED to 0.4194527 rad/s
     (TeachMover 0.42) so that R IV at the nominal 75 % takes the thesis's 9.9855 s."""
-    max_rate_full_load_rad_s: Five = _num((0.37, 0.15, 0.23, 1.31, 1.31), lo=0.0, lo_open=True)
+    max_rate_full_load_rad_s: Five = (0.37, 0.15, 0.23, 1.31, 1.31)
     """TeachMover speeds carrying the full load (1 lb)."""
-    full_load_oz: float = _num(16.0, lo=0.0, lo_open=True)
-    nominal_fraction: float = _num(0.75, lo=0.0, hi=1.0, lo_open=True)
+    full_load_oz: float = _num(16.0, gt=0.0, le=1e6)
+    """The load of those full-load figures."""
+    nominal_fraction: float = _num(0.75, gt=0.0, le=1.0)
     """Nominal operation at 75 % of rated output, peak on request (§7.2)."""
 
 
-@dataclass(frozen=True)
-class Robot:
+class RobotSettings(Section):
     """The MICROBOT arm (thesis §3, Table 3.1; link lengths from the TeachMover)."""
 
-    l2_in: float = _num(7.0, lo=0.0, lo_open=True)
-    l3_in: float = _num(7.0, lo=0.0, lo_open=True)
-    joint_limits_deg: JointLimits = _sub(JointLimits)
-    hand: Hand = _sub(Hand)
-    motors: Motors = _sub(Motors)
+    l2_in: float = _num(7.0, gt=0.0, le=MAX_LENGTH_IN)
+    """Upper arm (TeachMover)."""
+    l3_in: float = _num(7.0, gt=0.0, le=MAX_LENGTH_IN)
+    """Forearm (TeachMover)."""
+    joint_limits_deg: JointLimitSettings = JointLimitSettings()
+    hand: HandSettings = HandSettings()
+    motors: MotorSettings = MotorSettings()
     timing: Literal["constant-rate", "minimum-time"] = "constant-rate"
     """How the fastest R II and R IV are found: constant maximum step rates (the
     thesis) or the minimum-time planner (Shin & McKay)."""
 
 
 # --------------------------------------------------------------------------- belts
-@dataclass(frozen=True)
-class Belts:
+class BeltSettings(Section):
     """The two conveyors (thesis §4.3, §5.2)."""
 
-    input_nominal_in_s: float = _num(3.0, lo=0.0, lo_open=True)
-    output_nominal_in_s: float = _num(2.0, lo=0.0, lo_open=True)
-    spacing_in: float = _num(45.0, lo=0.0, lo_open=True)
+    input_nominal_in_s: float = _num(3.0, gt=0.0, le=MAX_SPEED_IN_S)
+    """Nominal input belt speed (§5.2)."""
+    output_nominal_in_s: float = _num(2.0, gt=0.0, le=MAX_SPEED_IN_S)
+    """Nominal output belt speed (§5.2)."""
+    spacing_in: float = _num(45.0, gt=0.0, le=MAX_LENGTH_IN)
     """Required spacing of parts on the output belt (§4.3 f)."""
-    spacing_tol_in: float = _num(0.25, lo=0.0)
-    input_max_in_s: float = _num(12.0, lo=0.0, lo_open=True)
-    """Fastest the input belt may run; assumed (§6.2 a gives belts infinite range)."""
-    output_max_in_s: float = _num(12.0, lo=0.0, lo_open=True)
-    """Fastest the output belt may run; assumed, as the input's."""
-    input_length_in: float | None = _num(None, lo=0.0, lo_open=True)
+    spacing_tol_in: float = _num(0.25, ge=0.0, le=MAX_LENGTH_IN)
+    """Tolerance on that spacing (§4.3 f)."""
+    input_max_in_s: float = _num(12.0, gt=0.0, le=MAX_SPEED_IN_S)
+    """Fastest the input belt may run; ASSUMED (§6.2 a gives belts infinite range)."""
+    output_max_in_s: float = _num(12.0, gt=0.0, le=MAX_SPEED_IN_S)
+    """Fastest the output belt may run; ASSUMED, as the input's."""
+    input_length_in: float | None = _num(None, gt=0.0, le=MAX_LENGTH_IN * 10)
     """Feeder drop point to B; the thesis gives none.  Empty: two nominal cycles of
     belt travel (2 × 3.0 × 22.5872 = 135.52 in), so the next part is usually on the
     belt when the controller looks ahead (§5.2)."""
 
 
 # --------------------------------------------------------------------------- arrivals
-WEIBULL_SHAPE = 1.0 / 0.2038  # eq. 6.9 exponent is 1/shape
+WEIBULL_SHAPE = 1.0 / 0.2038
+"""Eq. 6.9's exponent is 1/shape."""
 
 
-@dataclass(frozen=True)
-class Arrivals:
+class ArrivalSettings(Section):
     """Inter-arrival times of parts (thesis §6.2 d, eq. 6.9)."""
 
     distribution: str = "weibull_min"
     """Any continuous distribution in scipy.stats, by name."""
-    params: Mapping[str, float] = field(
+    params: dict[str, Annotated[float, Field(strict=True, allow_inf_nan=True)]] = Field(
         default_factory=lambda: {"c": WEIBULL_SHAPE, "loc": 17.6019, "scale": 5.4342})
     """Its parameters by scipy's names; the default is eq. 6.9."""
     trace_csv: str | None = None
     """A CSV of observed inter-arrival times (column ``interarrival_s``), used in
-    order instead of the distribution. Relative to the scenario file."""
+    order instead of the distribution; relative to the scenario file."""
 
 
 # --------------------------------------------------------------------------- controller
-@dataclass(frozen=True)
-class Controller:
+class ControllerSettings(Section):
     """Operating policy (thesis §5.3, §6.3)."""
 
-    policy: Literal["adaptive", "non-adaptive"] = "adaptive"
-    nominal_cycle_s: float = _num(22.5872, lo=0.0, lo_open=True)
+    policy: str = "adaptive"
+    """A registered policy: ``adaptive`` (§5.3), ``non-adaptive`` (§6.3), or a plug-in."""
+    nominal_cycle_s: float = _num(22.5872, gt=0.0, le=MAX_TIME_S)
     """Mean inter-arrival time: the ideal transfer time of §5.3."""
-    ideal_cycle_s: float | None = _num(None, lo=0.0, lo_open=True)
+    ideal_cycle_s: float | None = _num(None, gt=0.0, le=MAX_TIME_S)
     """The robot's fixed cycle for the non-adaptive policy (Table 7.1, column 1);
-    shortened in R IV only. Empty means the nominal cycle."""
+    shortened in R IV only.  Empty: the nominal cycle."""
+
+    @field_validator("policy")
+    @classmethod
+    def _known_policy(cls, value: str) -> str:
+        if value not in registry.names():
+            raise ValueError("must be one of " + ", ".join(registry.names()))
+        return value
 
 
-@dataclass(frozen=True)
-class Run:
-    parts: int = _num(500, lo=1)
-    """Parts to arrive (§6.3)."""
-    seed: int = _num(1984, lo=0)
+class RunSettings(Section):
+    """How long a run is and where its random numbers come from (§6.3)."""
+
+    parts: int = Field(500, strict=True, ge=1, le=MAX_PARTS)
+    """Parts to arrive (§6.3: 500)."""
+    seed: int = Field(1984, strict=True, ge=0, lt=MAX_SEED)
     """Root of every random stream (numpy SeedSequence)."""
 
 
-@dataclass(frozen=True)
-class MinTime:
-    """Minimum-time planner settings (Shin & McKay 1983; SPEC §9)."""
+class MinTimeSettings(Section):
+    """Minimum-time planner settings (Shin & McKay 1983; docs/model.md)."""
 
-    grid_points: int = _num(460, lo=3)
+    grid_points: int = Field(460, strict=True, ge=3, le=MAX_GRID_POINTS)
     """Grid points per regime (R II, R IV), s scaled to [0, 1]; 460 as the thesis's path."""
-    rate_fraction: float = _num(1.0, lo=0.0, hi=1.0, lo_open=True)
+    rate_fraction: float = _num(1.0, gt=0.0, le=1.0)
     """Joint velocity bounds = the motors' step rates at the regime's load (§6.1) times
     this: 1.0 is the peak, as in the thesis's minimum feasible cycle (§7.2)."""
-    acceleration_bounds: bool = True
+    acceleration_bounds: bool = Field(True, strict=True)
     """Apply ``qddot_max_rad_s2``; switch off when the dynamic model is to set the
     accelerations alone."""
-    qddot_max_rad_s2: Five = _num((2.0, 2.0, 4.0, 8.0, 8.0), lo=0.0, lo_open=True)
+    qddot_max_rad_s2: Five = (2.0, 2.0, 4.0, 8.0, 8.0)
     """Joint acceleration bounds; ASSUMED (a stepper indexer's ramp; the thesis has none)."""
     dynamics_file: str | None = None
     """YAML of the rigid-body model (relative to the scenario file); empty: no torque bounds."""
 
 
 # --------------------------------------------------------------------------- scenario
-@dataclass(frozen=True)
-class Scenario:
+class Scenario(Section):
     """A whole scenario: the cell, the robot, the parts and how the run goes."""
 
     name: str = "baseline"
+    """A short name, printed in summaries."""
     description: str = ""
-    cell: CellLayout = _sub(CellLayout)
-    path: PathSpec = _sub(PathSpec)
-    part: Part = _sub(Part)
-    robot: Robot = _sub(Robot)
-    belts: Belts = _sub(Belts)
-    arrivals: Arrivals = _sub(Arrivals)
-    controller: Controller = _sub(Controller)
-    run: Run = _sub(Run)
-    mintime: MinTime = _sub(MinTime)
-    source: str = field(default="<defaults>", metadata={"internal": True})
-    """The file it was read from (not a YAML key)."""
+    """One line on what the scenario is for."""
+    cell: LayoutSettings = LayoutSettings()
+    path: PathSettings = PathSettings()
+    part: PartSettings = PartSettings()
+    robot: RobotSettings = RobotSettings()
+    belts: BeltSettings = BeltSettings()
+    arrivals: ArrivalSettings = ArrivalSettings()
+    controller: ControllerSettings = ControllerSettings()
+    run: RunSettings = RunSettings()
+    mintime: MinTimeSettings = MinTimeSettings()
+
+    _source: str = PrivateAttr(default="<defaults>")
+
+    @property
+    def source(self) -> str:
+        """The file it was read from (``<defaults>`` for the built-in one)."""
+        return self._source
 
     @property
     def base_dir(self) -> Path:
-        return Path(self.source).parent if self.source != "<defaults>" else Path.cwd()
+        """Where the files it names (trace, dynamics model) are looked for."""
+        return Path(self._source).parent if self._source != "<defaults>" else Path.cwd()
 
     def get(self, dotted: str) -> Any:
         obj: Any = self
@@ -266,249 +300,117 @@ class Scenario:
             obj = obj[part] if isinstance(obj, Mapping) else getattr(obj, part)
         return obj
 
+    def to_dict(self) -> dict[str, Any]:
+        """Plain YAML-able data (tuples as lists)."""
+        return _plain(self.model_dump())
+
     def with_overrides(self, overrides: Mapping[str, Any], file: object = None) -> Scenario:
         """A new scenario with dotted keys replaced, validated as if read from ``file``."""
-        raw = to_dict(self)
-        for key, value in overrides.items():
-            set_dotted(raw, key, value, file or self.source)
-        return from_dict(raw, file or self.source, source=self.source)
+        raw = apply_overrides(self.to_dict(), overrides, file or self._source, is_section)
+        return validate(raw, file or self._source, source=self._source)
 
 
-# --------------------------------------------------------------------------- validation
-def _type_name(tp: Any) -> str:
-    return getattr(tp, "__name__", None) or str(tp).replace("typing.", "")
-
-
-def _check_bounds(value: float, meta: Mapping[str, Any], file: object, key: str, shown: Any) -> None:
-    if not math.isfinite(value):
-        raise ScenarioError(file, key, shown, "must be a finite number")
-    lo, hi = meta.get("lo"), meta.get("hi")
-    if lo is not None:
-        if meta.get("lo_open") and value <= lo:
-            raise ScenarioError(file, key, shown, f"must be greater than {lo:g}")
-        if value < lo:
-            raise ScenarioError(file, key, shown, f"must be at least {lo:g}")
-    if hi is not None and value > hi:
-        raise ScenarioError(file, key, shown, f"must be at most {hi:g}")
-
-
-def _convert(tp: Any, value: Any, file: object, key: str, meta: Mapping[str, Any]) -> Any:
-    origin = typing.get_origin(tp)
-    args = typing.get_args(tp)
-    if origin in (Union, types.UnionType):
-        if value is None and type(None) in args:
-            return None
-        (inner,) = [a for a in args if a is not type(None)]
-        return _convert(inner, value, file, key, meta)
-    if is_dataclass(tp):
-        return build(tp, value, file, key)
-    if origin is Literal:
-        if value not in args:
-            raise ScenarioError(file, key, value, "must be one of " + ", ".join(map(str, args)))
-        return value
-    if tp is bool:
-        if not isinstance(value, bool):
-            raise ScenarioError(file, key, value, "must be true or false")
-        return value
-    if tp is int:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise ScenarioError(file, key, value, "must be a whole number")
-        _check_bounds(value, meta, file, key, value)
-        return value
-    if tp is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ScenarioError(file, key, value, "must be a number")
-        _check_bounds(float(value), meta, file, key, value)
-        return float(value)
-    if tp is str:
-        if not isinstance(value, str):
-            raise ScenarioError(file, key, value, "must be text")
-        return value
-    if origin is tuple:
-        if not isinstance(value, (list, tuple)):
-            raise ScenarioError(file, key, value, f"must be a list of {len(args)} numbers")
-        if len(value) != len(args):
-            raise ScenarioError(file, key, value, f"must have exactly {len(args)} entries")
-        return tuple(_convert(a, v, file, f"{key}[{i}]", meta) for i, (a, v) in
-                     enumerate(zip(args, value)))
-    if origin in (Mapping, dict, typing.Mapping):
-        if not isinstance(value, Mapping):
-            raise ScenarioError(file, key, value, "must be a mapping")
-        return {str(k): _convert(args[1], v, file, f"{key}.{k}", meta) for k, v in value.items()}
-    raise TypeError(f"unsupported schema type {_type_name(tp)} at {key}")  # pragma: no cover
-
-
-def build(cls: type, data: Any, file: object, prefix: str = "") -> Any:
-    """Build dataclass ``cls`` from a mapping, rejecting unknown keys and bad values."""
-    if data is None:
-        data = {}
-    if not isinstance(data, Mapping):
-        raise ScenarioError(file, prefix or "(top level)", data, "must be a mapping of keys")
-    hints = typing.get_type_hints(cls)
-    allowed = {f.name: f for f in fields(cls) if not f.metadata.get("internal")}
-    for k, v in data.items():
-        if k not in allowed:
-            raise ScenarioError(file, f"{prefix}.{k}" if prefix else str(k), v,
-                                "unknown key (known: " + ", ".join(allowed) + ")")
-    kwargs = {name: _convert(hints[name], data[name], file,
-                             f"{prefix}.{name}" if prefix else name, f.metadata)
-              for name, f in allowed.items() if name in data}
-    return cls(**kwargs)
-
-
-def to_dict(obj: Any) -> Any:
-    """Plain YAML-able data of a scenario (no internal fields)."""
-    if is_dataclass(obj):
-        return {f.name: to_dict(getattr(obj, f.name)) for f in fields(obj)
-                if not f.metadata.get("internal")}
-    if isinstance(obj, tuple):
-        return [to_dict(v) for v in obj]
+def _plain(obj: Any) -> Any:
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
     if isinstance(obj, Mapping):
-        return {k: to_dict(v) for k, v in obj.items()}
+        return {k: _plain(v) for k, v in obj.items()}
     return obj
 
 
-def known_key(dotted: str) -> bool:
-    """Whether a dotted key names a setting of the scenario schema."""
-    cls: Any = Scenario
-    for part in dotted.split("."):
-        if not (is_dataclass(cls)):
-            return False
-        names = {f.name: f for f in fields(cls) if not f.metadata.get("internal")}
-        if part not in names:
-            return False
-        cls = typing.get_type_hints(cls)[part]
-    return True
-
-
-def set_dotted(raw: dict[str, Any], key: str, value: Any, file: object) -> None:
-    if not known_key(key):
-        raise ScenarioError(file, key, value, "unknown key: no such setting in a scenario")
-    node = raw
-    parts = key.split(".")
-    for part in parts[:-1]:
-        node = node.setdefault(part, {})
-    node[parts[-1]] = value
-
-
-def from_dict(raw: Any, file: object = "<dict>", source: str | None = None) -> Scenario:
-    scenario = build(Scenario, raw, file)
-    scenario = dataclasses.replace(scenario, source=str(source if source is not None else file))
+# --------------------------------------------------------------------------- validation
+def validate(raw: Any, file: object = "<dict>", source: str | None = None) -> Scenario:
+    """The scenario of a raw mapping; the first problem as one :class:`ScenarioError`."""
+    if not isinstance(raw, Mapping):
+        raise ScenarioError(file, "(top level)", raw, "must be a mapping of keys")
+    try:
+        scenario = Scenario.model_validate(raw)
+    except ValidationError as exc:
+        raise error_from_validation(exc, raw, file, Scenario) from None
+    scenario._source = str(source if source is not None else file)
     _cross_checks(scenario, file)
     return scenario
 
 
-def _cross_checks(s: Scenario, file: object) -> None:
-    """Checks that need more than one value."""
-    import numpy as np
-    import scipy.stats
+def is_section(path: tuple[str, ...]) -> bool:
+    """Whether a dotted path names a section (a model) of the schema."""
+    return model_at(Scenario, list(path)) is not None
 
+
+def known_key(dotted: str) -> bool:
+    """Whether a dotted key names a setting of the schema, or an entry of a mapping one
+    (``arrivals.params.scale``)."""
+    parts = dotted.split(".")
+    model: Any = Scenario
+    for i, part in enumerate(parts):
+        field = model.model_fields.get(part)
+        if field is None:
+            return False
+        annotation = field.annotation
+        if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+            model = annotation
+            continue
+        rest = parts[i + 1:]
+        is_mapping = getattr(annotation, "__origin__", None) is dict
+        return not rest or (is_mapping and len(rest) == 1 and bool(rest[0]))
+    return True
+
+
+def _cross_checks(s: Scenario, file: object) -> None:
+    """Checks that need more than one value but no maths."""
     p = s.path
-    window_in = float(np.linalg.norm(np.subtract(p.f_in, p.bot_in)))
+    window_in = math.dist(p.f_in, p.bot_in)
     if not p.lo_from_bot_in < window_in:
         raise ScenarioError(file, "path.lo_from_bot_in", p.lo_from_bot_in,
                             f"must lie inside the input window B-F ({window_in:g} in)")
-    window_out = float(np.linalg.norm(np.subtract(p.eot_in, p.g_in)))
+    window_out = math.dist(p.eot_in, p.g_in)
     if not p.td_from_g_in < window_out:
         raise ScenarioError(file, "path.td_from_g_in", p.td_from_g_in,
                             f"must lie inside the output window G-K ({window_out:g} in)")
-    for name, (lo, hi) in zip(("theta1", "theta2", "theta3", "theta4", "theta5"),
-                              s.robot.joint_limits_deg.as_array()):
+    for i, (lo, hi) in enumerate(s.robot.joint_limits_deg.as_list()):
         if not lo < hi:
-            raise ScenarioError(file, f"robot.joint_limits_deg.{name}", [lo, hi],
+            raise ScenarioError(file, f"robot.joint_limits_deg.theta{i + 1}", [lo, hi],
                                 "lower limit must be below the upper")
     h = s.robot.hand
     for key, g in (("robot.hand.open_in", h.open_in), ("part.size_in", s.part.size_in)):
         if (g - h.g0_in) ** 2 / 2 > h.l2_in ** 2:
             raise ScenarioError(file, key, g, "finger opening beyond what the hand linkage "
                                 "allows (eq. 6.2: (G - G0)^2 / 2 must not exceed L2^2)")
-    a = s.arrivals
-    if a.trace_csv is None:
-        dist = getattr(scipy.stats, a.distribution, None)
-        if not isinstance(dist, scipy.stats.rv_continuous):
-            raise ScenarioError(file, "arrivals.distribution", a.distribution,
-                                "not a continuous distribution in scipy.stats")
-        try:
-            frozen = dist(**a.params)
-            mean = float(frozen.mean())
-        except (TypeError, ValueError) as exc:
-            raise ScenarioError(file, "arrivals.params", dict(a.params),
-                                f"not accepted by scipy.stats.{a.distribution}: {exc}") from None
-        if not math.isfinite(mean) or frozen.support()[0] < 0:
-            raise ScenarioError(file, "arrivals.params", dict(a.params),
-                                "inter-arrival times must be non-negative with a finite mean")
-    else:
-        trace_path = s.base_dir / a.trace_csv
-        read_trace(trace_path, file)
-    c = s.controller
-    if c.ideal_cycle_s is not None and c.policy == "adaptive" and c.ideal_cycle_s != c.nominal_cycle_s:
-        raise ScenarioError(file, "controller.ideal_cycle_s", c.ideal_cycle_s,
-                            "the adaptive policy runs at the nominal cycle; "
-                            "set controller.nominal_cycle_s instead")
+    b = s.belts
+    if b.input_max_in_s < b.input_nominal_in_s:
+        raise ScenarioError(file, "belts.input_max_in_s", b.input_max_in_s,
+                            "must be at least belts.input_nominal_in_s")
+    if b.output_max_in_s < b.output_nominal_in_s:
+        raise ScenarioError(file, "belts.output_max_in_s", b.output_max_in_s,
+                            "must be at least belts.output_nominal_in_s")
+    from cell.arrivals import check_arrivals
+
+    check_arrivals(s.arrivals, s.base_dir, file)
 
 
-def read_trace(path: Path, file: object = None) -> Any:
-    """Inter-arrival times from a CSV trace: one column ``interarrival_s``, all > 0.
-
-    Parsed once per version of the file (path, size, modification time), so a
-    sweep's replications do not read it again.  The array is read-only.
-    """
-    if not path.is_file():
-        raise ScenarioError(file or path, "arrivals.trace_csv", str(path), "no such file")
-    st = path.stat()
-    times = _parse_trace(str(path.resolve()), st.st_size, st.st_mtime_ns)
-    if isinstance(times, str):
-        raise ScenarioError(file or path, "arrivals.trace_csv", str(path), times)
-    return times
-
-
-@functools.lru_cache(maxsize=32)
-def _parse_trace(path: str, size: int, mtime_ns: int) -> Any:
-    """The trace's times, or why they cannot be used (a message)."""
-    import numpy as np
-    import pandas as pd
-
-    del size, mtime_ns  # part of the cache key only
-    try:
-        frame = pd.read_csv(path)
-    except Exception as exc:  # pandas raises many kinds
-        return f"not a readable CSV: {exc}"
-    if "interarrival_s" not in frame.columns:
-        return "needs a column named interarrival_s"
-    times = pd.to_numeric(frame["interarrival_s"], errors="coerce").to_numpy(dtype=float)
-    bad = np.flatnonzero(~np.isfinite(times) | (times <= 0))
-    if bad.size:
-        return (f"row {bad[0] + 1} has inter-arrival time "
-                f"{frame['interarrival_s'].iloc[bad[0]]}; times must be positive")
-    if times.size == 0:
-        return "has no inter-arrival times"
-    times.setflags(write=False)
-    return times
-
-
-def read_yaml_mapping(path: str | Path, what: str = "scenario") -> dict[str, Any]:
-    """A YAML file's top-level mapping (an empty file is an empty mapping)."""
-    path = Path(path)
-    if not path.is_file():
-        raise ScenarioError(path, "(file)", str(path), f"no such {what} file")
-    try:
-        raw = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise ScenarioError(path, "(file)", str(path), f"not valid YAML: {exc}") from None
-    raw = {} if raw is None else raw
-    if not isinstance(raw, dict):
-        raise ScenarioError(path, "(top level)", raw, "must be a mapping of keys")
-    return raw
-
-
+# --------------------------------------------------------------------------- files
 def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) -> Scenario:
-    """Read and validate a scenario file; dotted ``overrides`` replace its values."""
-    raw = read_yaml_mapping(path)
-    for key, value in (overrides or {}).items():
-        set_dotted(raw, key, value, path)
-    return from_dict(raw, path, source=str(path))
+    """Read and validate a scenario file (or a built-in one by name, ``baseline``);
+    dotted ``overrides`` replace its values."""
+    from cell import catalog
+    from cell.yamlio import load_mapping
+
+    path = catalog.resolve(path)
+    raw = merge(_DEFAULTS.to_dict(), load_mapping(path, "scenario"), (), is_section)
+    raw = apply_overrides(raw, overrides or {}, path, is_section)
+    return validate(raw, path, source=str(path))
 
 
 def default_scenario() -> Scenario:
     """The thesis's cell with every default."""
-    return from_dict({}, "<defaults>")
+    return _DEFAULTS
+
+
+_DEFAULTS = Scenario()
+
+
+def json_schema() -> dict[str, Any]:
+    """The JSON Schema of a scenario file, for editors (``cell schema``)."""
+    schema = Scenario.model_json_schema()
+    schema["title"] = "cell scenario"
+    return schema

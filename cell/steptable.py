@@ -11,15 +11,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from cell.motors import max_rates, min_move_times
-from cell.path import REGIMES, TransferPath, build_path
-from cell.scenario import Motors, Scenario
+from cell.cache import memo
+from cell.motors import Motors, min_move_times
+from cell.path import REGIMES, CellGeometry, TransferPath, build_path
 
 #: The stretches of a cycle whose times a plan fixes: R I and R III split at LO
 #: and TD (the grasp / release move ends the first half).
@@ -46,8 +45,9 @@ class StepTable:
         return cls(path, motors, steps)
 
     @classmethod
-    def from_scenario(cls, s: Scenario) -> StepTable:
-        return cls.from_path(build_path(s), s.robot.motors)
+    def solve(cls, geometry: CellGeometry, motors: Motors) -> StepTable:
+        """The path of ``geometry`` solved once per process (cached on its inputs)."""
+        return _solved(geometry, motors)
 
     @property
     def move_in(self) -> NDArray[np.float64]:
@@ -104,13 +104,8 @@ class StepTable:
         t = self.nominal_min_times if nominal else self.peak_min_times
         return float(t[self.regime_rows(regime)].sum())
 
-    def limiting_joint(self, fraction: float = 1.0) -> NDArray[np.int64]:
-        """(N,) index 0..4 of the joint that sets each move's shortest time."""
-        rates = max_rates(self.path.load_oz, self.motors, fraction)
-        return np.argmax(np.abs(self.steps) / rates, axis=1)
-
     def to_frame(self) -> pd.DataFrame:
-        """The table with the documented column names (issue: ``cell path``)."""
+        """The table with the documented column names (``cell path``)."""
         p = self.path
         deg = np.degrees(p.q_rad)
         data = {"point": np.arange(p.n_points),
@@ -121,7 +116,7 @@ class StepTable:
         data.update({"move_in": p.move_in, "load_oz": p.load_oz, "event": p.events})
         return pd.DataFrame(data, columns=COLUMNS)
 
-    def write_csv(self, out: str | Path) -> None:
-        from cell.output import write_csv
 
-        write_csv(self.to_frame(), out)
+@memo(maxsize=16)
+def _solved(geometry: CellGeometry, motors: Motors) -> StepTable:
+    return StepTable.from_path(build_path(geometry), motors)

@@ -32,7 +32,6 @@ so it is byte-identical however the sweep was run.  Its columns: ``policy``,
 
 from __future__ import annotations
 
-import argparse
 import concurrent.futures as cf
 import hashlib
 import itertools
@@ -42,7 +41,6 @@ import signal
 import sys
 import threading
 import time
-import typing
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -51,28 +49,19 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from cell import registry
 from cell.errors import CellError, ScenarioError
 from cell.output import write_csv, write_text
-from cell.scenario import (
-    Controller,
-    Scenario,
-    known_key,
-    load_scenario,
-    read_yaml_mapping,
-    to_dict,
-)
+from cell.scenario import Scenario, known_key, load_scenario
 
 #: A replication: (scenario, stream) -> the run's summary row.
 Replicate = Callable[[Scenario, np.random.SeedSequence], Mapping[str, Any]]
 
 SWEEP_KEYS = ("name", "description", "base", "set", "grid", "policies",
               "replications", "seed", "batch")
-POLICIES: tuple[str, ...] = typing.get_args(typing.get_type_hints(Controller)["policy"])
 #: Keys the sweep itself sets for every run; they cannot be varied in a grid.
 RESERVED = {"controller.policy": "list policies under 'policies'",
             "run.seed": "every replication gets its own stream from the sweep's 'seed'"}
-#: Leading columns of replications.csv, before the grid keys and the summary.
-ID_COLUMNS = ("policy", "point")
 #: Float digits in the per-task files: enough to round-trip exactly.
 TASK_FLOAT_FORMAT = "%.17g"
 MANIFEST = "sweep.json"
@@ -129,10 +118,6 @@ class Sweep:
     seed: int
     batch: int
 
-    @property
-    def policies(self) -> tuple[str, ...]:
-        return tuple(dict.fromkeys(p.policy for p in self.points))
-
     def seeds(self) -> list[np.random.SeedSequence]:
         """Replication r's stream: the same for every point and policy (CRN)."""
         return np.random.SeedSequence(self.seed).spawn(self.replications)
@@ -150,7 +135,7 @@ class Sweep:
 
     def fingerprint(self) -> str:
         """Hash of everything that decides the results (for ``--resume``)."""
-        doc = {"base": to_dict(self.base), "fixed": [list(kv) for kv in self.fixed],
+        doc = {"base": self.base.to_dict(), "fixed": [list(kv) for kv in self.fixed],
                "points": [[p.policy, [list(kv) for kv in p.values]] for p in self.points],
                "replications": self.replications, "seed": self.seed, "batch": self.batch}
         text = json.dumps(doc, sort_keys=True, default=str)
@@ -196,7 +181,9 @@ def _whole(raw: Mapping[str, Any], key: str, default: Any, lo: int, file: object
 def load_sweep(path: str | Path) -> Sweep:
     """Read and validate a sweep file; every grid point's scenario is built and checked."""
     path = Path(path)
-    raw = read_yaml_mapping(path, "sweep")
+    from cell.yamlio import load_mapping
+
+    raw = load_mapping(path, "sweep")
     for key in raw:
         if key not in SWEEP_KEYS:
             raise ScenarioError(path, str(key), raw[key],
@@ -226,10 +213,11 @@ def load_sweep(path: str | Path) -> Sweep:
         per_policy = None
     if not per_policy:
         raise ScenarioError(path, "policies", policies_raw, "must list at least one of "
-                            + ", ".join(POLICIES) + " (a list, or policy: {key: [values]})")
+                            + ", ".join(registry.names()) + " (a list, or policy: {key: [values]})")
     for policy, grid in per_policy.items():
-        if policy not in POLICIES:
-            raise ScenarioError(path, "policies", policy, "must be one of " + ", ".join(POLICIES))
+        if policy not in registry.names():
+            raise ScenarioError(path, "policies", policy,
+                                "must be one of " + ", ".join(registry.names()))
         for key in set(grid) & set(shared):
             raise ScenarioError(path, f"policies.{policy}", key,
                                 "varied both in 'grid' and under the policy; keep one")
@@ -249,6 +237,7 @@ def load_sweep(path: str | Path) -> Sweep:
             values = tuple(zip(grid, combo, strict=True))
             scenario = base.with_overrides(
                 {**fixed, "controller.policy": policy, **dict(values)}, file=path)
+            _check_point(scenario, path)
             points.append(Point(policy, i, values, scenario))
 
     name = raw.get("name", path.stem)
@@ -256,12 +245,23 @@ def load_sweep(path: str | Path) -> Sweep:
                  tuple(fixed.items()), keys, tuple(points), replications, seed, batch)
 
 
+def _check_point(scenario: Scenario, file: object) -> None:
+    """Assemble a grid point's cell now, so that no bad point is found after work began;
+    an error names the sweep file, with the key and value it was about."""
+    from cell.assembly import assemble
+
+    try:
+        assemble(scenario)
+    except ScenarioError as exc:
+        raise ScenarioError(file, exc.key, exc.value, exc.why) from None
+
+
 # --------------------------------------------------------------------------- running
 def simulate_summary(scenario: Scenario, seed: np.random.SeedSequence) -> Mapping[str, Any]:
-    """The default replication: one run of the cell (issue 3), its summary row."""
+    """The default replication: one run of the cell, its summary row."""
     from cell.simulation import simulate
 
-    return simulate(scenario, seed=seed).summary
+    return simulate(scenario, seed=seed, keep_parts=False).summary.as_dict()
 
 
 def run_task(replicate: Replicate, scenario: Scenario,
@@ -466,38 +466,3 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     table = pd.concat(parts, ignore_index=True)
     write_csv(table, out / "replications.csv")
     return Outcome(pd.read_csv(out / "replications.csv"), len(todo), len(tasks) - len(todo))
-
-
-def _interrupt(signum: int, frame: Any) -> None:
-    raise KeyboardInterrupt
-
-
-def cmd_sweep(args: argparse.Namespace) -> int:
-    """``cell sweep SWEEP --out DIR [--workers N] [--scheduler ADDR] [--resume] [--report DIR]``."""
-    if threading.current_thread() is not threading.main_thread():
-        return _sweep_command(args)
-    # kill (SIGTERM) stops like Ctrl-C: pending tasks cancelled, finished ones kept.
-    previous = signal.signal(signal.SIGTERM, _interrupt)
-    try:
-        return _sweep_command(args)
-    finally:
-        signal.signal(signal.SIGTERM, previous)
-
-
-def _sweep_command(args: argparse.Namespace) -> int:
-    sweep = load_sweep(args.sweep)
-    if args.report:
-        from cell.report import check_table_7_1
-
-        check_table_7_1(sweep)
-    outcome = run_sweep(sweep, args.out, workers=args.workers, scheduler=args.scheduler,
-                        resume=args.resume, replicate=simulate_summary)
-    print(f"wrote {Path(args.out) / 'replications.csv'}: {len(sweep.points)} points x "
-          f"{sweep.replications} replications ({outcome.tasks_run} tasks run, "
-          f"{outcome.tasks_reused} reused)")
-    if args.report:
-        from cell.report import write_table_7_1
-
-        for path in write_table_7_1(outcome.replications, sweep, args.report):
-            print(f"wrote {path}")
-    return 0

@@ -36,16 +36,27 @@ def test_speed_must_be_positive():
 @given(st.lists(st.tuples(st.floats(0.1, 50.0), st.floats(0.05, 12.0)), min_size=1,
                 max_size=8),
        st.floats(0.0, 400.0))
-def test_time_at_inverts_travel(changes, t):
-    b = Belt(3.0)
+def test_travel_is_the_integral_of_the_schedule_and_every_change_is_told(changes, later):
+    told: list[tuple[float, float]] = []
+    b = Belt(3.0, on_change=lambda t, v: told.append((t, v)))
     now = 0.0
     for dt, v in changes:
         now += dt
         b.plan(now, v)
-    # brute-force integral of the schedule
+    t = now + later                       # a belt is asked about the present and the future
     knots = [0.0] + list(np.cumsum([dt for dt, _ in changes]))
     speeds = [3.0] + [v for _, v in changes]
     x = sum(s * (min(t, hi) - lo) for lo, hi, s in zip(knots, knots[1:] + [np.inf], speeds)
             if t > lo)
     assert b.travel(t) == pytest.approx(x, rel=1e-9, abs=1e-9)
     assert b.time_at(b.travel(t)) == pytest.approx(t, rel=1e-9, abs=1e-7)
+    b.close()
+    assert told == list(zip(knots, speeds))
+    assert b.max_speed_in_s == max(speeds)
+
+
+def test_only_the_schedule_ahead_is_kept():
+    b = Belt(3.0)
+    for i in range(1, 1000):
+        b.plan(float(i), 3.0 + i % 2)
+    assert len(b._t) <= 2  # noqa: SLF001 - the point of the test is the held schedule

@@ -4,16 +4,19 @@ Christoffel form of the Coriolis terms, and the thesis's rate-against-load line.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import yaml
 
-from cell.dynamics import IN, OZ, DynamicsModel, chain, free_speed, load_dynamics
+from cell.dynamics import IN, OZ, DynamicsModel, chain, free_speed
+from cell.dynamics_file import load_dynamics
 from cell.errors import ScenarioError
 from cell.kinematics import DH_ALPHA, a_matrix
 from cell.scenario import default_scenario
 
-MODEL = load_dynamics("scenarios/microbot_dynamics.yaml")
+MODEL = load_dynamics(Path(__file__).parents[1] / "scenarios" / "microbot_dynamics.yaml")
 CH = chain(MODEL, 7.0, 7.0, payload_oz=4.0, tcp_in=3.55)
 RNG = np.random.default_rng(7)
 QS = [np.radians([30, 40, -70, -120, 20]), RNG.uniform(-1.5, 1.5, 5), RNG.uniform(-1.5, 1.5, 5)]
@@ -126,7 +129,7 @@ def test_free_speed_holds_the_no_load_rate():
     ({"drives": {"gearratio": 3}}, "drives.gearratio"),
 ])
 def test_bad_values_name_file_key_and_value(tmp_path, patch, key):
-    raw = yaml.safe_load(open("scenarios/microbot_dynamics.yaml"))
+    raw = yaml.safe_load(open(Path(__file__).parents[1] / "scenarios" / "microbot_dynamics.yaml"))
     for sec, vals in patch.items():
         raw[sec].update(vals)
     f = tmp_path / "dyn.yaml"

@@ -9,12 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from cell.assembly import motors_of, step_table
 from cell.cli import main
 from cell.figures import FILES, make_figures
 from cell.figures.motion import nominal_timeline
 from cell.motors import max_rates
 from cell.scenario import default_scenario
-from cell.steptable import StepTable
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -60,7 +60,7 @@ def test_nominal_transfer_keeps_the_thesis_split() -> None:
     (8/3 s and 4 s, plus what the motors add after LO/TD), R IV at the base's
     nominal rate (thesis 9.9855 s), R II the rest (thesis 5.935 s at R I = 8/3 s)."""
     s = default_scenario()
-    table = StepTable.from_scenario(s)
+    table = step_table(s)
     tl = nominal_timeline(table, s)
     assert tl.t_s[-1] == pytest.approx(22.5872, abs=1e-9)
     assert sum(tl.regime_s.values()) == pytest.approx(22.5872, abs=1e-9)
@@ -84,10 +84,10 @@ def test_nominal_transfer_keeps_the_thesis_split() -> None:
 def test_no_joint_beyond_its_maximum_rate() -> None:
     """Fig. 17-21: every drawn rate is within the motor's rate at the move's load (§6.1)."""
     s = default_scenario()
-    table = StepTable.from_scenario(s)
+    table = step_table(s)
     tl = nominal_timeline(table, s)
     rate = np.abs(table.steps[1:]) / tl.dt_s[1:, None]
-    limit = max_rates(table.path.load_oz[1:], s.robot.motors)
+    limit = max_rates(table.path.load_oz[1:], motors_of(s))
     assert np.all(rate <= limit * (1 + 1e-9))
 
 

@@ -9,19 +9,20 @@ from cell.errors import UnreachableError
 from cell.kinematics import (
     GRASP,
     Arm,
+    Hand,
+    Placement,
     a_matrix,
     arm_target,
     forward,
     hand_length,
     inverse_kinematics,
-    placement,
     tool_centre,
 )
-from cell.scenario import default_scenario
 from cell.transforms import rot, trans
 
 ARM = Arm()
-S = default_scenario()
+CELL = Placement()
+HAND = Hand()
 
 
 def eq_3_14(q, l2=7.0, l3=7.0):
@@ -53,7 +54,7 @@ def test_a1_and_a4_match_eq_3_3_and_3_6():
 
 
 def in_range_q():
-    lim = np.degrees(ARM.limits)
+    lim = np.degrees(ARM.limits_rad)
     return st.tuples(*(st.floats(float(lo), float(hi)) for lo, hi in lim)).map(np.radians)
 
 
@@ -64,7 +65,7 @@ def test_forward_is_eq_3_14(q_deg):
 
 def test_forward_vectorised():
     rng = np.random.default_rng(0)
-    lim = ARM.limits
+    lim = ARM.limits_rad
     q = lim[:, 0] + rng.random((50, 5)) * (lim[:, 1] - lim[:, 0])
     batch = forward(q)
     assert batch.shape == (50, 4, 4)
@@ -109,18 +110,19 @@ def test_ik_outside_joint_range_names_the_joint():
     # wrist point reachable but behind-below: the base would need more than ±90°
     t = trans(-3.0, -9.0, 0.0) @ rot("x", np.pi)
     with pytest.raises(UnreachableError, match=r"theta\d .*outside its range"):
-        inverse_kinematics(t, labels=["test point"])
+        inverse_kinematics(t, label=lambda i: "test point")
 
 
 def test_ik_never_clamps_a_range_violation():
     q = np.radians([10.0, 30.0, -60.0, -100.0, 0.0])
-    narrow = Arm(limits=np.radians([[-90, 90], [-35, 144], [-149, 0], [-95, 0], [-180, 180]]))
+    narrow = Arm(limits=tuple(map(tuple, np.radians(
+        [[-90, 90], [-35, 144], [-149, 0], [-95, 0], [-180, 180]]))))
     with pytest.raises(UnreachableError, match="theta4"):
         inverse_kinematics(forward(q), narrow)
 
 
 def test_placement_eq_6_1():
-    z = placement(S)
+    z = CELL.frame()
     h = np.sqrt(0.5)
     np.testing.assert_allclose(z, [[h, h, 0, -8], [-h, h, 0, 8], [0, 0, 1, 7.68], [0, 0, 0, 1]],
                                atol=1e-15)
@@ -128,9 +130,9 @@ def test_placement_eq_6_1():
 
 def test_hand_length_eq_6_2_holding_a_cube():
     # SPEC §2: holding a 2.0 in cube, w11 = 3.5498 in
-    assert hand_length(2.0, S) == pytest.approx(3.5498, abs=5e-5)
+    assert hand_length(2.0, HAND) == pytest.approx(3.5498, abs=5e-5)
     # at G = G0 the linkage is straight: L1 + L2
-    assert hand_length(1.52, S) == pytest.approx(1.884 + 1.700)
+    assert hand_length(1.52, HAND) == pytest.approx(1.884 + 1.700)
 
 
 def test_grasp_eq_6_4():
@@ -140,7 +142,7 @@ def test_grasp_eq_6_4():
 def test_thesis_points_in_the_robot_frame_give_the_base_angles():
     """SPEC §1: B at θ1 = -90°, F at -45°, G at +45°, K at +90°."""
     pts = np.array([[-16, 0, 3], [-8, 0, 3], [0, 8, 3], [0, 16, 3]], dtype=float)
-    q = inverse_kinematics(arm_target(pts, 0.0, 2.0, S))
+    q = inverse_kinematics(arm_target(pts, 0.0, 2.0, CELL, HAND))
     np.testing.assert_allclose(np.degrees(q[:, 0]), [-90, -45, 45, 90], atol=1e-9)
 
 
@@ -148,7 +150,7 @@ def test_thesis_points_in_the_robot_frame_give_the_base_angles():
 def test_transformation_equation_round_trip(x, y, z, phi):
     """Z T5 E = P PG (eq. 6.6): solving eq. 6.7 and going forward lands on the point."""
     xyz = np.array([x, y, z])
-    q = inverse_kinematics(arm_target(xyz, phi, 2.0, S))
-    np.testing.assert_allclose(tool_centre(q, 2.0, S), xyz, atol=1e-9)
-    full = placement(S) @ forward(q) @ trans(0, 0, hand_length(2.0, S))
+    q = inverse_kinematics(arm_target(xyz, phi, 2.0, CELL, HAND))
+    np.testing.assert_allclose(tool_centre(q, 2.0, CELL, ARM, HAND), xyz, atol=1e-9)
+    full = CELL.frame() @ forward(q) @ trans(0, 0, hand_length(2.0, HAND))
     np.testing.assert_allclose(full[:3, 2], [0, 0, -1], atol=1e-9)  # approach straight down

@@ -8,14 +8,21 @@ import math
 import pandas as pd
 import pytest
 
+from cell.assembly import geometry_of, motors_of, planner_bounds
+from cell.catalog import BUILT_IN as SCENARIOS
 from cell.cli import main
-from cell.mintime import fastest_regime_times
-from cell.mintime.regimes import _CACHE
+from cell.mintime.regimes import fastest_regime_times as planner_times
 from cell.scenario import load_scenario
 
-KIN = "scenarios/mintime_kinematic.yaml"
-BASE = "scenarios/baseline.yaml"
+BASELINE = SCENARIOS / "baseline.yaml"
+
+KIN = str(SCENARIOS / "mintime_kinematic.yaml")
+BASE = str(BASELINE)
 BASE_RATE = 0.4194527          # rad/s, robot.motors (calibrated, SPEC §4)
+
+
+def fastest_regime_times(s):
+    return planner_times(geometry_of(s), motors_of(s), planner_bounds(s))
 
 
 def test_r4_kinematic_is_the_base_trapezoid():
@@ -49,11 +56,11 @@ def test_dynamic_model_is_never_faster_than_the_velocity_bound():
 def test_times_are_cached_per_scenario():
     s = load_scenario(KIN)
     first = fastest_regime_times(s)
-    n = len(_CACHE)
+    n = len(planner_times)
     again = fastest_regime_times(s.with_overrides({"run.parts": 3}))   # irrelevant to the planner
-    assert again == first and len(_CACHE) == n
+    assert again == first and len(planner_times) == n
     other = fastest_regime_times(s.with_overrides({"mintime.qddot_max_rad_s2": [1.0] * 5}))
-    assert other["R4"] > first["R4"] and len(_CACHE) == n + 1
+    assert other["R4"] > first["R4"] and len(planner_times) == n + 1
 
 
 @pytest.mark.parametrize("scenario,torque", [(KIN, False), (BASE, True)])

@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 from scipy.interpolate import CubicSpline
 
-from cell.dynamics import chain, load_dynamics
+from cell.catalog import BUILT_IN as SCENARIOS
+from cell.dynamics import chain
+from cell.dynamics_file import load_dynamics
 from cell.mintime.planner import PathRows, acceleration_rows, plan, torque_rows, velocity_rows
 from cell.mintime.reference import toppra_profile
 
@@ -22,7 +24,7 @@ V3, A3 = [1.0, 0.8, 0.6], [2.0, 1.5, 1.0]
 Q0 = np.radians([-45.0, 46.7, -109.5, -117.2, 90.0])
 DYN_PATH = Q0 + np.column_stack([np.pi / 2 * SW, 0.4 * np.sin(np.pi * SW), -0.3 * SW,
                                  0.2 * np.sin(2 * np.pi * SW), 0.5 * SW])
-MODEL = load_dynamics("scenarios/microbot_dynamics.yaml")
+MODEL = load_dynamics(SCENARIOS / "microbot_dynamics.yaml")
 CHAIN = chain(MODEL, 7.0, 7.0, payload_oz=4.0, tcp_in=3.55)
 TAU = np.array(MODEL.drives.stall_torque_nm)
 # Velocity bounds 20 times the TeachMover's, so that the torques (not the velocities)

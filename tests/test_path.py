@@ -3,13 +3,14 @@
 import numpy as np
 import pytest
 
-from cell.kinematics import Arm, forward, placement, tool_centre
-from cell.path import build_path
+from cell.assembly import geometry_of
+from cell.kinematics import Arm, forward, tool_centre
+from cell.path import CellGeometry, build_path
 from cell.scenario import default_scenario
 from cell.transforms import trans
 
-S = default_scenario()
-P = build_path(S)
+G = CellGeometry()
+P = build_path(G)
 BASE = np.array([-8.0, 8.0])
 
 
@@ -79,9 +80,10 @@ def test_regime_lengths_closed_forms():
 
 
 def test_every_point_is_reached_inside_the_joint_ranges():
-    lim = Arm().limits
+    lim = Arm().limits_rad
     assert np.all(P.q_rad >= lim[:, 0] - 1e-9) and np.all(P.q_rad <= lim[:, 1] + 1e-9)
-    np.testing.assert_allclose(tool_centre(P.q_rad, P.opening_in, S), P.xyz_in, atol=1e-9)
+    np.testing.assert_allclose(tool_centre(P.q_rad, P.opening_in, G.placement, G.arm, G.hand),
+                               P.xyz_in, atol=1e-9)
 
 
 def test_base_angles_span_the_whole_range():
@@ -93,7 +95,7 @@ def test_base_angles_span_the_whole_range():
 
 def _hand_frames():
     """Z T5 E: the hand's frame in the global frame (the hand length does not rotate it)."""
-    return placement(S) @ forward(P.q_rad) @ trans(0, 0, 1.0)
+    return G.placement.frame() @ forward(P.q_rad) @ trans(0, 0, 1.0)
 
 
 def test_hand_points_down_and_the_part_turns_90_degrees():
@@ -128,8 +130,8 @@ def test_load_and_finger_opening_between_lo_and_td():
 
 
 def test_moves_and_positions_come_from_the_scenario():
-    s = S.with_overrides({"path.moves.R1": 40, "path.lo_from_bot_in": 2.0,
-                          "path.pick_height_in": 1.5})
-    p = build_path(s)
+    s = default_scenario().with_overrides({"path.moves.R1": 40, "path.lo_from_bot_in": 2.0,
+                                           "path.pick_height_in": 1.5})
+    p = build_path(geometry_of(s))
     assert p.n_points == 460 - 56
     np.testing.assert_allclose(p.xyz_in[p.lo], [-14, 0, 1.5], atol=1e-12)

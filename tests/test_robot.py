@@ -7,15 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from cell.motors import move_times, velocity_for_time
-from cell.robot import Segment, robot_timing
-from cell.scenario import default_scenario
-
-
-@pytest.fixture(scope="module")
-def timing():
-    return robot_timing(default_scenario())
-
+from cell.motors import Segment, move_times, velocity_for_time
 
 moves = st.lists(st.tuples(st.one_of(st.just(0.0), st.floats(1e-3, 0.5)), st.floats(0.0, 0.2)),
                  min_size=1, max_size=40)
@@ -64,10 +56,8 @@ def test_robot_tracks_the_nominal_belts_and_is_never_faster_than_them(timing):
     assert sum(timing.r3_time(2.0)) >= 4.0     # SPEC §6: 4.0000 s
 
 
-def test_regime_floors_are_the_step_table_minima(timing):
-    from cell.steptable import StepTable
-
-    t = StepTable.from_scenario(default_scenario())
+def test_regime_floors_are_the_step_table_minima(timing, table):
+    t = table
     for name, seg in (("R2", timing.r2), ("R4", timing.r4)):
         rows = t.regime_rows(name)
         assert seg.floor_s == pytest.approx(t.regime_min_time(name))

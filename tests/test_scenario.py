@@ -5,15 +5,18 @@ import numpy as np
 import pytest
 import yaml
 
+from cell import catalog
+from cell.assembly import step_table
 from cell.errors import ScenarioError
-from cell.scenario import (
-    WEIBULL_SHAPE,
-    default_scenario,
-    from_dict,
-    known_key,
-    load_scenario,
-    to_dict,
-)
+from cell.scenario import WEIBULL_SHAPE, default_scenario, known_key, load_scenario, validate
+
+
+def from_dict(raw, file="<dict>"):
+    return validate(raw, file)
+
+
+def to_dict(s):
+    return s.to_dict()
 
 #: The planner's model switch.  A file is resolved beside its scenario, so the built-in
 #: defaults cannot name one: they plan with velocity and acceleration bounds, while
@@ -24,7 +27,7 @@ MODEL_SWITCH = {("mintime", "dynamics_file"): ("microbot_dynamics.yaml", None),
 
 def test_baseline_yaml_is_the_thesis_defaults():
     """scenarios/baseline.yaml spells out every default: file and code cannot drift apart."""
-    base = to_dict(load_scenario("scenarios/baseline.yaml"))
+    base = to_dict(load_scenario(catalog.path("baseline")))
     defaults = to_dict(default_scenario())
     for (section, key), (in_file, default) in MODEL_SWITCH.items():
         assert (base[section].pop(key), defaults[section].pop(key)) == (in_file, default)
@@ -121,15 +124,32 @@ def test_trace_resolves_beside_the_scenario(tmp_path):
 
 
 def test_unreachable_path_point_is_a_scenario_error():
-    from cell.path import build_path
-
     s = from_dict({"path": {"bot_in": [-26.0, 0.0, 3.0]}}, "x.yaml")
     with pytest.raises(ScenarioError, match=r"x.yaml: path.bot_in = \[-26.0, 0.0, 3.0\]: "
                                             r"path point 0 .*out of reach"):
-        build_path(s)
+        step_table(s)
     s = from_dict({"path": {"pick_height_in": 14.0}}, "y.yaml")
     with pytest.raises(ScenarioError, match=r"y.yaml: path.pick_height_in = 14.0: .*theta"):
-        build_path(s)
+        step_table(s)
+
+
+@pytest.mark.parametrize("key,value", [
+    ("cell.robot_yaw_deg", 0.0), ("cell.robot_base_in", [-14.0, 8.0, 0.0]),
+    ("cell.shoulder_height_in", 30.0), ("robot.l2_in", 3.0), ("robot.l3_in", 4.0),
+    ("robot.hand.l1_in", 12.0), ("robot.joint_limits_deg.theta3", [-100.0, 0.0]),
+    ("robot.joint_limits_deg.theta1", [-60.0, 60.0]), ("path.eot_in", [0.0, 24.0, 3.0]),
+    ("path.bot_in", [-20.0, 0.0, 3.0]),
+])
+def test_an_unreachable_point_names_the_key_that_caused_it(tmp_path, key, value):
+    """Whatever key puts a point out of reach, the error names that key and the file."""
+    f = tmp_path / "what-if.yaml"
+    f.write_text("name: what-if\n")
+    s = load_scenario(f, {key: value})
+    with pytest.raises(ScenarioError) as info:
+        step_table(s)
+    msg = str(info.value)
+    assert msg.startswith(f"{f}: {key} = "), msg
+    assert "\n" not in msg
 
 
 def test_distribution_by_name_and_params():
@@ -137,3 +157,25 @@ def test_distribution_by_name_and_params():
                                 "params": {"a": 4.0, "loc": 18.0, "scale": 1.0}}})
     assert s.arrivals.distribution == "gamma"
     assert np.isclose(s.arrivals.params["a"], 4.0)
+
+
+def test_dotted_keys_reach_into_mappings_and_sections_merge():
+    s = default_scenario()
+    assert s.with_overrides({"arrivals.params.scale": 6.0}).arrivals.params == \
+        {"c": WEIBULL_SHAPE, "loc": 17.6019, "scale": 6.0}
+    kept = s.with_overrides({"run.parts": 77}).with_overrides({"run": {"seed": 9}})
+    assert (kept.run.parts, kept.run.seed) == (77, 9)
+    # a distribution's parameters belong together: a mapping given for them replaces them
+    expon = s.with_overrides({"arrivals": {"distribution": "expon",
+                                           "params": {"loc": 12.5872, "scale": 10.0}}})
+    assert expon.arrivals.params == {"loc": 12.5872, "scale": 10.0}
+    assert known_key("arrivals.params.scale") and not known_key("arrivals.params.a.b")
+
+
+def test_set_on_the_command_line_reaches_into_mappings(tmp_path):
+    from cell.overrides import parse_sets
+
+    f = tmp_path / "s.yaml"
+    f.write_text("run:\n")                      # an empty section
+    s = load_scenario(f, parse_sets(["arrivals.params.scale=6.0", "run.parts=10"]))
+    assert s.arrivals.params["scale"] == 6.0 and s.run.parts == 10

@@ -10,13 +10,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from cell import catalog
 from cell.cli import main
+from cell.records import PART_COLUMNS, SUMMARY_COLUMNS
 from cell.scenario import default_scenario, load_scenario
-from cell.simulation import PART_COLUMNS, SUMMARY_COLUMNS, simulate
+from cell.simulation import simulate
 
-ROOT = Path(__file__).resolve().parents[1]
-BASELINE = ROOT / "scenarios" / "baseline.yaml"
-NON_ADAPTIVE = ROOT / "scenarios" / "non_adaptive.yaml"
+BASELINE = catalog.path("baseline")
+NON_ADAPTIVE = catalog.path("non_adaptive")
 
 
 @pytest.fixture(scope="module")
@@ -39,7 +40,7 @@ def test_issue_columns_are_present(adaptive):
                         "parts_per_hr_wallclock", "parts_per_hr_thesis", "vavg_r4_in_s",
                         "ip_wallclock", "ip_thesis", "spacing_min_in", "spacing_max_in"]
     assert set(required_parts) <= set(adaptive.parts.columns) == set(PART_COLUMNS)
-    assert set(required_summary) <= set(adaptive.summary) == set(SUMMARY_COLUMNS)
+    assert set(required_summary) <= set(adaptive.summary.as_dict()) == set(SUMMARY_COLUMNS)
     assert len(adaptive.parts) == 500
 
 
@@ -58,7 +59,7 @@ def test_adaptive_baseline_loses_nothing_and_spaces_parts_45_in(adaptive):
 
 def test_adaptive_never_exceeds_motor_or_belt_limits(adaptive):
     s = load_scenario(BASELINE)
-    from cell.robot import robot_timing
+    from cell.assembly import robot_timing
 
     t = robot_timing(s)
     p = adaptive.parts
@@ -174,11 +175,11 @@ def test_hostile_override_on_the_command_line(tmp_path, capsys):
 
 
 def test_minimum_time_robot_takes_its_fastest_r4_from_the_planner():
-    pytest.importorskip("cell.mintime")
-    from cell.mintime import fastest_regime_times
+    from cell.assembly import geometry_of, motors_of, planner_bounds
+    from cell.mintime.regimes import fastest_regime_times
 
     s = default_scenario().with_overrides({"robot.timing": "minimum-time", "run.parts": 60})
-    fastest = fastest_regime_times(s)
+    fastest = fastest_regime_times(geometry_of(s), motors_of(s), planner_bounds(s))
     r = simulate(s)
     t_r4 = r.parts["v_r4_in_s"].rdiv(35.5424)          # R IV times (SPEC §3 length)
     assert (t_r4 >= fastest["R4"] - 1e-3).all()
@@ -188,18 +189,6 @@ def test_minimum_time_robot_takes_its_fastest_r4_from_the_planner():
     from cell.errors import ScenarioError
     with pytest.raises(ScenarioError, match="controller.ideal_cycle_s"):
         simulate(fixed)
-
-
-def test_minimum_time_without_the_planner_is_a_clear_error(monkeypatch):
-    import sys
-
-    from cell.errors import CellError
-    from cell.robot import build_timing
-
-    monkeypatch.setitem(sys.modules, "cell.mintime", None)
-    s = default_scenario().with_overrides({"robot.timing": "minimum-time"})
-    with pytest.raises(CellError, match="minimum-time"):
-        build_timing(s)
 
 
 @settings(max_examples=25, deadline=None)

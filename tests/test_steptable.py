@@ -7,13 +7,13 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from cell.errors import InfeasibleError
-from cell.motors import max_rates, min_move_times, move_times, velocity_for_time
-from cell.scenario import default_scenario
+from cell.motors import Motors, max_rates, min_move_times, move_times, velocity_for_time
+from cell.output import write_csv
+from cell.path import CellGeometry
 from cell.steptable import COLUMNS, StepTable
 
-S = default_scenario()
-T = StepTable.from_scenario(S)
-M = S.robot.motors
+M = Motors()
+T = StepTable.solve(CellGeometry(), M)
 
 
 def test_r4_base_steps_are_1125_pi():
@@ -95,7 +95,7 @@ def test_frame_columns_and_rows():
 
 def test_csv_round_trip(tmp_path):
     out = tmp_path / "steps.csv"
-    T.write_csv(out)
+    write_csv(T.to_frame(), out)
     df = pd.read_csv(out, keep_default_na=False)
     assert list(df.columns) == COLUMNS and len(df) == 460
     np.testing.assert_allclose(df["theta1_deg"], np.degrees(T.path.q_rad[:, 0]), rtol=1e-9)

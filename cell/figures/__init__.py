@@ -1,4 +1,4 @@
-"""The thesis's figures, regenerated from this model: ``cell figures`` (issue 5).
+"""The thesis's figures, regenerated from this model: ``cell figures``.
 
 Writes ``figNN_<slug>.png`` for Fig. 8, 9, 12-30 of the thesis's list of
 illustrations, each titled with its number and caption.  Fig. 8-21 need only the
@@ -8,15 +8,13 @@ the six robot cycles of Table 7.1).
 
 from __future__ import annotations
 
-import argparse
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
-from cell.errors import CellError
+from cell.assembly import step_table
 from cell.figures import arrivals, layout, motion, runs
 from cell.figures.style import style
-from cell.scenario import Scenario, load_scenario
-from cell.steptable import StepTable
+from cell.scenario import Scenario
 
 #: Figure number -> file stem, as written into the output folder.
 FILES: dict[int, str] = {
@@ -65,7 +63,7 @@ def make_figures(scenario: Scenario, out: str | Path, *, parts: int | None = Non
             progress(p)
 
     with style():
-        table = StepTable.from_scenario(scenario)
+        table = step_table(scenario)
         if 8 in wanted:
             done(layout.fig08_working_environment(scenario, table, path[8]))
         if 9 in wanted:
@@ -98,15 +96,3 @@ def make_figures(scenario: Scenario, out: str | Path, *, parts: int | None = Non
                 if number in wanted:
                     done(runs.fig_ip(sims, cycle, number, path[number]))
     return written
-
-
-def cmd_figures(args: argparse.Namespace) -> int:
-    """``cell figures [--out DIR] [--scenario FILE]``."""
-    from cell.cli import parse_sets
-
-    scenario = load_scenario(args.scenario, parse_sets(getattr(args, "sets", None)))
-    try:
-        make_figures(scenario, args.out, progress=lambda p: print(f"wrote {p}"))
-    except OSError as exc:
-        raise CellError(f"cannot write figures into {args.out}: {exc.strerror or exc}") from None
-    return 0

@@ -20,7 +20,7 @@ def distribution(s: Scenario) -> scipy.stats.rv_continuous:
 def draws(s: Scenario, n: int) -> NDArray[np.float64]:
     """The first n inter-arrival times the simulation feeds (inverse cdf, eq. 6.9;
     the feeder's own stream of ``run.seed``)."""
-    from cell.feeder import interarrival_times
+    from cell.arrivals import interarrival_times
 
     return interarrival_times(s.arrivals, n, s.run.seed, s.base_dir)
 

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.patches import Circle, FancyArrow, Rectangle
 
+from cell.assembly import geometry_of
 from cell.figures.style import REGIME_COLOURS, REGIME_LABELS, new_figure, save
 from cell.kinematics import hand_length
 from cell.scenario import Scenario
@@ -109,13 +110,13 @@ def fig12_hand_length(s: Scenario, out: Path) -> Path:
     h = s.robot.hand
     g_max = (h.g0_in + h.l2_in * np.sqrt(2)) * (1 - 1e-12)  # where w11 = L1
     g = np.linspace(0.0, g_max, 400)
-    ax.plot(g, hand_length(g, s), color="black",
+    ax.plot(g, hand_length(g, geometry_of(s).hand), color="black",
             label="w11 = L1 + √(L2² − (G − G0)²/2)  (eq. 6.2)")
     marks = {f"G0 = {h.g0_in:g} in (longest)": h.g0_in,
              f"holding a {s.part.size_in:g} in cube": s.part.size_in,
              "open, no part (assumed)": h.open_in}
     for (label, gv), col in zip(marks.items(), ("#2ca02c", "#1f77b4", "#ff7f0e"), strict=True):
-        wv = float(hand_length(gv, s))
+        wv = float(hand_length(gv, geometry_of(s).hand))
         ax.plot(gv, wv, "o", color=col, ms=7, label=f"{label}: G = {gv:g}, w11 = {wv:.4f} in")
     ax.set_xlabel("finger opening G (in)")
     ax.set_ylabel("hand length w11 (in)")

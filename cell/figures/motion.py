@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from cell.assembly import motors_of
 from cell.figures.style import LIMIT_COLOUR, REGIME_LABELS, mark_events, new_figure, save, shade_regimes
 from cell.kinematics import JOINT_NAMES
 from cell.motors import max_rates, move_times, velocity_for_time
@@ -61,8 +62,7 @@ def nominal_timeline(table: StepTable, s: Scenario) -> Timeline:
     R I and R III locked to their belts at nominal speed, R IV at the nominal (75 %)
     motor rates, and R II the rest of the ideal cycle (the thesis's
     22.5872 - 8/3 - 4 - 9.9855 = 5.935 s if R I took exactly 8/3 s)."""
-    from cell.controller import constants
-    from cell.robot import robot_timing
+    from cell.assembly import constants, robot_timing
 
     k = constants(s, robot_timing(s))
     return timeline(table, {"r1_pre": k.r1_pre_nom, "r1_post": k.r1_post_nom, "r2": k.r2_nom,
@@ -117,7 +117,7 @@ def fig_joint_rate(table: StepTable, tl: Timeline, s: Scenario, joint: int, out:
     shade_regimes(ax, tl.t_s, p.regime)
     with np.errstate(invalid="ignore", divide="ignore"):
         rate = np.where(tl.dt_s[1:] > 0, table.steps[1:, joint] / tl.dt_s[1:], 0.0)
-    peak = max_rates(p.load_oz[1:], s.robot.motors, 1.0)[:, joint]
+    peak = max_rates(p.load_oz[1:], motors_of(s), 1.0)[:, joint]
     nominal = peak * s.robot.motors.nominal_fraction
     ax.stairs(peak, tl.t_s, baseline=None, color=LIMIT_COLOUR, lw=1.3,
               label="maximum rate (100 %, at the move's load)")

@@ -16,6 +16,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from cell.conveyors import speed_at
 from cell.figures.motion import Timeline, timeline
 from cell.figures.style import (
     IDEAL_COLOUR,
@@ -57,12 +58,12 @@ def simulate_runs(s: Scenario, cycles: tuple[float, ...] = TABLE_7_1_CYCLES) -> 
 
     ideal = s.controller.nominal_cycle_s
     a = simulate(s.with_overrides({"controller.policy": "adaptive"}))
-    adaptive = Run("adaptive", ideal, a.parts, dict(a.summary), a.belts)
+    adaptive = Run("adaptive", ideal, a.parts, a.summary.as_dict(), a.belts)
     non = {}
     for c in cycles:
         r = simulate(s.with_overrides({"controller.policy": "non-adaptive",
                                        "controller.ideal_cycle_s": c}))
-        non[c] = Run("non-adaptive", c, r.parts, dict(r.summary), r.belts)
+        non[c] = Run("non-adaptive", c, r.parts, r.summary.as_dict(), r.belts)
     return Runs(adaptive, non)
 
 
@@ -172,28 +173,20 @@ def fig_ip(runs: Runs, cycle: float, number: int, out: Path) -> Path:
 
 
 # --------------------------------------------------------------------------- Fig. 22
-def part_segments(row: pd.Series, table: StepTable) -> dict[str, float]:
-    """A simulated part's six segment times, from its parts.csv row.
-
-    B → LO is pick - at B; up to TD is touchdown - at B; each regime's total is
-    its length over its average tip velocity (v_rN_in_s).
-    """
-    total = {r: table.regime_length(r) / float(row[f"v_r{r}_in_s"]) for r in (1, 2, 3, 4)}
-    r1_pre = float(row["pick_s"] - row["at_bot_s"])
-    r3_pre = float(row["touchdown_s"] - row["at_bot_s"]) - total[1] - total[2]
-    seg = {"r1_pre": r1_pre, "r1_post": total[1] - r1_pre, "r2": total[2],
-           "r3_pre": r3_pre, "r3_post": total[3] - r3_pre, "r4": total[4]}
+def part_segments(row: pd.Series) -> dict[str, float]:
+    """A simulated part's six segment times from its record: each regime's time, split
+    at lift-off (``pick_s``) in R I and at touch-down in R III."""
+    start = float(row["at_bot_s"])
+    r1_pre = float(row["pick_s"]) - start
+    r3_pre = float(row["touchdown_s"]) - start - float(row["r1_s"]) - float(row["r2_s"])
+    seg = {"r1_pre": r1_pre, "r1_post": float(row["r1_s"]) - r1_pre, "r2": float(row["r2_s"]),
+           "r3_pre": r3_pre, "r3_post": float(row["r3_s"]) - r3_pre, "r4": float(row["r4_s"])}
     return {k: seg[k] for k in SEGMENTS}
 
 
 def belt_speed_at(history: list[tuple[float, float]], when: float) -> float:
-    """Speed of a belt at an instant, from its (instant, speed) changes (last one wins)."""
-    speed = history[0][1]
-    for instant, v in history:
-        if instant > when + 1e-9:
-            break
-        speed = v
-    return speed
+    """Speed of a belt at an instant, from its (instant, speed) changes."""
+    return speed_at([t for t, _ in history], [v for _, v in history], when + 1e-9)
 
 
 def pick_transfer(run: Run) -> int:
@@ -217,7 +210,7 @@ def fig22_tip_velocity(runs: Runs, table: StepTable, s: Scenario, out: Path) -> 
     run = runs.adaptive
     i = pick_transfer(run)
     row = run.parts.iloc[i]
-    tl: Timeline = timeline(table, part_segments(row, table))
+    tl: Timeline = timeline(table, part_segments(row))
     lag = tl.segment_s["r1_pre"]
     t = tl.t_s - lag  # 0 at LO: from here on the input belt may change (§5.3 3.1)
     p = table.path

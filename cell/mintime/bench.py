@@ -1,4 +1,4 @@
-"""Planner speed against toppra on the transfer path (issue 6; merged into
+"""Planner speed against toppra on the transfer path (merged into
 reports/bench.json by ``cell bench``).
 
 Input: the joint paths of R II and R IV from the step table, their peak
@@ -32,18 +32,21 @@ def _best_ms(fn: Callable[[], object], repeat: int) -> float:
 def benchmarks(repeat: int = 5) -> dict[str, float]:
     from scipy.interpolate import CubicSpline
 
-    from cell.dynamics import chain, load_dynamics
+    from cell.assembly import geometry_of, motors_of, planner_bounds, step_table
+    from cell.dynamics import chain
+    from cell.dynamics_file import load_dynamics
     from cell.mintime.planner import PathRows, acceleration_rows, plan, torque_rows, velocity_rows
     from cell.mintime.reference import toppra_profile
     from cell.mintime.regimes import FREE_REGIMES, regime_path, regime_rows
     from cell.scenario import load_scenario
-    from cell.steptable import StepTable
 
     kin = load_scenario(ROOT / "scenarios" / "mintime_kinematic.yaml")
-    table = StepTable.from_scenario(kin)
-    paths = [regime_path(table, r, kin) for r in FREE_REGIMES]
+    table = step_table(kin)
+    geometry, motors, bounds = geometry_of(kin), motors_of(kin), planner_bounds(kin)
+    paths = [regime_path(table, r, geometry) for r in FREE_REGIMES]
     amax = np.asarray(kin.mintime.qddot_max_rad_s2)
-    vmax = {rp.regime: regime_rows(kin, rp, 3)[3].qdot_max_rad_s for rp in paths}
+    vmax = {rp.regime: regime_rows(rp, motors, bounds, geometry, 3)[3].qdot_max_rad_s
+            for rp in paths}
 
     def ours(n: int) -> list[float]:
         s = np.linspace(0.0, 1.0, n)

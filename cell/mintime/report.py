@@ -7,9 +7,9 @@ import json
 import sys
 from pathlib import Path
 
+from cell.assembly import geometry_of, motors_of, planner_bounds, step_table
 from cell.output import write_text
 from cell.scenario import load_scenario
-from cell.steptable import StepTable
 
 from .regimes import plan_regimes, summary
 
@@ -19,7 +19,7 @@ SCENARIOS = {"kinematic": "mintime_kinematic.yaml", "dynamic": "baseline.yaml"}
 
 def cycles(out_dir: Path) -> dict:
     base = load_scenario(ROOT / "scenarios" / "baseline.yaml")
-    table = StepTable.from_scenario(base)
+    table = step_table(base)
     r1 = 8.0 / base.belts.input_nominal_in_s           # tracking, §4.3 (SPEC §6)
     r3 = 8.0 / base.belts.output_nominal_in_s
     r4_nominal = table.regime_min_time("R4", nominal=True)
@@ -28,8 +28,10 @@ def cycles(out_dir: Path) -> dict:
     rows = {"constant-rate": const}
     docs = {}
     for label, name in SCENARIOS.items():
-        res = plan_regimes(load_scenario(ROOT / "scenarios" / name))
-        docs[label] = summary(res, load_scenario(ROOT / "scenarios" / name))
+        sc = load_scenario(ROOT / "scenarios" / name)
+        bounds = planner_bounds(sc)
+        res = plan_regimes(geometry_of(sc), motors_of(sc), bounds)
+        docs[label] = summary(res, bounds)
         write_text(json.dumps(docs[label], indent=2) + "\n", out_dir / f"{label}.json")
         rows[f"minimum-time ({label})"] = {r: res[r].profile.time_s for r in res}
     table_out = {}

@@ -1,4 +1,4 @@
-"""The parts supply (cell.feeder): eq. 6.9, scipy's moments, traces, common random numbers."""
+"""The parts supply (cell.arrivals): eq. 6.9, scipy's moments, traces, common random numbers."""
 
 from __future__ import annotations
 
@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 import scipy.stats
 
-from cell.feeder import FEEDER_STREAM, interarrival_times, stream
-from cell.scenario import Arrivals, default_scenario
+from cell.arrivals import FEEDER_STREAM, interarrival_times, stream
+from cell.scenario import ArrivalSettings as Arrivals
+from cell.scenario import default_scenario
 
 WEIBULL = scipy.stats.weibull_min(1 / 0.2038, loc=17.6019, scale=5.4342)
 

@@ -1,4 +1,4 @@
-"""The policies' decisions (cell.controller) against thesis §5.3, §6.3 and Table 7.1."""
+"""The policies' decisions (cell.policies) against thesis §5.3, §6.3 and Table 7.1."""
 
 from __future__ import annotations
 
@@ -8,20 +8,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from cell.controller import adaptive_plan, constants, fixed_plan
 from cell.errors import ScenarioError
-from cell.robot import robot_timing
-from cell.scenario import default_scenario
+from cell.policies.adaptive import adaptive_plan
+from cell.policies.fixed import fixed_plan
 
 #: Table 7.1: ideal cycle -> Vavg R IV (in/s).
 VAVG_R4 = {22.5872: 3.5594, 22.0: 3.7818, 21.5: 3.9943, 21.0: 4.2321, 20.5: 4.5000,
            20.0907: 4.7459}
-
-
-@pytest.fixture(scope="module")
-def k():
-    s = default_scenario()
-    return constants(s, robot_timing(s))
 
 
 @pytest.mark.parametrize("ideal", sorted(VAVG_R4))

@@ -1,7 +1,7 @@
-"""``cell mintime SCENARIO --out FILE``: the minimum-time R II and R IV.
+"""``cell mintime SCENARIO --out STEM``: the minimum-time R II and R IV (Shin & McKay 1983).
 
-Writes FILE.csv (one row per grid point of each regime: regime, s, the joint
-angles, ṡ and the velocity-limit curve) and FILE.json (each regime's time and
+Writes STEM.csv (one row per grid point of each regime: regime, s, the joint
+angles, ṡ and the velocity-limit curve) and STEM.json (each regime's time and
 switching points, and the limits used), both whole or not at all.
 """
 
@@ -10,17 +10,23 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
-import pandas as pd
 
-from .regimes import plan_regimes, summary
+from cell.assembly import geometry_of, motors_of, planner_bounds, step_table
+from cell.errors import CellError, NoMotionError
+from cell.output import write_csv, write_text
+from cell.overrides import parse_sets
+from cell.scenario import load_scenario
 
 COLUMNS = ["regime", "s", "theta1_rad", "theta2_rad", "theta3_rad", "theta4_rad", "theta5_rad",
            "sdot", "sdot_limit"]
 
 
-def frame(results: dict) -> pd.DataFrame:
+def frame(results: dict[str, Any]) -> Any:
+    import pandas as pd
+
     parts = []
     for r, res in results.items():
         p = res.profile
@@ -36,15 +42,18 @@ def stem(out: str) -> Path:
     return path.with_suffix("") if path.suffix in (".csv", ".json") else path
 
 
-def cmd_mintime(args: argparse.Namespace) -> int:
-    from cell.cli import parse_sets
-    from cell.output import write_csv, write_text
-    from cell.scenario import load_scenario
+def main(args: argparse.Namespace) -> int:
+    from cell.mintime.regimes import plan_regimes, summary
 
     scenario = load_scenario(args.scenario, parse_sets(args.sets))
-    results = plan_regimes(scenario)
+    step_table(scenario)  # reach and motor checks, naming their keys
+    bounds = planner_bounds(scenario)
+    try:
+        results = plan_regimes(geometry_of(scenario), motors_of(scenario), bounds)
+    except NoMotionError as exc:
+        raise CellError(f"{scenario.source}: mintime: {exc}") from None
     table = frame(results)
-    doc = json.dumps(summary(results, scenario), indent=2, allow_nan=False) + "\n"
+    doc = json.dumps(summary(results, bounds), indent=2, allow_nan=False) + "\n"
     base = stem(args.out)
     csv_path, json_path = base.parent / (base.name + ".csv"), base.parent / (base.name + ".json")
     write_csv(table.replace([np.inf], np.nan), csv_path)

@@ -1,0 +1,227 @@
+"""The cell assembled from a scenario: where scenario keys become the maths' values.
+
+The maths (kinematics, path, motors, planner) works on small plain values
+(:class:`~cell.path.CellGeometry`, :class:`~cell.motors.Motors`,
+:class:`~cell.mintime.regimes.PlannerBounds`) and knows nothing of files.  This
+module builds those values from a :class:`~cell.scenario.Scenario`, checks what
+needs the robot's maths (reach, motor rates at the load, a nominal cycle the
+motors can make), and turns any maths error into a
+:class:`~cell.errors.ScenarioError` naming the key and file that caused it.
+Everything solved is cached on the plain values it depends on.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from cell import registry
+from cell.cache import memo
+from cell.errors import CellError, InfeasibleError, NoMotionError, ScenarioError, UnreachableError
+from cell.kinematics import JOINT_NAMES, Arm, Hand, Placement
+from cell.motors import Motors, max_rates
+from cell.path import CellGeometry, Route, build_path
+from cell.policies.base import CellConstants, Policy
+from cell.robot import RobotTiming, build_timing
+from cell.scenario import Scenario, default_scenario
+from cell.steptable import StepTable
+
+
+# --------------------------------------------------------------------------- plain values
+def geometry_of(s: Scenario) -> CellGeometry:
+    """Everything the path's shape and joint angles depend on."""
+    p, r = s.path, s.robot
+    m = p.moves
+    h = r.hand
+    return CellGeometry(
+        route=Route(p.bot_in, p.f_in, p.g_in, p.eot_in, p.pick_height_in, p.place_height_in,
+                    p.lo_from_bot_in, p.td_from_g_in, (m.R1, m.R2, m.R3, m.R4)),
+        placement=Placement(s.cell.robot_base_in, s.cell.shoulder_height_in,
+                            math.radians(s.cell.robot_yaw_deg)),
+        arm=Arm(r.l2_in, r.l3_in, tuple((math.radians(lo), math.radians(hi))
+                                        for lo, hi in r.joint_limits_deg.as_list())),
+        hand=Hand(h.l1_in, h.l2_in, h.g0_in, h.open_in),
+        part_size_in=s.part.size_in, part_weight_oz=s.part.weight_oz)
+
+
+def motors_of(s: Scenario) -> Motors:
+    m = s.robot.motors
+    return Motors(m.steps_per_rad, m.max_rate_no_load_rad_s, m.max_rate_full_load_rad_s,
+                  m.full_load_oz, m.nominal_fraction)
+
+
+def planner_bounds(s: Scenario) -> Any:
+    """The minimum-time planner's bounds (``mintime`` section; the dynamics file read)."""
+    from cell.dynamics_file import load_dynamics
+    from cell.mintime.regimes import PlannerBounds
+
+    mt = s.mintime
+    model = None
+    if mt.dynamics_file is not None:
+        path = s.base_dir / mt.dynamics_file
+        if not path.is_file():
+            raise ScenarioError(s.source, "mintime.dynamics_file", mt.dynamics_file,
+                                f"no such file (looked for {path})")
+        model = load_dynamics(path)
+    return PlannerBounds(mt.grid_points, mt.rate_fraction, mt.qddot_max_rad_s2,
+                         mt.acceleration_bounds, model)
+
+
+# --------------------------------------------------------------------------- the path
+def step_table(s: Scenario) -> StepTable:
+    """The scenario's solved path; a point out of reach names the key that put it there."""
+    _check_motor_rates(s)
+    geometry, motors = geometry_of(s), motors_of(s)
+    try:
+        return StepTable.solve(geometry, motors)
+    except UnreachableError as exc:
+        key, value, hint = _blame(s, geometry)
+        raise ScenarioError(s.source, key, value, f"{exc}{hint}") from None
+
+
+#: Keys that shape the path, in the order blame is given.
+GEOMETRY_KEYS = (
+    "cell.robot_base_in", "cell.shoulder_height_in", "cell.robot_yaw_deg",
+    "path.bot_in", "path.f_in", "path.g_in", "path.eot_in", "path.pick_height_in",
+    "path.place_height_in", "path.lo_from_bot_in", "path.td_from_g_in",
+    "robot.l2_in", "robot.l3_in", "robot.hand.l1_in", "robot.hand.l2_in", "robot.hand.g0_in",
+    "robot.hand.open_in", "part.size_in",
+    *(f"robot.joint_limits_deg.theta{j}" for j in range(1, 6)),
+    *(f"path.moves.R{j}" for j in range(1, 5)),
+)
+
+
+def _blame(s: Scenario, geometry: CellGeometry) -> tuple[str, Any, str]:
+    """The key whose value makes the path unreachable: of the keys that differ from the
+    thesis's cell, the first whose thesis value alone makes every point reachable."""
+    thesis = default_scenario()
+    changed = [k for k in GEOMETRY_KEYS if s.get(k) != thesis.get(k)]
+    for key in changed:
+        trial = _with(s, key, thesis.get(key))
+        if trial is None:
+            continue
+        try:
+            build_path(geometry_of(trial))
+        except UnreachableError:
+            continue
+        return key, _shown(s.get(key)), f" (with the thesis's {key} it is reachable)"
+    if changed:
+        others = ", ".join(changed[1:])
+        return changed[0], _shown(s.get(changed[0])), \
+            f" (together with {others})" if others else ""
+    return "path", None, ""  # pragma: no cover - the thesis's own cell is reachable
+
+
+def _with(s: Scenario, key: str, value: Any) -> Scenario | None:
+    try:
+        return s.with_overrides({key: value})
+    except ScenarioError:
+        return None
+
+
+def _shown(value: Any) -> Any:
+    return list(value) if isinstance(value, tuple) else value
+
+
+def _check_motor_rates(s: Scenario) -> None:
+    """Rates are linear in the load (§6.1): each must stay positive at the part's weight."""
+    m = s.robot.motors
+    rates = max_rates(s.part.weight_oz, motors_of(s))
+    if np.all(rates > 0):
+        return
+    j = int(np.flatnonzero(rates <= 0)[0])
+    no, full = m.max_rate_no_load_rad_s[j], m.max_rate_full_load_rad_s[j]
+    limit = m.full_load_oz * no / (no - full) if no > full else math.inf
+    raise ScenarioError(s.source, "part.weight_oz", s.part.weight_oz,
+                        f"the {JOINT_NAMES[j]} motor's rate, linear in the load (§6.1), would be "
+                        f"{rates[j]:.4g} steps/s at this load: the parts may weigh less than "
+                        f"{limit:.4g} oz")
+
+
+# --------------------------------------------------------------------------- timing
+def robot_timing(s: Scenario) -> RobotTiming:
+    """The robot's regime segments (§6.1), floored by the planner under minimum-time timing."""
+    step_table(s)  # reach and motor checks, with their keys
+    if s.robot.timing != "minimum-time":
+        return _timing(geometry_of(s), motors_of(s), None)
+    bounds = planner_bounds(s)
+    try:
+        return _timing(geometry_of(s), motors_of(s), bounds)
+    except InfeasibleError as exc:
+        j = getattr(exc, "joint", 0)
+        raise ScenarioError(s.base_dir / str(s.mintime.dynamics_file),
+                            f"drives.viscous_nm_s_rad[{j}]", None, str(exc)) from None
+    except NoMotionError as exc:
+        raise CellError(f"{s.source}: robot.timing = 'minimum-time': {exc}") from None
+
+
+@memo(maxsize=16)
+def _timing(geometry: CellGeometry, motors: Motors, bounds: Any) -> RobotTiming:
+    table = StepTable.solve(geometry, motors)
+    if bounds is None:
+        return build_timing(table)
+    from cell.mintime.regimes import fastest_regime_times
+
+    return build_timing(table, fastest_regime_times(geometry, motors, bounds))
+
+
+def constants(s: Scenario, timing: RobotTiming) -> CellConstants:
+    """The policies' constants; a cell that cannot run its nominal cycle is an error."""
+    b, c = s.belts, s.controller
+    file = s.source
+    if b.input_nominal_in_s > timing.input_track_max_in_s:
+        raise ScenarioError(file, "belts.input_nominal_in_s", b.input_nominal_in_s,
+                            f"the robot can follow the input belt down to LO at no more "
+                            f"than {timing.input_track_max_in_s:.4f} in/s")
+    if b.output_nominal_in_s > timing.output_track_max_in_s:
+        raise ScenarioError(file, "belts.output_nominal_in_s", b.output_nominal_in_s,
+                            f"the robot can follow the output belt down to TD at no more "
+                            f"than {timing.output_track_max_in_s:.4f} in/s")
+    t = timing
+    r1a, r1b = t.r1_time(b.input_nominal_in_s)
+    r3a, r3b = t.r3_time(b.output_nominal_in_s)
+    r4 = max(t.r4_nominal_s, t.r4_min_s)
+    r2 = c.nominal_cycle_s - r1a - r1b - r3a - r3b - r4
+    if r2 < t.r2_min_s:
+        raise ScenarioError(file, "controller.nominal_cycle_s", c.nominal_cycle_s,
+                            f"leaves {r2:.4f} s for R II, which takes at least "
+                            f"{t.r2_min_s:.4f} s at the motors' peak rates")
+    length = b.input_length_in if b.input_length_in is not None else \
+        b.input_nominal_in_s * c.nominal_cycle_s * 2
+    return CellConstants(
+        timing=t, v_nom=b.input_nominal_in_s, u_nom=b.output_nominal_in_s,
+        cycle_nom=c.nominal_cycle_s, input_max=min(b.input_max_in_s, 1e9),
+        output_max=b.output_max_in_s, spacing=b.spacing_in, tol=b.spacing_tol_in,
+        input_length=length, r1_pre_nom=r1a, r1_post_nom=r1b, r3_pre_nom=r3a,
+        r3_post_nom=r3b, r4_nom=r4, r2_nom=r2, r1_nom=r1a + r1b)
+
+
+# --------------------------------------------------------------------------- the whole cell
+@dataclass(frozen=True)
+class AssembledCell:
+    """A scenario's cell, ready to run: its solved path, timing, constants and policy."""
+
+    scenario: Scenario
+    table: StepTable
+    timing: RobotTiming
+    k: CellConstants
+    policy: Policy
+
+
+def make_policy(s: Scenario, k: CellConstants) -> Policy:
+    try:
+        cls = registry.get(s.controller.policy)
+    except KeyError:
+        raise ScenarioError(s.source, "controller.policy", s.controller.policy,
+                            "must be one of " + ", ".join(registry.names())) from None
+    return cls(k, s.controller, s.source)
+
+
+def assemble(s: Scenario) -> AssembledCell:
+    """Every check and every solved value the simulation needs, errors first."""
+    timing = robot_timing(s)
+    k = constants(s, timing)
+    return AssembledCell(s, step_table(s), timing, k, make_policy(s, k))

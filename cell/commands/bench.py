@@ -1,0 +1,30 @@
+"""``cell bench [--out FILE]``: the speed figures of this machine (``make bench``)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+from typing import Any
+
+from cell.bench import TARGET_PARTS_PER_S, benchmarks
+from cell.output import write_text
+
+
+def main(args: argparse.Namespace) -> int:
+    from cell.mintime.bench import benchmarks as planner_benchmarks
+
+    results: dict[str, Any] = benchmarks()
+    results.update(planner_benchmarks())
+    results["machine"] = f"{platform.machine()} {platform.python_implementation()} " \
+                         f"{platform.python_version()}"
+    for key, value in results.items():
+        shown = f"{value:,.0f}" if isinstance(value, float) and value >= 100 else \
+            (f"{value:.3f}" if isinstance(value, float) else str(value))
+        print(f"{key:<28} {shown}")
+    for key in ("parts_per_s_adaptive", "parts_per_s_non_adaptive"):
+        if results[key] < TARGET_PARTS_PER_S:
+            print(f"note: {key} is below the target of {TARGET_PARTS_PER_S:,} parts/s")
+    write_text(json.dumps(results, indent=2, sort_keys=True) + "\n", args.out)
+    print(f"wrote {args.out}")
+    return 0

@@ -1,0 +1,45 @@
+"""``cell sweep SWEEP --out DIR [--workers N] [--scheduler ADDR] [--resume] [--report DIR]``."""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import threading
+from pathlib import Path
+from typing import Any
+
+from cell.sweep import load_sweep, run_sweep, simulate_summary
+
+
+def _interrupt(signum: int, frame: Any) -> None:
+    raise KeyboardInterrupt
+
+
+def main(args: argparse.Namespace) -> int:
+    if threading.current_thread() is not threading.main_thread():
+        return _sweep(args)
+    # kill (SIGTERM) stops like Ctrl-C: pending tasks cancelled, finished ones kept.
+    previous = signal.signal(signal.SIGTERM, _interrupt)
+    try:
+        return _sweep(args)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _sweep(args: argparse.Namespace) -> int:
+    sweep = load_sweep(args.sweep)
+    if args.report:
+        from cell.report import check_table_7_1
+
+        check_table_7_1(sweep)
+    outcome = run_sweep(sweep, args.out, workers=args.workers, scheduler=args.scheduler,
+                        resume=args.resume, replicate=simulate_summary)
+    print(f"wrote {Path(args.out) / 'replications.csv'}: {len(sweep.points)} points x "
+          f"{sweep.replications} replications ({outcome.tasks_run} tasks run, "
+          f"{outcome.tasks_reused} reused)")
+    if args.report:
+        from cell.report import write_table_7_1
+
+        for path in write_table_7_1(outcome.replications, sweep, args.report):
+            print(f"wrote {path}")
+    return 0

@@ -1,0 +1,134 @@
+"""The adaptive controller (thesis §5.3; steps 1.0-2.1 reconstructed, docs/model.md).
+
+One part ahead:
+
+1.0  the next part's distance and the belt speeds are read;
+2.x  R I tracks the input belt at its current speed v; the difference from the
+     nominal R I time is given to (2.1) or taken from (2.2) R II, so the cycle
+     stays at the ideal 22.5872 s unless R II is already at its fastest;
+3.1  next part late: after the tracking lag (B → LO) the input belt speeds up so
+     that the part reaches B as the robot gets back;
+3.2  next part early: the time is made up in R IV down to the base's maximum rate,
+     then the input belt slows for the rest;
+5.0  the output belt runs, until the robot reaches G, at the average of the
+     speeds that would give 44.75 and 45.25 in spacing, then nominal;
+6.2  the thesis's "time between deliveries": motion time to TD plus the previous
+     cycle's residual (TD → K and R IV), idle waits not counted;
+6.3  after the cycle, an input speed above nominal becomes (current + nominal)/2.
+
+Targets are physical: the controller knows the belts' schedules, so it aims
+the next part at B for the instant the robot gets back, and the spacing at 45 in,
+exactly; only motor and belt limits can make it miss, and then it says so.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from cell import accounting
+from cell.errors import ScenarioError
+from cell.policies.base import CellConstants, CellView, MotionTimeAccounting, Plan, Policy
+from cell.records import RunSummary
+
+#: The output belt never runs backwards; this is its crawl when asked to stop (in/s).
+OUTPUT_MIN_IN_S = 0.01
+
+
+def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
+                  gap_in: float | None, lag: float | None = None) -> Plan:
+    """Thesis §5.3 steps 2.0-6.3 for one part (pure).
+
+    ``v``: input belt speed now (R I tracks it).  ``nxt = (a, b)``: the next part
+    reaches B a + b/w seconds from now if the input belt runs at w from LO on
+    (a = the lag B → LO and b = its pseudo-distance then, or, for a part not yet
+    on the belt, a = time until the feeder drops it and b = the belt's length);
+    None if no part is coming.  ``gap_in``: how far the last part set down has
+    travelled on the output belt (None before the first).  ``lag``: B → LO at v,
+    if the caller has it already.
+    """
+    t = k.timing
+    notes = []
+    r1a = t.r1_pre.time(v) if lag is None else lag
+    r1b = t.r1_post.time(v)
+    # 2.1-2.3: R I's difference from nominal goes to R II.
+    r2 = k.r2_nom + (k.r1_nom - r1a - r1b)
+    if r2 < t.r2_min_s:
+        notes.append("R II at its fastest")
+        r2 = t.r2_min_s
+    r3a, r3b, r4 = k.r3_pre_nom, k.r3_post_nom, k.r4_nom
+    cycle = r1a + r1b + r2 + r3a + r3b + r4
+    w = v
+    if nxt is not None:
+        a, b = nxt
+        eta = a + b / v                       # 3.0: next arrival at the current speed
+        if eta > cycle:                       # 3.1: late; speed the belt up after the lag
+            w = b / (cycle - a) if cycle > a else math.inf
+            if w > k.input_max:
+                w = k.input_max
+                notes.append("input belt at its maximum: robot waits")
+        elif eta < cycle:                     # 3.2: early; R IV first, then the belt
+            need = cycle - eta
+            if r4 - need >= t.r4_min_s:
+                r4 -= need
+                cycle -= need
+            else:
+                cycle -= r4 - t.r4_min_s
+                r4 = t.r4_min_s
+                w = b / (cycle - a)
+    # 6.3: decay toward nominal after the cycle.
+    v_next = 0.5 * (w + k.v_nom) if w > k.v_nom else w
+    if v_next > t.input_track_max_in_s:
+        v_next = t.input_track_max_in_s
+        notes.append("input belt held to the robot's tracking limit")
+    # 5.0: output belt until G, between the 44.75 and 45.25 in limits.
+    u = k.u_nom
+    if gap_in is not None:
+        ttsot = r1a + r1b + r2
+        rest = gap_in + k.u_nom * r3a
+        lo = (k.spacing - k.tol - rest) / ttsot
+        hi = (k.spacing + k.tol - rest) / ttsot
+        u = 0.5 * (lo + hi)
+        if not OUTPUT_MIN_IN_S <= u <= k.output_max:
+            u = min(max(u, OUTPUT_MIN_IN_S), k.output_max)
+            notes.append("output belt at its limit: spacing off")
+    return Plan(r1a, r1b, r2, r3a, r3b, r4, v, w, v_next, u, r1a + r1b + r2, cycle,
+                "; ".join(notes))
+
+
+class Adaptive(Policy):
+    """``adaptive``: thesis §5.3, steps 1.0-7.0."""
+
+    name = "adaptive"
+
+    def __init__(self, k: CellConstants, controller: Any, file: object = None):
+        super().__init__(k, controller, file)
+        ideal = controller.ideal_cycle_s
+        if ideal is not None and ideal != k.cycle_nom:
+            raise ScenarioError(file, "controller.ideal_cycle_s", ideal,
+                                "the adaptive policy runs at the nominal cycle; "
+                                "set controller.nominal_cycle_s instead")
+
+    def plan(self, view: CellView) -> Plan:
+        k = self.k
+        v = view.input_speed()
+        lag = k.timing.r1_pre.time(v)
+        return adaptive_plan(k, v, view.next_part(lag, v), view.output_gap(), lag)
+
+    def accounting(self) -> MotionTimeAccounting:
+        return AdaptiveAccounting(self)
+
+
+class AdaptiveAccounting(MotionTimeAccounting):
+    """Step 6.2, and beside it the memoryless reading that reproduces the published IP
+    (each next arrival counted from the current pick-up; docs/accounting.md)."""
+
+    def finish(self, s: RunSummary, picked_r4_s: np.ndarray, t_next: np.ndarray) -> None:
+        super().finish(s, picked_r4_s, t_next)
+        k = self.policy.k
+        memo = accounting.thesis_adaptive_memoryless(t_next, k.cycle_nom, k.shortest_cycle_s)
+        s.ip_thesis_memoryless = float(memo.mean_ip)
+        s.cycle_vs_nominal_memoryless_pct = \
+            100.0 * (float(memo.actual_cycle_s) - k.cycle_nom) / k.cycle_nom

@@ -1,0 +1,171 @@
+"""What every control policy shares: the cell's constants, the plan of one cycle,
+the view of the cell a policy decides from, and the thesis-style accounting.
+
+A policy (thesis §5.3, §6.3) is a class with a ``name`` and one decision,
+:meth:`Policy.plan`: given the cell's state when a part reaches B with the
+robot free, the regime times of the part's cycle and, if it steers them, the
+belt speeds.  Its :meth:`Policy.accounting` counts the run the way the thesis
+would have (docs/accounting.md); the default is step 6.2's motion time.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from array import array
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, ClassVar, NamedTuple, Protocol
+
+import numpy as np
+
+from cell import accounting
+from cell.records import PartRecord, RunSummary
+from cell.robot import RobotTiming
+
+
+@dataclass(frozen=True)
+class CellConstants:
+    """What the policies know of the cell, computed once per scenario."""
+
+    timing: RobotTiming
+    v_nom: float
+    """Nominal input belt speed, in/s (§5.2)."""
+    u_nom: float
+    """Nominal output belt speed, in/s (§5.2)."""
+    cycle_nom: float
+    """The ideal cycle, mean inter-arrival time (§5.3)."""
+    input_max: float
+    output_max: float
+    spacing: float
+    tol: float
+    input_length: float
+    """Feeder drop point to B (in)."""
+    r1_pre_nom: float
+    r1_post_nom: float
+    r3_pre_nom: float
+    r3_post_nom: float
+    r4_nom: float
+    r2_nom: float
+    """R II's share of the ideal cycle: what the other regimes leave of it."""
+    r1_nom: float
+    """R I at the nominal input belt: belt pace to LO plus the motor floor after it."""
+
+    @property
+    def shortest_cycle_s(self) -> float:
+        """The nominal cycle with R IV at the base's peak rate (Table 7.1's last row)."""
+        return self.cycle_nom - (self.r4_nom - self.timing.r4_min_s)
+
+
+class Plan(NamedTuple):
+    """One transfer cycle: regime times (s), belt speeds (in/s) and what went wrong."""
+
+    r1_pre: float
+    r1_post: float
+    r2: float
+    r3_pre: float
+    r3_post: float
+    r4: float
+    input_speed: float
+    """Input belt while R I tracks the part (the belt's speed when it reached B)."""
+    input_after_lo: float
+    """Input belt from LO until the cycle ends (steps 3.1/3.2)."""
+    input_next: float
+    """Input belt after the cycle (step 6.3): the next part's R I tracking speed."""
+    output_to_g: float
+    """Output belt until the robot reaches G (step 5.0)."""
+    to_g: float
+    """TTSOT counted from the start of this cycle: R I + R II (step 5.0)."""
+    cycle: float
+    """The robot's motion time for the whole cycle B → B."""
+    note: str
+    steers_belts: bool = True
+    """Whether the belt speeds above are commands (False: the belts are left alone)."""
+
+
+class CellView(Protocol):
+    """The cell as a policy sees it when a part reaches B and the robot is free."""
+
+    k: CellConstants
+
+    def input_speed(self) -> float:
+        """The input belt's speed now (R I tracks the part at it)."""
+
+    def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
+        """(a, b): the next part that can still be caught reaches B a + b/w s from now if
+        the input belt runs at w from LO (``lag`` s from now) on; None if none is coming."""
+
+    def output_gap(self) -> float | None:
+        """How far the last part set down has travelled on the output belt (None: none yet)."""
+
+
+class Policy(ABC):
+    """A control policy: decides each part's cycle (subclass and :func:`cell.registry.register`)."""
+
+    name: ClassVar[str]
+
+    def __init__(self, k: CellConstants, controller: Any, file: object = None):
+        """``controller``: the scenario's ``controller`` section; ``file`` for error messages."""
+        self.k = k
+
+    @property
+    def ideal_cycle_s(self) -> float:
+        """The cycle this policy plans for (reported beside the results)."""
+        return self.k.cycle_nom
+
+    @abstractmethod
+    def plan(self, view: CellView) -> Plan:
+        """The cycle of the part now at B."""
+
+    def accounting(self) -> Accounting:
+        """How the thesis would count this policy's run (default: step 6.2's motion time)."""
+        return MotionTimeAccounting(self)
+
+
+class Accounting:
+    """Counts a run part by part, then sums it up; parts come in order, each once.
+
+    ``part`` fills the record's thesis-accounting columns as the part completes
+    (the controller has written step 6.2's motion interval into
+    ``thesis_interval_s`` for a part it picked); ``finish`` the summary's.  The
+    per-part values are kept in flat arrays, so a long run costs a few bytes per part.
+    """
+
+    def __init__(self, policy: Policy):
+        self.policy = policy
+        self.interval = array("d")
+        self.ip = array("d")
+        self.missed = 0
+
+    def part(self, rec: PartRecord, next_interarrival_s: float) -> None:
+        raise NotImplementedError
+
+    def finish(self, s: RunSummary, picked_r4_s: np.ndarray, t_next: np.ndarray) -> None:
+        raise NotImplementedError
+
+
+class MotionTimeAccounting(Accounting):
+    """Step 6.2: the time between deliveries is the robot's motion time to TD plus the
+    previous cycle's residual (idle waits not counted); IP = T(i+1) / that; a part is
+    lost when it is lost on the wall clock."""
+
+    def part(self, rec: PartRecord, next_interarrival_s: float) -> None:
+        d = rec.thesis_interval_s if rec.picked else math.nan
+        rec.missed_thesis = not rec.picked
+        rec.thesis_interval_s = d
+        rec.ip_thesis = next_interarrival_s / d
+        self.interval.append(d)
+        self.missed += not rec.picked
+
+    def finish(self, s: RunSummary, picked_r4_s: np.ndarray, t_next: np.ndarray) -> None:
+        k = self.policy.k
+        thesis = accounting.thesis_adaptive(t_next, np.frombuffer(self.interval))
+        s.parts_missed_thesis = self.missed
+        s.actual_cycle_thesis_s = float(thesis.actual_cycle_s)
+        s.ip_thesis = float(thesis.mean_ip)
+        s.cycle_vs_nominal_pct = 100.0 * (s.actual_cycle_thesis_s - k.cycle_nom) / k.cycle_nom
+        s.r4_s = float(picked_r4_s.mean()) if picked_r4_s.size else math.nan
+
+
+#: A policy's factory as the registry holds it.
+PolicyFactory = Callable[[CellConstants, Any, object], Policy]

@@ -1,0 +1,172 @@
+"""One record type per row of each output file, filled as events happen.
+
+* :class:`PartRecord`: a row of ``parts.csv``, one per arriving part;
+* :class:`RunSummary`: the one row of ``summary.csv`` (and of a sweep's
+  ``replications.csv``, after the grid columns);
+* :class:`BeltChange`: a row of ``belts.csv``, one per speed change of a belt.
+
+The fields, in order, *are* the columns; each field's docstring is its
+meaning (the README's column tables are checked against them).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from typing import Any
+
+NAN = math.nan
+
+
+@dataclass(slots=True)
+class PartRecord:
+    """What happened to one part, from the feeder to the output belt (or the floor)."""
+
+    part: int
+    """1 … N, in order of arrival."""
+    arrival_s: float = NAN
+    """When the feeder dropped it on the input belt."""
+    interarrival_s: float = NAN
+    """T_i, its inter-arrival time (eq. 6.9 draw, or the trace)."""
+    at_bot_s: float = NAN
+    """When it reached B, the beginning of tracking."""
+    picked: bool = False
+    """Picked up by the robot (the robot was back at B when it arrived)."""
+    missed: bool = False
+    """Reached B while the robot was busy: rode on and fell off at F (§6.3)."""
+    missed_thesis: bool = False
+    """Lost under the thesis's bookkeeping (docs/accounting.md)."""
+    pick_s: float = NAN
+    """Lift-off (LO): the hand closes on the part."""
+    touchdown_s: float = NAN
+    """Touch-down (TD): the part is set on the output belt."""
+    delivery_interval_s: float = NAN
+    """Wall clock: time since the previous part's touch-down."""
+    motion_cycle_s: float = NAN
+    """The robot's motion B → B for this part."""
+    thesis_interval_s: float = NAN
+    """The thesis's "time between deliveries" under the policy's own accounting."""
+    ip_wallclock: float = NAN
+    """IP (eq. 5.1) = T(i+1) / delivery interval."""
+    ip_thesis: float = NAN
+    """IP in the thesis's accounting."""
+    input_speed_in_s: float = NAN
+    """Input belt speed while R I tracks the part."""
+    output_speed_in_s: float = NAN
+    """Output belt speed until the robot reaches G (step 5.0)."""
+    spacing_in: float = NAN
+    """Distance to the previous part on the output belt."""
+    v_r1_in_s: float = NAN
+    """R I's length over its time: the regime's average tip velocity."""
+    v_r2_in_s: float = NAN
+    """R II's length over its time."""
+    v_r3_in_s: float = NAN
+    """R III's length over its time."""
+    v_r4_in_s: float = NAN
+    """R IV's length over its time."""
+    r1_s: float = NAN
+    """Time in R I (B → F)."""
+    r2_s: float = NAN
+    """Time in R II (F → G)."""
+    r3_s: float = NAN
+    """Time in R III (G → K)."""
+    r4_s: float = NAN
+    """Time in R IV (K → B)."""
+    note: str = ""
+    """Limits hit, or why the part was lost."""
+
+
+@dataclass(slots=True)
+class RunSummary:
+    """One run in one row: counts, both accountings, spacing and belt extremes."""
+
+    scenario: str = ""
+    """The scenario's name."""
+    policy: str = ""
+    """The control policy."""
+    seed: Any = None
+    """The root seed (an int, or entropy/spawn key of a sweep's stream)."""
+    ideal_cycle_s: float = NAN
+    """The cycle the policy plans for (Table 7.1, column 1)."""
+    parts_arrived: int = 0
+    """Parts dropped on the input belt."""
+    parts_delivered: int = 0
+    """Parts set down on the output belt."""
+    parts_missed: int = 0
+    """Parts lost on the wall clock (fell off at F)."""
+    parts_in_cell: int = 0
+    """Arrived but neither delivered nor lost when the run ended."""
+    parts_missed_thesis: int = 0
+    """Parts lost under the thesis's bookkeeping."""
+    actual_cycle_wallclock_s: float = NAN
+    """Mean time between consecutive set-downs."""
+    actual_cycle_thesis_s: float = NAN
+    """Actual cycle in the thesis's accounting."""
+    parts_per_hr_wallclock: float = NAN
+    """3600 / wall-clock actual cycle."""
+    parts_per_hr_thesis: float = NAN
+    """3600 / the thesis's actual cycle (Table 7.1's column)."""
+    vavg_r4_in_s: float = NAN
+    """R IV's length over its mean time (Table 7.1's column)."""
+    ip_wallclock: float = NAN
+    """Mean IP on the wall clock."""
+    ip_thesis: float = NAN
+    """Mean IP in the thesis's accounting."""
+    cycle_vs_nominal_pct: float = NAN
+    """The thesis's actual cycle against the ideal one, %."""
+    ip_thesis_memoryless: float = NAN
+    """The adaptive IP with each next arrival counted from the current pick-up."""
+    cycle_vs_nominal_memoryless_pct: float = NAN
+    """The same reading's cycle against the ideal one, %."""
+    spacing_min_in: float = NAN
+    """Closest spacing on the output belt."""
+    spacing_max_in: float = NAN
+    """Widest spacing on the output belt."""
+    spacing_outside_tol: int = 0
+    """Spacings outside 45 ± 0.25 in (§4.3 f)."""
+    parts_noted: int = 0
+    """Parts with a note (limits hit, lost)."""
+    input_speed_max_in_s: float = NAN
+    """Fastest the input belt ran."""
+    output_speed_min_in_s: float = NAN
+    """Slowest output belt speed asked before G."""
+    output_speed_max_in_s: float = NAN
+    """Fastest output belt speed asked before G."""
+    r1_nominal_s: float = NAN
+    """R I at the nominal input belt."""
+    r2_nominal_s: float = NAN
+    """R II's share of the nominal cycle."""
+    r4_s: float = NAN
+    """Mean R IV time of the parts picked."""
+    thesis_slack_s: float = NAN
+    """The calibrated slack of the thesis's bookkeeping (non-adaptive), s."""
+    sim_end_s: float = NAN
+    """Simulated time when the run ended."""
+
+    def __getitem__(self, name: str) -> Any:
+        return getattr(self, name)
+
+    def as_dict(self) -> dict[str, Any]:
+        return {name: getattr(self, name) for name in SUMMARY_COLUMNS}
+
+
+@dataclass(slots=True, frozen=True)
+class BeltChange:
+    """A belt runs at a new speed from an instant on."""
+
+    belt: str
+    """``input`` or ``output``."""
+    from_s: float
+    """The instant the speed takes effect."""
+    speed_in_s: float
+    """The speed from then on (in/s)."""
+
+
+def columns(record_type: type) -> list[str]:
+    """The CSV columns of a record type: its fields, in order."""
+    return [f.name for f in fields(record_type)]
+
+
+PART_COLUMNS = columns(PartRecord)
+SUMMARY_COLUMNS = columns(RunSummary)
+BELT_COLUMNS = columns(BeltChange)

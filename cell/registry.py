@@ -1,0 +1,67 @@
+"""The control policies the cell knows, by name.
+
+A policy is a class implementing :class:`cell.policies.Policy`.  The two of the
+thesis are built in (``non-adaptive``, §6.3, and ``adaptive``, §5.3); another is
+added with :func:`register` (in-process, e.g. from a test or a notebook) or by a
+package that declares an entry point in the group ``cell.policies``.  The names
+feed the scenario's allowed values of ``controller.policy`` and a sweep's
+policy list.  Built-ins are imported only when used, so reading a scenario does
+not load the simulation.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+#: Built-in policies: name -> "module:Class", imported on first use.
+BUILT_IN: dict[str, str] = {
+    "non-adaptive": "cell.policies.fixed:FixedCycle",
+    "adaptive": "cell.policies.adaptive:Adaptive",
+}
+ENTRY_POINT_GROUP = "cell.policies"
+
+_registered: dict[str, Any] = {}
+_entry_points: dict[str, Any] | None = None
+
+
+def _plugins() -> dict[str, Any]:
+    global _entry_points
+    if _entry_points is None:
+        from importlib.metadata import entry_points
+
+        _entry_points = {ep.name: ep for ep in entry_points(group=ENTRY_POINT_GROUP)}
+    return _entry_points
+
+
+def register(policy: Any, name: str | None = None) -> Any:
+    """Make a policy class known under ``name`` (default: its ``name`` attribute).
+
+    Usable as a class decorator.  Registering a name twice replaces the first.
+    """
+    key = name or getattr(policy, "name", None)
+    if not isinstance(key, str) or not key:
+        raise ValueError("a policy needs a non-empty name")
+    _registered[key] = policy
+    return policy
+
+
+def unregister(name: str) -> None:
+    _registered.pop(name, None)
+
+
+def names() -> tuple[str, ...]:
+    """Every known policy name: the built-ins, then registered ones, then plug-ins."""
+    return tuple(dict.fromkeys([*BUILT_IN, *_registered, *_plugins()]))
+
+
+def get(name: str) -> Any:
+    """The policy class registered as ``name`` (KeyError if there is none)."""
+    if name in _registered:
+        return _registered[name]
+    if name in BUILT_IN:
+        module, _, cls = BUILT_IN[name].partition(":")
+        return getattr(importlib.import_module(module), cls)
+    if name in _plugins():
+        return _plugins()[name].load()
+    raise KeyError(name)
