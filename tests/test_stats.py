@@ -135,6 +135,27 @@ def test_paired_identical_inputs_have_no_variation():
     assert no_variation(a - a)
 
 
+@pytest.mark.filterwarnings("ignore:Precision loss:RuntimeWarning")  # scipy, on near-equal differences
+@settings(max_examples=100, deadline=None)
+@given(st.lists(st.tuples(st.floats(-1e6, 1e6), st.floats(-1e6, 1e6)), min_size=2, max_size=40)
+       .filter(lambda pairs: np.std([a - b for a, b in pairs], ddof=1) > 0))
+def test_paired_properties(pairs):
+    a, b = (np.array(v) for v in zip(*pairs))
+    p = paired_difference(a, b)
+    assert p["n"] == len(pairs) and all(math.isfinite(v) for v in p.values())
+    assert p["ci_low"] <= p["mean"] <= p["ci_high"] and 0.0 <= p["p_value"] <= 1.0
+
+
+@given(st.dictionaries(st.integers(0, 9), st.integers(0, 200), min_size=1), st.integers(1, 50),
+       st.integers(1, 150), st.data())
+def test_next_round_never_overshoots(counts, batch, max_n, data):
+    reached = {k: data.draw(st.booleans()) for k in counts}
+    need = next_round(counts, reached, batch, max_n)
+    for k, n in counts.items():
+        assert 0 <= need[k] <= batch
+        assert need[k] == 0 if reached[k] or n >= max_n else n + need[k] <= max_n
+
+
 def test_paired_rejects_unequal_lengths():
     with pytest.raises(ValueError):
         paired_difference([1.0, 2.0], [1.0])

@@ -24,7 +24,7 @@ PAIRED_KEYS = ("n", "mean", "sd", "ci_low", "ci_high", "p_value")
 
 def _clean(x: ArrayLike) -> NDArray[np.float64]:
     """``x`` as a flat float array without NaNs."""
-    a = np.asarray(x, dtype=float).ravel()
+    a: NDArray[np.float64] = np.asarray(x, dtype=np.float64).ravel()
     return a[~np.isnan(a)]
 
 
@@ -174,7 +174,9 @@ def mser_statistic(x: ArrayLike, batch: int = 5) -> NDArray[np.float64]:
 
     With Z_1..Z_k the means of consecutive batches of ``batch`` observations (an
     incomplete last batch is ignored) and Z̄(d) the mean of Z_{d+1}..Z_k,
-    MSER(d) = Σ_{j>d} (Z_j − Z̄(d))² / (k − d)²  (White 1997).
+    MSER(d) = Σ_{j>d} (Z_j − Z̄(d))² / (k − d)²  (White 1997), i.e. the variance of
+    the remaining batch means over their number (with divisor k − d; the sample
+    variance's k − d − 1 chose the same d on every test series we tried).
     """
     if batch < 1:
         raise ValueError(f"batch must be at least 1, got {batch!r}")
@@ -192,7 +194,8 @@ def mser_statistic(x: ArrayLike, batch: int = 5) -> NDArray[np.float64]:
     tail_sq = np.cumsum((z - z.mean())[::-1] ** 2)[::-1]  # centred for accuracy
     tail_mean_c = tail_sum / tail_n - z.mean()
     ss = np.maximum(tail_sq - tail_n * tail_mean_c ** 2, 0.0)
-    return (ss / tail_n ** 2)[: last + 1]
+    out: NDArray[np.float64] = (ss / tail_n ** 2)[: last + 1]
+    return out
 
 
 def mser(x: ArrayLike, batch: int = 5) -> int:
