@@ -93,9 +93,9 @@ def _fit_threshold(dist: Any, x: NDArray[np.float64]) -> list[float]:
     two-parameter likelihood (scipy's fit with ``floc``) on a grid of
     thresholds, denser towards min(x) and never closer than 1e-4 of the data's
     range; take the best grid point, preferring an interior local maximum to
-    the end next to min(x); refine it with bounded Brent; and finally let
-    scipy's free fit polish it, kept only when it raises the log-likelihood
-    and stays in bounds.  The grid is the set of starts whose likelihoods are
+    the end next to min(x); refine it with bounded Brent; then run scipy's free
+    fit from there and from scipy's own (moments) start, each kept only when it
+    raises the log-likelihood and stays in bounds.  The grid is the set of starts whose likelihoods are
     compared, so the answer is a real (local) maximum, and deterministic.
     ``loc`` stays ≥ 0 because scenario files accept only non-negative times.
     """
@@ -142,7 +142,7 @@ def _fit_one(family: str, x: NDArray[np.float64]) -> Fit:
         warnings.simplefilter("ignore", RuntimeWarning)
         theta = _fit_threshold(dist, x) if family in THRESHOLD_FAMILIES else \
             [float(v) for v in dist.fit(x)]
-        ll = _loglik(dist, x, theta)
+        ll = _loglik(dist, x, theta) if theta else -math.inf
         if not (np.all(np.isfinite(theta)) and math.isfinite(ll)):
             raise RuntimeError(f"{family}: the fit did not converge")
         ks = stats.kstest(x, dist.cdf, args=tuple(theta))
