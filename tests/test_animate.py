@@ -294,3 +294,10 @@ def test_importing_the_command_loads_no_plotting() -> None:
     code = "import sys, cell.animation; print('matplotlib' in sys.modules, 'numpy' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["False", "False"]
+
+
+def test_a_gif_too_long_to_hold_is_refused_before_drawing(tmp_path: Path,
+                                                          scenario: Scenario) -> None:
+    with pytest.raises(CellError, match="raise --speed"):
+        animate(scenario, tmp_path / "a.gif", parts=12, speed=0.05, progress=False)
+    assert list(tmp_path.iterdir()) == []

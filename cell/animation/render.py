@@ -85,6 +85,8 @@ class Panel:
     texts: dict[str, Text]
     gaps: list[Text]
     """Distances between neighbours on the output belt."""
+    output_end: float
+    """The output strip's far end (y, in): gaps are labelled only between parts before it."""
 
     def artists(self) -> list[Artist]:
         """Everything that moves, in drawing order."""
@@ -185,13 +187,25 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene) -> Panel
     strip_out.add_collection(parts_out)
     gaps = [strip_out.text(0, 0, "", fontsize=6.5, ha="center", va="center", color="0.1",
                            clip_on=True, zorder=3) for _ in range(4)]
-    return Panel(scene, parts, parts_in, parts_out, labels, arm, texts, gaps)
+    return Panel(scene, parts, parts_in, parts_out, labels, arm, texts, gaps, y_end)
+
+
+def _figure_in(columns: int) -> tuple[float, float]:
+    """Width and height of the figure (in) for one or more runs side by side."""
+    return (COLUMN_IN if columns > 1 else COLUMN_IN + 0.5) * columns, HEIGHT_IN
+
+
+def frame_pixels(columns: int, dpi: float) -> int:
+    """Pixels in one frame."""
+    w, h = _figure_in(columns)
+    return round(w * dpi) * round(h * dpi)
 
 
 def build_figure(scenes: list[Scene], dpi: float) -> tuple[Figure, list[Panel]]:
     """The figure, on an Agg canvas, and one :class:`Panel` per run, side by side."""
-    column = COLUMN_IN if len(scenes) > 1 else COLUMN_IN + 0.5
-    fig = Figure(figsize=(column * len(scenes), HEIGHT_IN), dpi=dpi)
+    size = _figure_in(len(scenes))
+    column = size[0] / len(scenes)
+    fig = Figure(figsize=size, dpi=dpi)
     FigureCanvasAgg(fig)
     panels = [_panel(fig, i * column, column, sc) for i, sc in enumerate(scenes)]
     return fig, panels
@@ -227,7 +241,7 @@ def draw_frame(panel: Panel, t: float) -> None:
     y_out = at.xy[on_out, 1]
     show(panel.parts_out, on_out,
          _square(np.column_stack([y_out, np.zeros_like(y_out)]), np.zeros(len(y_out)), size))
-    ys = np.sort(y_out)
+    ys = np.sort(y_out[y_out + size / 2 <= panel.output_end])
     for k, gap in enumerate(panel.gaps):
         gap.set_visible(k + 1 < len(ys))
         if k + 1 < len(ys):
