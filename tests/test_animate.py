@@ -215,6 +215,25 @@ def test_the_arm_tip_is_on_the_path_at_every_path_point(scenes: list[Scene],
     assert set(state.regime[1:]) == {1, 2, 3, 4}
 
 
+def test_the_links_keep_their_lengths(scenes: list[Scene], scenario: Scenario) -> None:
+    """Upper arm and forearm 7 in (SPEC §2), shoulder 7.68 in above the base (§6.1), and the
+    hand 3.5498 in long while it holds the 2 in cube (eq. 6.2)."""
+    sc = scenes[0]
+    d = sc.data
+    times = np.linspace(d.start_s[FIRST], d.start_s[FIRST + 2], 997)
+    state = robot_state(sc, times)
+    base, elbow, wrist, tcp = np.moveaxis(arm_pose(scenario, state.q_rad, state.opening_in).joints,
+                                          1, 0)
+    shoulder = base + [0.0, 0.0, 7.68]
+    np.testing.assert_allclose(np.linalg.norm(elbow - shoulder, axis=1), 7.0, atol=1e-9)
+    np.testing.assert_allclose(np.linalg.norm(wrist - elbow, axis=1), 7.0, atol=1e-9)
+    holding = np.zeros(len(times), dtype=bool)
+    for i in np.flatnonzero(d.picked):
+        holding |= (times >= d.pick_s[i]) & (times <= d.touchdown_s[i])
+    assert holding.any() and not holding.all()
+    np.testing.assert_allclose(np.linalg.norm(tcp - wrist, axis=1)[holding], 3.5498, atol=5e-5)
+
+
 # --------------------------------------------------------------------------- files
 def gif_frames(path: Path) -> int:
     assert path.read_bytes()[:4] == b"GIF8"
