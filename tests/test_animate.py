@@ -235,10 +235,15 @@ def test_the_links_keep_their_lengths(scenes: list[Scene], scenario: Scenario) -
 
 
 # --------------------------------------------------------------------------- files
-def gif_frames(path: Path) -> int:
+def gif_durations_ms(path: Path) -> list[int]:
+    """Each frame's delay, read back by Pillow (the file must be a GIF)."""
     assert path.read_bytes()[:4] == b"GIF8"
     with Image.open(path) as im:
-        return sum(1 for _ in ImageSequence.Iterator(im))
+        return [int(frame.info["duration"]) for frame in ImageSequence.Iterator(im)]
+
+
+def gif_frames(path: Path) -> int:
+    return len(gif_durations_ms(path))
 
 
 def test_a_short_gif_is_written_whole(tmp_path: Path, scenario: Scenario) -> None:
@@ -252,6 +257,8 @@ def test_a_short_gif_is_written_whole(tmp_path: Path, scenario: Scenario) -> Non
     done = animate(scenario, out, policy="adaptive", parts=1, speed=120.0, fps=6, dpi=20.0,
                    progress=False)
     assert gif_frames(out) == done.frames == int((t1 - t0) // step) + 1
+    # plays at 6 frames a second although GIF delays are whole hundredths
+    assert sum(gif_durations_ms(out)) == pytest.approx(1000 * done.frames / 6, abs=10)
     with Image.open(out) as im:
         assert im.size == (120, 140)
     assert [p.name for p in tmp_path.iterdir()] == ["cell.gif"]

@@ -11,6 +11,7 @@ Nothing here computes a position: :mod:`cell.animation.scene` does.
 from __future__ import annotations
 
 import sys
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -277,8 +278,9 @@ class CanvasGifWriter(PillowWriter):
 
     PillowWriter redraws the whole figure for every frame and holds each as RGB(A)
     to the end: a few hundred 1100 x 700 frames would take most of a gigabyte.
-    Here the caller draws (only what moved) and each frame is reduced to its own
-    palette at once; a frame of this drawing has some 250 colours.
+    Here the caller draws (only what moved), each frame is reduced to its own
+    palette at once (a frame of this drawing has some 250 colours), and each is
+    let go as Pillow takes its copy.
     """
 
     def setup(self, fig: Figure, outfile: Any, dpi: float | None = None) -> None:
@@ -293,9 +295,21 @@ class CanvasGifWriter(PillowWriter):
             256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE))
 
     def finish(self) -> None:
-        if self._paletted:
-            self._paletted[0].save(self.outfile, save_all=True, append_images=self._paletted[1:],
-                                   duration=round(1000 / self.fps), loop=0)
+        frames = self._paletted
+        if not frames:
+            return
+        # GIF delays are whole hundredths of a second: alternate them to keep the mean rate
+        ticks = np.round(np.arange(len(frames) + 1) * 100 / self.fps)
+        duration = [int(10 * d) for d in np.diff(ticks)]
+        frames.reverse()
+
+        def handed_over() -> Iterator[Any]:   # Pillow copies each frame: let go of ours
+            while frames:
+                yield frames.pop()
+
+        first = frames.pop()
+        first.save(self.outfile, save_all=True, append_images=handed_over(),
+                   duration=duration, loop=0)
 
 
 def render(scenes: list[Scene], times: Floats, out: Path, *, fps: int, dpi: float,
