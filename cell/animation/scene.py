@@ -262,7 +262,8 @@ def arm_pose(scenario: Scenario, q_rad: ArrayLike, opening_in: ArrayLike) -> Arm
 
 
 # --------------------------------------------------------------------------- the parts
-#: Where a part is: not on the belt yet (or gone), input belt, hand, output belt, falling off.
+#: Where a part is: not on the belt yet (or gone), input belt, hand, output belt, or fallen
+#: off the input belt's end (lying tipped just past F for FALL_S, fading, then gone).
 ABSENT, INPUT, HAND, OUTPUT, FALLING = 0, 1, 2, 3, 4
 
 
@@ -277,7 +278,7 @@ class PartsAt:
     angle_rad: Floats
     """(n,) turn about z (the part turns 90° in R II)."""
     alpha: Floats
-    """(n,) opacity: 1, fading to 0 while it falls."""
+    """(n,) opacity: 1, fading to 0 over FALL_S once it has fallen."""
 
 
 def parts_at(scene: Scene, t: float) -> PartsAt:
