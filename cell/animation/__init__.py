@@ -1,0 +1,184 @@
+"""``cell animate``: watch the cell run, seen from above (thesis §4.1, Fig. 8).
+
+The arm, both belts and every part at its true position, frame by frame, with
+the clock, the counts of parts arrived, delivered and lost, the belt speeds and
+the robot's regime; ``--policy both`` puts the adaptive robot (§5.3) beside the
+fixed-cycle one (§6.3) on the same parts (same seed: common random numbers).
+
+:mod:`cell.animation.scene` says where everything is at an instant (pure
+numpy); :mod:`cell.animation.render` draws it.  This module only wires them to
+the command line; it imports neither numpy nor matplotlib, so ``cell --help``
+stays fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from cell.errors import CellError
+
+if TYPE_CHECKING:
+    from cell.animation.scene import Scene
+    from cell.scenario import Scenario
+
+SUFFIXES = (".gif", ".mp4")
+POLICIES = ("adaptive", "non-adaptive", "both")
+#: Parts simulated past the last one shown, to start with (doubled until enough).
+EXTRA_PARTS = 3
+#: A GIF's frames are all held (one byte a pixel) until it is written: at most this much.
+GIF_MEMORY_BYTES = 1.5e9
+
+
+@dataclass(frozen=True)
+class Rendered:
+    """What :func:`animate` wrote."""
+
+    path: Path
+    frames: int
+    t0_s: float
+    """Simulated time of the first frame."""
+    t1_s: float
+    """Simulated time of the last frame."""
+    size_bytes: int
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options of ``cell animate`` (the caller adds the subcommand)."""
+    parser.add_argument("scenario", help="scenario YAML file (see scenarios/)")
+    parser.add_argument("--set", dest="sets", action="append", metavar="KEY=VALUE",
+                        help="override a scenario value, e.g. --set belts.input_nominal_in_s=3.5 "
+                             "(repeatable)")
+    parser.add_argument("--parts", type=int, default=12, metavar="N",
+                        help="how many parts to follow (default 12)")
+    parser.add_argument("--from-part", dest="from_part", type=int, default=1, metavar="K",
+                        help="the first part to follow (default 1): the animation runs from its "
+                             "arrival to part K+N-1's set-down or fall")
+    parser.add_argument("--policy", choices=POLICIES, default=None,
+                        help="controller to show (default: the scenario's); 'both' puts the "
+                             "adaptive and the fixed-cycle robot side by side on the same parts")
+    parser.add_argument("--out", required=True, metavar="FILE",
+                        help="FILE.gif (Pillow) or FILE.mp4 (needs ffmpeg on the PATH)")
+    parser.add_argument("--speed", type=float, default=20.0,
+                        help="simulated seconds per second of animation (default 20)")
+    parser.add_argument("--fps", type=int, default=12, help="frames per second (default 12)")
+    parser.add_argument("--dpi", type=float, default=100.0, help="resolution (default 100)")
+
+
+def check_output(out: str | Path) -> Path:
+    """The output path if it can be written: .gif, or .mp4 with ffmpeg on the PATH."""
+    path = Path(out)
+    suffix = path.suffix.lower()
+    if suffix not in SUFFIXES:
+        raise CellError(f"--out {str(out)!r}: the animation is written as .gif or .mp4, "
+                        f"not {suffix or 'a file without a suffix'!r}")
+    if suffix == ".mp4":
+        from matplotlib.animation import writers
+
+        if not writers.is_available("ffmpeg"):
+            raise CellError("MP4 needs ffmpeg on the PATH; write a .gif instead")
+    return path
+
+
+def simulate_scenes(scenario: Scenario, policies: list[str], first: int, count: int
+                    ) -> list[Scene]:
+    """Each policy's run, long enough that every part on the belts in the window exists.
+
+    Parts are numbered as in a run of any length (the feeder's draws are the same
+    whatever ``run.parts`` is), and the parts after the window keep the last one
+    shown from being the run's last (whose look-ahead would find nothing coming).
+    """
+    from cell.animation.scene import build_scene, frames_input, window
+    from cell.simulation import simulate
+    from cell.steptable import StepTable
+
+    if count < 1 or first < 1:
+        raise CellError(f"--parts {count} --from-part {first}: both must be at least 1")
+    table = StepTable.from_scenario(scenario)
+    extra = EXTRA_PARTS
+    while True:
+        n = first + count - 1 + extra
+        scenes = []
+        for policy in policies:
+            s = scenario.with_overrides({"controller.policy": policy, "run.parts": n})
+            scenes.append(build_scene(frames_input(simulate(s), table, s), table, s))
+        _, t1 = window(scenes, first, count)
+        if all(sc.data.arrival_s[-1] > t1 for sc in scenes):
+            return scenes
+        extra *= 2
+
+
+def animate(scenario: Scenario, out: str | Path, *, policy: str | None = None, parts: int = 12,
+            first: int = 1, speed: float = 20.0, fps: int = 12, dpi: float = 100.0,
+            progress: bool = True) -> Rendered:
+    """Simulate, then draw parts ``first`` .. ``first + parts - 1`` into ``out``, whole or not at all.
+
+    ``policy``: 'adaptive', 'non-adaptive', 'both' or None (the scenario's).  A frame
+    every ``speed / fps`` simulated seconds.
+    """
+    from cell.animation.render import render
+    from cell.animation.scene import frame_times, window
+    from cell.output import atomic_path
+
+    path = check_output(out)
+    if not (speed > 0 and fps > 0 and dpi > 0):
+        raise CellError(f"--speed {speed:g} --fps {fps:g} --dpi {dpi:g}: all must be positive")
+    chosen = policy or scenario.controller.policy
+    if chosen not in POLICIES:
+        raise CellError(f"--policy {chosen!r}: one of {', '.join(POLICIES)}")
+    policies = ["adaptive", "non-adaptive"] if chosen == "both" else [chosen]
+    scenes = simulate_scenes(scenario, policies, first, parts)
+    t0, t1 = window(scenes, first, parts)
+    times = frame_times(t0, t1, speed / fps)
+    if path.suffix.lower() == ".gif":
+        from cell.animation.render import frame_pixels
+
+        need = len(times) * frame_pixels(len(scenes), dpi)
+        if need > GIF_MEMORY_BYTES:
+            raise CellError(f"{len(times)} frames would hold {need / 1e9:.1f} GB while the GIF "
+                            f"is built; raise --speed, lower --dpi or --parts, or write a .mp4")
+    with atomic_path(path) as tmp:
+        staged = tmp.with_name(tmp.name + path.suffix)  # the writers go by the suffix
+        try:
+            render(scenes, times, staged, fps=fps, dpi=dpi, progress=progress)
+            os.replace(staged, tmp)
+        finally:
+            staged.unlink(missing_ok=True)
+    return Rendered(path, len(times), float(times[0]), float(times[-1]), path.stat().st_size)
+
+
+def animate_both(scenario: Scenario, out: str | Path, **options: Any) -> Rendered:
+    """The adaptive and the fixed-cycle robot side by side, same parts, same clock."""
+    return animate(scenario, out, policy="both", **options)
+
+
+#: The demo's window on the baseline scenario (seed 1984): parts 3-12, of which the
+#: fixed-cycle robot loses four (3, 7, 9, 11) and the adaptive one none.
+DEMO_FIRST, DEMO_PARTS, DEMO_SPEED = 3, 10, 10.0
+
+
+def demo(out_path: str | Path, *, progress: bool = True) -> Rendered:
+    """The committed demo: both robots side by side on ``scenarios/baseline.yaml``,
+    parts 3-12, ten simulated seconds a second."""
+    from cell.scenario import load_scenario
+
+    baseline = Path(__file__).resolve().parents[2] / "scenarios" / "baseline.yaml"
+    return animate_both(load_scenario(baseline), out_path, parts=DEMO_PARTS, first=DEMO_FIRST,
+                        speed=DEMO_SPEED, progress=progress)
+
+
+def cmd_animate(args: argparse.Namespace) -> int:
+    """``cell animate SCENARIO --out FILE.gif|FILE.mp4``."""
+    check_output(args.out)  # before anything is simulated
+    from cell.cli import parse_sets
+    from cell.scenario import load_scenario
+
+    scenario = load_scenario(args.scenario, parse_sets(args.sets))
+    done = animate(scenario, args.out, policy=args.policy, parts=args.parts, first=args.from_part,
+                   speed=args.speed, fps=args.fps, dpi=args.dpi)
+    print(f"wrote {done.path}: {done.frames} frames, simulated {done.t0_s:.1f}-{done.t1_s:.1f} s, "
+          f"{done.size_bytes / 1e6:.2f} MB")
+    return 0

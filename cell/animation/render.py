@@ -1,0 +1,347 @@
+"""Drawing the scene frame by frame, and writing the GIF or MP4.
+
+The cell is seen from above as in Fig. 8 (§4.1): a close-up of the robot and
+both tracking windows, and under it each belt whole as a strip (the input belt
+from the feeder's drop point to its end at F; the output belt unrolled from its
+edge past two part spacings, with the distance between neighbours).  The static
+drawing is rendered once; each frame restores it and draws only what moves.
+Nothing here computes a position: :mod:`cell.animation.scene` does.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.animation import FFMpegWriter, PillowWriter
+from matplotlib.artist import Artist
+from matplotlib.axes import Axes
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import PolyCollection
+from matplotlib.colors import to_rgba
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Circle, Rectangle
+from matplotlib.text import Text
+
+from cell.animation.scene import (
+    FALLING,
+    INPUT,
+    OUTPUT,
+    Floats,
+    Scene,
+    arm_pose,
+    belt_speed,
+    counts_at,
+    parts_at,
+    robot_state,
+)
+from cell.figures.layout import BELT_COLOUR
+from cell.figures.style import LIMIT_COLOUR, POLICY_COLOURS, REGIME_COLOURS, REGIME_LABELS, style
+
+PART_COLOUR = "#d9a441"
+PART_EDGE = "#5c4510"
+LOST_COLOUR = LIMIT_COLOUR
+IDLE_COLOUR = "0.45"
+#: The close-up's extent (in): the robot, both tracking windows and some belt either side.
+CLOSE_X = (-36.0, 10.0)
+CLOSE_Y = (-9.0, 37.0)
+#: How many part spacings of output belt the strip shows past TD.
+OUTPUT_SPACINGS = 2.4
+#: Figure height and one column's width (in); the layout below is in inches too.
+HEIGHT_IN, COLUMN_IN = 7.0, 5.5
+CLOSE_IN, STRIP_IN, GAP_IN = 4.55, 0.55, 0.36
+
+POLICY_TITLES = {"adaptive": "adaptive controller (§5.3)",
+                 "non-adaptive": "fixed cycle, not adaptive (§6.3)"}
+
+
+def _square(xy: Floats, angle: Floats, size: float) -> Floats:
+    """(n, 4, 2) corners of squares of side ``size`` centred at xy, turned by angle."""
+    h = size / 2
+    corners = np.array([[-h, -h], [h, -h], [h, h], [-h, h]])
+    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    x = xy[:, None, 0] + c * corners[:, 0] - s * corners[:, 1]
+    y = xy[:, None, 1] + s * corners[:, 0] + c * corners[:, 1]
+    return np.stack([x, y], axis=-1)
+
+
+@dataclass
+class Panel:
+    """The moving artists of one run's column."""
+
+    scene: Scene
+    parts: PolyCollection
+    """Parts in the close-up."""
+    parts_in: PolyCollection
+    parts_out: PolyCollection
+    labels: list[Text]
+    """Part numbers in the close-up."""
+    arm: list[Line2D]
+    """Upper arm, forearm with the hand, fingers."""
+    texts: dict[str, Text]
+    gaps: list[Text]
+    """Distances between neighbours on the output belt."""
+    output_end: float
+    """The output strip's far end (y, in): gaps are labelled only between parts before it."""
+
+    def artists(self) -> list[Artist]:
+        """Everything that moves, in drawing order."""
+        moving: list[Artist] = [self.parts_in, self.parts_out, *self.gaps, self.parts,
+                                *self.labels, *self.arm, *self.texts.values()]
+        return sorted(moving, key=lambda a: a.get_zorder())
+
+
+def _axes(fig: Figure, left: float, bottom: float, width: float, height: float) -> Axes:
+    w, h = fig.get_size_inches()
+    return fig.add_axes((left / w, bottom / h, width / w, height / h))
+
+
+def _strip(ax: Axes, x0: float, x1: float, w: float, width_in: float,
+           marks: dict[str, float], title: str, title_x: float, ha: str) -> None:
+    """A belt drawn whole along x, squares kept square (equal aspect by the limits)."""
+    y0 = -w / 2 - 1.0
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y0 + (x1 - x0) * STRIP_IN / width_in)
+    ax.add_patch(Rectangle((x0, -w / 2), x1 - x0, w, color=BELT_COLOUR, zorder=0))
+    for name, x in marks.items():
+        ax.plot([x, x], [-w / 2, w / 2 + 0.4], color="0.3", lw=0.6, zorder=1)
+        ax.text(x, w / 2 + 0.5, name, fontsize=6.5, ha="center", va="bottom", color="0.25")
+    ax.text(title_x, w / 2 + 0.5, title, fontsize=7, ha=ha, va="bottom", color="0.15")
+    ax.set_yticks([])
+    ax.tick_params(labelsize=6.5, pad=1, length=2)
+    ax.grid(False)
+    for side in ("left", "right", "top"):
+        ax.spines[side].set_visible(False)
+
+
+def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene) -> Panel:
+    s, p = scene.scenario, scene.table.path
+    w = s.cell.belt_width_in
+    policy = scene.data.policy
+    fig.text((left_in + column_in / 2) / fig.get_size_inches()[0], 1 - 0.2 / HEIGHT_IN,
+             POLICY_TITLES.get(policy, policy), ha="center", va="center", fontsize=11,
+             fontweight="bold", color=POLICY_COLOURS.get(policy, "black"))
+    close_bottom = HEIGHT_IN - 0.42 - CLOSE_IN
+    close = _axes(fig, left_in + (column_in - CLOSE_IN) / 2 + 0.12, close_bottom, CLOSE_IN, CLOSE_IN)
+    strip_w = column_in - 0.45
+    in_bottom = close_bottom - GAP_IN - STRIP_IN
+    strip_in = _axes(fig, left_in + 0.25, in_bottom, strip_w, STRIP_IN)
+    strip_out = _axes(fig, left_in + 0.25, in_bottom - GAP_IN - STRIP_IN, strip_w, STRIP_IN)
+    # the close-up: Fig. 8's plan view
+    b, f = scene.b_xy, scene.f_xy
+    close.add_patch(Rectangle((CLOSE_X[0] - 1, b[1] - w / 2), f[0] - CLOSE_X[0] + 1, w,
+                              color=BELT_COLOUR, zorder=0))
+    close.add_patch(Rectangle((scene.td_xy[0] - w / 2, w / 2), w, CLOSE_Y[1] + 1 - w / 2,
+                              color=BELT_COLOUR, zorder=0))
+    for reg in (1, 2, 3, 4):
+        idx = np.flatnonzero(p.regime == reg)
+        idx = np.concatenate([[idx[0] - 1], idx]) if idx[0] > 0 else idx
+        close.plot(p.xyz_in[idx, 0], p.xyz_in[idx, 1], color=REGIME_COLOURS[reg], lw=0.9,
+                   alpha=0.5, zorder=1)
+    named = {"B": b, "F": f, "G": np.asarray(s.path.g_in[:2]), "K": np.asarray(s.path.eot_in[:2]),
+             "LO": p.xyz_in[p.lo, :2], "TD": scene.td_xy}
+    for name, (x, y) in named.items():
+        close.plot(x, y, "+", color="0.25", ms=5, mew=0.9, zorder=2)
+        close.annotate(name, (x, y), xytext=(3, -9), textcoords="offset points", fontsize=7,
+                       color="0.25", zorder=2)
+    bx, by, _ = s.cell.robot_base_in
+    close.add_patch(Circle((bx, by), 1.3, color="0.25", zorder=5))
+    close.set_xlim(*CLOSE_X)
+    close.set_ylim(*CLOSE_Y)
+    close.set_aspect("equal")
+    close.tick_params(labelsize=6.5, pad=1, length=2)
+    close.grid(False)
+    close.text(0.99, 0.01, "x, y (in)", transform=close.transAxes, fontsize=6.5, ha="right",
+               va="bottom", color="0.4")
+    arm = [close.plot([], [], "-", lw=5.5, solid_capstyle="round", zorder=6)[0],
+           close.plot([], [], "o-", lw=3.5, ms=4.5, solid_capstyle="round", zorder=6)[0],
+           close.plot([], [], "-", lw=2.2, color="0.1", solid_capstyle="butt", zorder=7)[0]]
+    parts = PolyCollection([], edgecolors=PART_EDGE, linewidths=0.6, zorder=4)
+    close.add_collection(parts)
+    labels = [close.text(0, 0, str(n), fontsize=6, ha="center", va="center", zorder=4.5,
+                         clip_on=True) for n in scene.data.part]
+    mono: dict[str, Any] = {"transform": close.transAxes, "fontsize": 8, "va": "top", "ha": "left",
+            "family": "monospace", "zorder": 8}
+    texts = {"clock": close.text(0.02, 0.985, "", fontweight="bold", **mono),
+             "tally": close.text(0.02, 0.94, "", **mono),
+             "lost": close.text(0.02, 0.895, "", **mono),
+             "belts": close.text(0.02, 0.845, "", **mono),
+             "robot": close.text(0.02, 0.755, "", fontweight="bold", **mono)}
+    # the whole input belt, drop point to its end at F; the close-up's stretch dotted
+    drop = b[0] - scene.data.input_length_in
+    _strip(strip_in, drop - 3, f[0] + 3, w, strip_w, {"drop": drop, "B": b[0], "F": f[0]},
+           "input belt, drop point → F (falls off at F)", (drop + b[0]) / 2, "center")
+    strip_in.add_patch(Rectangle((CLOSE_X[0], -w / 2), f[0] - CLOSE_X[0], w, fill=False, ec="0.45",
+                                 lw=0.6, ls=":", zorder=1))
+    parts_in = PolyCollection([], edgecolors=PART_EDGE, linewidths=0.4, zorder=2)
+    strip_in.add_collection(parts_in)
+    # the output belt unrolled along its y
+    y_end = scene.td_xy[1] + OUTPUT_SPACINGS * s.belts.spacing_in
+    _strip(strip_out, w / 2, y_end, w, strip_w, {"TD": scene.td_xy[1], "K": s.path.eot_in[1]},
+           "output belt, unrolled (y) →", y_end, "right")
+    parts_out = PolyCollection([], edgecolors=PART_EDGE, linewidths=0.4, zorder=2)
+    strip_out.add_collection(parts_out)
+    gaps = [strip_out.text(0, 0, "", fontsize=6.5, ha="center", va="center", color="0.1",
+                           clip_on=True, zorder=3) for _ in range(4)]
+    return Panel(scene, parts, parts_in, parts_out, labels, arm, texts, gaps, y_end)
+
+
+def _figure_in(columns: int) -> tuple[float, float]:
+    """Width and height of the figure (in) for one or more runs side by side."""
+    return (COLUMN_IN if columns > 1 else COLUMN_IN + 0.5) * columns, HEIGHT_IN
+
+
+def frame_pixels(columns: int, dpi: float) -> int:
+    """Pixels in one frame."""
+    w, h = _figure_in(columns)
+    return round(w * dpi) * round(h * dpi)
+
+
+def build_figure(scenes: list[Scene], dpi: float) -> tuple[Figure, list[Panel]]:
+    """The figure, on an Agg canvas, and one :class:`Panel` per run, side by side."""
+    size = _figure_in(len(scenes))
+    column = size[0] / len(scenes)
+    fig = Figure(figsize=size, dpi=dpi)
+    FigureCanvasAgg(fig)
+    panels = [_panel(fig, i * column, column, sc) for i, sc in enumerate(scenes)]
+    return fig, panels
+
+
+def draw_frame(panel: Panel, t: float) -> None:
+    """Move every artist of ``panel`` to instant t."""
+    sc = panel.scene
+    d = sc.data
+    size = sc.scenario.part.size_in
+    at = parts_at(sc, t)
+    falling = at.where == FALLING
+    face = np.tile(np.array(to_rgba(PART_COLOUR)), (len(d.part), 1))
+    edge = np.tile(np.array(to_rgba(PART_EDGE)), (len(d.part), 1))
+    face[falling] = edge[falling] = to_rgba(LOST_COLOUR)
+    face[:, 3] = edge[:, 3] = at.alpha
+    corners = _square(np.nan_to_num(at.xy), at.angle_rad, size)
+
+    def show(collection: PolyCollection, rows: Any, verts: Floats) -> None:
+        collection.set_verts(list(verts))
+        collection.set_facecolor(face[rows])
+        collection.set_edgecolor(edge[rows])
+
+    shown = at.where > 0
+    show(panel.parts, shown, corners[shown])
+    for i, label in enumerate(panel.labels):
+        label.set_visible(bool(shown[i] and not falling[i]))
+        if shown[i]:
+            label.set_position(at.xy[i])
+    on_in = (at.where == INPUT) | falling
+    show(panel.parts_in, on_in, corners[on_in])
+    on_out = at.where == OUTPUT
+    y_out = at.xy[on_out, 1]
+    show(panel.parts_out, on_out,
+         _square(np.column_stack([y_out, np.zeros_like(y_out)]), np.zeros(len(y_out)), size))
+    ys = np.sort(y_out[y_out + size / 2 <= panel.output_end])
+    for k, gap in enumerate(panel.gaps):
+        gap.set_visible(k + 1 < len(ys))
+        if k + 1 < len(ys):
+            gap.set_position(((ys[k] + ys[k + 1]) / 2, sc.td_xy[0]))
+            gap.set_text(f"{ys[k + 1] - ys[k]:.2f} in")
+    state = robot_state(sc, t)
+    pose = arm_pose(sc.scenario, state.q_rad, state.opening_in)
+    j = pose.joints[0]
+    reg = int(state.regime[0])
+    colour = REGIME_COLOURS.get(reg, IDLE_COLOUR)
+    upper, fore, fingers = panel.arm
+    upper.set_data(j[:2, 0], j[:2, 1])
+    fore.set_data(j[1:, 0], j[1:, 1])
+    upper.set_color(colour)
+    fore.set_color(colour)
+    fingers.set_data(pose.fingers[0, :, 0], pose.fingers[0, :, 1])
+    n = counts_at(sc, t)
+    texts = panel.texts
+    texts["clock"].set_text(f"t = {t:6.1f} s")
+    texts["tally"].set_text(f"arrived {n.arrived:3d}   delivered {n.delivered:3d}")
+    texts["lost"].set_text(f"lost {n.lost:3d} (fell off at F)")
+    texts["lost"].set_color(LOST_COLOUR if n.lost else "black")
+    v_in, v_out = float(belt_speed(d.input_belt, t)), float(belt_speed(d.output_belt, t))
+    texts["belts"].set_text(f"input belt  {v_in:5.2f} in/s\noutput belt {v_out:5.2f} in/s")
+    texts["robot"].set_text(f"robot: {REGIME_LABELS[reg]}, part {d.part[state.part[0]]}" if reg
+                            else "robot: waiting at B")
+    texts["robot"].set_color(colour)
+
+
+class CanvasGifWriter(PillowWriter):
+    """matplotlib's Pillow GIF writer, taking each frame as last drawn on the Agg canvas
+    and keeping it at one byte a pixel.
+
+    PillowWriter redraws the whole figure for every frame and holds each as RGB(A)
+    to the end: a few hundred 1100 x 700 frames would take most of a gigabyte.
+    Here the caller draws (only what moved), each frame is reduced to its own
+    palette at once (a frame of this drawing has some 250 colours), and each is
+    let go as Pillow takes its copy.
+    """
+
+    def setup(self, fig: Figure, outfile: Any, dpi: float | None = None) -> None:
+        super().setup(fig, outfile, dpi=dpi)
+        self._paletted: list[Any] = []
+
+    def grab_frame(self, **savefig_kwargs: Any) -> None:
+        from PIL import Image
+
+        rgba = np.asarray(self.fig.canvas.buffer_rgba())  # type: ignore[attr-defined]
+        self._paletted.append(Image.fromarray(rgba[..., :3]).quantize(
+            256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE))
+
+    def finish(self) -> None:
+        frames = self._paletted
+        if not frames:
+            return
+        # GIF delays are whole hundredths of a second: alternate them to keep the mean rate
+        ticks = np.round(np.arange(len(frames) + 1) * 100 / self.fps)
+        duration = [int(10 * d) for d in np.diff(ticks)]
+        frames.reverse()
+
+        def handed_over() -> Iterator[Any]:   # Pillow copies each frame: let go of ours
+            while frames:
+                yield frames.pop()
+
+        first = frames.pop()
+        first.save(self.outfile, save_all=True, append_images=handed_over(),
+                   duration=duration, loop=0)
+
+
+def render(scenes: list[Scene], times: Floats, out: Path, *, fps: int, dpi: float,
+           progress: bool = True) -> None:
+    """Draw one frame per instant of ``times`` into ``out`` (.gif or .mp4, by its suffix).
+
+    ``out`` is written as given; making it atomic is the caller's business.
+    """
+    from tqdm import tqdm
+
+    gif = out.suffix.lower() == ".gif"
+    with style():
+        fig, panels = build_figure(scenes, dpi)
+        canvas = fig.canvas
+        assert isinstance(canvas, FigureCanvasAgg)
+        moving = [a for panel in panels for a in panel.artists()]
+        for a in moving:
+            a.set_visible(False)
+        canvas.draw()
+        background = canvas.copy_from_bbox(fig.bbox)
+        for a in moving:
+            a.set_visible(True)
+        writer: PillowWriter | FFMpegWriter = CanvasGifWriter(fps=fps) if gif \
+            else FFMpegWriter(fps=fps, codec="h264")
+        label = " | ".join(sc.data.policy for sc in scenes)
+        with writer.saving(fig, str(out), dpi):
+            for t in tqdm(times, desc=f"cell animate ({label})", unit="frame", file=sys.stderr,
+                          disable=not progress, leave=False):
+                for panel in panels:
+                    draw_frame(panel, float(t))
+                if gif:  # ffmpeg's writer redraws the whole figure itself
+                    canvas.restore_region(background)
+                    for a in moving:
+                        fig.draw_artist(a)
+                writer.grab_frame()

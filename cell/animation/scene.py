@@ -1,0 +1,352 @@
+"""Where everything in the cell is at an instant: pure functions, no drawing.
+
+The animation's facts come from one run's records through :func:`frames_input`
+(the only function that reads a :class:`~cell.simulation.SimResult`); the rest
+works on the plain arrays of :class:`AnimationInput`:
+
+* a belt is a piecewise-constant speed history, so its travel X(t) is piecewise
+  linear (§6.2 a: speed changes take effect at once), :func:`travel`;
+* a part on the input belt is ``input_length_in`` upstream of B when the feeder
+  drops it, and moves by the belt's travel; one not caught rides on and falls off
+  the belt's end at F (§6.3);
+* from LO to TD it is in the hand, at the tool-centre point Z T5 E (eq. 6.6);
+* from TD on it moves with the output belt's travel;
+* the arm follows the path's joint angles (eq. 6.7), each cycle's moves timed
+  as :func:`cell.figures.motion.timeline` spreads the part's regime times (§6.1),
+  and waits at B between cycles.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from cell.kinematics import Arm, forward, hand, placement
+from cell.scenario import Scenario
+from cell.steptable import SEGMENTS, StepTable
+
+Floats = NDArray[np.float64]
+
+#: Seconds a lost part lies, fading, at the input belt's end after it falls off at F.
+FALL_S = 6.0
+#: How a fallen part lies: tipped by this much (rad), just past the belt's end.
+FALL_TURN_RAD = 0.4
+#: Seconds shown after the last part of the window is set down (or has fallen).
+TAIL_S = 2.0
+
+
+@dataclass(frozen=True)
+class AnimationInput:
+    """One run as the animation needs it: one entry per simulated part, times in s."""
+
+    policy: str
+    part: NDArray[np.int64]
+    """Part numbers 1..n."""
+    arrival_s: Floats
+    """The feeder drops the part on the input belt, ``input_length_in`` upstream of B."""
+    at_bot_s: Floats
+    """The part reaches B."""
+    picked: NDArray[np.bool_]
+    """Caught by the robot (else it fell off at F)."""
+    start_s: Floats
+    """The robot starts the part's cycle at B (NaN if not picked)."""
+    pick_s: Floats
+    """Lift-off, LO."""
+    touchdown_s: Floats
+    """Touch-down, TD."""
+    regime_s: Floats
+    """(n, 4) time of R I .. R IV of the part's cycle (NaN if not picked)."""
+    input_belt: Floats
+    """(m, 2) rows (from_s, speed_in_s) of the input belt: each speed holds until the next."""
+    output_belt: Floats
+    """(k, 2) the same for the output belt."""
+    input_length_in: float
+    """Feeder drop point to B."""
+
+
+def frames_input(result: Any, table: StepTable, scenario: Scenario) -> AnimationInput:
+    """The adapter from today's :class:`~cell.simulation.SimResult` (README, ``cell run``).
+
+    ``start_s`` is ``at_bot_s`` for a picked part (the robot is at B, free, when
+    the part arrives, or the part is not caught); regime N's time is its length
+    over ``v_rN_in_s``; the drop point is the controllers' ``input_length``.
+    """
+    from cell.controller import constants
+    from cell.robot import robot_timing
+
+    d = result.parts
+    picked = d["picked"].to_numpy(dtype=bool)
+    lengths = np.array([table.regime_length(r) for r in (1, 2, 3, 4)])
+    speeds = d[[f"v_r{r}_in_s" for r in (1, 2, 3, 4)]].to_numpy(dtype=float)
+    at_bot = d["at_bot_s"].to_numpy(dtype=float)
+    return AnimationInput(
+        policy=str(result.summary["policy"]),
+        part=d["part"].to_numpy(dtype=np.int64),
+        arrival_s=d["arrival_s"].to_numpy(dtype=float),
+        at_bot_s=at_bot,
+        picked=picked,
+        start_s=np.where(picked, at_bot, np.nan),
+        pick_s=d["pick_s"].to_numpy(dtype=float),
+        touchdown_s=d["touchdown_s"].to_numpy(dtype=float),
+        regime_s=np.where(picked[:, None], lengths / speeds, np.nan),
+        input_belt=np.array(result.belts["input"], dtype=float).reshape(-1, 2),
+        output_belt=np.array(result.belts["output"], dtype=float).reshape(-1, 2),
+        input_length_in=float(constants(scenario, robot_timing(scenario)).input_length))
+
+
+# --------------------------------------------------------------------------- belts
+def travel(history: ArrayLike, t: ArrayLike) -> Floats:
+    """X(t), inches a belt has moved since its first speed change, for any shape of t.
+
+    ``history``: rows (from_s, speed_in_s), sorted, piecewise-constant (§6.2 a);
+    the last speed holds for ever.  Before the first instant the first speed is
+    extrapolated back.
+    """
+    h = np.asarray(history, dtype=float).reshape(-1, 2)
+    start, speed = h[:, 0], h[:, 1]
+    knots = np.concatenate([[0.0], np.cumsum(speed[:-1] * np.diff(start))])
+    t = np.asarray(t, dtype=float)
+    k = np.clip(np.searchsorted(start, t, side="right") - 1, 0, len(start) - 1)
+    return knots[k] + speed[k] * (t - start[k])
+
+
+def time_at(history: ArrayLike, x: ArrayLike) -> Floats:
+    """The instant the belt's travel reaches x (the inverse of :func:`travel`; speeds > 0)."""
+    h = np.asarray(history, dtype=float).reshape(-1, 2)
+    start = h[:, 0]
+    knots = travel(h, start)
+    x = np.asarray(x, dtype=float)
+    k = np.clip(np.searchsorted(knots, x, side="right") - 1, 0, len(start) - 1)
+    return start[k] + (x - knots[k]) / h[k, 1]
+
+
+def belt_speed(history: ArrayLike, t: ArrayLike) -> Floats:
+    """The belt's speed at t (a change at t already holds)."""
+    h = np.asarray(history, dtype=float).reshape(-1, 2)
+    k = np.clip(np.searchsorted(h[:, 0], np.asarray(t, dtype=float), side="right") - 1, 0,
+                len(h) - 1)
+    return h[k, 1]
+
+
+# --------------------------------------------------------------------------- the scene
+@dataclass(frozen=True)
+class Scene:
+    """A run, the cell's geometry and the robot's timed cycles, ready to ask "where, when"."""
+
+    data: AnimationInput
+    table: StepTable
+    scenario: Scenario
+    cycle_part: NDArray[np.int64]
+    """(c,) index (0-based) of the part each robot cycle carries."""
+    cycle_t_s: Floats
+    """(c, N) instant the robot reaches each path point in each cycle."""
+    fall_s: Floats
+    """(n,) instant a part not caught reaches the belt's end at F (NaN if picked)."""
+
+    @property
+    def b_xy(self) -> Floats:
+        return np.asarray(self.scenario.path.bot_in[:2], dtype=float)
+
+    @property
+    def f_xy(self) -> Floats:
+        return np.asarray(self.scenario.path.f_in[:2], dtype=float)
+
+    @property
+    def td_xy(self) -> Floats:
+        return self.table.path.xyz_in[self.table.path.td, :2]
+
+
+def segments(start_s: float, pick_s: float, touchdown_s: float,
+             regime_s: ArrayLike) -> dict[str, float]:
+    """A cycle's six stretches (:data:`~cell.steptable.SEGMENTS`) from its records:
+    R I and R III split at LO and TD (§4.2)."""
+    r1, r2, r3, r4 = (float(v) for v in np.asarray(regime_s, dtype=float))
+    r1_pre = pick_s - start_s
+    r3_pre = touchdown_s - start_s - r1 - r2
+    seg = {"r1_pre": r1_pre, "r1_post": r1 - r1_pre, "r2": r2, "r3_pre": r3_pre,
+           "r3_post": r3 - r3_pre, "r4": r4}
+    return {k: seg[k] for k in SEGMENTS}
+
+
+def build_scene(data: AnimationInput, table: StepTable, scenario: Scenario) -> Scene:
+    """Time every robot cycle move by move (``timeline``, §6.1) and find each lost part's fall."""
+    from cell.figures.motion import timeline
+
+    cycles = np.flatnonzero(data.picked)
+    t_s = np.empty((len(cycles), table.path.n_points))
+    for row, i in enumerate(cycles):
+        seg = segments(data.start_s[i], data.pick_s[i], data.touchdown_s[i], data.regime_s[i])
+        t_s[row] = data.start_s[i] + timeline(table, seg).t_s
+    to_f = data.input_length_in + float(scenario.path.f_in[0] - scenario.path.bot_in[0])
+    fall = np.where(data.picked, np.nan,
+                    time_at(data.input_belt, travel(data.input_belt, data.arrival_s) + to_f))
+    return Scene(data, table, scenario, cycles.astype(np.int64), t_s, fall)
+
+
+# --------------------------------------------------------------------------- the robot
+@dataclass(frozen=True)
+class RobotState:
+    """The robot at instants t (leading dimension T)."""
+
+    q_rad: Floats
+    """(T, 5) joint angles, interpolated between path points by time."""
+    opening_in: Floats
+    """(T,) finger opening G (eq. 6.2)."""
+    phi_rad: Floats
+    """(T,) the held part's turn about z (eq. 6.3-6.5)."""
+    regime: NDArray[np.int64]
+    """(T,) 1..4, or 0 waiting at B."""
+    part: NDArray[np.int64]
+    """(T,) index of the part of the current cycle, -1 waiting."""
+
+
+def robot_state(scene: Scene, t: ArrayLike) -> RobotState:
+    """Where the joints are at each t: in a cycle, linear in time between path points."""
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    p = scene.table.path
+    values = np.column_stack([p.q_rad, p.opening_in, p.phi_rad])  # (N, 7)
+    out = np.tile(values[0], (len(t), 1))
+    regime = np.zeros(len(t), dtype=np.int64)
+    part = np.full(len(t), -1, dtype=np.int64)
+    times = scene.cycle_t_s
+    if len(times):
+        k = np.searchsorted(times[:, 0], t, side="right") - 1
+        active = (k >= 0) & (t <= times[np.maximum(k, 0), -1])
+        for c in np.unique(k[active]):
+            sel = active & (k == c)
+            tc = t[sel]
+            out[sel] = np.column_stack([np.interp(tc, times[c], values[:, j])
+                                        for j in range(values.shape[1])])
+            move = np.clip(np.searchsorted(times[c], tc, side="left"), 1, p.n_points - 1)
+            regime[sel] = p.regime[move]
+            part[sel] = scene.cycle_part[c]
+    return RobotState(out[:, :5], out[:, 5], out[:, 6], regime, part)
+
+
+@dataclass(frozen=True)
+class ArmPose:
+    """The arm projected on the table (global frame, inches), leading dimension T."""
+
+    joints: Floats
+    """(T, 4, 3) base axis on the table, elbow, wrist, tool-centre point."""
+    fingers: Floats
+    """(T, 2, 3) the two finger tips: tool centre ± G/2 along the hand's o axis."""
+
+    @property
+    def tcp(self) -> Floats:
+        return self.joints[:, 3]
+
+
+def arm_pose(scenario: Scenario, q_rad: ArrayLike, opening_in: ArrayLike) -> ArmPose:
+    """Forward kinematics Z A1 ... A5 E (eq. 3.13, 6.1, 6.2, 6.6) of the arm's joints.
+
+    The shoulder is on the base axis; the elbow is the origin of A1 A2 (the same
+    chain with no forearm); the wrist is T5's origin (a4 = a5 = d = 0, Table 3.1).
+    """
+    q = np.atleast_2d(np.asarray(q_rad, dtype=float))
+    g = np.atleast_1d(np.asarray(opening_in, dtype=float))
+    arm = Arm.from_scenario(scenario)
+    z = placement(scenario)
+    wrist_frame = z @ forward(q, arm)
+    elbow = (z @ forward(q * [1, 1, 0, 0, 0], Arm(arm.l2, 0.0, arm.limits)))[:, :3, 3]
+    tool = wrist_frame @ hand(g, scenario)
+    base = np.broadcast_to(np.asarray(scenario.cell.robot_base_in, dtype=float), elbow.shape)
+    joints = np.stack([base, elbow, wrist_frame[:, :3, 3], tool[:, :3, 3]], axis=1)
+    half = 0.5 * g[:, None] * tool[:, :3, 1]
+    fingers = np.stack([tool[:, :3, 3] - half, tool[:, :3, 3] + half], axis=1)
+    return ArmPose(joints, fingers)
+
+
+# --------------------------------------------------------------------------- the parts
+#: Where a part is: not on the belt yet (or gone), input belt, hand, output belt, or fallen
+#: off the input belt's end (lying tipped just past F for FALL_S, fading, then gone).
+ABSENT, INPUT, HAND, OUTPUT, FALLING = 0, 1, 2, 3, 4
+
+
+@dataclass(frozen=True)
+class PartsAt:
+    """Every part at one instant."""
+
+    where: NDArray[np.int64]
+    """(n,) ABSENT, INPUT, HAND, OUTPUT or FALLING."""
+    xy: Floats
+    """(n, 2) centre on the table (NaN when absent)."""
+    angle_rad: Floats
+    """(n,) turn about z (the part turns 90° in R II)."""
+    alpha: Floats
+    """(n,) opacity: 1, fading to 0 over FALL_S once it has fallen."""
+
+
+def parts_at(scene: Scene, t: float) -> PartsAt:
+    """Every part's place at instant t (see the module's docstring)."""
+    d = scene.data
+    n = len(d.part)
+    xy = np.full((n, 2), np.nan)
+    angle = np.zeros(n)
+    alpha = np.ones(n)
+    where = np.full(n, ABSENT, dtype=np.int64)
+    with np.errstate(invalid="ignore"):
+        dropped = d.arrival_s <= t
+        gone_by = np.where(d.picked, d.pick_s, scene.fall_s + FALL_S)
+        on_input = dropped & (t < gone_by)
+        falling = on_input & ~d.picked & (t >= scene.fall_s)
+        held = d.picked & (d.pick_s <= t) & (t < d.touchdown_s)
+        out = d.picked & (t >= d.touchdown_s)
+    x_in = scene.b_xy[0] - d.input_length_in + (travel(d.input_belt, t)
+                                                 - travel(d.input_belt, d.arrival_s))
+    xy[on_input] = np.column_stack([x_in, np.full(n, scene.b_xy[1])])[on_input]
+    where[on_input] = INPUT
+    where[falling] = FALLING
+    xy[falling] = scene.f_xy + [scene.scenario.part.size_in / 2, 0.0]
+    angle[falling] = FALL_TURN_RAD
+    alpha[falling] = np.clip(1.0 - (t - scene.fall_s[falling]) / FALL_S, 0.0, 1.0)
+    if held.any():
+        state = robot_state(scene, t)
+        xy[held] = arm_pose(scene.scenario, state.q_rad, state.opening_in).tcp[0, :2]
+        angle[held] = state.phi_rad[0]
+        where[held] = HAND
+    y_out = scene.td_xy[1] + travel(d.output_belt, t) - travel(d.output_belt, d.touchdown_s)
+    xy[out] = np.column_stack([np.full(n, scene.td_xy[0]), y_out])[out]
+    angle[out] = scene.table.path.phi_rad[scene.table.path.td]
+    where[out] = OUTPUT
+    return PartsAt(where, xy, angle, alpha)
+
+
+@dataclass(frozen=True)
+class Counts:
+    arrived: int
+    delivered: int
+    lost: int
+
+
+def counts_at(scene: Scene, t: float) -> Counts:
+    """Parts dropped, set down and fallen off by t, since the run began."""
+    d = scene.data
+    with np.errstate(invalid="ignore"):
+        return Counts(int(np.sum(d.arrival_s <= t)), int(np.sum(d.touchdown_s <= t)),
+                      int(np.sum(scene.fall_s <= t)))
+
+
+# --------------------------------------------------------------------------- the window
+def part_done_s(scene: Scene, index: int) -> float:
+    """When part ``index`` (0-based) leaves the story: set down, or faded after its fall."""
+    d = scene.data
+    return float(d.touchdown_s[index] if d.picked[index] else scene.fall_s[index] + FALL_S)
+
+
+def window(scenes: list[Scene], first: int, count: int) -> tuple[float, float]:
+    """From part ``first``'s arrival (1-based) to the set-down or fall of part
+    ``first + count - 1`` in whichever run is later, plus :data:`TAIL_S`."""
+    t0 = float(scenes[0].data.arrival_s[first - 1])
+    t1 = max(part_done_s(s, first + count - 2) for s in scenes) + TAIL_S
+    return t0, t1
+
+
+def frame_times(t0: float, t1: float, step_s: float) -> Floats:
+    """Instants of the frames: every ``step_s`` from t0, the last at or before t1."""
+    n = math.floor((t1 - t0) / step_s + 1e-9) + 1
+    return (t0 + step_s * np.arange(n)).astype(np.float64)

@@ -1,0 +1,329 @@
+"""``cell animate``: every part is drawn where the belts and the arm put it, and the
+file is a whole GIF (or nothing at all).
+
+Positions are checked against facts computed here, not by the animation's code:
+belt travel by fine numerical integration of the recorded speed history, the
+named points of the scenario (B, LO, F, G, TD, K, §4.2), the records' event
+instants (arrival, at B, LO, TD) and regime times.
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image, ImageSequence
+from scipy.integrate import cumulative_trapezoid  # type: ignore[import-untyped]
+
+from cell.animation import add_arguments, animate, cmd_animate, simulate_scenes
+from cell.animation.scene import (
+    HAND,
+    INPUT,
+    OUTPUT,
+    TAIL_S,
+    Scene,
+    arm_pose,
+    parts_at,
+    robot_state,
+    time_at,
+    travel,
+    window,
+)
+from cell.errors import CellError
+from cell.figures.motion import timeline
+from cell.scenario import Scenario, default_scenario
+
+FIRST, COUNT = 2, 6
+
+
+@pytest.fixture(scope="module")
+def scenario() -> Scenario:
+    return default_scenario()
+
+
+@pytest.fixture(scope="module")
+def scenes(scenario: Scenario) -> list[Scene]:
+    """Both policies, the same parts (common random numbers)."""
+    return simulate_scenes(scenario, ["adaptive", "non-adaptive"], FIRST, COUNT)
+
+
+def integrated(history: np.ndarray, until_s: float, dt: float = 1e-3):  # noqa: ANN201
+    """X(t) of a belt by the trapezoid rule on a fine grid, speeds looked up the plain way."""
+    grid = np.arange(0.0, until_s + dt, dt)
+    speed = np.empty_like(grid)
+    for start, v in history:                  # each change holds from its instant on
+        speed[grid >= start] = v
+    x = cumulative_trapezoid(speed, grid, initial=0.0)
+    return lambda t: np.interp(t, grid, x)
+
+
+def sample_times(scenes: list[Scene]) -> np.ndarray:
+    t0, t1 = window(scenes, FIRST, COUNT)
+    return np.linspace(t0 - 40.0, t1, 400)
+
+
+def named_points(s: Scenario) -> dict[str, np.ndarray]:
+    p = s.path
+    b, g = np.array(p.bot_in), np.array(p.g_in)
+    return {"B": b, "F": np.array(p.f_in), "G": g, "K": np.array(p.eot_in),
+            "LO": np.array([b[0] + p.lo_from_bot_in, b[1], p.pick_height_in]),
+            "TD": np.array([g[0], g[1] + p.td_from_g_in, p.place_height_in])}
+
+
+# --------------------------------------------------------------------------- belts
+def test_travel_is_the_area_under_the_speed_history() -> None:
+    history = np.array([[0.0, 3.0], [10.0, 1.0], [20.0, 2.0]])
+    assert travel(history, [0.0, 5.0, 10.0, 15.0, 25.0]) == pytest.approx([0, 15, 30, 35, 50])
+    assert time_at(history, [15.0, 35.0, 50.0]) == pytest.approx([5.0, 15.0, 25.0])
+
+
+def test_the_input_length_is_two_nominal_cycles_of_belt(scenes: list[Scene],
+                                                         scenario: Scenario) -> None:
+    """Baseline leaves it empty: 2 x 3.0 in/s x 22.5872 s = 135.52 in (README)."""
+    for sc in scenes:
+        assert sc.data.input_length_in == pytest.approx(2 * 3.0 * 22.5872)
+
+
+@pytest.mark.parametrize("policy", [0, 1], ids=["adaptive", "non-adaptive"])
+def test_parts_on_the_input_belt_ride_its_travel(scenes: list[Scene], scenario: Scenario,
+                                                 policy: int) -> None:
+    sc = scenes[policy]
+    d = sc.data
+    times = sample_times(scenes)
+    x_of = integrated(d.input_belt, times[-1] + 1)
+    b = np.array(scenario.path.bot_in)
+    length = 2 * scenario.belts.input_nominal_in_s * scenario.controller.nominal_cycle_s
+    checked = 0
+    for t in times:
+        at = parts_at(sc, t)
+        on = np.flatnonzero(at.where == INPUT)
+        expected = b[0] - length + (x_of(t) - x_of(d.arrival_s[on]))
+        assert at.xy[on, 0] == pytest.approx(expected, abs=0.02)
+        assert at.xy[on, 1] == pytest.approx(np.full(len(on), b[1]))
+        checked += len(on)
+    assert checked > 200
+    # and each part is at B when the run says it reached B
+    for i in range(FIRST - 1, FIRST + COUNT - 1):
+        assert parts_at(sc, d.at_bot_s[i]).xy[i] == pytest.approx(b[:2], abs=1e-9)
+
+
+@pytest.mark.parametrize("policy", [0, 1], ids=["adaptive", "non-adaptive"])
+def test_parts_on_the_output_belt_ride_its_travel_from_td(scenes: list[Scene],
+                                                          scenario: Scenario, policy: int) -> None:
+    sc = scenes[policy]
+    d = sc.data
+    times = sample_times(scenes)
+    y_of = integrated(d.output_belt, times[-1] + 1)
+    td = named_points(scenario)["TD"]
+    checked = 0
+    for t in times:
+        at = parts_at(sc, t)
+        on = np.flatnonzero(at.where == OUTPUT)
+        assert at.xy[on, 1] == pytest.approx(td[1] + y_of(t) - y_of(d.touchdown_s[on]), abs=0.02)
+        assert at.xy[on, 0] == pytest.approx(np.full(len(on), td[0]))
+        checked += len(on)
+    assert checked > 200
+
+
+def test_parts_in_the_hand_are_at_lo_and_td(scenes: list[Scene], scenario: Scenario) -> None:
+    pts = named_points(scenario)
+    for sc in scenes:
+        d = sc.data
+        for i in np.flatnonzero(d.picked)[FIRST - 1:]:
+            at_lo = parts_at(sc, d.pick_s[i])
+            assert at_lo.where[i] == HAND
+            assert at_lo.xy[i] == pytest.approx(pts["LO"][:2], abs=1e-6)
+            at_td = parts_at(sc, d.touchdown_s[i] - 1e-9)
+            assert at_td.where[i] == HAND
+            assert at_td.xy[i] == pytest.approx(pts["TD"][:2], abs=1e-6)
+            assert parts_at(sc, d.touchdown_s[i]).where[i] == OUTPUT
+
+
+def test_no_two_parts_on_a_belt_overlap(scenes: list[Scene], scenario: Scenario) -> None:
+    size = scenario.part.size_in
+    for sc in scenes:
+        for t in sample_times(scenes):
+            at = parts_at(sc, t)
+            for where, axis in ((INPUT, 0), (OUTPUT, 1)):
+                along = np.sort(at.xy[at.where == where, axis])
+                assert np.all(np.diff(along) >= size), (sc.data.policy, t, along)
+
+
+def test_a_part_not_caught_falls_off_at_f(scenes: list[Scene], scenario: Scenario) -> None:
+    """Fixed cycle: the belt stays at 3 in/s, so B -> F (8 in) takes 8/3 s (§6.3)."""
+    sc = scenes[1]
+    d = sc.data
+    lost = np.flatnonzero(~d.picked)
+    assert len(lost) > 0
+    np.testing.assert_allclose(sc.fall_s[lost], d.at_bot_s[lost] + 8.0 / 3.0, atol=1e-9)
+    i = lost[0]
+    before = parts_at(sc, sc.fall_s[i] - 1e-6)
+    assert before.where[i] == INPUT
+    assert before.xy[i, 0] == pytest.approx(scenario.path.f_in[0], abs=1e-4)
+    assert parts_at(sc, sc.fall_s[i] + 0.1).alpha[i] < 1.0
+    assert not np.any(~scenes[0].data.picked[:FIRST + COUNT])   # the adaptive robot saves them
+
+
+def test_both_policies_see_the_same_parts(scenes: list[Scene]) -> None:
+    np.testing.assert_array_equal(scenes[0].data.arrival_s, scenes[1].data.arrival_s)
+
+
+# --------------------------------------------------------------------------- the arm
+def test_the_arm_tip_passes_the_named_points_at_the_recorded_instants(
+        scenes: list[Scene], scenario: Scenario) -> None:
+    pts = named_points(scenario)
+    waits = 0
+    for sc in scenes:
+        d = sc.data
+        starts = np.append(d.start_s[d.picked], np.inf)
+        for n, i in enumerate(np.flatnonzero(d.picked)):
+            start, (r1, r2, r3, r4) = d.start_s[i], d.regime_s[i]
+            when = {"B": start, "LO": d.pick_s[i], "F": start + r1, "G": start + r1 + r2,
+                    "TD": d.touchdown_s[i], "K": start + r1 + r2 + r3}
+            state = robot_state(sc, list(when.values()))
+            tip = arm_pose(scenario, state.q_rad, state.opening_in).tcp
+            for k, name in enumerate(when):
+                assert tip[k] == pytest.approx(pts[name], abs=1e-6), (sc.data.policy, i, name)
+            # back at B at the end of the cycle, and waiting there until the next one
+            end = start + r1 + r2 + r3 + r4
+            assert starts[n + 1] >= end - 1e-9
+            between = [end, (end + starts[n + 1]) / 2] if starts[n + 1] > end + 1e-6 else [end]
+            idle = robot_state(sc, between)
+            back = arm_pose(scenario, idle.q_rad, idle.opening_in).tcp
+            assert back == pytest.approx(np.tile(pts["B"], (len(between), 1)), abs=1e-6)
+            waits += int(idle.regime[-1] == 0)
+    assert waits > 3
+
+
+def test_the_arm_tip_is_on_the_path_at_every_path_point(scenes: list[Scene],
+                                                         scenario: Scenario) -> None:
+    sc = scenes[0]
+    d, table = sc.data, sc.table
+    i = int(np.flatnonzero(d.picked)[FIRST])
+    r1, r2, r3, r4 = d.regime_s[i]
+    r1_pre = d.pick_s[i] - d.start_s[i]
+    r3_pre = d.touchdown_s[i] - d.start_s[i] - r1 - r2
+    tl = timeline(table, {"r1_pre": r1_pre, "r1_post": r1 - r1_pre, "r2": r2, "r3_pre": r3_pre,
+                          "r3_post": r3 - r3_pre, "r4": r4})
+    state = robot_state(sc, d.start_s[i] + tl.t_s)
+    tip = arm_pose(scenario, state.q_rad, state.opening_in).tcp
+    np.testing.assert_allclose(tip, table.path.xyz_in, atol=1e-6)
+    assert set(state.regime[1:]) == {1, 2, 3, 4}
+
+
+def test_the_links_keep_their_lengths(scenes: list[Scene], scenario: Scenario) -> None:
+    """Upper arm and forearm 7 in (SPEC §2), shoulder 7.68 in above the base (§6.1), and the
+    hand 3.5498 in long while it holds the 2 in cube (eq. 6.2)."""
+    sc = scenes[0]
+    d = sc.data
+    times = np.linspace(d.start_s[FIRST], d.start_s[FIRST + 2], 997)
+    state = robot_state(sc, times)
+    base, elbow, wrist, tcp = np.moveaxis(arm_pose(scenario, state.q_rad, state.opening_in).joints,
+                                          1, 0)
+    shoulder = base + [0.0, 0.0, 7.68]
+    np.testing.assert_allclose(np.linalg.norm(elbow - shoulder, axis=1), 7.0, atol=1e-9)
+    np.testing.assert_allclose(np.linalg.norm(wrist - elbow, axis=1), 7.0, atol=1e-9)
+    holding = np.zeros(len(times), dtype=bool)
+    for i in np.flatnonzero(d.picked):
+        holding |= (times >= d.pick_s[i]) & (times <= d.touchdown_s[i])
+    assert holding.any() and not holding.all()
+    np.testing.assert_allclose(np.linalg.norm(tcp - wrist, axis=1)[holding], 3.5498, atol=5e-5)
+
+
+# --------------------------------------------------------------------------- files
+def gif_durations_ms(path: Path) -> list[int]:
+    """Each frame's delay, read back by Pillow (the file must be a GIF)."""
+    assert path.read_bytes()[:4] == b"GIF8"
+    with Image.open(path) as im:
+        return [int(frame.info["duration"]) for frame in ImageSequence.Iterator(im)]
+
+
+def gif_frames(path: Path) -> int:
+    return len(gif_durations_ms(path))
+
+
+def test_a_short_gif_is_written_whole(tmp_path: Path, scenario: Scenario) -> None:
+    from cell.simulation import simulate
+
+    parts = simulate(scenario.with_overrides({"run.parts": 3})).parts
+    step = 20.0                                   # --speed 120 at 6 fps
+    t0 = parts["arrival_s"].iloc[0]
+    t1 = parts["touchdown_s"].iloc[0] + TAIL_S
+    out = tmp_path / "cell.gif"
+    done = animate(scenario, out, policy="adaptive", parts=1, speed=120.0, fps=6, dpi=20.0,
+                   progress=False)
+    assert gif_frames(out) == done.frames == int((t1 - t0) // step) + 1
+    # plays at 6 frames a second although GIF delays are whole hundredths
+    assert sum(gif_durations_ms(out)) == pytest.approx(1000 * done.frames / 6, abs=10)
+    with Image.open(out) as im:
+        assert im.size == (120, 140)
+    assert [p.name for p in tmp_path.iterdir()] == ["cell.gif"]
+
+
+def test_both_policies_side_by_side(tmp_path: Path, scenario: Scenario) -> None:
+    out = tmp_path / "both.gif"
+    done = animate(scenario, out, policy="both", parts=2, first=3, speed=240.0, fps=6,
+                   dpi=20.0, progress=False)
+    assert gif_frames(out) == done.frames >= 2
+    with Image.open(out) as im:
+        assert im.size == (220, 140)
+
+
+def parse(argv: list[str]) -> argparse.Namespace:
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    return parser.parse_args(argv)
+
+
+@pytest.fixture
+def no_simulation(monkeypatch: pytest.MonkeyPatch) -> None:
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise AssertionError("simulated before checking --out")
+
+    monkeypatch.setattr("cell.simulation.simulate", refuse)
+
+
+def test_mp4_without_ffmpeg_is_one_clear_error(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                               no_simulation: None) -> None:
+    from matplotlib.animation import writers
+
+    monkeypatch.setattr(writers, "is_available", lambda name: False)
+    with pytest.raises(CellError, match="MP4 needs ffmpeg on the PATH; write a .gif instead"):
+        cmd_animate(parse(["scenarios/baseline.yaml", "--out", str(tmp_path / "a.mp4")]))
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("name", ["a.png", "a", "a.gif.tmp"])
+def test_a_bad_suffix_is_refused(tmp_path: Path, name: str, no_simulation: None) -> None:
+    with pytest.raises(CellError, match=r"\.gif or \.mp4"):
+        cmd_animate(parse(["scenarios/baseline.yaml", "--out", str(tmp_path / name)]))
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_failed_render_leaves_nothing(tmp_path: Path, scenario: Scenario,
+                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    def half(scenes: object, times: object, out: Path, **kwargs: object) -> None:
+        out.write_bytes(b"GIF89a")
+        raise RuntimeError("interrupted")
+
+    monkeypatch.setattr("cell.animation.render.render", half)
+    with pytest.raises(RuntimeError):
+        animate(scenario, tmp_path / "a.gif", parts=1, progress=False)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_importing_the_command_loads_no_plotting() -> None:
+    code = "import sys, cell.animation; print('matplotlib' in sys.modules, 'numpy' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["False", "False"]
+
+
+def test_a_gif_too_long_to_hold_is_refused_before_drawing(tmp_path: Path,
+                                                          scenario: Scenario) -> None:
+    with pytest.raises(CellError, match="raise --speed"):
+        animate(scenario, tmp_path / "a.gif", parts=12, speed=0.05, progress=False)
+    assert list(tmp_path.iterdir()) == []
