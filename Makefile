@@ -28,13 +28,15 @@ sweep-mintime: $(STAMP)
 
 figures: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m cell figures --out reports/figures
-	$(PY) -m cell.mintime.report
+	$(PY) -m cell.reporting.mintime
 
 bench: $(STAMP)
 	$(PY) -m cell bench --out reports/bench.json
 
 lint: $(STAMP)
 	$(PY) -m ruff check cell tests
+	$(PY) -m mypy
+	$(VENV)/bin/lint-imports
 
 clean:
 	rm -rf $(VENV) build .pytest_cache .hypothesis

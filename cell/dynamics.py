@@ -54,7 +54,7 @@ class Drives:
 
     gear_ratio: Five = (73.6, 73.6, 44.0, 15.8, 15.8)
     """Motor radians per joint radian."""
-    rotor_inertia_kg_m2: Five = (5e-7,) * 5  # type: ignore[assignment]
+    rotor_inertia_kg_m2: Five = (5e-7, 5e-7, 5e-7, 5e-7, 5e-7)
     """Motor rotor inertia (motor side); the joint sees ratio² times this."""
     stall_torque_nm: Five = (3.1, 3.4, 1.66, 1.14, 1.14)
     """τ_s, joint side: torque at zero speed of the torque-speed line."""

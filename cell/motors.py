@@ -53,8 +53,8 @@ def max_rates(load_oz: ArrayLike, motors: Motors, fraction: float = 1.0) -> NDAr
 def min_move_times(steps: ArrayLike, load_oz: ArrayLike, motors: Motors,
                    fraction: float = 1.0) -> NDArray[np.float64]:
     """Shortest time of each move: its slowest joint at its (fractional) maximum rate."""
-    steps = np.abs(np.asarray(steps, dtype=float))
-    return np.max(steps / max_rates(load_oz, motors, fraction), axis=-1)
+    counts = np.abs(np.asarray(steps, dtype=float))
+    return np.max(counts / max_rates(load_oz, motors, fraction), axis=-1)
 
 
 def move_times(lengths_in: ArrayLike, min_times_s: ArrayLike,

@@ -33,6 +33,7 @@ so it is byte-identical however the sweep was run.  Its columns: ``policy``,
 from __future__ import annotations
 
 import concurrent.futures as cf
+import functools
 import hashlib
 import itertools
 import json
@@ -156,8 +157,9 @@ def _grid(raw: Any, file: object, where: str) -> dict[str, list[Any]]:
         if not known_key(key):
             raise ScenarioError(file, key, values, "unknown key to vary: no such setting in a "
                                 "scenario (keys are dotted, e.g. controller.ideal_cycle_s)")
-        if key in RESERVED:
-            raise ScenarioError(file, key, values, f"cannot be varied: {RESERVED[key]}")
+        reserved = _reserved(key, values)
+        if reserved:
+            raise ScenarioError(file, key, values, f"cannot be varied: {RESERVED[reserved]}")
         if not isinstance(values, list):
             raise ScenarioError(file, key, values, "must be a list of values to try")
         if not values:
@@ -169,6 +171,19 @@ def _grid(raw: Any, file: object, where: str) -> dict[str, list[Any]]:
             seen.append(v)
         out[key] = values
     return out
+
+
+def _reserved(key: str, values: Any) -> str | None:
+    """The reserved key that ``key`` (or a section mapping given for it) would set."""
+    if key in RESERVED:
+        return key
+    for value in values if isinstance(values, list) else [values]:
+        if isinstance(value, Mapping):
+            for sub in value:
+                found = _reserved(f"{key}.{sub}", [value[sub]])
+                if found:
+                    return found
+    return None
 
 
 def _whole(raw: Mapping[str, Any], key: str, default: Any, lo: int, file: object) -> int:
@@ -199,11 +214,13 @@ def load_sweep(path: str | Path) -> Sweep:
     for key, value in fixed.items():
         if not known_key(str(key)):
             raise ScenarioError(path, str(key), value, "unknown key: no such setting in a scenario")
-        if key in RESERVED:
-            raise ScenarioError(path, str(key), value, f"cannot be set here: {RESERVED[key]}")
+        reserved = _reserved(str(key), [value])
+        if reserved:
+            raise ScenarioError(path, str(key), value, f"cannot be set here: {RESERVED[reserved]}")
 
     shared = _grid(raw["grid"], path, "grid") if "grid" in raw else {}
     policies_raw = raw.get("policies", [base.controller.policy])
+    per_policy: dict[str, dict[str, list[Any]]] | None
     if isinstance(policies_raw, list):
         per_policy = {p: {} for p in policies_raw} if policies_raw else None
     elif isinstance(policies_raw, Mapping):
@@ -221,9 +238,6 @@ def load_sweep(path: str | Path) -> Sweep:
         for key in set(grid) & set(shared):
             raise ScenarioError(path, f"policies.{policy}", key,
                                 "varied both in 'grid' and under the policy; keep one")
-    if not shared and not any(per_policy.values()):
-        raise ScenarioError(path, "grid", raw.get("grid"), "empty grid: nothing to vary "
-                            "(give 'grid' or per-policy keys with lists of values)")
 
     replications = _whole(raw, "replications", None, 1, path)
     seed = _whole(raw, "seed", base.run.seed, 0, path)
@@ -363,7 +377,7 @@ def _run_tasks(sweep: Sweep, todo: Sequence[Task], replicate: Replicate,
 
     if executor is None:
         for task in todo:
-            done(task, _guarded(sweep, task, lambda t=task: run_task(*args(t))))
+            done(task, _guarded(sweep, task, functools.partial(run_task, *args(task))))
         return
     futures = {executor.submit(run_task, *args(task)): task for task in todo}
     try:

@@ -19,7 +19,7 @@ import pytest
 from PIL import Image, ImageSequence
 from scipy.integrate import cumulative_trapezoid  # type: ignore[import-untyped]
 
-from cell.animation import add_arguments, animate, cmd_animate, simulate_scenes
+from cell.animation import animate, simulate_scenes
 from cell.animation.scene import (
     HAND,
     INPUT,
@@ -33,6 +33,8 @@ from cell.animation.scene import (
     travel,
     window,
 )
+from cell.commands.animate import add_arguments
+from cell.commands.animate import main as cmd_animate
 from cell.errors import CellError
 from cell.figures.motion import timeline
 from cell.scenario import Scenario, default_scenario

@@ -1,5 +1,6 @@
 """The command line: subcommands, `cell path`, and hostile input."""
 
+import importlib
 import subprocess
 import sys
 from pathlib import Path
@@ -10,7 +11,8 @@ import pytest
 
 from cell.cli import build_parser, main
 
-SUBCOMMANDS = ["path", "run", "sweep", "figures", "mintime", "bench"]
+SUBCOMMANDS = ["path", "run", "sweep", "figures", "mintime", "bench", "fit", "animate",
+               "scenarios", "schema"]
 
 
 def test_help_lists_the_subcommands():
@@ -30,9 +32,10 @@ def test_installed_cell_command():
 def test_parser_knows_every_subcommand():
     parser = build_parser()
     for name in SUBCOMMANDS:
-        assert parser.parse_args([name, "x", "--out", "y"] if name in ("path", "run", "mintime")
-                                 else [name, "x", "--out", "y"] if name == "sweep"
-                                 else [name]).command == name
+        argv = {"path": ["x", "--out", "y"], "run": ["x", "--out", "y"],
+                "mintime": ["x", "--out", "y"], "sweep": ["x", "--out", "y"],
+                "fit": ["x"], "animate": ["x", "--out", "y.gif"]}.get(name, [])
+        assert parser.parse_args([name, *argv]).command == name
 
 
 def test_cell_path_writes_the_thesis_table(tmp_path):
@@ -87,9 +90,28 @@ def test_set_overrides_from_the_command_line(tmp_path):
     assert main(["path", "scenarios/baseline.yaml", "--set", "nonsense", "--out", str(out)]) == 2
 
 
-def test_every_subcommand_has_its_handler():
-    from cell.cli import HANDLERS, _handler
+def test_every_subcommand_has_its_module():
+    from cell.cli import COMMANDS
 
-    assert set(HANDLERS) == set(SUBCOMMANDS)
+    assert set(COMMANDS) == set(SUBCOMMANDS)
     for name in SUBCOMMANDS:
-        assert callable(_handler(name)), name
+        module = importlib.import_module(f"cell.commands.{name}")
+        assert callable(module.main) and callable(module.add_arguments), name
+
+
+def test_built_in_scenarios_are_listed_and_run_by_name(tmp_path, capsys):
+    assert main(["scenarios"]) == 0
+    listed = capsys.readouterr().out
+    assert "baseline" in listed and "table_7_1" in listed
+    out = tmp_path / "run"
+    assert main(["run", "baseline", "--set", "run.parts=5", "--out", str(out)]) == 0
+    assert (out / "parts.csv").is_file()
+
+
+def test_schema_describes_every_section(capsys):
+    import json
+
+    assert main(["schema"]) == 0
+    schema = json.loads(capsys.readouterr().out)
+    assert {"cell", "path", "part", "robot", "belts", "arrivals", "controller", "run",
+            "mintime"} <= set(schema["properties"])

@@ -12,7 +12,9 @@ import pytest
 import yaml
 from scipy import stats
 
-from cell.analysis.fit import Fit, add_arguments, arrivals_yaml, cmd_fit, fit_trace, format_table
+from cell.analysis.fit import Fit, arrivals_yaml, fit_trace, format_table
+from cell.commands.fit import add_arguments
+from cell.commands.fit import main as cmd_fit
 from cell.errors import ScenarioError
 
 # Thesis eq. 6.9: T = 17.6019 + 5.4342 (-ln(1 - u))^0.2038.

@@ -4,13 +4,19 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+import pandas as pd
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from cell import catalog, registry
+from cell.cli import main
 from cell.errors import ScenarioError
+from cell.policies import Plan, Policy
 from cell.policies.adaptive import adaptive_plan
 from cell.policies.fixed import fixed_plan
+from cell.simulation import simulate
 
 #: Table 7.1: ideal cycle -> Vavg R IV (in/s).
 VAVG_R4 = {22.5872: 3.5594, 22.0: 3.7818, 21.5: 3.9943, 21.0: 4.2321, 20.5: 4.5000,
@@ -118,3 +124,51 @@ def test_plans_never_ask_more_than_the_motors_and_belts_can_do(k, v, a, b, gap):
     if "output belt" not in plan.note and gap is not None:
         spacing = gap + plan.output_to_g * plan.to_g + k.u_nom * plan.r3_pre
         assert spacing == pytest.approx(45.0, abs=1e-9)
+
+
+# --------------------------------------------------------------------------- a plug-in policy
+class AlwaysNominal(Policy):
+    """A policy defined only here: every part gets the nominal cycle, belts untouched."""
+
+    name = "always-nominal"
+
+    def plan(self, view):
+        k = self.k
+        return Plan(k.r1_pre_nom, k.r1_post_nom, k.r2_nom, k.r3_pre_nom, k.r3_post_nom, k.r4_nom,
+                    k.v_nom, k.v_nom, k.v_nom, k.u_nom, k.r1_nom + k.r2_nom, k.cycle_nom, "",
+                    steers_belts=False)
+
+
+@pytest.fixture
+def plug_in():
+    registry.register(AlwaysNominal)
+    yield AlwaysNominal.name
+    registry.unregister(AlwaysNominal.name)
+
+
+def test_a_policy_from_outside_the_package_runs_like_the_fixed_cycle_it_is(plug_in, thesis_cell):
+    """The plug-in is physically the non-adaptive robot at the nominal cycle (§6.3): the
+    same parts are lost and delivered at the same instants."""
+    s = thesis_cell.with_overrides({"run.parts": 300, "controller.policy": plug_in})
+    ours = simulate(s, seed=5)
+    fixed = simulate(s.with_overrides({"controller.policy": "non-adaptive"}), seed=5)
+    assert ours.summary.policy == plug_in
+    assert ours.summary.parts_missed == fixed.summary.parts_missed > 0
+    np.testing.assert_allclose(ours.parts["touchdown_s"], fixed.parts["touchdown_s"], rtol=1e-12)
+    assert ours.belt_changes == [c for c in fixed.belt_changes]   # never steered
+
+
+def test_a_plug_in_policy_runs_through_a_sweep(plug_in, tmp_path, capsys):
+    sweep = tmp_path / "sweep.yaml"
+    sweep.write_text(f"base: {catalog.path('baseline')}\nset: {{run.parts: 60}}\n"
+                     f"policies: [{plug_in}, non-adaptive]\nreplications: 3\nseed: 7\n")
+    assert main(["sweep", str(sweep), "--out", str(tmp_path / "out"), "--workers", "1"]) == 0
+    rows = pd.read_csv(tmp_path / "out" / "replications.csv")
+    assert sorted(set(rows["policy"])) == sorted([plug_in, "non-adaptive"])
+    by = rows.groupby("policy")["parts_missed"].apply(list)
+    assert by[plug_in] == by["non-adaptive"]
+
+
+def test_an_unknown_policy_lists_the_known_ones(thesis_cell):
+    with pytest.raises(ScenarioError, match="must be one of non-adaptive, adaptive"):
+        thesis_cell.with_overrides({"controller.policy": "random"})

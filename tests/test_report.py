@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from test_sweep import SCENARIOS, spec_bookkeeping, write_sweep
 
 from cell.errors import CellError
-from cell.report import (
+from cell.reporting.table_7_1 import (
     COLUMNS,
     markdown,
     reading,
@@ -177,7 +177,7 @@ def test_memoryless_reading_follows_the_numbers():
     import numpy as np
     import pandas as pd
 
-    from cell.report import _memoryless
+    from cell.reporting.table_7_1 import _memoryless
 
     rng = np.random.default_rng(0)
     near = pd.DataFrame({"policy": "adaptive", "ip_thesis_memoryless": 1.0214 + rng.normal(0, 1e-3, 200),

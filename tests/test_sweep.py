@@ -107,7 +107,6 @@ def test_grid_is_the_product_of_shared_and_per_policy_keys(tmp_path):
 BAD = [
     ({"grid": {"controller.idle_cycle_s": [20.0]}}, "controller.idle_cycle_s", "unknown key"),
     ({"grid": {}, "policies": ["non-adaptive"]}, "grid", "empty grid"),
-    ({"policies": ["non-adaptive", "adaptive"]}, "grid", "empty grid"),
     ({"replications": 0}, "replications", "at least 1"),
     ({"policies": {"non-adaptive": {"controller.ideal_cycle_s": []}}},
      "controller.ideal_cycle_s", "empty list"),
@@ -329,3 +328,22 @@ def test_zero_workers_is_one_clear_error_and_no_output(tmp_path, capsys):
                  "--workers", "0"])
     assert code == 2 and "--workers 0" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def test_a_section_in_the_grid_merges_and_keeps_each_policy(tmp_path):
+    """A whole section given as a grid value merges into it: the sweep's policy stays."""
+    path = write_sweep(tmp_path, grid={"controller": [{"nominal_cycle_s": 22.5872}]},
+                       policies=["non-adaptive", "adaptive"])
+    sweep = load_sweep(path)
+    assert [p.scenario.controller.policy for p in sweep.points] == ["non-adaptive", "adaptive"]
+    bad = write_sweep(tmp_path, grid={"controller": [{"policy": "adaptive"}]})
+    with pytest.raises(ScenarioError, match="cannot be varied"):
+        load_sweep(bad)
+
+
+def test_a_grid_over_a_distribution_parameter(tmp_path):
+    path = write_sweep(tmp_path, grid={"arrivals.params.loc": [16.0, 17.6019]},
+                       policies=["adaptive"])
+    sweep = load_sweep(path)
+    assert [p.scenario.arrivals.params["loc"] for p in sweep.points] == [16.0, 17.6019]
+    assert all(p.scenario.arrivals.params["scale"] == 5.4342 for p in sweep.points)

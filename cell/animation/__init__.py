@@ -13,7 +13,6 @@ stays fast.
 
 from __future__ import annotations
 
-import argparse
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,28 +45,6 @@ class Rendered:
     size_bytes: int
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The options of ``cell animate`` (the caller adds the subcommand)."""
-    parser.add_argument("scenario", help="scenario YAML file (see scenarios/)")
-    parser.add_argument("--set", dest="sets", action="append", metavar="KEY=VALUE",
-                        help="override a scenario value, e.g. --set belts.input_nominal_in_s=3.5 "
-                             "(repeatable)")
-    parser.add_argument("--parts", type=int, default=12, metavar="N",
-                        help="how many parts to follow (default 12)")
-    parser.add_argument("--from-part", dest="from_part", type=int, default=1, metavar="K",
-                        help="the first part to follow (default 1): the animation runs from its "
-                             "arrival to part K+N-1's set-down or fall")
-    parser.add_argument("--policy", choices=POLICIES, default=None,
-                        help="controller to show (default: the scenario's); 'both' puts the "
-                             "adaptive and the fixed-cycle robot side by side on the same parts")
-    parser.add_argument("--out", required=True, metavar="FILE",
-                        help="FILE.gif (Pillow) or FILE.mp4 (needs ffmpeg on the PATH)")
-    parser.add_argument("--speed", type=float, default=20.0,
-                        help="simulated seconds per second of animation (default 20)")
-    parser.add_argument("--fps", type=int, default=12, help="frames per second (default 12)")
-    parser.add_argument("--dpi", type=float, default=100.0, help="resolution (default 100)")
-
-
 def check_output(out: str | Path) -> Path:
     """The output path if it can be written: .gif, or .mp4 with ffmpeg on the PATH."""
     path = Path(out)
@@ -92,12 +69,12 @@ def simulate_scenes(scenario: Scenario, policies: list[str], first: int, count: 
     shown from being the run's last (whose look-ahead would find nothing coming).
     """
     from cell.animation.scene import build_scene, frames_input, window
+    from cell.assembly import step_table
     from cell.simulation import simulate
-    from cell.steptable import StepTable
 
     if count < 1 or first < 1:
         raise CellError(f"--parts {count} --from-part {first}: both must be at least 1")
-    table = StepTable.from_scenario(scenario)
+    table = step_table(scenario)
     extra = EXTRA_PARTS
     while True:
         n = first + count - 1 + extra
@@ -165,20 +142,5 @@ def demo(out_path: str | Path, *, progress: bool = True) -> Rendered:
     parts 3-12, ten simulated seconds a second."""
     from cell.scenario import load_scenario
 
-    baseline = Path(__file__).resolve().parents[2] / "scenarios" / "baseline.yaml"
-    return animate_both(load_scenario(baseline), out_path, parts=DEMO_PARTS, first=DEMO_FIRST,
+    return animate_both(load_scenario("baseline"), out_path, parts=DEMO_PARTS, first=DEMO_FIRST,
                         speed=DEMO_SPEED, progress=progress)
-
-
-def cmd_animate(args: argparse.Namespace) -> int:
-    """``cell animate SCENARIO --out FILE.gif|FILE.mp4``."""
-    check_output(args.out)  # before anything is simulated
-    from cell.cli import parse_sets
-    from cell.scenario import load_scenario
-
-    scenario = load_scenario(args.scenario, parse_sets(args.sets))
-    done = animate(scenario, args.out, policy=args.policy, parts=args.parts, first=args.from_part,
-                   speed=args.speed, fps=args.fps, dpi=args.dpi)
-    print(f"wrote {done.path}: {done.frames} frames, simulated {done.t0_s:.1f}-{done.t1_s:.1f} s, "
-          f"{done.size_bytes / 1e6:.2f} MB")
-    return 0

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cell.kinematics import Arm, forward, hand, placement
+from cell.kinematics import Arm, forward, hand_frame
 from cell.scenario import Scenario
 from cell.steptable import SEGMENTS, StepTable
 
@@ -69,22 +69,20 @@ class AnimationInput:
 
 
 def frames_input(result: Any, table: StepTable, scenario: Scenario) -> AnimationInput:
-    """The adapter from today's :class:`~cell.simulation.SimResult` (README, ``cell run``).
+    """The run's part records and belt changes as plain arrays.
 
-    ``start_s`` is ``at_bot_s`` for a picked part (the robot is at B, free, when
-    the part arrives, or the part is not caught); regime N's time is its length
-    over ``v_rN_in_s``; the drop point is the controllers' ``input_length``.
+    ``start_s`` is ``at_bot_s`` for a picked part (the robot starts its cycle the
+    moment the part reaches B); each regime's time is the record's ``rN_s``; the
+    drop point is the cell's ``input_length``.
     """
-    from cell.controller import constants
-    from cell.robot import robot_timing
+    from cell.assembly import constants, robot_timing
 
     d = result.parts
     picked = d["picked"].to_numpy(dtype=bool)
-    lengths = np.array([table.regime_length(r) for r in (1, 2, 3, 4)])
-    speeds = d[[f"v_r{r}_in_s" for r in (1, 2, 3, 4)]].to_numpy(dtype=float)
     at_bot = d["at_bot_s"].to_numpy(dtype=float)
+    del table
     return AnimationInput(
-        policy=str(result.summary["policy"]),
+        policy=str(result.summary.policy),
         part=d["part"].to_numpy(dtype=np.int64),
         arrival_s=d["arrival_s"].to_numpy(dtype=float),
         at_bot_s=at_bot,
@@ -92,7 +90,8 @@ def frames_input(result: Any, table: StepTable, scenario: Scenario) -> Animation
         start_s=np.where(picked, at_bot, np.nan),
         pick_s=d["pick_s"].to_numpy(dtype=float),
         touchdown_s=d["touchdown_s"].to_numpy(dtype=float),
-        regime_s=np.where(picked[:, None], lengths / speeds, np.nan),
+        regime_s=np.where(picked[:, None],
+                          d[[f"r{r}_s" for r in (1, 2, 3, 4)]].to_numpy(dtype=float), np.nan),
         input_belt=np.array(result.belts["input"], dtype=float).reshape(-1, 2),
         output_belt=np.array(result.belts["output"], dtype=float).reshape(-1, 2),
         input_length_in=float(constants(scenario, robot_timing(scenario)).input_length))
@@ -249,11 +248,14 @@ def arm_pose(scenario: Scenario, q_rad: ArrayLike, opening_in: ArrayLike) -> Arm
     """
     q = np.atleast_2d(np.asarray(q_rad, dtype=float))
     g = np.atleast_1d(np.asarray(opening_in, dtype=float))
-    arm = Arm.from_scenario(scenario)
-    z = placement(scenario)
+    from cell.assembly import geometry_of
+
+    geometry = geometry_of(scenario)
+    arm = geometry.arm
+    z = geometry.placement.frame()
     wrist_frame = z @ forward(q, arm)
     elbow = (z @ forward(q * [1, 1, 0, 0, 0], Arm(arm.l2, 0.0, arm.limits)))[:, :3, 3]
-    tool = wrist_frame @ hand(g, scenario)
+    tool = wrist_frame @ hand_frame(g, geometry.hand)
     base = np.broadcast_to(np.asarray(scenario.cell.robot_base_in, dtype=float), elbow.shape)
     joints = np.stack([base, elbow, wrist_frame[:, :3, 3], tool[:, :3, 3]], axis=1)
     half = 0.5 * g[:, None] * tool[:, :3, 1]

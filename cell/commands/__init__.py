@@ -1,3 +1,24 @@
-"""The ``cell`` command's subcommands: each a thin shell that reads its input,
-calls the package and writes its output whole or not at all.  Nothing below
-this layer imports it."""
+"""The ``cell`` command's subcommands, one module each.
+
+Each module holds ``HELP`` and ``DESCRIPTION``, ``add_arguments(parser)`` and
+``main(args)``; it imports the package inside ``main`` only, so building the
+parser (and ``cell --help``) loads nothing heavy, and a command loads only what
+it needs.  Nothing below this layer imports it.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+
+def scenario_arguments(p: argparse.ArgumentParser) -> None:
+    """SCENARIO and ``--set KEY=VALUE``, as every scenario command takes them."""
+    p.add_argument("scenario", help="a scenario file, or the name of a built-in one "
+                                    "(`cell scenarios` lists them), e.g. baseline")
+    set_argument(p)
+
+
+def set_argument(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--set", dest="sets", action="append", metavar="KEY=VALUE",
+                   help="override a scenario value, e.g. --set run.parts=100 or "
+                        "--set arrivals.params.scale=6.0 (repeatable)")

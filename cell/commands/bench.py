@@ -7,12 +7,18 @@ import json
 import platform
 from typing import Any
 
-from cell.bench import TARGET_PARTS_PER_S, benchmarks
-from cell.output import write_text
+HELP = "measure simulation and planner speed"
+DESCRIPTION = "Benchmarks; writes a JSON of the figures (make bench)."
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--out", default="reports/bench.json", help="JSON file to write")
 
 
 def main(args: argparse.Namespace) -> int:
+    from cell.bench import TARGET_PARTS_PER_S, benchmarks
     from cell.mintime.bench import benchmarks as planner_benchmarks
+    from cell.output import write_text
 
     results: dict[str, Any] = benchmarks()
     results.update(planner_benchmarks())

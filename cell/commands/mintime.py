@@ -12,14 +12,11 @@ import json
 from pathlib import Path
 from typing import Any
 
-import numpy as np
+from cell.commands import scenario_arguments
 
-from cell.assembly import geometry_of, motors_of, planner_bounds, step_table
-from cell.errors import CellError, NoMotionError
-from cell.output import write_csv, write_text
-from cell.overrides import parse_sets
-from cell.scenario import load_scenario
-
+HELP = "minimum-time motion along the path (Shin & McKay)"
+DESCRIPTION = ("Phase-plane minimum-time parameterisation of R II and R IV; writes STEM.csv "
+               "and STEM.json.")
 COLUMNS = ["regime", "s", "theta1_rad", "theta2_rad", "theta3_rad", "theta4_rad", "theta5_rad",
            "sdot", "sdot_limit"]
 
@@ -37,13 +34,25 @@ def frame(results: dict[str, Any]) -> Any:
     return pd.concat(parts, ignore_index=True)
 
 
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    scenario_arguments(p)
+    p.add_argument("--out", required=True, help="output stem: STEM.csv and STEM.json")
+
+
 def stem(out: str) -> Path:
     path = Path(out)
     return path.with_suffix("") if path.suffix in (".csv", ".json") else path
 
 
 def main(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from cell.assembly import geometry_of, motors_of, planner_bounds, step_table
+    from cell.errors import CellError, NoMotionError
     from cell.mintime.regimes import plan_regimes, summary
+    from cell.output import write_csv, write_text
+    from cell.overrides import parse_sets
+    from cell.scenario import load_scenario
 
     scenario = load_scenario(args.scenario, parse_sets(args.sets))
     step_table(scenario)  # reach and motor checks, naming their keys

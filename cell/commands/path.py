@@ -4,13 +4,24 @@ from __future__ import annotations
 
 import argparse
 
-from cell.assembly import step_table
-from cell.output import write_csv
-from cell.overrides import parse_sets
-from cell.scenario import load_scenario
+from cell.commands import scenario_arguments
+
+HELP = "write the joint-step table of the transfer path (CSV)"
+DESCRIPTION = ("Solve the transfer path once (thesis §4.2, eq. 6.7) and write one row per path "
+               "point: coordinates, joint angles, motor steps, move length, load and LO/TD events.")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    scenario_arguments(p)
+    p.add_argument("--out", required=True, help="CSV file to write")
 
 
 def main(args: argparse.Namespace) -> int:
+    from cell.assembly import step_table
+    from cell.output import write_csv
+    from cell.overrides import parse_sets
+    from cell.scenario import load_scenario
+
     scenario = load_scenario(args.scenario, parse_sets(args.sets))
     table = step_table(scenario)
     write_csv(table.to_frame(), args.out)

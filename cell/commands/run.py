@@ -8,20 +8,27 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from cell import thesis as published
-from cell.assembly import assemble
-from cell.csvfile import RowWriter
-from cell.output import atomic_path
-from cell.overrides import parse_sets
-from cell.records import BELT_COLUMNS, PART_COLUMNS, SUMMARY_COLUMNS, RunSummary
-from cell.scenario import load_scenario
-from cell.simulation import simulate
+from cell.commands import scenario_arguments
+
+if TYPE_CHECKING:
+    from cell.records import RunSummary
+
+HELP = "simulate one scenario; write parts.csv, summary.csv and belts.csv"
+DESCRIPTION = "Run the cell in simulated time under the scenario's policy."
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    scenario_arguments(p)
+    p.add_argument("--out", required=True,
+                   help="directory for parts.csv, summary.csv and belts.csv")
 
 
 def format_summary(summary: RunSummary) -> str:
     """The summary as a two-column table, with the thesis's figures where it has them."""
+    from cell import thesis as published
+
     adaptive = summary.policy == "adaptive"
     row = None if adaptive else published.TABLE_7_1.get(round(summary.ideal_cycle_s, 4))
     # the published figures as printed: four decimals, whole parts
@@ -65,6 +72,14 @@ def format_summary(summary: RunSummary) -> str:
 
 
 def main(args: argparse.Namespace) -> int:
+    from cell.assembly import assemble
+    from cell.csvfile import RowWriter
+    from cell.output import atomic_path
+    from cell.overrides import parse_sets
+    from cell.records import BELT_COLUMNS, PART_COLUMNS, SUMMARY_COLUMNS
+    from cell.scenario import load_scenario
+    from cell.simulation import simulate
+
     scenario = load_scenario(args.scenario, parse_sets(args.sets))
     cell = assemble(scenario)  # every error is raised before anything is written
     out = Path(args.out)

@@ -8,7 +8,21 @@ import threading
 from pathlib import Path
 from typing import Any
 
-from cell.sweep import load_sweep, run_sweep, simulate_summary
+HELP = "replicated sweep over scenario keys (Table 7.1)"
+DESCRIPTION = ("Run a grid of scenarios with replications; write replications.csv and, with "
+               "--report, Table 7.1.")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("sweep", help="sweep YAML file, or a built-in one by name (table_7_1)")
+    p.add_argument("--out", required=True, help="directory for results")
+    p.add_argument("--workers", type=int, default=None,
+                   help="local worker processes (default: number of cores)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run on a dask.distributed cluster at ADDRESS")
+    p.add_argument("--resume", action="store_true", help="run only what is missing in --out")
+    p.add_argument("--report", default=None, metavar="DIR",
+                   help="also write table_7_1.csv and table_7_1.md into DIR")
 
 
 def _interrupt(signum: int, frame: Any) -> None:
@@ -27,9 +41,11 @@ def main(args: argparse.Namespace) -> int:
 
 
 def _sweep(args: argparse.Namespace) -> int:
+    from cell.sweep import load_sweep, run_sweep, simulate_summary
+
     sweep = load_sweep(args.sweep)
     if args.report:
-        from cell.report import check_table_7_1
+        from cell.reporting.table_7_1 import check_table_7_1
 
         check_table_7_1(sweep)
     outcome = run_sweep(sweep, args.out, workers=args.workers, scheduler=args.scheduler,
@@ -38,7 +54,7 @@ def _sweep(args: argparse.Namespace) -> int:
           f"{sweep.replications} replications ({outcome.tasks_run} tasks run, "
           f"{outcome.tasks_reused} reused)")
     if args.report:
-        from cell.report import write_table_7_1
+        from cell.reporting.table_7_1 import write_table_7_1
 
         for path in write_table_7_1(outcome.replications, sweep, args.report):
             print(f"wrote {path}")

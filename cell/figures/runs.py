@@ -74,7 +74,7 @@ def lot_means(values: pd.Series, lot: int = LOT) -> tuple[NDArray[np.float64], N
     blocks = v[:n].reshape(-1, lot)
     with np.errstate(invalid="ignore"):
         means = np.nanmean(np.where(np.isfinite(blocks), blocks, np.nan), axis=1)
-    return np.arange(1, len(blocks) + 1) * lot, means
+    return (np.arange(1, len(blocks) + 1) * lot).astype(float), means
 
 
 def running_mean(values: pd.Series) -> NDArray[np.float64]:

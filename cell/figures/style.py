@@ -54,7 +54,7 @@ LIMIT_COLOUR = "#d62728"
 @contextmanager
 def style() -> Iterator[None]:
     """Apply the shared rcParams for the figures drawn inside the block."""
-    with mpl.rc_context(RC):
+    with mpl.rc_context(RC):  # type: ignore[arg-type]
         yield
 
 

@@ -172,7 +172,8 @@ def _layout(table: pd.DataFrame, policy: str, accounting: str, with_thesis: bool
         head += [f"{LABELS[m]}: thesis", "ours"] if with_thesis else [LABELS[m]]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for cycle, group in sub.groupby("ideal_cycle_s", sort=False):
-        by = {r["measure"]: r for r in group.to_dict("records")}
+        by: dict[str, Mapping[str, Any]] = {str(r["measure"]): {str(k): v for k, v in r.items()}
+                                            for r in group.to_dict("records")}
         cells = [f"{cycle:.4f}"]
         for m in MEASURES:
             if with_thesis:
@@ -186,7 +187,7 @@ def _get(table: pd.DataFrame, policy: str, cycle: float, accounting: str,
          measure: str) -> Mapping[str, Any]:
     sel = table[(table["policy"] == policy) & np.isclose(table["ideal_cycle_s"], cycle)
                 & (table["accounting"] == accounting) & (table["measure"] == measure)]
-    return sel.iloc[0].to_dict()
+    return {str(k): v for k, v in sel.iloc[0].to_dict().items()}
 
 
 def reading(table: pd.DataFrame, parts: int | None,

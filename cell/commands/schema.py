@@ -1,0 +1,32 @@
+"""``cell schema [--out FILE]``: the JSON Schema of scenario files, for editors.
+
+With the YAML language server (VS Code's YAML extension and others), a first
+line ``# yaml-language-server: $schema=scenario.schema.json`` gives completion,
+hover documentation and checking of every key while a scenario is edited.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+HELP = "print the JSON Schema of scenario files (for editor completion and checking)"
+DESCRIPTION = __doc__.splitlines()[0] if __doc__ else ""
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--out", default=None, help="write it to this file (default: print it)")
+
+
+def main(args: argparse.Namespace) -> int:
+    import json
+
+    from cell.output import write_text
+    from cell.scenario import json_schema
+
+    text = json.dumps(json_schema(), indent=2, ensure_ascii=False) + "\n"
+    if args.out:
+        write_text(text, args.out)
+        print(f"wrote {args.out}")
+    else:
+        print(text, end="")
+    return 0
