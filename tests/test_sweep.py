@@ -254,7 +254,7 @@ def test_dask_cluster_gives_the_same_numbers_as_local_workers(tmp_path):
 
 def test_unreachable_scheduler_is_one_clear_error_and_no_output(tmp_path, monkeypatch):
     pytest.importorskip("distributed")
-    monkeypatch.setattr("cell.sweep.CONNECT_TIMEOUT", "1s")
+    monkeypatch.setattr("cell.sweep.runner.CONNECT_TIMEOUT", "1s")
     sweep = load_sweep(write_sweep(tmp_path))
     with pytest.raises(CellError, match="cannot reach"):
         run_sweep(sweep, tmp_path / "o", scheduler="tcp://127.0.0.1:9", progress=False,
