@@ -18,10 +18,9 @@ faster on big inputs), PyYAML's Python code otherwise; the composer, which keeps
 from __future__ import annotations
 
 import codecs
-import itertools
 import math
 import re
-from collections.abc import Callable, Hashable, Iterable, Sized
+from collections.abc import Callable, Hashable, Iterable
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -338,60 +337,3 @@ def parse_value(text: str, origin: str = "--set KEY") -> Any:
         if exc.key in ("(file)", "(top level)", "(syntax)"):
             raise ScenarioError(exc.file, "(value)", _oneline(text, 60), exc.why) from None
         raise
-
-
-def short(value: object, limit: int = 80) -> str:
-    """``repr(value)`` cut near ``limit`` characters, with the size of what was cut.
-
-    ``'aaaa…' (39,000,000 characters)``, ``[1, 2, …] (20,000 items)``.  The cost depends on
-    ``limit``, not on the size of ``value``, except for types other than str, bytes, numbers,
-    lists, tuples, dicts and sets, whose own ``repr`` is used.
-    """
-    text, complete = _short(value, max(limit, 8))
-    if complete:
-        return text
-    if isinstance(value, int):
-        return f"{text} (about {_digits(value):,} digits)"
-    if not isinstance(value, Sized):
-        return f"{text} ({type(value).__name__})"
-    unit = "characters" if isinstance(value, str) else "bytes" if isinstance(value, (bytes, bytearray)) \
-        else "items" if len(value) != 1 else "item"
-    return f"{text} ({len(value):,} {unit})"
-
-
-def _digits(value: int) -> int:
-    return int(abs(value).bit_length() * math.log10(2)) + 1
-
-
-def _short(value: object, budget: int) -> tuple[str, bool]:
-    """``(text, complete)``: the repr of ``value`` if it fits in ``budget``, else a cut one."""
-    if isinstance(value, (str, bytes, bytearray)):
-        head = repr(value[:budget])
-        if len(value) <= budget and len(head) <= budget:
-            return head, True
-        return head[:max(budget - 2, 2)] + "…" + head[-1], False
-    if isinstance(value, int) and not isinstance(value, bool) and _digits(value) > 1000:
-        return ("-" if value < 0 else "") + "<integer>", False
-    if not (isinstance(value, (list, tuple, dict)) or isinstance(value, (set, frozenset)) and value):
-        try:
-            text = _oneline(repr(value), 10**9)
-        except Exception:  # noqa: BLE001 - a failing repr still gives a name
-            text = f"<{type(value).__name__}>"
-        return (text, True) if len(text) <= budget else (text[:max(budget - 1, 1)] + "…", False)
-    pairs, text, shown, complete = isinstance(value, dict), "", 0, True
-    for item in itertools.islice(value.items() if isinstance(value, dict) else value, budget):
-        room = budget - len(text) - 6  # keep room for ", …]"
-        if room < 2:
-            break
-        part, complete = _short(item[0] if pairs else item, room)
-        if pairs and complete:
-            tail, complete = _short(item[1], max(room - len(part) - 2, 2))
-            part += ": " + tail
-        text, shown = text + (", " if shown else "") + part, shown + 1
-        if not complete:
-            break
-    if shown < len(value):
-        text, complete = text + (", …" if shown else "…"), False
-    brackets = "[]" if isinstance(value, list) else "()" if isinstance(value, tuple) else "{}"
-    comma = "," if isinstance(value, tuple) and len(value) == 1 and complete else ""
-    return brackets[0] + text + comma + brackets[1], complete

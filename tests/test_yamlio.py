@@ -12,8 +12,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from cell import yamlio
-from cell.errors import ScenarioError
-from cell.yamlio import MAX_BYTES, load_mapping, parse_value, short
+from cell.errors import ScenarioError, short
+from cell.yamlio import MAX_BYTES, load_mapping, parse_value
 
 LOADERS = ["python"] + (["libyaml"] if yaml.__with_libyaml__ else [])
 SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
