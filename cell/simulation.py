@@ -144,14 +144,15 @@ def _seed_value(seed: Any) -> Any:
 
 def simulate(scenario: Scenario | AssembledCell,
              seed: int | np.random.SeedSequence | None = None, *, keep_parts: bool = True,
-             on_part: PartSink | None = None, on_belt: BeltSink | None = None) -> SimResult:
+             on_part: PartSink | None = None, on_belt: BeltSink | None = None,
+             keep_belts: bool = True) -> SimResult:
     """Run ``run.parts`` parts through the cell under its policy.
 
     ``seed``: int or SeedSequence; None means ``run.seed``.  Policies given the
     same seed see the same inter-arrival times (common random numbers).
-    ``keep_parts``: keep every part's record in the result (off for long runs,
-    which stream them to ``on_part`` instead); ``on_belt`` is told every belt
-    speed change as it becomes final (all of them are kept in the result too).
+    ``keep_parts`` / ``keep_belts``: keep every part's record / belt speed change
+    in the result (off for long runs, which stream them to ``on_part`` /
+    ``on_belt`` instead, as each becomes final: memory then stays flat).
     """
     cell = scenario if isinstance(scenario, AssembledCell) else assemble(scenario)
     s, k, policy = cell.scenario, cell.k, cell.policy
@@ -169,7 +170,8 @@ def simulate(scenario: Scenario | AssembledCell,
     def belt_sink(name: str) -> Callable[[float, float], None]:
         def told(t: float, v: float) -> None:
             change = BeltChange(name, t, v)
-            changes.append(change)
+            if keep_belts:
+                changes.append(change)
             if on_belt is not None:
                 on_belt(change)
         return told

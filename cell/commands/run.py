@@ -7,7 +7,6 @@ runs, so a long run needs little memory; the three files appear together.
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from cell.commands import scenario_arguments
@@ -71,26 +70,30 @@ def format_summary(summary: RunSummary) -> str:
     return "\n".join(f"{label:<{width}}  {text}" for label, text in rows)
 
 
+#: The files of a run, written as one set.
+RUN_FILES = ("parts.csv", "summary.csv", "belts.csv")
+
+
 def main(args: argparse.Namespace) -> int:
     from cell.assembly import assemble
     from cell.csvfile import RowWriter
-    from cell.output import atomic_path
+    from cell.output import OutputDir
     from cell.overrides import parse_sets
     from cell.records import BELT_COLUMNS, PART_COLUMNS, SUMMARY_COLUMNS
     from cell.scenario import load_scenario
     from cell.simulation import simulate
 
+    OutputDir.check(args.out, RUN_FILES)  # before any work
     scenario = load_scenario(args.scenario, parse_sets(args.sets))
     cell = assemble(scenario)  # every error is raised before anything is written
-    out = Path(args.out)
-    with atomic_path(out / "parts.csv") as parts_tmp, atomic_path(out / "belts.csv") as belts_tmp, \
-            open(parts_tmp, "w", newline="") as pf, open(belts_tmp, "w", newline="") as bf:
-        parts = RowWriter(pf, PART_COLUMNS)
-        belts = RowWriter(bf, BELT_COLUMNS)
-        result = simulate(cell, keep_parts=False, on_part=parts.record)
-        belts.rows_of(result.belt_changes)
-        with atomic_path(out / "summary.csv") as summary_tmp, open(summary_tmp, "w", newline="") as sf:
+    with OutputDir(args.out, RUN_FILES) as out:
+        with out.open("parts.csv", newline="") as pf, out.open("belts.csv", newline="") as bf:
+            parts, belts = RowWriter(pf, PART_COLUMNS), RowWriter(bf, BELT_COLUMNS)
+            result = simulate(cell, keep_parts=False, on_part=parts.record,
+                              on_belt=belts.record, keep_belts=False)
+        with out.open("summary.csv", newline="") as sf:
             RowWriter(sf, SUMMARY_COLUMNS).record(result.summary)
     print(format_summary(result.summary))
-    print(f"wrote {out / 'parts.csv'}, {out / 'summary.csv'} and {out / 'belts.csv'}")
+    shown = out.target
+    print(f"wrote {shown}/parts.csv, summary.csv and belts.csv")
     return 0
