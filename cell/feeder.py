@@ -17,7 +17,11 @@ import numpy as np
 import simpy
 from numpy.typing import NDArray
 
+from cell.conveyors import EPS_S
 from cell.records import HELD_AT_FEEDER, PartRecord
+
+#: Belt travel this close to clear counts as clear (the rounding of travel and its inverse).
+CLEAR_TOL_IN = 1e-9
 
 
 class Loadable(Protocol):
@@ -54,12 +58,12 @@ class Feeder:
         belt, size = self.conveyor.belt, self.part_size_in
         clear_at = -float("inf")
         for i in range(self.n_parts):
-            yield env.timeout(fed[i] - env.now)
-            held = belt.travel(env.now) < clear_at
-            while belt.travel(env.now) < clear_at:
+            yield env.timeout(max(fed[i] - env.now, 0.0))  # after a hold it may be due already
+            held = belt.travel(env.now) < clear_at - CLEAR_TOL_IN
+            while belt.travel(env.now) < clear_at - CLEAR_TOL_IN:
                 self.holding = True
                 try:
-                    yield env.timeout(max(belt.time_at(clear_at) - env.now, 0.0))
+                    yield env.timeout(max(belt.time_at(clear_at) - env.now, EPS_S))
                 except simpy.Interrupt:  # the belt was replanned: time the wait again
                     pass
             self.holding = False

@@ -219,6 +219,12 @@ class ArrivalSettings(Section):
     params: dict[str, Annotated[float, Field(strict=True, allow_inf_nan=True)]] = Field(
         default_factory=lambda: {"c": WEIBULL_SHAPE, "loc": 17.6019, "scale": 5.4342})
     """Its parameters by scipy's names; the default is eq. 6.9."""
+    mean_s: float | None = _num(None, gt=0.0, le=MAX_TIME_S)
+    """With ``cv``: the mean inter-arrival time; the family's shape and scale are then
+    derived from the two (no location) and ``params`` is not used."""
+    cv: float | None = _num(None, gt=0.0, le=10.0)
+    """With ``mean_s``: the coefficient of variation (sd / mean) of the inter-arrival time;
+    ``gamma``, ``weibull_min``, ``lognorm`` and ``expon`` (shifted; cv ≤ 1) take it."""
     trace_csv: str | None = None
     """A CSV of observed inter-arrival times (column ``interarrival_s``), used in
     order instead of the distribution; relative to the scenario file."""
