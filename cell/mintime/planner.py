@@ -70,7 +70,7 @@ def path_grid(n: int) -> Array:
     1.15/(n − 1)) and grow by the factor 1 + 1/(GRADING_WIDTH (n − 1)) until they reach H.
     A rest-to-rest motion starts and stops there, and a drive that reaches top speed in
     far less than H (the MICROBOT's, in milliseconds) still gets grid points on its
-    ramp: the time of each ramp is then accurate to O(H²) instead of O(H).  Doubling n
+    ramp: its share of the paper's T = ∫ dλ/μ (§4) is then accurate to O(H²), not O(H).  Doubling n
     halves every step, so grids of 460, 920, 1840, ... points refine one another.
     Products and sums only: the same points on every machine.
     """
@@ -241,8 +241,9 @@ def _umin(b: tuple[float, ...], x: float, sd: float) -> float:
 
 def _advance(b: tuple[float, ...], bound: Callable[[tuple[float, ...], float, float], float],
              xk: float, uk: float, h: float, top: float) -> float:
-    """x = ṡ² one step of signed length h along dx/ds = 2u, from xk where the bound gives uk,
-    to the next point whose bounds are ``b``; never above ``top``.  Negative: stalled.
+    """x = ṡ² one step of signed length h along dx/ds = 2u (the paper's phase-plane
+    trajectory, §4: eq. 11b divided by 11a), from xk where the bound gives uk, to the next
+    point whose bounds are ``b``; never above ``top``.  Negative: stalled.
 
     Heun's method, unless the next point's bound has opposite signs at xk and at the
     predictor, or Heun ends below zero: then the step crosses a speed at which the bound
