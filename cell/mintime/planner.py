@@ -43,7 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from cell.errors import CellError
+from cell.errors import NoMotionError
 
 from .rows import PathRows, acceleration_rows, torque_rows, velocity_rows
 
@@ -86,10 +86,6 @@ def path_grid(n: int) -> Array:
     steps = np.concatenate([ramp, np.ones(n - 1 - 2 * len(ramp)), ramp[::-1]])
     s = np.concatenate([[0.0], np.cumsum(steps)])
     return s / s[-1]
-
-
-class NoMotionError(CellError):
-    """No admissible motion along the path under the given bounds."""
 
 
 # --------------------------------------------------------------------------- limit curve
