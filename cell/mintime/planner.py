@@ -254,31 +254,38 @@ def _advance(b: tuple[float, ...], bound: Callable[[tuple[float, ...], float, fl
     if math.isfinite(u1) and (x < 0.0 or xq < top):
         u_here = bound(b, xk, math.sqrt(xk))
         if x < 0.0 or (u_here > 0.0) != (u1 > 0.0):
-            x = _implicit_euler(b, bound, xk, h, -2.0 * h * u_here, top)
+            x = _implicit_euler(b, bound, xk, h, u_here, (xq, 0.0, top), x)
     return min(x, top)
 
 
 def _implicit_euler(b: tuple[float, ...], bound: Callable[[tuple[float, ...], float, float], float],
-                    xk: float, h: float, g_here: float, top: float) -> float:
-    """The root y in [0, top] of g(y) = y − xk − 2h u(y), given g(xk) = ``g_here``; −1 if
-    there is none below xk (even at rest the bound slows the path: a stall), top if none above."""
+                    xk: float, h: float, u_here: float, ends: tuple[float, ...],
+                    fallback: float) -> float:
+    """The root y of g(y) = y − xk − 2h u(y) between xk and the first of ``ends`` on the side
+    where it lies (below xk if g(xk) > 0) that brackets it.  None below: −1 (even at rest
+    the bound slows the path, a stall); none above: ``fallback``."""
     def g(y: float) -> float:
         return y - xk - 2.0 * h * bound(b, y, math.sqrt(y))
+    g_here = -2.0 * h * u_here
     if g_here == 0.0:
         return xk
-    lo, hi = (0.0, xk) if g_here > 0.0 else (xk, top)
-    g_lo = g(lo) if g_here > 0.0 else g_here
-    g_hi = g_here if g_here > 0.0 else g(hi)
-    if (g_lo < 0.0) == (g_hi < 0.0):
-        return -1.0 if g_here > 0.0 else top
-    for _ in range(64):
-        mid = 0.5 * (lo + hi)
-        g_mid = g(mid)
-        if (g_mid < 0.0) == (g_lo < 0.0):
-            lo, g_lo = mid, g_mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
+    below = g_here > 0.0
+    for end in ends:
+        if (end < xk) != below or not math.isfinite(end):
+            continue
+        g_end = g(end)
+        if (g_end > 0.0) == below:
+            continue
+        lo, hi, g_lo = end, xk, g_end
+        for _ in range(64):
+            mid = 0.5 * (lo + hi)
+            g_mid = g(mid)
+            if (g_mid < 0.0) == (g_lo < 0.0):
+                lo, g_lo = mid, g_mid
+            else:
+                hi = mid
+        return 0.5 * (lo + hi)
+    return -1.0 if below else fallback
 
 
 @dataclass(frozen=True)
