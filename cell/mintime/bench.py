@@ -1,12 +1,16 @@
-"""Planner speed against toppra on the transfer path (merged into
-reports/bench.json by ``cell bench``).
+"""Planner speed against toppra on the transfer path, and the planner's accuracy
+(merged into reports/bench.json by ``cell bench``).
 
-Input: the joint paths of R II and R IV from the step table, their peak
-velocity bounds and the acceleration bounds of ``scenarios/mintime_kinematic.yaml``
-(velocity + acceleration: toppra's fastest, Cython, case).  Both planners start
-from the same waypoints, build their own spline and constraints on the same
-uniform grid, and return ṡ on it; the time of the best of several runs, in ms.
+Speed: the joint paths of R II and R IV from the step table, their peak velocity
+bounds and the acceleration bounds of ``scenarios/mintime_kinematic.yaml`` (velocity +
+acceleration: toppra's fastest, Cython, case).  Both planners start from the same
+waypoints, build their own spline and constraints on the same grid
+(``path_grid(n)``), and return ṡ on it; the time of the best of several runs, in ms.
 The torque case (baseline dynamic model, 460 points) is reported beside it.
+
+Accuracy: ``mintime_r4_dynamic_rel_err`` is R IV under the baseline's dynamic model on
+its default grid against the converged time, from the planner on 460·2^k points
+(k = 0 … 4) extrapolated at second order (Richardson).
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[2]
+RICHARDSON = tuple(460 * 2 ** k for k in range(5))
 
 
 def _best_ms(fn: Callable[[], object], repeat: int) -> float:
@@ -29,15 +34,26 @@ def _best_ms(fn: Callable[[], object], repeat: int) -> float:
     return 1e3 * best
 
 
+def converged_time(times: list[float]) -> float:
+    """T∞ from times on doubling grids: the last plus a third of the last change (second order)."""
+    return times[-1] + (times[-1] - times[-2]) / 3.0
+
+
 def benchmarks(repeat: int = 5) -> dict[str, float]:
     from scipy.interpolate import CubicSpline
 
     from cell.assembly import geometry_of, motors_of, planner_bounds, step_table
     from cell.dynamics import chain
-    from cell.dynamics_file import load_dynamics
-    from cell.mintime.planner import PathRows, acceleration_rows, plan, torque_rows, velocity_rows
+    from cell.mintime.planner import (
+        PathRows,
+        acceleration_rows,
+        path_grid,
+        plan,
+        torque_rows,
+        velocity_rows,
+    )
     from cell.mintime.reference import toppra_profile
-    from cell.mintime.regimes import FREE_REGIMES, regime_path, regime_rows
+    from cell.mintime.regimes import FREE_REGIMES, plan_regimes, regime_path, regime_rows
     from cell.scenario import load_scenario
 
     kin = load_scenario(ROOT / "scenarios" / "mintime_kinematic.yaml")
@@ -49,7 +65,7 @@ def benchmarks(repeat: int = 5) -> dict[str, float]:
             for rp in paths}
 
     def ours(n: int) -> list[float]:
-        s = np.linspace(0.0, 1.0, n)
+        s = path_grid(n)
         out = []
         for rp in paths:
             sp = CubicSpline(rp.s_way, rp.q_way)
@@ -60,7 +76,7 @@ def benchmarks(repeat: int = 5) -> dict[str, float]:
         return out
 
     def theirs(n: int) -> list[float]:
-        s = np.linspace(0.0, 1.0, n)
+        s = path_grid(n)
         return [toppra_profile(rp.s_way, rp.q_way, s, qdot_max=vmax[rp.regime], qddot_max=amax)[1]
                 for rp in paths]
 
@@ -74,11 +90,13 @@ def benchmarks(repeat: int = 5) -> dict[str, float]:
     # Torque (baseline dynamic model) on R IV at 460 points: toppra calls the same inverse
     # dynamics once per grid point and coefficient, the planner batches it.
     base = load_scenario(ROOT / "scenarios" / "baseline.yaml")
-    model = load_dynamics(base.base_dir / base.mintime.dynamics_file)
+    base_geometry, base_motors, base_bounds = geometry_of(base), motors_of(base), planner_bounds(base)
+    model = base_bounds.dynamics
+    assert model is not None, "scenarios/baseline.yaml names a dynamics file"
     r4 = next(rp for rp in paths if rp.regime == "R4")
     ch = chain(model, base.robot.l2_in, base.robot.l3_in, r4.load_oz, r4.tcp_in)
     tau = np.asarray(model.drives.stall_torque_nm)
-    s = np.linspace(0.0, 1.0, 460)
+    s = path_grid(460)
 
     def ours_tau() -> float:
         sp = CubicSpline(r4.s_way, r4.q_way)
@@ -93,6 +111,12 @@ def benchmarks(repeat: int = 5) -> dict[str, float]:
 
     out["mintime_torque_ms_460"] = _best_ms(ours_tau, 3)
     out["toppra_torque_ms_460"] = _best_ms(theirs_tau, 1)
+
+    r4_times = [plan_regimes(base_geometry, base_motors, base_bounds, n)["R4"].profile.time_s
+                for n in RICHARDSON]
+    default = plan_regimes(base_geometry, base_motors, base_bounds)["R4"].profile.time_s
+    t_inf = converged_time(r4_times)
+    out["mintime_r4_dynamic_rel_err"] = abs(default - t_inf) / t_inf
     return {k: round(v, 3) if "ms" in k else v for k, v in out.items()}
 
 

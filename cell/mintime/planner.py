@@ -22,20 +22,33 @@ motor's torque-speed line).  The planner works in x = ṡ², where dx/ds = 2u:
    backward curve: the result is the bang-bang profile (accelerate, ride the
    limit curve, decelerate) with its switching points.
 
-Both integrations are Heun's method (second order) on the grid.  The time is
-T = Σ 2Δs / (ṡ_i + ṡ_{i+1}), the formula SPEC §9 fixes for comparisons.
+Both integrations are Heun's method (second order) on the grid, with an implicit
+Euler step where a drive settles on its torque balance within one step.  The time
+is T = Σ 2Δs / (ṡ_i + ṡ_{i+1}), the formula SPEC §9 fixes for comparisons: exact
+where x is linear in s between grid points, which it is not where a fast drive
+reaches top speed inside one step (O(Δs) each start and stop on a uniform grid);
+:func:`path_grid` therefore grades the grid toward both ends.
+
+Every step is IEEE arithmetic (+, −, ×, ÷, √, min, max) in a fixed order and the
+sum is correctly rounded: the same rows give the same plan bit for bit, on every
+run and whichever SIMD code paths numpy picks on the machine.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
-from cell.errors import CellError
+from cell.errors import NoMotionError
+
+from .rows import PathRows, acceleration_rows, torque_rows, velocity_rows
+
+__all__ = ["NoMotionError", "PathRows", "Profile", "acceleration_rows", "path_grid", "plan",
+           "torque_rows", "velocity_limit", "velocity_rows"]
 
 Array = NDArray[np.float64]
 
@@ -43,63 +56,36 @@ Array = NDArray[np.float64]
 #: zero: the row then bounds ṡ only (a zero-inertia point).
 ZERO_INERTIA = 1e-9
 
+#: Width, in s, over which :func:`path_grid` grades the grid at each end (its steps grow
+#: by 1 + 1/(GRADING_WIDTH (n − 1)) from one to the next).
+GRADING_WIDTH = 0.01
+#: The first step at each end, as a fraction of the step in the middle.
+SMALLEST_STEP = 1e-3
 
-class NoMotionError(CellError):
-    """No admissible motion along the path under the given bounds."""
 
+def path_grid(n: int) -> Array:
+    """n grid points on [0, 1]: uniform in the middle, graded geometrically toward both ends.
 
-@dataclass(frozen=True)
-class PathRows:
-    """Bounds on the path acceleration along a grid, in the reduced form above.
-
-    Every array has one entry (or one row) per grid point.
+    The steps at each end start at ``SMALLEST_STEP`` of the middle step H (about
+    1.15/(n − 1)) and grow by the factor 1 + 1/(GRADING_WIDTH (n − 1)) until they reach H.
+    A rest-to-rest motion starts and stops there, and a drive that reaches top speed in
+    far less than H (the MICROBOT's, in milliseconds) still gets grid points on its
+    ramp: its share of the paper's T = ∫ dλ/μ (§4) is then accurate to O(H²), not O(H).  Doubling n
+    halves every step, so grids of 460, 920, 1840, ... points refine one another.
+    Products and sums only: the same points on every machine.
     """
-
-    s: Array
-    """(N,) grid, increasing from 0 to 1."""
-    a: Array
-    """(N, m) coefficient of s̈ (the paper's M for a torque row)."""
-    b: Array
-    """(N, m) coefficient of ṡ² (Q)."""
-    e: Array
-    """(N, m) coefficient of ṡ (R: friction and the motor line)."""
-    c: Array
-    """(N, m) constant (S: gravity)."""
-    lo: Array
-    """(N, m) lower bound."""
-    hi: Array
-    """(N, m) upper bound."""
-    sdot_max: Array = field(default=None)  # type: ignore[assignment]
-    """(N,) direct cap on ṡ from the joint velocity bounds (inf: none)."""
-
-    def __post_init__(self) -> None:
-        if self.sdot_max is None:
-            object.__setattr__(self, "sdot_max", np.full(len(self.s), np.inf))
-
-    @staticmethod
-    def join(*parts: PathRows) -> PathRows:
-        """All rows of several sets on the same grid; the tightest ṡ cap."""
-        cat = lambda name: np.hstack([getattr(p, name) for p in parts])  # noqa: E731
-        return PathRows(parts[0].s, cat("a"), cat("b"), cat("e"), cat("c"), cat("lo"), cat("hi"),
-                        np.min([p.sdot_max for p in parts], axis=0))
-
-
-def velocity_rows(s: ArrayLike, dq: ArrayLike, qdot_max: ArrayLike) -> PathRows:
-    """|q'_j ṡ| ≤ q̇max_j: no acceleration rows, only the cap ṡ ≤ min_j q̇max_j / |q'_j|."""
-    s, dq = np.asarray(s, float), np.asarray(dq, float)
-    with np.errstate(divide="ignore"):
-        cap = np.min(np.asarray(qdot_max, float) / np.abs(dq), axis=1)
-    empty = np.zeros((len(s), 0))
-    return PathRows(s, empty, empty, empty, empty, empty, empty, cap)
-
-
-def acceleration_rows(s: ArrayLike, dq: ArrayLike, ddq: ArrayLike,
-                      qddot_max: ArrayLike) -> PathRows:
-    """|q'_j s̈ + q''_j ṡ²| ≤ q̈max_j."""
-    dq, ddq = np.asarray(dq, float), np.asarray(ddq, float)
-    amax = np.broadcast_to(np.asarray(qddot_max, float), dq.shape)
-    return PathRows(np.asarray(s, float), dq, ddq, np.zeros_like(dq), np.zeros_like(dq),
-                    -amax, amax.copy())
+    if n < 2:
+        raise ValueError("a path grid needs at least 2 points")
+    ratio = 1.0 + 1.0 / (GRADING_WIDTH * (n - 1))
+    ramp, w = [], SMALLEST_STEP
+    while w < 1.0:
+        ramp.append(w)
+        w *= ratio
+    if 4 * len(ramp) > n - 1:        # too few points to grade
+        return np.linspace(0.0, 1.0, n)
+    steps = np.concatenate([ramp, np.ones(n - 1 - 2 * len(ramp)), ramp[::-1]])
+    s = np.concatenate([[0.0], np.cumsum(steps)])
+    return s / s[-1]
 
 
 # --------------------------------------------------------------------------- limit curve
@@ -184,43 +170,122 @@ def velocity_limit(rows: PathRows) -> Array:
 
 
 # --------------------------------------------------------------------------- integration
-def _bound_lists(rows: PathRows) -> tuple[list, list, bool]:
-    """Per grid point, the coefficients (k0, k1, k2) of its bounds u ≤ k0 + k1 ṡ + k2 ṡ²
-    (from α > 0) and u ≥ ... (from α < 0), as Python lists for the scalar loop.
+Bounds = list[tuple[float, ...]]
 
-    Halves that bound nothing at a point get ±inf; halves that bound nothing
-    anywhere are dropped.  The flag says whether any bound has a ṡ term.
+
+def _bound_lists(rows: PathRows, limit: Array) -> tuple[Bounds, Bounds]:
+    """Per grid point, the bounds u ≤ k0 + k1 ṡ + k2 ṡ² (from α > 0) and u ≥ … (from α < 0)
+    as flat tuples (k0, k1, k2, k0', k1', k2', …) for the scalar loop.
+
+    Only bounds that can bind somewhere on 0 ≤ ṡ ≤ ṡ_max(s) are kept: one that another
+    bound undercuts on that whole range (the difference is a quadratic in ṡ, checked at
+    both ends and its vertex) is dropped, so that usually one bound a side remains.
     """
     alpha, b0, b1, b2 = _halves(rows)
-    safe = np.where(alpha == 0, 1.0, alpha)
+    y = np.where(np.isfinite(limit), limit, np.nan)[:, None, None]
     out = []
-    for mask, fill in ((alpha > 0, np.inf), (alpha < 0, -np.inf)):
-        cols = mask.any(axis=0)
-        m = mask[:, cols]
-        k0 = np.where(m, b0[:, cols] / safe[:, cols], fill)
-        k1 = np.where(m, b1[:, cols] / safe[:, cols], 0.0)
-        k2 = np.where(m, b2[:, cols] / safe[:, cols], 0.0)
-        out.append([list(zip(r0, r1, r2)) for r0, r1, r2 in
-                    zip(k0.tolist(), k1.tolist(), k2.tolist())])
-    return out[0], out[1], bool(np.any(b1))
+    for sign in (1.0, -1.0):
+        act = sign * alpha > 0
+        cols = act.any(axis=0)
+        act = act[:, cols]
+        a = np.where(act, alpha[:, cols], 1.0)
+        k = np.stack([b[:, cols] / a for b in (b0, b1, b2)], axis=-1)          # (N, c, 3)
+        # d[i, j, j'] = sign (f_j − f_j') ≥ 0 on [0, ṡ_max]: bound j is never tighter than j'.
+        d = sign * (k[:, :, None, :] - k[:, None, :, :])
+        d0, d1, d2 = d[..., 0], d[..., 1], d[..., 2]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            yv = np.where(d2 > 0, -d1 / (2.0 * d2), 0.0)
+            yv = np.clip(yv, 0.0, y)
+            worst = np.minimum(np.minimum(d0, d0 + (d1 + d2 * y) * y), d0 + (d1 + d2 * yv) * yv)
+            loose = (worst >= 0) & act[:, None, :]
+        c = k.shape[1]
+        later = np.arange(c)[:, None] > np.arange(c)[None, :]                 # j' before j
+        tie = loose & np.swapaxes(loose, 1, 2)
+        dominated = (loose & (~tie | later)).any(axis=2)
+        keep = act & ~dominated
+        order = np.argsort(~keep, axis=1, kind="stable")
+        k = np.take_along_axis(k, order[:, :, None], axis=1)                  # kept ones first
+        count = keep.sum(axis=1)
+        side: Bounds = list(zip(*(k[:, 0, j].tolist() for j in range(3)))) if c else [()] * len(k)
+        for i in np.flatnonzero(count != 1).tolist():
+            side[i] = tuple(k[i, :count[i]].ravel().tolist())
+        out.append(side)
+    return out[0], out[1]
 
 
-def _umax(bounds: list, x: float, sd: float) -> float:
+def _umax(b: tuple[float, ...], x: float, sd: float) -> float:
+    if len(b) == 3:
+        return b[0] + b[1] * sd + b[2] * x
     best = math.inf
-    for k0, k1, k2 in bounds:
-        v = k0 + k1 * sd + k2 * x
+    for j in range(0, len(b), 3):
+        v = b[j] + b[j + 1] * sd + b[j + 2] * x
         if v < best:
             best = v
     return best
 
 
-def _umin(bounds: list, x: float, sd: float) -> float:
+def _umin(b: tuple[float, ...], x: float, sd: float) -> float:
+    if len(b) == 3:
+        return b[0] + b[1] * sd + b[2] * x
     best = -math.inf
-    for k0, k1, k2 in bounds:
-        v = k0 + k1 * sd + k2 * x
+    for j in range(0, len(b), 3):
+        v = b[j] + b[j + 1] * sd + b[j + 2] * x
         if v > best:
             best = v
     return best
+
+
+def _advance(b: tuple[float, ...], bound: Callable[[tuple[float, ...], float, float], float],
+             xk: float, uk: float, h: float, top: float) -> float:
+    """x = ṡ² one step of signed length h along dx/ds = 2u (the paper's phase-plane
+    trajectory, §4: eq. 11b divided by 11a), from xk where the bound gives uk, to the next
+    point whose bounds are ``b``; never above ``top``.  Negative: stalled.
+
+    Heun's method, unless the next point's bound has opposite signs at xk and at the
+    predictor, or Heun ends below zero: then the step crosses a speed at which the bound
+    vanishes (a drive on its torque-speed line reaching its torque balance within one step),
+    where Heun overshoots and is unstable.  The implicit Euler step x = xk + 2h u(x), which
+    settles on that speed however long the step, is then solved by bisection.
+    """
+    xp = xk + 2.0 * h * uk
+    xq = min(max(xp, 0.0), top)
+    u1 = bound(b, xq, math.sqrt(xq))
+    x = xk + h * (uk + u1)
+    if math.isfinite(u1) and (x < 0.0 or xq < top):
+        u_here = bound(b, xk, math.sqrt(xk))
+        if x < 0.0 or (u_here > 0.0) != (u1 > 0.0):
+            x = _implicit_euler(b, bound, xk, h, u_here, (xq, 0.0, top), x)
+    return min(x, top)
+
+
+def _implicit_euler(b: tuple[float, ...], bound: Callable[[tuple[float, ...], float, float], float],
+                    xk: float, h: float, u_here: float, ends: tuple[float, ...],
+                    fallback: float) -> float:
+    """The root y of g(y) = y − xk − 2h u(y) between xk and the first of ``ends`` on the side
+    where it lies (below xk if g(xk) > 0) that brackets it.  None below: −1 (even at rest
+    the bound slows the path, a stall); none above: ``fallback``."""
+    def g(y: float) -> float:
+        return y - xk - 2.0 * h * bound(b, y, math.sqrt(y))
+    g_here = -2.0 * h * u_here
+    if g_here == 0.0:
+        return xk
+    below = g_here > 0.0
+    for end in ends:
+        if (end < xk) != below or not math.isfinite(end):
+            continue
+        g_end = g(end)
+        if (g_end > 0.0) == below:
+            continue
+        lo, hi, g_lo = end, xk, g_end
+        for _ in range(64):
+            mid = 0.5 * (lo + hi)
+            g_mid = g(mid)
+            if (g_mid < 0.0) == (g_lo < 0.0):
+                lo, g_lo = mid, g_mid
+            else:
+                hi = mid
+        return 0.5 * (lo + hi)
+    return -1.0 if below else fallback
 
 
 @dataclass(frozen=True)
@@ -267,7 +332,7 @@ def plan(rows: PathRows, sdot_start: float = 0.0, sdot_end: float = 0.0) -> Prof
     if sdot_start > limit[0] * (1 + 1e-9) or sdot_end > limit[-1] * (1 + 1e-9):
         raise NoMotionError("the start or end path velocity is above the velocity-limit curve")
     mvc = limit * limit
-    ups, downs, _ = _bound_lists(rows)
+    ups, downs = _bound_lists(rows, limit)
     sq = math.sqrt
     ds = np.diff(s).tolist()
     mvc_l = mvc.tolist()
@@ -276,17 +341,10 @@ def plan(rows: PathRows, sdot_start: float = 0.0, sdot_end: float = 0.0) -> Prof
     xb = [0.0] * n
     xb[-1] = sdot_end ** 2
     for i in range(n - 2, -1, -1):
-        d, x1 = ds[i], xb[i + 1]
+        x1 = xb[i + 1]
         l1 = _umin(downs[i + 1], x1, sq(x1))
-        if l1 == -math.inf:
-            xb[i] = mvc_l[i]
-            continue
-        xp = min(x1 - 2.0 * d * l1, mvc_l[i])
-        xp = max(xp, 0.0)
-        l0 = _umin(downs[i], xp, sq(xp))
-        x0 = x1 - d * (l1 + l0) if l0 != -math.inf else mvc_l[i]
-        xb[i] = min(x0, mvc_l[i])
-        if xb[i] <= 0.0 and i > 0:
+        xb[i] = mvc_l[i] if l1 == -math.inf else _advance(downs[i], _umin, x1, l1, -ds[i], mvc_l[i])
+        if xb[i] < 0.0 or (xb[i] == 0.0 and i > 0):
             raise NoMotionError(f"no motion possible at {_where(s, i)}: the arm cannot brake "
                                 "in time to stay on the path")
 
@@ -298,15 +356,13 @@ def plan(rows: PathRows, sdot_start: float = 0.0, sdot_end: float = 0.0) -> Prof
         d, x0 = ds[i], xf[i]
         cap = xb[i + 1]
         u0 = _umax(ups[i], x0, sq(x0))
-        xp = x0 + 2.0 * d * u0 if u0 != math.inf else math.inf
-        if xp >= cap:
+        if u0 == math.inf or x0 + 2.0 * d * u0 >= cap:
             x1 = cap
         else:
-            if xp < 0.0:
+            x1 = _advance(ups[i + 1], _umax, x0, u0, d, cap)
+            if x1 < 0.0:
                 raise NoMotionError(f"no motion possible at {_where(s, i)}: the bounds leave "
                                     "no acceleration to keep moving along the path")
-            u1 = _umax(ups[i + 1], xp, sq(xp))
-            x1 = min(x0 + d * (u0 + u1), cap)
         if x1 < cap * (1.0 - 1e-9):
             phase[i] = 1
         else:
@@ -317,7 +373,8 @@ def plan(rows: PathRows, sdot_start: float = 0.0, sdot_end: float = 0.0) -> Prof
     if np.any(speed <= 0):
         i = int(np.flatnonzero(speed <= 0)[0])
         raise NoMotionError(f"no motion possible at {_where(s, i)}: the path velocity is zero")
-    time_s = float(np.sum(2.0 * np.diff(s) / speed))
+    # math.fsum is correctly rounded: T does not depend on the order of the terms.
+    time_s = math.fsum((2.0 * np.diff(s) / speed).tolist())
     return Profile(s, sdot, limit, phase, time_s, _switches(s, phase))
 
 
@@ -333,27 +390,3 @@ def _switches(s: Array, phase: NDArray[np.int8]) -> list[float]:
     vals = phase[keep]
     out = [float(s[k]) for j, k in enumerate(keep) if j > 0 and vals[j] != vals[j - 1]]
     return out
-
-
-def torque_rows(s: ArrayLike, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike, rnea: Callable,
-                tau_max: ArrayLike, *, viscous: ArrayLike | None = None,
-                line_slope: ArrayLike | None = None) -> PathRows:
-    """The paper's reduced dynamics (eq. 11b) as rows, one per joint.
-
-    ``rnea(q, qd, qdd, friction=False, gravity=...)`` is the rigid-body inverse
-    dynamics.  M = J q' (a), Q = J q'' + c(q', q') (b), R = K q' plus the
-    torque-speed line's slope τ_s/ω_f times q' (e), S = g(q) (c); bounded by
-    ±τ_max.
-    """
-    q, dq, ddq = (np.asarray(v, float) for v in (q, dq, ddq))
-    zero = np.zeros_like(q)
-    a = rnea(q, zero, dq, friction=False, gravity=False)
-    b = rnea(q, dq, ddq, friction=False, gravity=False)
-    c = rnea(q, zero, zero, friction=False, gravity=True)
-    e = np.zeros_like(q)
-    if viscous is not None:
-        e = e + np.asarray(viscous, float) * dq
-    if line_slope is not None:
-        e = e + np.asarray(line_slope, float) * dq
-    t = np.broadcast_to(np.asarray(tau_max, float), q.shape)
-    return PathRows(np.asarray(s, float), a, b, e, c, -t, t.copy())

@@ -28,7 +28,7 @@ from cell.motors import Motors, max_rates
 from cell.path import CellGeometry
 from cell.steptable import StepTable
 
-from .planner import PathRows, Profile, acceleration_rows, plan, torque_rows, velocity_rows
+from .planner import PathRows, Profile, acceleration_rows, path_grid, plan, torque_rows, velocity_rows
 
 FREE_REGIMES = ("R2", "R4")
 
@@ -85,7 +85,7 @@ def regime_rows(rp: RegimePath, motors: Motors, bounds: PlannerBounds, geometry:
                 ) -> tuple[NDArray[np.float64], NDArray[np.float64], PathRows, Limits]:
     """(grid s, q(s), the rows of every bound, the limits used) for one regime."""
     n = n_grid or bounds.grid_points
-    s = np.linspace(0.0, 1.0, n)
+    s = path_grid(n)
     sp = rp.spline()
     q, dq, ddq = sp(s), sp(s, 1), sp(s, 2)
     vmax = (max_rates(rp.load_oz, motors, bounds.rate_fraction)
