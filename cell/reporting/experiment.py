@@ -90,7 +90,8 @@ def _shared(path: Path, names: Sequence[str]) -> bool:
 
 def write_report(replications: pd.DataFrame, sweep: Sweep, target: Target,
                  command: str) -> list[Path]:
-    """Write the report (see the module's docstring); return the paths written."""
+    """Write the report (see the module's docstring); return the paths written.
+    A target that names ``replications.csv`` gets the replications too."""
     summary = summary_table(replications, sweep)
     differences = difference_table(replications, sweep)
     pngs = figures(summary, replications, sweep)
@@ -103,6 +104,9 @@ def write_report(replications: pd.DataFrame, sweep: Sweep, target: Target,
         for name, data in pngs.items():
             out.write_bytes(name, data)
         written = ["report.md", "summary.csv", "differences.csv", *pngs]
+        if "replications.csv" in target.names:
+            out.write_csv("replications.csv", replications)
+            written.append("replications.csv")
         if target.table_7_1 and target.beside is None:
             table, t71_text = table_7_1_files(replications, sweep)
             out.write_csv("table_7_1.csv", table)

@@ -30,6 +30,8 @@ from cell.sweep.columns import NAME_SUFFIX
 DPI = 110
 #: Most panels a figure gets; a grid with more combinations gets no figures.
 MAX_PANELS = 16
+#: Means further apart than this (ratio) are drawn on a log scale.
+LOG_SPAN = 1e3
 COLOURS = {"adaptive": "#1f77b4", "non-adaptive": "#d62728"}
 OTHERS = ("#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f")
 RC = {"font.size": 10, "axes.grid": True, "grid.alpha": 0.35, "grid.linestyle": ":",
@@ -60,15 +62,24 @@ def _figure(h: Headline, rows: pd.DataFrame, sweep: Sweep, cols: Sequence[str],
     ncols = min(3, n)
     nrows = math.ceil(n / ncols)
     with mpl.rc_context(RC):
-        fig = Figure(figsize=(min(12.0, 5.2 * ncols), 3.8 * nrows + 0.6), layout="constrained")
+        fig = Figure(figsize=(min(12.0, 1.0 + 5.2 * ncols), 3.8 * nrows + 0.6),
+                     layout="constrained")
         axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
         level = f"{sweep.confidence * 100:g} %"
-        fig.suptitle(f"{h.title}: mean and its {level} confidence interval", fontsize=11.5)
+        mean = rows["mean"].to_numpy(float)
+        log = bool(np.all(mean > 0) and mean.max() / mean.min() > LOG_SPAN)
+        fig.suptitle(f"{h.title}: mean and {level} confidence interval"
+                     + (" (log scale)" if log else ""), fontsize=11)
+        if log:  # a few runs many orders of magnitude out: keep the others readable
+            floor = mean.min() / 2
+            rows = rows.assign(ci_low=rows["ci_low"].clip(lower=floor))
         for ax, combo in zip(axes, panels, strict=False):
             sub = rows
             for c, v in zip(cols[1:], combo, strict=True):
                 sub = sub[sub[c].map(show) == v]
             _panel(ax, h, sub, sweep, cols, colours)
+            if log:
+                ax.set_yscale("log")
             if cols[1:]:
                 ax.set_title(", ".join(f"{c.removesuffix(NAME_SUFFIX)} = {v}"
                                        for c, v in zip(cols[1:], combo, strict=True)),

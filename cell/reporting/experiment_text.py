@@ -17,7 +17,15 @@ import pandas as pd
 
 from cell.analysis.stats import relative_half_width
 from cell.reporting.experiment_data import runs_of
-from cell.reporting.headlines import HEADLINES, Headline, decimals, headline, number
+from cell.reporting.headlines import (
+    HEADLINES,
+    HUGE,
+    Headline,
+    decimals,
+    headline,
+    number,
+    plus_minus,
+)
 from cell.sweep import Sweep, grid_columns
 from cell.sweep.columns import NAME_SUFFIX
 
@@ -65,10 +73,16 @@ def cell(s: Mapping[str, Any], whole: bool = False) -> str:
     half = (float(s["ci_high"]) - float(s["ci_low"])) / 2
     if float(s["sd"]) == 0.0:
         return f"{number(mean)} (no variation)"
-    d = decimals(half)
     lo, hi = float(s["run_p2_5"]), float(s["run_p97_5"])
-    r = 0 if whole or lo == round(lo) and hi == round(hi) else d
-    return f"{mean:.{d}f} ± {half:.{d}f} [{lo:.{r}f}–{hi:.{r}f}]"
+    r = 0 if whole or lo == round(lo) and hi == round(hi) else decimals(half)
+    return f"{plus_minus(mean, half)} [{number(lo, r)}–{number(hi, r)}]"
+
+
+def _against(a: str, b: str, at: bool = True) -> str:
+    """``b`` without ``a``'s name when it is ``a``'s own policy elsewhere in the grid."""
+    if b.startswith(a + " at "):
+        return b[len(a) + 1:] if at else b[len(a) + 4:]
+    return b
 
 
 def sentence(h: Headline, d: Mapping[str, Any], a: str, b: str, parts: int | None,
@@ -76,6 +90,7 @@ def sentence(h: Headline, d: Mapping[str, Any], a: str, b: str, parts: int | Non
     """A paired difference in words: ``A delivers 31.2 ± 1.4 parts more than B per
     500-part run (95 % CI, paired over 200 replications).``"""
     n, mean = int(d["n"]), float(d["mean"])
+    b = _against(a, b)
     level = f"{confidence * 100:g} %"
     per = f" per {parts}-part run" if h.per_run and parts else ""
     direction = h.words[0] if mean >= 0 else h.words[1]
@@ -85,14 +100,12 @@ def sentence(h: Headline, d: Mapping[str, Any], a: str, b: str, parts: int | Non
             f" ({n} replication{'s' if n != 1 else ''}: no interval)."
     if float(d["sd"]) == 0.0:
         if mean == 0.0:
-            return f"{a} and {b} are equal in every replication ({h.title.lower()}: " \
+            return f"{a} is the same as {b} in every replication ({h.title.lower()}: " \
                    f"no variation between replications)."
         return h.sentence.format(a=a, x=number(abs(mean)), dir=direction, b=b) + per + \
             f" in every one of {n} replications (no variation between replications)."
     lo, hi = float(d["ci_low"]), float(d["ci_high"])
-    half = (hi - lo) / 2
-    p = decimals(half)
-    text = h.sentence.format(a=a, x=f"{abs(mean):.{p}f} ± {half:.{p}f}", dir=direction, b=b)
+    text = h.sentence.format(a=a, x=plus_minus(abs(mean), (hi - lo) / 2), dir=direction, b=b)
     text += f"{per} ({level} CI, paired over {n} replications)"
     if lo <= 0.0 <= hi:
         text += "; the interval includes zero: no difference shown"
@@ -216,13 +229,15 @@ def _sentences(h: Headline, differences: pd.DataFrame, cols: Sequence[str], part
 
 def reading(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
             cols: Sequence[str], present: Sequence[Headline]) -> list[str]:
-    """Sentences drawn from the numbers: who is ahead where, by how much, and trends."""
+    """Sentences drawn from the numbers: who is ahead where, by how much, trends, and
+    where single runs scatter so widely that the mean says little."""
     out: list[str] = []
     if differences.empty:
         out.append("No paired differences: the sweep runs one policy and names no "
                    "`baseline:`; name a point there to compare the others with it.")
     for h in present:
-        text = _verdicts(h, differences, cols) + _trend(h, summary, sweep, cols)
+        text = _verdicts(h, differences, cols) + _trend(h, summary, sweep, cols) \
+            + _scatter(h, summary, cols)
         if text:
             out.append(f"**{h.title}.** " + " ".join(text))
     return out
@@ -237,26 +252,56 @@ def _verdicts(h: Headline, differences: pd.DataFrame, cols: Sequence[str]) -> li
         level, n = len(group) - up - down, len(group)
         counts = [f"{h.words[0]} at {up}" if up else "", f"{h.words[1]} at {down}" if down else "",
                   f"no difference shown at {level}" if level else ""]
-        said = "; ".join(c for c in counts if c)
-        if n > 1 and max(up, down, level) == n:
-            said = said.replace(f" at {n}", f" at all {n} points")
+        counts = [c for c in counts if c]
+        if n == 1:
+            counts[0] = counts[0].removesuffix(" at 1")
+        elif len(counts) == 1:
+            counts[0] = counts[0].replace(f" at {n}", f" at all {n} points")
         else:
-            said += f" of {n} point{'s' if n > 1 else ''}"
-        text = f"{a.capitalize()} against {b}: {said}"
+            counts[0] += f" of {n} points"
+        text = f"{str(a).capitalize()} against {_against(str(a), str(b), at=False)}: "
+        text += ", ".join(counts)
+        recs = group.to_dict("records")
         if n > 1 and np.isfinite(mean).all():
-            recs = group.to_dict("records")
             order = np.argsort(-np.abs(mean), kind="stable")
             big, small = recs[int(order[0])], recs[int(order[-1])]
-            text += (f", by {float(big['mean']):+.{_places(big)}f} at {where(big, cols)} down to "
-                     f"{float(small['mean']):+.{_places(small)}f} at {where(small, cols)}")
+            text += (f"; largest {_signed(big)} (at {where(big, cols)}), smallest "
+                     f"{_signed(small)} (at {where(small, cols)})")
         elif n == 1 and np.isfinite(mean).all():
-            text += f" ({float(mean[0]):+.{_places(group.iloc[0])}f})"
+            text += f" ({_signed(recs[0])})"
         out.append(text + ".")
     return out
 
 
-def _places(row: Mapping[str, Any]) -> int:
-    return decimals((float(row["ci_high"]) - float(row["ci_low"])) / 2)
+def _signed(row: Mapping[str, Any]) -> str:
+    """A difference's mean, signed, to its interval's precision."""
+    mean, sd = float(row["mean"]), float(row["sd"])
+    if not sd > 0:
+        return f"{mean:+.6g}"
+    half = (float(row["ci_high"]) - float(row["ci_low"])) / 2
+    return f"{mean:+.3g}" if abs(mean) >= HUGE else f"{mean:+.{decimals(half)}f}"
+
+
+def _scatter(h: Headline, summary: pd.DataFrame, cols: Sequence[str]) -> list[str]:
+    """Points whose interval is wider than their mean: runs far apart, or a mean made
+    by a few extreme runs (it lies outside the range of 95 % of them)."""
+    out = []
+    rows = summary[(summary["measure"] == h.column) & (summary["n"] >= 2)]
+    for r in rows.to_dict("records"):
+        mean, lo, hi = (float(r[k]) for k in ("mean", "run_p2_5", "run_p97_5"))
+        half = (float(r["ci_high"]) - float(r["ci_low"])) / 2
+        if not half > abs(mean) / 2:
+            continue
+        at = where(r, cols)
+        who = f"{str(r['policy']).capitalize()}{' at ' + at if at else ''}"
+        runs = f"95 % of single runs {lo:.4g} to {hi:.4g}"
+        if lo <= mean <= hi:
+            out.append(f"{who} scatters widely between runs ({runs}; mean {mean:.4g} ± "
+                       f"{half:.2g}).")
+        else:
+            out.append(f"{who}: a few runs lie far outside the others ({runs}, yet the mean is "
+                       f"{mean:.4g} ± {half:.2g}): the mean is theirs; look at the replications.")
+    return out
 
 
 def _trend(h: Headline, summary: pd.DataFrame, sweep: Sweep, cols: Sequence[str]) -> list[str]:

@@ -40,12 +40,12 @@ HEADLINES: tuple[Headline, ...] = (
              "{a} delivers {x} parts/hr {dir} than {b} on the wall clock",
              ("more", "fewer"), "higher", unit="parts/hr"),
     Headline("actual_cycle_wallclock_s", "Actual cycle (wall clock, s)",
-             "{a}'s actual cycle on the wall clock is {x} s {dir} than {b}'s",
+             "{a} runs a wall-clock actual cycle {x} s {dir} than {b}",
              ("longer", "shorter"), "lower", unit="s"),
     Headline("ip_wallclock", "IP (wall clock, eq. 5.1)",
-             "{a}'s wall-clock IP is {x} {dir} than {b}'s", ("higher", "lower"), "one"),
+             "{a} reaches a wall-clock IP {x} {dir} than {b}", ("higher", "lower"), "one"),
     Headline("spacing_outside_tol", "Spacings outside 45 ± 0.25 in",
-             "{a} leaves {x} spacings {dir} than {b} outside 45 ± 0.25 in",
+             "{a} leaves {x} {dir} spacings outside 45 ± 0.25 in than {b}",
              ("more", "fewer"), "lower", per_run=True, unit="spacings"),
 )
 BY_COLUMN = {h.column: h for h in HEADLINES}
@@ -54,7 +54,7 @@ BY_COLUMN = {h.column: h for h in HEADLINES}
 def headline(column: str) -> Headline:
     """The measure's headline, or a plain one for any other column."""
     return BY_COLUMN.get(column) or Headline(
-        column, column, "{a}'s " + column + " is {x} {dir} than {b}'s", ("higher", "lower"),
+        column, column, "{a} has a " + column + " {x} {dir} than {b}", ("higher", "lower"),
         "higher")
 
 
@@ -65,13 +65,26 @@ def decimals(half: float) -> int:
     return min(6, max(0, 1 - math.floor(math.log10(half))))
 
 
+#: Beyond this magnitude figures are printed in exponent form.
+HUGE = 1e7
+
+
 def number(value: float, places: int | None = None) -> str:
     """A figure for the text: ``places`` decimals, or six significant figures."""
     if not math.isfinite(value):
         return "—"
-    if places is None:
-        return f"{value:.6g}"
+    if places is None or abs(value) >= HUGE:
+        return f"{value:.6g}" if places is None else f"{value:.3g}"
     return f"{value:.{places}f}"
+
+
+def plus_minus(mean: float, half: float, signed: bool = False) -> str:
+    """``mean ± half`` to the half-width's two significant figures (exponent form if huge)."""
+    sign = "+" if signed else ""
+    if max(abs(mean), abs(half)) >= HUGE:
+        return f"{mean:{sign}.3g} ± {half:.2g}"
+    d = decimals(half)
+    return f"{mean:{sign}.{d}f} ± {half:.{d}f}"
 
 
 def better(h: Headline, a: float, b: float) -> int:

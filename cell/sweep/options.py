@@ -57,9 +57,13 @@ class Baseline:
     values: tuple[tuple[str, Any], ...]
     names: tuple[tuple[str, str], ...] = ()
     """For keys with named grid values: the name the sweep file used."""
+    text: str = ""
+    """How to name the baseline point, if not by its policy and values."""
 
     def label(self, policy: str) -> str:
         """``policy``, with the values the baseline fixes: ``non-adaptive at x = 3``."""
+        if self.text:
+            return self.text
         named = dict(self.names)
         fixed = [f"{k} = {named.get(k) or show(v)}" for k, v in self.values]
         return policy + (" at " + ", ".join(fixed) if fixed else "")

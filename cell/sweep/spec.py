@@ -293,3 +293,17 @@ def _check_point(scenario: Scenario, file: object) -> None:
         assemble(scenario)
     except ScenarioError as exc:
         raise ScenarioError(file, exc.key, exc.value, exc.why) from None
+
+
+def comparison(a: Scenario, b: Scenario, labels: tuple[str, str], replications: int, seed: int,
+               batch: int = 20) -> Sweep:
+    """Two scenarios as a sweep of two points, varying the pseudo-key ``scenario`` (their
+    labels): ``a`` against ``b`` (the baseline), with common random numbers."""
+    la, lb = labels if labels[0] != labels[1] else (f"A: {labels[0]}", f"B: {labels[1]}")
+    pa = Point(a.controller.policy, 0, (("scenario", la),), a)
+    pb = Point(b.controller.policy, int(b.controller.policy == a.controller.policy),
+               (("scenario", lb),), b)
+    return Sweep(f"{la} against {lb}", "compare", f"{la} against {lb}", a, (), ("scenario",),
+                 (pa, pb), replications, seed, min(batch, replications),
+                 baseline=Baseline(b.controller.policy, (("scenario", lb),),
+                                   text=f"{lb} ({b.controller.policy})"))
