@@ -1,4 +1,4 @@
-"""The thesis's published figures (King 1984, §7.2; SPEC §8), printed beside ours.
+"""The thesis's published figures (King 1984, §7.2; docs/accounting.md), printed beside ours.
 
 One place for every number the reports and the summary table compare against.
 :data:`PUBLISHED` holds them by policy: what §7.2 printed for each, as data, so a

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import warnings
 
+import numpy as np
 import pandas as pd
 
 from cell.analysis.stats import PAIRED_KEYS, SUMMARY_KEYS, paired_difference, summarise
@@ -47,6 +48,18 @@ def _plain(value: object) -> object:
     return value.item() if hasattr(value, "item") else value
 
 
+def _exact(stats: dict[str, float], x: np.ndarray) -> dict[str, float]:
+    """Values (or differences) all equal: no variation, exactly -- the sd the mean's
+    rounding leaves (1e-15 of it) is not a spread between replications."""
+    x = x[~np.isnan(x)]
+    if x.size >= 2 and np.all(x == x[0]) and stats["sd"] != 0.0:
+        stats = {**stats, "mean": float(x[0]), "sd": 0.0, "ci_low": float(x[0]),
+                 "ci_high": float(x[0])}
+        if "p_value" in stats:
+            stats["p_value"] = float("nan")
+    return stats
+
+
 def summary_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     """``summary.csv``: every point, policy and measure with its statistics."""
     cols = [c.name for c in grid_columns(sweep)]
@@ -54,7 +67,8 @@ def summary_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     for i, p in enumerate(sweep.points):
         runs, keys = runs_of(replications, sweep, i), grid_values(replications, sweep, i)
         for m in measures(replications, sweep):
-            s = summarise(runs[m].to_numpy(dtype=float), sweep.confidence)
+            x = runs[m].to_numpy(dtype=float)
+            s = _exact(summarise(x, sweep.confidence), x)
             rows.append({**keys, "policy": p.policy, "measure": m, **s})
     return pd.DataFrame(rows, columns=[*cols, "policy", "measure", *SUMMARY_KEYS])
 
@@ -78,8 +92,8 @@ def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
         for m in measures(replications, sweep):
             with warnings.catch_warnings():  # nearly equal pairs: scipy warns, the sd says it
                 warnings.filterwarnings("ignore", "Precision loss", RuntimeWarning)
-                d = paired_difference(both[m].to_numpy(dtype=float),
-                                      both[m + "@b"].to_numpy(dtype=float), sweep.confidence)
+                x, y = both[m].to_numpy(dtype=float), both[m + "@b"].to_numpy(dtype=float)
+                d = _exact(paired_difference(x, y, sweep.confidence), x - y)
             rows.append({**keys, "policy": a.policy, "versus": pair.label, "measure": m, **d})
     return pd.DataFrame(rows, columns=[*[c.name for c in columns], "policy", "versus", "measure",
                                        *PAIRED_KEYS])

@@ -15,6 +15,7 @@ from __future__ import annotations
 import io
 import math
 from collections.abc import Sequence
+from typing import Any
 
 import matplotlib as mpl
 import numpy as np
@@ -34,15 +35,17 @@ MAX_PANELS = 16
 LOG_SPAN = 1e3
 COLOURS = {"adaptive": "#1f77b4", "non-adaptive": "#d62728"}
 OTHERS = ("#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f")
-RC = {"font.size": 10, "axes.grid": True, "grid.alpha": 0.35, "grid.linestyle": ":",
+RC: dict[str, Any] = {"font.size": 10, "axes.grid": True, "grid.alpha": 0.35, "grid.linestyle": ":",
       "axes.spines.top": False, "axes.spines.right": False, "legend.fontsize": 8.5}
 
 
 def figures(summary: pd.DataFrame, replications: pd.DataFrame, sweep: Sweep) -> dict[str, bytes]:
     """``fig_<measure>.png`` -> PNG bytes, for each headline measure in the summary."""
     cols = display_columns(summary, sweep)
-    panels = list(dict.fromkeys(tuple(show(v) for v in r) for r in
-                                summary[cols[1:]].itertuples(index=False))) if cols else [()]
+    panels: list[tuple[str, ...]] = [()]
+    if cols:
+        panels = list(dict.fromkeys(tuple(show(v) for v in r)
+                                    for r in summary[cols[1:]].itertuples(index=False)))
     if len(panels) > MAX_PANELS:
         return {}
     policies = list(dict.fromkeys(p.policy for p in sweep.points))
@@ -61,7 +64,7 @@ def _figure(h: Headline, rows: pd.DataFrame, sweep: Sweep, cols: Sequence[str],
     n = len(panels)
     ncols = min(3, n)
     nrows = math.ceil(n / ncols)
-    with mpl.rc_context(RC):
+    with mpl.rc_context(RC):  # type: ignore[arg-type]
         fig = Figure(figsize=(min(12.0, 1.0 + 5.2 * ncols), 3.8 * nrows + 0.6),
                      layout="constrained")
         axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
@@ -118,9 +121,9 @@ def _panel(ax: Axes, h: Headline, rows: pd.DataFrame, sweep: Sweep, cols: Sequen
             _level(ax, r.iloc[0], colours[policy], f"{policy} (does not vary {key})")
         elif numeric:
             r = r.assign(_x=pd.to_numeric(r[x])).sort_values("_x")
-            xs, mean = r["_x"].to_numpy(float), r["mean"].to_numpy(float)
-            ax.plot(xs, mean, "o-", color=colours[policy], label=policy, ms=4)
-            ax.fill_between(xs, r["ci_low"].to_numpy(float), r["ci_high"].to_numpy(float),
+            x_num, mean = r["_x"].to_numpy(float), r["mean"].to_numpy(float)
+            ax.plot(x_num, mean, "o-", color=colours[policy], label=policy, ms=4)
+            ax.fill_between(x_num, r["ci_low"].to_numpy(float), r["ci_high"].to_numpy(float),
                             color=colours[policy], alpha=0.2, lw=0)
         else:
             dodge = (k - (len(policies) - 1) / 2) * 0.08

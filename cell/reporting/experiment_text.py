@@ -57,12 +57,12 @@ def show(value: Any) -> str:
     return str(value)
 
 
-def where(row: Mapping[str, Any], cols: Sequence[str]) -> str:
+def where(row: Mapping[Any, Any], cols: Sequence[str]) -> str:
     """``key = value, ...`` of a row's display columns."""
     return ", ".join(f"{c.removesuffix(NAME_SUFFIX)} = {show(row[c])}" for c in cols)
 
 
-def cell(s: Mapping[str, Any], whole: bool = False) -> str:
+def cell(s: Mapping[Any, Any], whole: bool = False) -> str:
     """A summary row as ``mean ± half [p2.5–p97.5]``, or what stands in for an interval;
     ``whole``: the measure counts things, so single runs are shown as whole numbers."""
     n, mean = int(s["n"]), float(s["mean"])
@@ -85,7 +85,7 @@ def _against(a: str, b: str, at: bool = True) -> str:
     return b
 
 
-def sentence(h: Headline, d: Mapping[str, Any], a: str, b: str, parts: int | None,
+def sentence(h: Headline, d: Mapping[Any, Any], a: str, b: str, parts: int | None,
              confidence: float) -> str:
     """A paired difference in words: ``A delivers 31.2 ± 1.4 parts more than B per
     500-part run (95 % CI, paired over 200 replications).``"""
@@ -273,7 +273,7 @@ def _verdicts(h: Headline, differences: pd.DataFrame, cols: Sequence[str]) -> li
     return out
 
 
-def _signed(row: Mapping[str, Any]) -> str:
+def _signed(row: Mapping[Any, Any]) -> str:
     """A difference's mean, signed, to its interval's precision."""
     mean, sd = float(row["mean"]), float(row["sd"])
     if not sd > 0:

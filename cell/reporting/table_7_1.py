@@ -1,4 +1,4 @@
-"""Table 7.1 beside the thesis: ``cell sweep ... --report DIR`` (thesis §7.2; SPEC §8).
+"""Table 7.1 beside the thesis: ``cell sweep ... --report DIR`` (thesis §7.2; docs/accounting.md).
 
 For a sweep laid out like Table 7.1 (see :func:`is_table_7_1`), beside the
 general report (:mod:`cell.reporting.experiment`), this writes
@@ -11,7 +11,7 @@ general report (:mod:`cell.reporting.experiment`), this writes
 - ``table_7_1.md``: the table in the thesis's layout with ours beside it, the
   adaptive results, and a reading generated from the numbers.
 
-Two accountings of the same runs (SPEC §8): ``thesis`` reproduces the thesis's
+Two accountings of the same runs (docs/accounting.md): ``thesis`` reproduces the thesis's
 bookkeeping, ``wallclock`` counts on the clock of a physically consistent cell.
 
 What the thesis published for each policy is data (:data:`cell.thesis.PUBLISHED`):

@@ -1,4 +1,4 @@
-"""Table 7.1's reading: sentences drawn from the numbers (thesis §7.2; SPEC §8).
+"""Table 7.1's reading: sentences drawn from the numbers (thesis §7.2; docs/accounting.md).
 
 The readings of :mod:`cell.reporting.table_7_1`, one per kind of published
 figures: a policy published row by row (Table 7.1: agreement, and where the two
@@ -175,7 +175,7 @@ def reading_one_run(table: pd.DataFrame, policy: str, parts: int | None,
 
 
 def memoryless(replications: pd.DataFrame | None, ip_published: float,
-                policy: str = "adaptive") -> list[str]:
+                policy: str) -> list[str]:
     """The simulation's reading with each next arrival counted from the current pick-up."""
     cols = ("ip_thesis_memoryless", "cycle_vs_nominal_memoryless_pct")
     if replications is None or not all(c in replications for c in cols):
