@@ -50,6 +50,7 @@ def _label(arg: str) -> str:
 
 def main(args: argparse.Namespace) -> int:
     import tempfile
+    from pathlib import Path
 
     from cell.errors import CellError
     from cell.overrides import parse_sets
@@ -75,7 +76,7 @@ def main(args: argparse.Namespace) -> int:
 
         names = (*REPORT_FILES, "replications.csv")
         OutputDir.check(args.out, names)  # before anything runs
-        target = Target(OutputDir.check(args.out, names), names, False)
+        target = Target(Path(args.out), names, False)
     with tempfile.TemporaryDirectory(prefix="cell-compare-") as work:
         outcome = run_sweep(sweep, work, workers=args.workers, replicate=simulate_summary)
         replications = outcome.replications
