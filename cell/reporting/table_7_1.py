@@ -48,7 +48,7 @@ from cell.reporting.table_7_1_reading import (
 )
 
 if TYPE_CHECKING:
-    from cell.sweep import Sweep
+    from cell.sweep import Point, Sweep
 
 COLUMNS = ["policy", "ideal_cycle_s", "accounting", "measure", "thesis",
            "mean", "ci_low", "ci_high", "run_p2_5", "run_p97_5"]
@@ -83,10 +83,13 @@ def summary_column(accounting: str, measure: str, columns: Sequence[str]) -> str
                     f"({accounting} accounting)")
 
 
-def ideal_cycle(point: Any) -> float:
-    """A point's robot cycle: ``controller.ideal_cycle_s``, else the nominal cycle."""
+def ideal_cycle(point: Point) -> float:
+    """A point's robot cycle: ``controller.ideal_cycle_s``, else the nominal cycle
+    (:func:`cell.assembly.nominal_cycle`: the arrivals' mean when the scenario sets none)."""
+    from cell.assembly import nominal_cycle
+
     c = point.scenario.controller
-    return float(c.ideal_cycle_s if c.ideal_cycle_s is not None else c.nominal_cycle_s)
+    return float(c.ideal_cycle_s if c.ideal_cycle_s is not None else nominal_cycle(point.scenario))
 
 
 def is_table_7_1(sweep: Sweep) -> bool:
