@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-stamp
 WORKERS ?= 2
 
-.PHONY: all venv test sweep sweep-mintime figures bench lint clean
+.PHONY: all venv test sweep sweep-mintime whatif figures bench lint clean
 
 all: test
 
@@ -25,6 +25,9 @@ sweep: $(STAMP)
 
 sweep-mintime: $(STAMP)
 	$(PY) -m cell sweep scenarios/table_7_1_mintime.yaml --out build/sweep_mintime --workers $(WORKERS) --report reports/mintime
+
+whatif: $(STAMP)
+	MPLBACKEND=Agg $(PY) -m cell sweep scenarios/whatif.yaml --out build/whatif --workers $(WORKERS) --report reports/whatif
 
 figures: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m cell figures --out reports/figures

@@ -21,7 +21,7 @@ from cell import __version__
 from cell.errors import CellError
 
 #: Subcommands in the order ``cell --help`` lists them; each is cell.commands.<name>.
-COMMANDS = ("run", "sweep", "fit", "figures", "animate", "path", "mintime",
+COMMANDS = ("run", "sweep", "compare", "fit", "figures", "animate", "path", "mintime",
             "scenarios", "schema", "bench")
 
 

@@ -1,4 +1,4 @@
-"""Table 7.1 beside the thesis (thesis §7.2; SPEC §8): statistics, layout, reading."""
+"""Table 7.1 beside the thesis (thesis §7.2; docs/accounting.md): statistics, layout, reading."""
 
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ from cell.reporting.table_7_1 import (
 )
 from cell.sweep import load_sweep, run_sweep
 
-# Table 7.1 as printed (thesis §7.2, SPEC §8): cycle, actual, missed, parts/hr, Vavg R IV, IP.
+# Table 7.1 as printed (thesis §7.2; docs/accounting.md): cycle, actual, missed, parts/hr, Vavg R IV, IP.
 PUBLISHED = [
     (22.5872, 54.1660, 206, 66.4624, 3.5594, 0.3901),
     (22.0000, 35.6057, 113, 101.1074, 3.7818, 0.4388),
@@ -85,7 +85,7 @@ def test_summary_columns_follow_the_simulation_names():
 
 @pytest.fixture(scope="module")
 def spec_table(tmp_path_factory):
-    """The Table 7.1 sweep on SPEC §8's reconstructed bookkeeping (200 x 500 parts)."""
+    """The Table 7.1 sweep on the reconstructed bookkeeping of docs/accounting.md (200 x 500 parts)."""
     tmp = tmp_path_factory.mktemp("t71")
     sweep = load_sweep(SCENARIOS / "table_7_1.yaml")
     frame = run_sweep(sweep, tmp / "out", workers=1, replicate=spec_bookkeeping,
@@ -109,7 +109,7 @@ def test_long_form_has_exactly_the_columns_and_rows(spec_table):
 
 
 def test_spec_bookkeeping_puts_the_thesis_inside_single_run_ranges(spec_table):
-    """SPEC §8: s = 0.23 s reproduces the random columns in all six rows; this checks
+    """docs/accounting.md: s = 0.23 s reproduces the random columns in all six rows; this checks
     the report matches each published figure to its own row and measure."""
     _sweep, _frame, table = spec_table
     t = table[(table["policy"] == "non-adaptive") & (table["accounting"] == "thesis")]
@@ -177,14 +177,31 @@ def test_memoryless_reading_follows_the_numbers():
     import numpy as np
     import pandas as pd
 
-    from cell.reporting.table_7_1 import _memoryless
+    from cell.reporting.table_7_1 import memoryless as _memoryless
 
     rng = np.random.default_rng(0)
     near = pd.DataFrame({"policy": "adaptive", "ip_thesis_memoryless": 1.0214 + rng.normal(0, 1e-3, 200),
                          "cycle_vs_nominal_memoryless_pct": -2.0})
     far = near.assign(ip_thesis_memoryless=1.0 + rng.normal(0, 1e-3, 200))
-    assert "1.0214 is inside" in _memoryless(near, 1.0214)[0]
-    assert "reproduces the published IP" in _memoryless(near, 1.0214)[0]
-    assert "is outside" in _memoryless(far, 1.0214)[0]
-    assert "does not reproduce" in _memoryless(far, 1.0214)[0]
-    assert _memoryless(near.drop(columns="ip_thesis_memoryless"), 1.0214) == []
+    assert "1.0214 is inside" in _memoryless(near, 1.0214, "adaptive")[0]
+    assert "reproduces the published IP" in _memoryless(near, 1.0214, "adaptive")[0]
+    assert "is outside" in _memoryless(far, 1.0214, "adaptive")[0]
+    assert "does not reproduce" in _memoryless(far, 1.0214, "adaptive")[0]
+    assert _memoryless(near.drop(columns="ip_thesis_memoryless"), 1.0214, "adaptive") == []
+
+
+def test_published_figures_are_data_that_route_the_layout(monkeypatch):
+    """What the thesis published per policy decides the tables and the reading."""
+    from cell import thesis
+    from cell.reporting.table_7_1 import LAYOUTS
+    from cell.reporting.table_7_1_reading import reading_by_cycle, reading_one_run
+
+    assert set(LAYOUTS) == set(thesis.PUBLISHED) == {"non-adaptive", "adaptive"}
+    for policy, layout in LAYOUTS.items():
+        assert layout.published is thesis.PUBLISHED[policy]
+        expected = reading_by_cycle if layout.published.by_cycle else reading_one_run
+        assert layout.reading is expected
+    assert thesis.PUBLISHED["adaptive"].value(21.0, "ip") == 1.0214  # one run, any cycle
+    patched = {**thesis.PUBLISHED, "adaptive": thesis.Published({}, {"ip": 0.5}, "x")}
+    monkeypatch.setattr(thesis, "PUBLISHED", patched)
+    assert thesis_value("adaptive", 22.5872, "thesis", "ip") == 0.5

@@ -1,4 +1,4 @@
-"""The sweep runner: sweep files, streams, workers, resume, dask (thesis §6.3; SPEC §8).
+"""The sweep runner: sweep files, streams, workers, resume, dask (thesis §6.3; docs/accounting.md).
 
 The runner takes the replication as a function, so these tests drive it with
 small deterministic stand-ins that draw from the stream they are given.
@@ -20,17 +20,17 @@ from cell.sweep import load_sweep, run_sweep
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIOS = ROOT / "scenarios"
 
-# Table 7.1, column 1 (thesis §7.2; SPEC §8).
+# Table 7.1, column 1 (thesis §7.2; docs/accounting.md).
 TABLE_7_1_CYCLES = [22.5872, 22.0, 21.5, 21.0, 20.5, 20.0907]
 
 
 def weibull_interarrivals(rng: np.random.Generator, n: int) -> np.ndarray:
-    """Eq. 6.9 by inverse cdf: T = 17.6019 + 5.4342 (-ln(1 - u))^0.2038 (SPEC §5)."""
+    """Eq. 6.9 by inverse cdf: T = 17.6019 + 5.4342 (-ln(1 - u))^0.2038 (docs/model.md)."""
     return 17.6019 + 5.4342 * (-np.log1p(-rng.random(n))) ** 0.2038
 
 
 def spec_bookkeeping(scenario, seed) -> dict:
-    """A stand-in replication: SPEC §8's reconstruction of the thesis's bookkeeping
+    """A stand-in replication: the reconstruction (docs/accounting.md) of the thesis's bookkeeping
     (lost when T_i < C - s, s = 0.23 s; D_i = T_i, + C when lost) beside a naive
     wall clock (a part is lost when the robot is still busy), from the stream given."""
     rng = np.random.default_rng(seed)
@@ -120,6 +120,26 @@ BAD = [
     ({"seed": -3}, "seed", "at least 0"),
     ({"set": {"run.part": 10}}, "run.part", "unknown key"),
     ({"base": "nowhere.yaml"}, "(file)", "no such scenario file"),
+    ({"replications": {"precision": 0, "measure": "parts_missed", "max": 50}},
+     "replications.precision", "above 0"),
+    ({"replications": {"precision": 0.01, "measure": "parts_mised", "max": 50}},
+     "replications.measure", "numeric column"),
+    ({"replications": {"precision": 0.01, "measure": "parts_missed", "min": 10, "max": 5}},
+     "replications.max", "at least 10"),
+    ({"replications": {"precision": 0.01, "measure": "parts_missed", "max": 50,
+                       "confidence": 95}}, "replications.confidence", "between 0 and 1"),
+    ({"replications": {"precision": 0.01, "measure": "parts_missed", "maximum": 50}},
+     "replications.maximum", "unknown key"),
+    ({"baseline": {"policy": "fast"}}, "baseline.policy", "not a policy of this sweep"),
+    ({"baseline": {"controller.ideal_cycle_s": 19.0}}, "baseline.controller.ideal_cycle_s",
+     "not among the grid's values"),
+    ({"baseline": {"belts.output_nominal_in_s": 2.0}}, "baseline.belts.output_nominal_in_s",
+     "not a key this sweep varies"),
+    ({"baseline": {"policy": "adaptive", "controller.ideal_cycle_s": 22.0}},
+     "baseline.controller.ideal_cycle_s", "does not vary this key"),
+    ({"baseline": {"policy": "non-adaptive"}}, "baseline", "name the value of "
+     "controller.ideal_cycle_s"),
+    ({"baseline": [1, 2]}, "baseline", "must name a point"),
 ]
 
 
@@ -166,11 +186,22 @@ def test_rows_sorted_and_labelled(tmp_path):
     sweep = load_sweep(write_sweep(tmp_path))
     frame = run_sweep(sweep, tmp_path / "out", workers=1, replicate=first_draw,
                       progress=False).replications
-    assert list(frame.columns[:4]) == ["policy", "point", "controller.ideal_cycle_s",
+    assert list(frame.columns[:5]) == ["policy", "point", "controller.ideal_cycle_s", "seed",
                                        "replication"]
     assert list(frame["policy"]) == ["non-adaptive"] * 12 + ["adaptive"] * 6
     assert list(frame["replication"]) == list(range(6)) * 3
-    assert math.isnan(frame["controller.ideal_cycle_s"].iloc[-1])  # not varied for adaptive
+    assert set(frame["seed"]) == {7}
+    # not varied for adaptive, and this stand-in reports no effective cycle: empty
+    assert math.isnan(frame["controller.ideal_cycle_s"].iloc[-1])
+
+
+def test_points_that_do_not_vary_a_key_hold_their_effective_value(tmp_path):
+    sweep = load_sweep(write_sweep(tmp_path))
+    frame = run_sweep(sweep, tmp_path / "out", workers=1, replicate=spec_bookkeeping,
+                      progress=False).replications
+    by_policy = frame.groupby(["policy", "controller.ideal_cycle_s"]).size()
+    assert by_policy.to_dict() == {("adaptive", 22.5872): 6, ("non-adaptive", 21.0): 6,
+                                   ("non-adaptive", 22.0): 6}
 
 
 def test_workers_1_and_2_give_byte_identical_replications(tmp_path):
@@ -184,16 +215,16 @@ def test_workers_1_and_2_give_byte_identical_replications(tmp_path):
 
 # --------------------------------------------------------------------------- resume
 class Interrupt:
-    """A replication that is 'killed' (KeyboardInterrupt) after ``after`` runs."""
+    """A replication that is 'killed' (KeyboardInterrupt) after ``after`` runs of ``of``."""
 
-    def __init__(self, after: int):
-        self.after, self.calls = after, 0
+    def __init__(self, after: int, of=spec_bookkeeping):
+        self.after, self.calls, self.of = after, 0, of
 
     def __call__(self, scenario, seed):
         self.calls += 1
         if self.calls > self.after:
             raise KeyboardInterrupt
-        return spec_bookkeeping(scenario, seed)
+        return self.of(scenario, seed)
 
 
 def test_interrupted_then_resumed_equals_uninterrupted(tmp_path):
@@ -274,12 +305,16 @@ def test_cli_writes_replications_and_report(tmp_path, monkeypatch, capsys):
     assert (tmp_path / "rep" / "table_7_1.md").is_file()
 
 
-def test_cli_report_refuses_a_sweep_that_is_not_table_7_1(tmp_path, capsys):
+def test_cli_reports_any_sweep(tmp_path, monkeypatch, capsys):
+    """A sweep that is not Table 7.1's gets the general report, without Table 7.1."""
+    monkeypatch.setattr("cell.sweep.simulate_summary", spec_bookkeeping)
     path = write_sweep(tmp_path, grid={"belts.output_nominal_in_s": [2.0, 2.5]})
     code = main(["sweep", str(path), "--out", str(tmp_path / "o"), "--workers", "1",
                  "--report", str(tmp_path / "rep")])
-    assert code == 2 and "belts.output_nominal_in_s" in capsys.readouterr().err
-    assert not (tmp_path / "o").exists()
+    assert code == 0, capsys.readouterr().err
+    names = {p.name for p in (tmp_path / "rep").iterdir()}
+    assert {"report.md", "summary.csv", "differences.csv"} <= names
+    assert "table_7_1.md" not in names
 
 
 def spawning(scenario, seed) -> dict:
@@ -297,7 +332,7 @@ def test_a_replication_that_spawns_cannot_break_common_random_numbers(tmp_path):
 
 # --------------------------------------------------------------------------- the real cell
 def test_real_simulation_same_numbers_locally_and_on_dask(tmp_path):
-    """The cell itself (issue 3), a few short runs: in-process, 2 workers and dask agree."""
+    """The cell itself, a few short runs: in-process, 2 workers and dask agree."""
     pytest.importorskip("cell.simulation")
     distributed = pytest.importorskip("distributed")
     sweep = load_sweep(write_sweep(tmp_path, replications=2, batch=1))

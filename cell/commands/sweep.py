@@ -3,14 +3,17 @@
 from __future__ import annotations
 
 import argparse
+import shlex
 import signal
 import threading
 from pathlib import Path
 from typing import Any
 
-HELP = "replicated sweep over scenario keys (Table 7.1)"
-DESCRIPTION = ("Run a grid of scenarios with replications; write replications.csv and, with "
-               "--report, Table 7.1.")
+HELP = "replicated sweep over scenario keys, with its report"
+DESCRIPTION = ("Run a grid of scenarios with replications (common random numbers); write "
+               "replications.csv and, with --report, the experiment's report: summary.csv, "
+               "differences.csv (paired), report.md and a figure per headline measure "
+               "(and Table 7.1 beside the thesis for a sweep laid out like it).")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -22,7 +25,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="run on a dask.distributed cluster at ADDRESS")
     p.add_argument("--resume", action="store_true", help="run only what is missing in --out")
     p.add_argument("--report", default=None, metavar="DIR",
-                   help="also write table_7_1.csv and table_7_1.md into DIR")
+                   help="also write the report into DIR, as a unit (into DIR/NAME/ if DIR "
+                        "holds other files)")
 
 
 def _interrupt(signum: int, frame: Any) -> None:
@@ -41,21 +45,28 @@ def main(args: argparse.Namespace) -> int:
 
 
 def _sweep(args: argparse.Namespace) -> int:
+    from cell.errors import CellError
     from cell.sweep import load_sweep, run_sweep, simulate_summary
 
     sweep = load_sweep(args.sweep)
+    if args.workers is not None and args.workers < 1:
+        raise CellError(f"--workers {args.workers}: must be at least 1")
+    target = None
     if args.report:
-        from cell.reporting.table_7_1 import check_table_7_1
+        from cell.reporting.experiment import plan_report
 
-        check_table_7_1(sweep)
+        target = plan_report(sweep, args.report)  # checked before anything runs
     outcome = run_sweep(sweep, args.out, workers=args.workers, scheduler=args.scheduler,
                         resume=args.resume, replicate=simulate_summary)
+    counts = sorted(set(outcome.counts.values()))
+    reps = (f"{counts[0]}" if len(counts) == 1 else f"{counts[0]}-{counts[-1]}")
     print(f"wrote {Path(args.out) / 'replications.csv'}: {len(sweep.points)} points x "
-          f"{sweep.replications} replications ({outcome.tasks_run} tasks run, "
+          f"{reps} replications ({outcome.tasks_run} tasks run, "
           f"{outcome.tasks_reused} reused)")
-    if args.report:
-        from cell.reporting.table_7_1 import write_table_7_1
+    if target is not None:
+        from cell.reporting.experiment import write_report
 
-        for path in write_table_7_1(outcome.replications, sweep, args.report):
+        command = f"cell sweep {shlex.quote(sweep.source)} --report ..."
+        for path in write_report(outcome.replications, sweep, target, command):
             print(f"wrote {path}")
     return 0

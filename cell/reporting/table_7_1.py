@@ -1,6 +1,7 @@
-"""Table 7.1 beside the thesis: ``cell sweep ... --report DIR`` (thesis §7.2; SPEC §8).
+"""Table 7.1 beside the thesis: ``cell sweep ... --report DIR`` (thesis §7.2; docs/accounting.md).
 
-From the replications of a Table 7.1 sweep this writes
+For a sweep laid out like Table 7.1 (see :func:`is_table_7_1`), beside the
+general report (:mod:`cell.reporting.experiment`), this writes
 
 - ``table_7_1.csv``: long form, one row per (policy, ideal cycle, accounting,
   measure): the published value, the mean over replications with its 95 %
@@ -10,48 +11,60 @@ From the replications of a Table 7.1 sweep this writes
 - ``table_7_1.md``: the table in the thesis's layout with ours beside it, the
   adaptive results, and a reading generated from the numbers.
 
-Two accountings of the same runs (SPEC §8): ``thesis`` reproduces the thesis's
+Two accountings of the same runs (docs/accounting.md): ``thesis`` reproduces the thesis's
 bookkeeping, ``wallclock`` counts on the clock of a physically consistent cell.
+
+What the thesis published for each policy is data (:data:`cell.thesis.PUBLISHED`):
+a policy published row by row (Table 7.1) gets the thesis's table beside ours, one
+published as a single run gets one row; :data:`LAYOUTS` maps each policy to its
+published figures, its tables and its reading.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
-import scipy.stats
 
 from cell import thesis as published
+from cell.analysis.stats import summarise
 from cell.errors import CellError
 from cell.output import write_csv, write_text
+from cell.reporting.table_7_1_reading import (
+    ACCOUNTINGS,
+    LABELS,
+    MEASURES,
+    inside,
+    memoryless,
+    reading_by_cycle,
+    reading_one_run,
+    row_of,
+    thesis_value,
+)
 
 if TYPE_CHECKING:
-    from cell.sweep import Sweep
+    from cell.sweep import Point, Sweep
 
 COLUMNS = ["policy", "ideal_cycle_s", "accounting", "measure", "thesis",
            "mean", "ci_low", "ci_high", "run_p2_5", "run_p97_5"]
-POLICIES = ("non-adaptive", "adaptive")
-ACCOUNTINGS = ("thesis", "wallclock")
-MEASURES = ("actual_cycle_s", "parts_missed", "parts_per_hr", "vavg_r4_in_s", "ip")
+#: The policies the thesis published figures for, in the report's order.
+POLICIES = tuple(published.PUBLISHED)
 CONFIDENCE = 0.95
 VARIED_KEY = "controller.ideal_cycle_s"
-
-#: The adaptive run's published figures by measure (§7.2).
-THESIS_ADAPTIVE = {"ip": published.ADAPTIVE_IP,
-                   "parts_missed": float(published.ADAPTIVE_PARTS_MISSED)}
-
-LABELS = {"actual_cycle_s": "actual cycle (s)", "parts_missed": "parts missed",
-          "parts_per_hr": "parts/hr", "vavg_r4_in_s": "Vavg R IV (in/s)", "ip": "IP"}
 DECIMALS = {"actual_cycle_s": 2, "parts_missed": 1, "parts_per_hr": 1,
             "vavg_r4_in_s": 4, "ip": 4}
+__all__ = ["ACCOUNTINGS", "COLUMNS", "LABELS", "LAYOUTS", "MEASURES", "inside", "is_table_7_1",
+           "markdown", "reading", "statistics", "summary_column", "table_7_1", "table_7_1_files",
+           "thesis_value", "write_table_7_1", "memoryless"]
 
 
 def summary_column(accounting: str, measure: str, columns: Sequence[str]) -> str:
-    """The summary column holding ``measure`` under ``accounting`` (issue 3's names).
+    """The summary column holding ``measure`` under ``accounting`` (the simulation's names).
 
     A measure both accountings share (Vavg R IV; parts missed unless the
     simulation splits it) is read from its one column.
@@ -70,54 +83,30 @@ def summary_column(accounting: str, measure: str, columns: Sequence[str]) -> str
                     f"({accounting} accounting)")
 
 
-def ideal_cycle(point: Any) -> float:
-    """A point's robot cycle: ``controller.ideal_cycle_s``, else the nominal cycle."""
+def ideal_cycle(point: Point) -> float:
+    """A point's robot cycle: ``controller.ideal_cycle_s``, else the nominal cycle
+    (:func:`cell.assembly.nominal_cycle`: the arrivals' mean when the scenario sets none)."""
+    from cell.assembly import nominal_cycle
+
     c = point.scenario.controller
-    return float(c.ideal_cycle_s if c.ideal_cycle_s is not None else c.nominal_cycle_s)
+    return float(c.ideal_cycle_s if c.ideal_cycle_s is not None else nominal_cycle(point.scenario))
 
 
-def check_table_7_1(sweep: Sweep) -> None:
-    """Refuse, before anything runs, a sweep that --report cannot lay out as Table 7.1."""
-    other = [k for k in sweep.keys if k != VARIED_KEY]
-    if other:
-        raise CellError(f"{sweep.source}: --report lays out Table 7.1, which varies only "
-                        f"{VARIED_KEY}; this sweep also varies {', '.join(other)}")
-    seen: set[tuple[str, float]] = set()
-    for p in sweep.points:
-        key = (p.policy, ideal_cycle(p))
-        if key in seen:  # pragma: no cover - the grid rejects repeated values
-            raise CellError(f"{sweep.source}: two {p.policy} points at ideal cycle {key[1]}")
-        seen.add(key)
-
-
-def thesis_value(policy: str, cycle: float, accounting: str, measure: str) -> float:
-    """The published figure, or NaN; published figures are all in the thesis's accounting."""
-    if accounting != "thesis":
-        return math.nan
-    if policy == "adaptive":
-        return THESIS_ADAPTIVE.get(measure, math.nan)
-    for c, row in published.TABLE_7_1.items():
-        if abs(c - cycle) < 5e-5:
-            return float(row[MEASURES.index(measure)])
-    return math.nan
+def is_table_7_1(sweep: Sweep) -> bool:
+    """Whether the sweep can be laid out as Table 7.1: it varies at most the robot cycle,
+    runs only policies the thesis published figures for, a fixed number of times."""
+    return (set(sweep.keys) <= {VARIED_KEY} and sweep.precision is None
+            and all(p.policy in published.PUBLISHED for p in sweep.points))
 
 
 def statistics(values: Sequence[float] | np.ndarray) -> dict[str, float]:
-    """Mean, its t confidence interval, and the 2.5/97.5 percentiles of single runs."""
+    """Mean, its t confidence interval and the 2.5/97.5 percentiles of single runs
+    (:func:`cell.analysis.stats.summarise`); one run: a zero-width interval."""
     x = np.asarray(values, dtype=float)
-    x = x[np.isfinite(x)]
-    if x.size == 0:
-        nan = math.nan
-        return {"mean": nan, "ci_low": nan, "ci_high": nan, "run_p2_5": nan, "run_p97_5": nan}
-    mean = float(x.mean())
-    sem = float(scipy.stats.sem(x)) if x.size > 1 else 0.0
-    if sem > 0:
-        lo, hi = scipy.stats.t.interval(CONFIDENCE, x.size - 1, loc=mean, scale=sem)
-    else:
-        lo = hi = mean
-    p_lo, p_hi = np.percentile(x, [2.5, 97.5])
-    return {"mean": mean, "ci_low": float(lo), "ci_high": float(hi),
-            "run_p2_5": float(p_lo), "run_p97_5": float(p_hi)}
+    s = summarise(x[np.isfinite(x)], CONFIDENCE)
+    if s["n"] == 1:
+        s["ci_low"] = s["ci_high"] = s["mean"]
+    return {k: s[k] for k in ("mean", "ci_low", "ci_high", "run_p2_5", "run_p97_5")}
 
 
 def table_7_1(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
@@ -141,13 +130,6 @@ def table_7_1(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
 
 
 # --------------------------------------------------------------------------- markdown
-def inside(thesis: float, low: float, high: float, measure: str) -> bool:
-    """Whether a published figure lies in [low, high], to the thesis's printed precision
-    (four decimals; parts missed are whole numbers)."""
-    tol = 0.0 if measure == "parts_missed" else 0.5e-4
-    return low - tol <= thesis <= high + tol
-
-
 def _fmt(value: float, measure: str, decimals: int | None = None) -> str:
     if not math.isfinite(value):
         return ""
@@ -183,172 +165,20 @@ def _layout(table: pd.DataFrame, policy: str, accounting: str, with_thesis: bool
     return lines
 
 
-def _get(table: pd.DataFrame, policy: str, cycle: float, accounting: str,
-         measure: str) -> Mapping[str, Any]:
-    sel = table[(table["policy"] == policy) & np.isclose(table["ideal_cycle_s"], cycle)
-                & (table["accounting"] == accounting) & (table["measure"] == measure)]
-    return {str(k): v for k, v in sel.iloc[0].to_dict().items()}
-
-
 def reading(table: pd.DataFrame, parts: int | None,
             replications: pd.DataFrame | None = None) -> list[str]:
-    """Sentences drawn from the numbers: agreement, where the accountings part, and why."""
+    """Sentences drawn from the numbers: agreement, where the accountings part, and why;
+    each policy's by its layout (:data:`LAYOUTS`), in the thesis's order."""
     out: list[str] = []
-    na = table[table["policy"] == "non-adaptive"]
-    cycles = list(dict.fromkeys(na["ideal_cycle_s"]))
-    if cycles:
-        out += _reading_non_adaptive(table, cycles, parts)
-    if (table["policy"] == "adaptive").any():
-        out += _reading_adaptive(table, replications)
+    for policy in _present(table):
+        out += LAYOUTS[policy].reading(table, policy, parts, replications)
     return out
 
 
-def _cycles(cycles: Sequence[float]) -> str:
-    text = [f"{c:.4f}" if c != round(c, 1) else f"{c:.1f}" for c in cycles]
-    return ", ".join(text[:-1]) + " and " + text[-1] if len(text) > 1 else text[0]
-
-
-def _reading_non_adaptive(table: pd.DataFrame, cycles: list[float],
-                          parts: int | None) -> list[str]:
-    out = []
-    mean = {(c, a, m): _get(table, "non-adaptive", c, a, m)["mean"]
-            for c in cycles for a in ACCOUNTINGS for m in MEASURES}
-    checked, outside = 0, []
-    for c in cycles:
-        for m in ("parts_missed", "actual_cycle_s", "ip"):
-            r = _get(table, "non-adaptive", c, "thesis", m)
-            if math.isfinite(r["thesis"]):
-                checked += 1
-                if not inside(r["thesis"], r["run_p2_5"], r["run_p97_5"], m):
-                    outside.append(f"{LABELS[m]} at {c:.4f} s")
-    if checked:
-        out.append(
-            f"**Against the thesis.** In the thesis's accounting the published parts missed, "
-            f"actual cycle and IP fall inside the range of 95 % of single runs in "
-            f"{checked - len(outside)} of {checked} cases"
-            + (f" (outside: {'; '.join(outside)})." if outside else ".")
-        )
-    vrows = [_get(table, "non-adaptive", c, "thesis", "vavg_r4_in_s") for c in cycles]
-    vv = [abs(r["mean"] - r["thesis"]) for r in vrows if math.isfinite(r["thesis"])]
-    if vv:
-        fixed = all(r["run_p2_5"] == r["run_p97_5"] for r in vrows)
-        out.append(f"Vavg R IV differs from the published column by at most {max(vv):.5f} in/s"
-                   + (" (the R IV length over the shortened R IV time: the same in every run)."
-                      if fixed else "."))
-
-    top, bottom = cycles[0], cycles[-1]
-    tm, wm = mean[top, "thesis", "parts_missed"], mean[top, "wallclock", "parts_missed"]
-    ta, wa = mean[top, "thesis", "actual_cycle_s"], mean[top, "wallclock", "actual_cycle_s"]
-    tb, wb = mean[bottom, "thesis", "actual_cycle_s"], mean[bottom, "wallclock", "actual_cycle_s"]
-    tmb, wmb = mean[bottom, "thesis", "parts_missed"], mean[bottom, "wallclock", "parts_missed"]
-    of = f" of {parts}" if parts else ""
-    gap_top, gap_bottom = ta / wa - 1, tb / wb - 1
-    trend = ("narrows as the cycle shortens and losses grow rare"
-             if abs(gap_bottom) < abs(gap_top) else "widens as the cycle shortens")
-    out.append(
-        f"**Where the accountings part.** At {top:.4f} s the thesis's bookkeeping loses "
-        f"{tm:.1f}{of} parts on average against {wm:.1f} on the wall clock, and its actual "
-        f"cycle is {ta:.2f} s against {wa:.2f} s ({gap_top:+.1%}). At {bottom:.4f} s it is "
-        f"{tmb:.1f} against {wmb:.1f} parts and {tb:.2f} against {wb:.2f} s "
-        f"({gap_bottom:+.1%}): the gap {trend}.")
-    more = [c for c in cycles
-            if mean[c, "thesis", "parts_missed"] > mean[c, "wallclock", "parts_missed"] + 0.5]
-    fewer = [c for c in cycles
-             if mean[c, "thesis", "parts_missed"] < mean[c, "wallclock", "parts_missed"] - 0.5]
-    if more:
-        out.append(
-            f"Why, at {_cycles(more)} s, where the thesis loses more: it counts a part lost "
-            "whenever its own inter-arrival time is shorter than the robot cycle (less a small "
-            "slack), whatever the robot is doing, and books a lost part as one more robot cycle "
-            "between deliveries (D = T + C). On the wall clock a robot left idle by a lost part "
-            "is ready for the next one, so losses cannot come twice running, and a lost part "
-            "costs only the wait for the next.")
-    if fewer:
-        out.append(
-            f"At {_cycles(fewer)} s the thesis loses fewer than the wall clock: it judges each "
-            "inter-arrival time on its own, while on the wall clock the robot's lag builds up "
-            "over runs of gaps each a little shorter than the cycle, until a part is missed.")
-    if not more and not fewer:
-        out.append(
-            "Both accountings lose the same number of parts; they part in how the time between "
-            "deliveries is booked: the thesis adds a whole robot cycle per lost part (D = T + C).")
-    ratios = [mean[c, "wallclock", "ip"] / mean[c, "thesis", "ip"] for c in cycles
-              if mean[c, "thesis", "ip"] > 0]
-    if ratios:
-        out.append(
-            f"IP: the thesis's column averages T(i+1) / (2 D(i)), a doubled denominator, so it "
-            f"reads {min(ratios):.2f}–{max(ratios):.2f} times lower than the wall-clock IP "
-            f"({mean[top, 'thesis', 'ip']:.4f} against {mean[top, 'wallclock', 'ip']:.4f} at "
-            f"{top:.4f} s, {mean[bottom, 'thesis', 'ip']:.4f} against "
-            f"{mean[bottom, 'wallclock', 'ip']:.4f} at {bottom:.4f} s).")
-    ideal_pph = 3600 / top
-    cut_t = 1 - mean[top, "thesis", "parts_per_hr"] / ideal_pph
-    cut_w = 1 - mean[top, "wallclock", "parts_per_hr"] / ideal_pph
-    thesis_row = published.TABLE_7_1.get(round(top, 4))
-    if thesis_row and parts:
-        out.append(
-            f"Throughput at {top:.4f} s: the thesis's accounting gives "
-            f"{mean[top, 'thesis', 'parts_per_hr']:.1f} parts/hr, {cut_t:.0%} below the "
-            f"{ideal_pph:.1f}/hr of the ideal cycle (the thesis's table: "
-            f"{1 - thesis_row[2] / ideal_pph:.0%}), while {tm / parts:.1%} of the parts are lost "
-            f"(the thesis's text: {published.TEXT_THROUGHPUT_CUT:.1%}, 206 of 500): the table's parts/hr and "
-            f"the text's throughput cut measure different things. On the wall clock the cut is "
-            f"{cut_w:.0%}.")
-    return out
-
-
-def _reading_adaptive(table: pd.DataFrame,
-                      replications: pd.DataFrame | None = None) -> list[str]:
-    ad = table[table["policy"] == "adaptive"]
-    cycle = float(ad["ideal_cycle_s"].iloc[0])
-
-    def m(accounting: str, measure: str) -> Mapping[str, Any]:
-        return _get(table, "adaptive", cycle, accounting, measure)
-
-    ip_t, ip_w = m("thesis", "ip"), m("wallclock", "ip")
-    lost_t, lost_w = m("thesis", "parts_missed"), m("wallclock", "parts_missed")
-    cyc_t, cyc_w = m("thesis", "actual_cycle_s"), m("wallclock", "actual_cycle_s")
-    ip_published = THESIS_ADAPTIVE["ip"]
-    where = ("inside" if inside(ip_published, ip_t["run_p2_5"], ip_t["run_p97_5"], "ip")
-             else "outside")
-    text = [f"**Adaptive.** In the thesis's accounting the IP averages {ip_t['mean']:.4f} "
-            f"(single runs {ip_t['run_p2_5']:.4f}–{ip_t['run_p97_5']:.4f}): the published "
-            f"{ip_published:.4f} is {where} that range."]
-    if all(math.isfinite(v) for v in (cyc_t["mean"], cyc_w["mean"], ip_w["mean"])):
-        text.append(
-            f"Its time between deliveries is the robot's motion time (step 6.2), "
-            f"{cyc_t['mean']:.2f} s, {cyc_t['mean'] / cycle - 1:+.2%} against the {cycle:.4f} s "
-            f"requested; the published IP implies a motion time {1 / ip_published - 1:+.1%} "
-            f"against the arrival interval. On the wall clock the cycle is {cyc_w['mean']:.2f} s "
-            f"({cyc_w['mean'] / cycle - 1:+.2%}) and the IP {ip_w['mean']:.4f}.")
-    text += _memoryless(replications, ip_published)
-    text.append(
-        f"Parts lost: {lost_w['mean']:.2f} per run on average "
-        f"(95 % of runs {lost_w['run_p2_5']:.0f}–{lost_w['run_p97_5']:.0f}; the thesis: none)"
-        + (f"; {lost_t['mean']:.2f} in the thesis's accounting." if
-           lost_t["mean"] != lost_w["mean"] else "."))
-    return [" ".join(text)]
-
-
-def _memoryless(replications: pd.DataFrame | None, ip_published: float) -> list[str]:
-    """The simulation's reading with each next arrival counted from the current pick-up."""
-    cols = ("ip_thesis_memoryless", "cycle_vs_nominal_memoryless_pct")
-    if replications is None or not all(c in replications for c in cols):
-        return []
-    ad = replications[replications["policy"] == "adaptive"]
-    ip, pct = ad[cols[0]].astype(float), ad[cols[1]].astype(float)
-    if ip.empty or not np.isfinite(ip).all():
-        return []
-    lo, hi = np.percentile(ip, [2.5, 97.5])
-    where = "inside" if lo <= ip_published <= hi else "outside"
-    return [f"Counted instead with each next arrival measured from the current pick-up, so that "
-            f"a late part's lateness is not carried to the parts behind it, the IP is "
-            f"{ip.mean():.4f} (single runs {lo:.4f}–{hi:.4f}; the published {ip_published:.4f} "
-            f"is {where}) and the motion cycle {pct.mean():+.1f} % against the requested "
-            f"(the thesis: within 2.1 %)"
-            + (": this reading reproduces the published IP, which suggests it is how the "
-               "thesis counted." if where == "inside" else
-               ": this reading does not reproduce the published IP either.")]
+def _present(table: pd.DataFrame) -> list[str]:
+    """The published policies the table holds, in the thesis's order."""
+    held = set(table["policy"])
+    return [p for p in POLICIES if p in held]
 
 
 def markdown(table: pd.DataFrame, sweep: Sweep, replications: pd.DataFrame | None = None) -> str:
@@ -365,37 +195,68 @@ def markdown(table: pd.DataFrame, sweep: Sweep, replications: pd.DataFrame | Non
         "Long form with every figure: `table_7_1.csv`.",
         "",
     ]
-    if (table["policy"] == "non-adaptive").any():
-        lines += ["## Non-adaptive, the thesis's accounting (its Table 7.1 beside ours)", ""]
-        lines += _layout(table, "non-adaptive", "thesis", with_thesis=True)
-        lines += ["", "## Non-adaptive, on the wall clock (a physically consistent count)", ""]
-        lines += _layout(table, "non-adaptive", "wallclock", with_thesis=False)
-        lines += [""]
-    if (table["policy"] == "adaptive").any():
-        lines += ["## Adaptive (thesis §7.2: IP 1.0214, within 2.1 % of the requested cycle, "
-                  "no parts lost)", ""]
-        head = ["accounting"] + [LABELS[m] for m in MEASURES]
-        lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-        ad = table[table["policy"] == "adaptive"]
-        cycle = float(ad["ideal_cycle_s"].iloc[0])
-        published_cells = [_fmt(thesis_value("adaptive", cycle, "thesis", m), m,
-                          0 if m == "parts_missed" else 4) for m in MEASURES]
-        lines.append("| thesis (published) | " + " | ".join(published_cells) + " |")
-        for accounting in ACCOUNTINGS:
-            cells = [_ours(_get(table, "adaptive", cycle, accounting, m), m) for m in MEASURES]
-            lines.append(f"| ours, {accounting} | " + " | ".join(cells) + " |")
-        lines += [""]
+    for policy in _present(table):
+        lines += LAYOUTS[policy].tables(table, policy)
     lines += ["## Reading", ""]
     for sentence in reading(table, parts, replications):
         lines += [sentence, ""]
     return "\n".join(lines).rstrip() + "\n"
 
 
+def _by_cycle_tables(table: pd.DataFrame, policy: str) -> list[str]:
+    """The thesis's table beside ours, then ours on the wall clock."""
+    name = policy.capitalize()
+    return [f"## {name}, the thesis's accounting (its Table 7.1 beside ours)", "",
+            *_layout(table, policy, "thesis", with_thesis=True), "",
+            f"## {name}, on the wall clock (a physically consistent count)", "",
+            *_layout(table, policy, "wallclock", with_thesis=False), ""]
+
+
+def _one_run_table(table: pd.DataFrame, policy: str) -> list[str]:
+    """The published run's figures, then ours in both accountings."""
+    lines = [f"## {policy.capitalize()} (thesis §7.2: {published.PUBLISHED[policy].summary})", ""]
+    head = ["accounting"] + [LABELS[m] for m in MEASURES]
+    lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    cycle = float(table.loc[table["policy"] == policy, "ideal_cycle_s"].iloc[0])
+    published_cells = [_fmt(thesis_value(policy, cycle, "thesis", m), m,
+                            0 if m == "parts_missed" else 4) for m in MEASURES]
+    lines.append("| thesis (published) | " + " | ".join(published_cells) + " |")
+    for accounting in ACCOUNTINGS:
+        cells = [_ours(row_of(table, policy, cycle, accounting, m), m) for m in MEASURES]
+        lines.append(f"| ours, {accounting} | " + " | ".join(cells) + " |")
+    return lines + [""]
+
+
+@dataclass(frozen=True)
+class Layout:
+    """How one policy's part of the report is laid out: from what the thesis published."""
+
+    published: published.Published
+    tables: Callable[[pd.DataFrame, str], list[str]]
+    reading: Callable[[pd.DataFrame, str, int | None, pd.DataFrame | None], list[str]]
+
+
+def _layout_of(figures: published.Published) -> Layout:
+    if figures.by_cycle:
+        return Layout(figures, _by_cycle_tables, reading_by_cycle)
+    return Layout(figures, _one_run_table, reading_one_run)
+
+
+#: Policy -> its published figures, tables and reading.
+LAYOUTS: Mapping[str, Layout] = {policy: _layout_of(figures)
+                                 for policy, figures in published.PUBLISHED.items()}
+
+
+def table_7_1_files(replications: pd.DataFrame, sweep: Sweep) -> tuple[pd.DataFrame, str]:
+    """The long-form table and the markdown text, for ``table_7_1.csv`` and ``.md``."""
+    table = table_7_1(replications, sweep)
+    return table, markdown(table, sweep, replications)
+
+
 def write_table_7_1(replications: pd.DataFrame, sweep: Sweep, out: str | Path) -> list[Path]:
     """Write ``table_7_1.csv`` and ``table_7_1.md`` into ``out``; return their paths."""
     out = Path(out)
-    table = table_7_1(replications, sweep)
-    text = markdown(table, sweep, replications)
+    table, text = table_7_1_files(replications, sweep)
     paths = [out / "table_7_1.csv", out / "table_7_1.md"]
     write_csv(table, paths[0])
     write_text(text, paths[1])

@@ -4,12 +4,25 @@ A task is one batch of replications of one grid point.  Tasks run in local
 worker processes, or on a dask.distributed cluster through its
 concurrent.futures executor; each finished task is written at once, atomically,
 to ``OUT/tasks/``, so ``--resume`` runs only the tasks that are missing.
-``OUT/replications.csv`` is always assembled from those files in a fixed order,
-so it is byte-identical however the sweep was run: no result depends on the
-number of workers or the order tasks finish in.  Its columns: ``policy``,
-``point`` (index of the grid point within its policy), one column per varied key
-(empty where a policy does not vary it), ``replication``, then the run's summary
-(:class:`cell.records.RunSummary`).  ``--workers 1`` runs in this process.
+
+A sweep with a precision (:class:`cell.sweep.spec.Precision`) runs in rounds:
+the first gives every point ``min`` replications; after each whole round, and
+only then, each point's replications so far (in replication order) decide
+whether it needs another ``batch`` (:func:`cell.analysis.stats.precision_reached`,
+:func:`~cell.analysis.stats.next_round`).  A round's tasks are ordinary tasks, so
+``--resume`` replays the same rounds from the files.
+
+``OUT/replications.csv`` is always assembled from those files in a fixed order
+(point, then replication), so it is byte-identical however the sweep was run: no
+result depends on the number of workers or the order tasks finish in.  Its
+columns: ``policy``; ``point`` (index of the grid point within its policy); the
+grid's columns (:mod:`cell.sweep.columns`: one per varied key, one per leaf for
+mapping values, filled for points that do not vary the key); ``seed`` (the
+sweep's root seed) and ``replication`` (r); then the run's summary
+(:class:`cell.records.RunSummary`, without its ``policy`` and ``seed``).  A row
+is reproduced by ``simulate(scenario, seed=np.random.SeedSequence(seed,
+spawn_key=(replication,)))``, which is ``SeedSequence(seed).spawn(n)[replication]``
+for any n > replication.  ``--workers 1`` runs in this process.
 """
 
 from __future__ import annotations
@@ -22,8 +35,8 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -31,8 +44,9 @@ import numpy as np
 import pandas as pd
 
 from cell.errors import CellError
-from cell.output import write_csv, write_text
+from cell.output import FLOAT_FORMAT, atomic_path, write_csv, write_text
 from cell.scenario import Scenario
+from cell.sweep.columns import Column, grid_columns, point_values
 from cell.sweep.spec import Sweep, Task
 
 #: A replication: (scenario, stream) -> the run's summary row.
@@ -44,6 +58,8 @@ MANIFEST = "sweep.json"
 #: How long to try reaching a dask scheduler.
 CONNECT_TIMEOUT = "20s"
 TASK_DIR = "tasks"
+#: Tasks in flight on a dask cluster at once (local workers: twice their number).
+CLUSTER_WINDOW = 1024
 
 
 def simulate_summary(scenario: Scenario, seed: np.random.SeedSequence) -> Mapping[str, Any]:
@@ -72,20 +88,21 @@ def _plain(value: Any) -> Any:
     return value.item() if isinstance(value, np.generic) else value
 
 
-def _task_frame(sweep: Sweep, task: Task, rows: Sequence[Mapping[str, Any]]) -> pd.DataFrame:
+def _task_frame(sweep: Sweep, columns: Sequence[Column], task: Task,
+                rows: Sequence[Mapping[str, Any]]) -> pd.DataFrame:
     point = sweep.points[task.point]
-    values = dict(point.values)
     records = []
     for r, summary in zip(range(task.first, task.last), rows, strict=True):
         record: dict[str, Any] = {"policy": point.policy, "point": point.index}
-        record.update({k: values.get(k) for k in sweep.keys})
+        record.update(point_values(columns, point, summary))
+        record["seed"] = sweep.seed
         record["replication"] = r
         record.update({k: v for k, v in summary.items() if k not in record})
         records.append(record)
     return pd.DataFrame.from_records(records)
 
 
-def _read_task(path: Path, task: Task) -> pd.DataFrame | None:
+def _read_task(sweep: Sweep, path: Path, task: Task) -> pd.DataFrame | None:
     """A finished task's rows, or None if the file is missing or not this task's."""
     if not path.is_file():
         return None
@@ -93,20 +110,28 @@ def _read_task(path: Path, task: Task) -> pd.DataFrame | None:
         frame = pd.read_csv(path)
     except (OSError, ValueError):
         return None
-    if len(frame) != task.size or "replication" not in frame.columns:
+    if len(frame) != task.size or not {"replication", "policy", "point"} <= set(frame.columns):
         return None
-    if list(frame["replication"]) != list(range(task.first, task.last)):
+    point = sweep.points[task.point]
+    if list(frame["replication"]) != list(range(task.first, task.last)) \
+            or (frame["policy"] != point.policy).any() or (frame["point"] != point.index).any():
         return None
     return frame
 
 
 @dataclass
 class Outcome:
-    """What :func:`run_sweep` did."""
+    """What :func:`run_sweep` did; ``replications`` reads ``replications.csv`` when asked."""
 
-    replications: pd.DataFrame
+    path: Path
     tasks_run: int
     tasks_reused: int
+    counts: dict[int, int] = field(default_factory=dict)
+    """Replications run per point (index into :attr:`Sweep.points`)."""
+
+    @functools.cached_property
+    def replications(self) -> pd.DataFrame:
+        return pd.read_csv(self.path)
 
 
 def _open_executor(workers: int, scheduler: str | None) -> tuple[cf.Executor | None, Any]:
@@ -142,25 +167,34 @@ def _worker_init(parent: int) -> None:
     threading.Thread(target=watch, daemon=True, name="watch-sweep").start()
 
 
-def _run_tasks(sweep: Sweep, todo: Sequence[Task], replicate: Replicate,
-               executor: cf.Executor | None,
+def _run_tasks(sweep: Sweep, todo: Iterable[Task], replicate: Replicate,
+               executor: cf.Executor | None, window: int,
                done: Callable[[Task, list[dict[str, Any]]], None]) -> None:
-    seeds = sweep.seeds()
-
+    """Run ``todo``, at most ``window`` tasks in flight; ``done`` as each one finishes."""
     def args(task: Task) -> tuple[Any, ...]:
-        return (replicate, sweep.points[task.point].scenario, seeds[task.first:task.last])
+        seeds = [sweep.stream(r) for r in range(task.first, task.last)]
+        return (replicate, sweep.points[task.point].scenario, seeds)
 
     if executor is None:
         for task in todo:
             done(task, _guarded(sweep, task, functools.partial(run_task, *args(task))))
         return
-    futures = {executor.submit(run_task, *args(task)): task for task in todo}
+    queue = iter(todo)
+    pending: dict[cf.Future[list[dict[str, Any]]], Task] = {}
     try:
-        for future in cf.as_completed(futures):
-            task = futures[future]
-            done(task, _guarded(sweep, task, future.result))
+        while True:
+            for task in queue:
+                pending[executor.submit(run_task, *args(task))] = task
+                if len(pending) >= window:
+                    break
+            if not pending:
+                return
+            finished, _ = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
+            for future in finished:
+                task = pending.pop(future)
+                done(task, _guarded(sweep, task, future.result))
     except BaseException:
-        for future in futures:
+        for future in pending:
             future.cancel()
         raise
 
@@ -185,6 +219,32 @@ def _close(executor: cf.Executor | None, client: Any, wait: bool) -> None:
         client.close()
 
 
+def _prepare(sweep: Sweep, out: Path, resume: bool) -> None:
+    """Check a resumed directory is this sweep's, or clear a fresh one; write the manifest."""
+    task_dir, manifest = out / TASK_DIR, out / MANIFEST
+    fingerprint = sweep.fingerprint()
+    if resume and manifest.is_file():
+        try:
+            previous = json.loads(manifest.read_text()).get("fingerprint")
+        except (OSError, ValueError):
+            previous = None
+        if previous != fingerprint:
+            raise CellError(f"--resume: {out} holds the results of a different sweep "
+                            f"(or of {sweep.source} before it was edited); "
+                            "run without --resume or choose another --out")
+    else:
+        for stale in task_dir.glob("task-*.csv") if task_dir.is_dir() else ():
+            stale.unlink()
+        (out / "replications.csv").unlink(missing_ok=True)
+    doc: dict[str, Any] = {"sweep": sweep.source, "name": sweep.name, "fingerprint": fingerprint,
+                           "tasks": len(sweep.points) * -(-sweep.first_round // sweep.batch),
+                           "replications": sweep.replications, "seed": sweep.seed,
+                           "batch": sweep.batch}
+    if sweep.precision is not None:
+        doc["precision"] = sweep.precision.as_dict()
+    write_text(json.dumps(doc, indent=2) + "\n", manifest)
+
+
 def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
               scheduler: str | None = None, resume: bool = False,
               replicate: Replicate = simulate_summary, progress: bool = True) -> Outcome:
@@ -195,63 +255,95 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     """
     from tqdm import tqdm
 
+    from cell.analysis.stats import next_round, precision_reached
+
     out = Path(out)
     workers = (os.cpu_count() or 1) if workers is None else workers
     if workers < 1:
         raise CellError(f"--workers {workers}: must be at least 1")
     executor, client = _open_executor(workers, scheduler)
+    window = CLUSTER_WINDOW if scheduler else 2 * workers
+    columns = grid_columns(sweep)
+    task_dir = out / TASK_DIR
+    counts = dict.fromkeys(range(len(sweep.points)), 0)
+    values: dict[int, list[float]] = {p: [] for p in counts}
+    run = reused = 0
     try:
-        tasks = sweep.tasks()
-        task_dir = out / TASK_DIR
-        manifest = out / MANIFEST
-        fingerprint = sweep.fingerprint()
-        frames: dict[int, pd.DataFrame] = {}
-        if resume and manifest.is_file():
-            try:
-                previous = json.loads(manifest.read_text()).get("fingerprint")
-            except (OSError, ValueError):
-                previous = None
-            if previous != fingerprint:
-                raise CellError(f"--resume: {out} holds the results of a different sweep "
-                                f"(or of {sweep.source} before it was edited); "
-                                "run without --resume or choose another --out")
-            for task in tasks:
-                frame = _read_task(task_dir / task.filename, task)
-                if frame is not None:
-                    frames[task.id] = frame
-        else:
-            for stale in task_dir.glob("task-*.csv") if task_dir.is_dir() else ():
-                stale.unlink()
-            (out / "replications.csv").unlink(missing_ok=True)
-        write_text(json.dumps({"sweep": sweep.source, "name": sweep.name,
-                               "fingerprint": fingerprint, "tasks": len(tasks),
-                               "replications": sweep.replications, "seed": sweep.seed,
-                               "batch": sweep.batch}, indent=2) + "\n", manifest)
-        todo = [t for t in tasks if t.id not in frames]
-        bar = tqdm(total=sweep.total_replications, initial=sweep.total_replications
-                   - sum(t.size for t in todo), unit="rep", desc=sweep.name,
+        _prepare(sweep, out, resume)
+        bar = tqdm(total=sweep.total_replications, unit="rep", desc=sweep.name,
                    disable=not progress, file=sys.stderr, dynamic_ncols=True)
 
         def done(task: Task, rows: list[dict[str, Any]]) -> None:
-            write_csv(_task_frame(sweep, task, rows), task_dir / task.filename,
+            write_csv(_task_frame(sweep, columns, task, rows), task_dir / task.filename,
                       float_format=TASK_FLOAT_FORMAT)
             bar.update(task.size)
 
+        def todo(ranges: dict[int, tuple[int, int]]) -> Iterable[Task]:
+            nonlocal run, reused
+            for task in sweep.iter_tasks(ranges):
+                if resume and _read_task(sweep, task_dir / task.filename, task) is not None:
+                    reused += 1
+                    bar.update(task.size)
+                else:
+                    run += 1
+                    yield task
+
+        ranges = {p: (0, sweep.first_round) for p in counts}
         with bar:
-            _run_tasks(sweep, todo, replicate, executor, done)
+            while ranges:
+                _run_tasks(sweep, todo(ranges), replicate, executor, window, done)
+                for p, (_, last) in ranges.items():
+                    counts[p] = last
+                if sweep.precision is None:
+                    break
+                q = sweep.precision
+                for task in sweep.iter_tasks(ranges):
+                    values[task.point] += _measure(sweep, task_dir, task, q.measure)
+                reached = precision_reached(values, q.precision, q.confidence, q.min_n)
+                more = next_round(counts, reached, sweep.batch, q.max_n)
+                ranges = {p: (counts[p], counts[p] + k) for p, k in more.items() if k}
+                bar.total += sum(more.values())
+                bar.refresh()
     except BaseException:
         _close(executor, client, wait=False)
         raise
     _close(executor, client, wait=True)
+    final = {p: (0, n) for p, n in counts.items()}
+    path = _assemble(sweep, task_dir, list(sweep.iter_tasks(final)), out / "replications.csv")
+    return Outcome(path, run, reused, counts)
 
-    # Assemble from the files, never from memory: a resumed sweep and an
-    # uninterrupted one go through the same bytes.
-    parts = []
+
+def _measure(sweep: Sweep, task_dir: Path, task: Task, measure: str) -> list[float]:
+    """A finished task's values of the precision's measure, from its file."""
+    frame = _read_task(sweep, task_dir / task.filename, task)
+    if frame is None:  # pragma: no cover - written just before
+        raise CellError(f"{task_dir / task.filename}: missing or damaged; rerun the sweep")
+    if measure not in frame.columns:
+        raise CellError(f"{sweep.source}: replications.measure = {measure!r}: the replications "
+                        "have no such column")
+    return [float(v) for v in pd.to_numeric(frame[measure], errors="coerce")]
+
+
+def _assemble(sweep: Sweep, task_dir: Path, tasks: Sequence[Task], target: Path) -> Path:
+    """``replications.csv`` from the task files, in the tasks' order, one task at a time.
+
+    Assembled from the files, never from memory: a resumed sweep and an
+    uninterrupted one go through the same bytes.
+    """
+    names: dict[str, None] = {}
     for task in tasks:
-        frame = _read_task(task_dir / task.filename, task)
-        if frame is None:  # pragma: no cover - written above
-            raise CellError(f"{task_dir / task.filename}: missing or damaged; rerun the sweep")
-        parts.append(frame)
-    table = pd.concat(parts, ignore_index=True)
-    write_csv(table, out / "replications.csv")
-    return Outcome(pd.read_csv(out / "replications.csv"), len(todo), len(tasks) - len(todo))
+        path = task_dir / task.filename
+        try:
+            names.update(dict.fromkeys(pd.read_csv(path, nrows=0).columns))
+        except (OSError, ValueError):
+            raise CellError(f"{path}: missing or damaged; rerun the sweep") from None
+    with atomic_path(target) as tmp, open(tmp, "w", encoding="utf-8", newline="") as stream:
+        for i, task in enumerate(tasks):
+            frame = _read_task(sweep, task_dir / task.filename, task)
+            if frame is None:  # pragma: no cover - written above
+                raise CellError(f"{task_dir / task.filename}: missing or damaged; rerun the sweep")
+            frame.reindex(columns=list(names)).to_csv(
+                stream, header=i == 0, index=False, float_format=FLOAT_FORMAT,
+                lineterminator="\n")
+    return target
+

@@ -10,21 +10,34 @@ a scenario), the policies to run, the number of replications and a root seed::
     policies:                      # a list, or policy -> its own extra grid
       non-adaptive: {controller.ideal_cycle_s: [22.5872, 22.0]}
       adaptive: {}
-    replications: 200
+    replications: 200              # or {precision: 0.01, measure: ..., min: 10, max: 2000}
     seed: 1984
     batch: 20                      # replications per task (optional)
+    baseline: {policy: non-adaptive, controller.ideal_cycle_s: 22.5872}   # optional
 
 Replication ``r`` of every grid point and every policy is driven by the same
-stream, ``SeedSequence(seed).spawn(replications)[r]``: the policies and the
-grid points see the same parts (common random numbers).
+stream, ``SeedSequence(seed, spawn_key=(r,))`` -- the same as
+``SeedSequence(seed).spawn(n)[r]`` for any n > r, so it does not depend on how
+many replications are run: the policies and the grid points see the same parts
+(common random numbers), and a precision-driven sweep that stops early draws
+exactly what a fixed one would.
+
+``replications`` as a mapping asks for a precision (:class:`Precision`): rounds
+of ``batch`` replications are added to every point whose confidence half-width
+for ``measure`` is still above ``precision`` × |mean|, until ``max``.
+
+``baseline`` names the point every other point is compared with (paired
+differences, :meth:`Sweep.pairs`); without it, every policy is compared with
+each policy listed before it, at every grid point.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import itertools
 import json
-from collections.abc import Mapping
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -34,12 +47,23 @@ import numpy as np
 from cell import registry
 from cell.errors import ScenarioError
 from cell.scenario import Scenario, known_key, load_scenario
+from cell.sweep.options import (
+    RESERVED,
+    Baseline,
+    Precision,
+    baseline_point,
+    grid,
+    read_baseline,
+    read_replications,
+    reserved,
+    summary_measures,
+    whole,
+)
 
 SWEEP_KEYS = ("name", "description", "base", "set", "grid", "policies",
-              "replications", "seed", "batch")
-#: Keys the sweep itself sets for every run; they cannot be varied in a grid.
-RESERVED = {"controller.policy": "list policies under 'policies'",
-            "run.seed": "every replication gets its own stream from the sweep's 'seed'"}
+              "replications", "seed", "batch", "baseline")
+__all__ = ["RESERVED", "SWEEP_KEYS", "Baseline", "Pair", "Point", "Precision", "Sweep", "Task",
+           "load_sweep", "summary_measures"]
 
 
 @dataclass(frozen=True)
@@ -52,13 +76,32 @@ class Point:
     values: tuple[tuple[str, Any], ...]
     """The varied keys and their values here, in the sweep file's order."""
     scenario: Scenario
+    names: tuple[tuple[str, str], ...] = ()
+    """For keys whose grid values are named: the name of the value here."""
+
+    def name_of(self, key: str) -> str | None:
+        """The name of this point's value of ``key``, if the sweep file named it."""
+        return dict(self.names).get(key)
+
+    def agrees(self, values: dict[str, Any]) -> bool:
+        """Whether every key this point varies has the given value in ``values``."""
+        return all(k in values and values[k] == v for k, v in self.values)
+
+
+@dataclass(frozen=True)
+class Pair:
+    """A paired comparison: point ``point`` minus point ``versus``, replication by replication."""
+
+    point: int
+    versus: int
+    label: str
+    """How the report names ``versus``: its policy, and the keys a baseline fixes."""
 
 
 @dataclass(frozen=True)
 class Task:
     """A batch of replications ``first .. last-1`` of one point."""
 
-    id: int
     point: int
     """Index into :attr:`Sweep.points`."""
     first: int
@@ -70,7 +113,7 @@ class Task:
 
     @property
     def filename(self) -> str:
-        return f"task-{self.id:05d}.csv"
+        return f"task-{self.point:05d}-{self.first:010d}.csv"
 
 
 @dataclass(frozen=True)
@@ -86,88 +129,91 @@ class Sweep:
     """Every varied key, in order of first appearance (the grid's, then each policy's)."""
     points: tuple[Point, ...]
     replications: int
+    """Replications per point; with a precision, the most any point gets (``max``)."""
     seed: int
     batch: int
+    precision: Precision | None = None
+    baseline: Baseline | None = None
 
-    def seeds(self) -> list[np.random.SeedSequence]:
-        """Replication r's stream: the same for every point and policy (CRN)."""
-        return np.random.SeedSequence(self.seed).spawn(self.replications)
+    def stream(self, replication: int) -> np.random.SeedSequence:
+        """Replication r's stream: the same for every point and policy (CRN), and
+        ``SeedSequence(seed).spawn(n)[r]`` for any n > r."""
+        return np.random.SeedSequence(self.seed, spawn_key=(replication,))
 
-    def tasks(self) -> list[Task]:
-        out: list[Task] = []
-        for p in range(len(self.points)):
-            for first in range(0, self.replications, self.batch):
-                out.append(Task(len(out), p, first, min(first + self.batch, self.replications)))
-        return out
+    @property
+    def confidence(self) -> float:
+        """The confidence level of every interval of the sweep's report."""
+        return self.precision.confidence if self.precision else 0.95
+
+    @property
+    def first_round(self) -> int:
+        """Replications every point gets before any precision is judged."""
+        return self.precision.min_n if self.precision else self.replications
+
+    def tasks(self, ranges: dict[int, tuple[int, int]] | None = None) -> list[Task]:
+        """The tasks covering replications ``first .. last-1`` of each point (by default
+        the first round), cut into batches, in point order."""
+        return list(self.iter_tasks(ranges))
+
+    def iter_tasks(self, ranges: dict[int, tuple[int, int]] | None = None) -> Iterator[Task]:
+        """:meth:`tasks`, one at a time (a sweep of many replications holds no list of them)."""
+        if ranges is None:
+            ranges = {p: (0, self.first_round) for p in range(len(self.points))}
+        for p, (start, last) in sorted(ranges.items()):
+            for first in range(start, last, self.batch):
+                yield Task(p, first, min(first + self.batch, last))
 
     @property
     def total_replications(self) -> int:
-        return len(self.points) * self.replications
+        return len(self.points) * self.first_round
 
     def fingerprint(self) -> str:
         """Hash of everything that decides the results (for ``--resume``)."""
-        doc = {"base": self.base.to_dict(), "fixed": [list(kv) for kv in self.fixed],
-               "points": [[p.policy, [list(kv) for kv in p.values]] for p in self.points],
-               "replications": self.replications, "seed": self.seed, "batch": self.batch}
+        doc: dict[str, Any] = {
+            "base": self.base.to_dict(), "fixed": [list(kv) for kv in self.fixed],
+            "points": [[p.policy, [list(kv) for kv in p.values]] for p in self.points],
+            "replications": self.replications, "seed": self.seed, "batch": self.batch}
+        if self.precision is not None:
+            doc["precision"] = self.precision.as_dict()
         text = json.dumps(doc, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()
 
+    def pairs(self) -> list[Pair]:
+        """The paired comparisons: every point against its baseline point (the one the
+        ``baseline`` names, with this point's values for the keys it does not name); or,
+        without a baseline, every point against each point of a policy listed before
+        its own that agrees with it on the keys both vary."""
+        out: list[Pair] = []
+        if self.baseline is not None:
+            b = self.baseline
+            for i in range(len(self.points)):
+                j = self.baseline_of(i)
+                if j is not None and j != i:
+                    out.append(Pair(i, j, b.label(self.points[j].policy)))
+            return out
+        order = list(dict.fromkeys(p.policy for p in self.points))
+        for i, p in enumerate(self.points):
+            mine = dict(p.values)
+            for j, q in enumerate(self.points):
+                if order.index(q.policy) < order.index(p.policy) and all(
+                        mine[k] == v for k, v in q.values if k in mine):
+                    out.append(Pair(i, j, q.policy))
+        return out
 
-def _grid(raw: Any, file: object, where: str) -> dict[str, list[Any]]:
-    """A mapping of dotted keys to non-empty lists of values, checked against the schema."""
-    if raw is None or (isinstance(raw, Mapping) and not raw and where == "grid"):
-        raise ScenarioError(file, where, raw, "empty grid: give at least one key with a "
-                            "list of values (or leave 'grid' out and vary keys per policy)")
-    if not isinstance(raw, Mapping):
-        raise ScenarioError(file, where, raw, "must be a mapping of dotted scenario keys "
-                            "to lists of values, e.g. controller.ideal_cycle_s: [22.0, 21.5]")
-    out: dict[str, list[Any]] = {}
-    for key, values in raw.items():
-        key = str(key)
-        if not known_key(key):
-            raise ScenarioError(file, key, values, "unknown key to vary: no such setting in a "
-                                "scenario (keys are dotted, e.g. controller.ideal_cycle_s)")
-        reserved = _reserved(key, values)
-        if reserved:
-            raise ScenarioError(file, key, values, f"cannot be varied: {RESERVED[reserved]}")
-        if not isinstance(values, list):
-            raise ScenarioError(file, key, values, "must be a list of values to try")
-        if not values:
-            raise ScenarioError(file, key, values, "empty list: nothing to vary")
-        seen: list[Any] = []
-        for v in values:
-            if v in seen:
-                raise ScenarioError(file, key, v, "listed twice")
-            seen.append(v)
-        out[key] = values
-    return out
-
-
-def _reserved(key: str, values: Any) -> str | None:
-    """The reserved key that ``key`` (or a section mapping given for it) would set."""
-    if key in RESERVED:
-        return key
-    for value in values if isinstance(values, list) else [values]:
-        if isinstance(value, Mapping):
-            for sub in value:
-                found = _reserved(f"{key}.{sub}", [value[sub]])
-                if found:
-                    return found
-    return None
-
-
-def _whole(raw: Mapping[str, Any], key: str, default: Any, lo: int, file: object) -> int:
-    value = raw.get(key, default)
-    if isinstance(value, bool) or not isinstance(value, int) or value < lo:
-        raise ScenarioError(file, key, value, f"must be a whole number of at least {lo}")
-    return value
+    def baseline_of(self, i: int) -> int | None:
+        """The baseline point of point ``i`` (None without a baseline, or if there is none)."""
+        if self.baseline is None:
+            return None
+        return baseline_point(self.points, self.baseline, self.points[i])
 
 
 def load_sweep(path: str | Path) -> Sweep:
-    """Read and validate a sweep file; every grid point's scenario is built and checked."""
-    path = Path(path)
+    """Read and validate a sweep file (or a built-in one by name); every grid point's
+    scenario is built and checked."""
+    from cell import catalog
     from cell.yamlio import load_mapping
 
+    path = catalog.resolve(path)
     raw = load_mapping(path, "sweep")
     for key in raw:
         if key not in SWEEP_KEYS:
@@ -179,54 +225,63 @@ def load_sweep(path: str | Path) -> Sweep:
     base = load_scenario(path.parent / raw["base"])
 
     fixed = raw.get("set") or {}
-    if not isinstance(fixed, Mapping):
+    if not isinstance(fixed, dict):
         raise ScenarioError(path, "set", fixed, "must be a mapping of dotted keys to values")
     for key, value in fixed.items():
         if not known_key(str(key)):
             raise ScenarioError(path, str(key), value, "unknown key: no such setting in a scenario")
-        reserved = _reserved(str(key), [value])
-        if reserved:
-            raise ScenarioError(path, str(key), value, f"cannot be set here: {RESERVED[reserved]}")
+        found = reserved(str(key), [value])
+        if found:
+            raise ScenarioError(path, str(key), value, f"cannot be set here: {RESERVED[found]}")
 
-    shared = _grid(raw["grid"], path, "grid") if "grid" in raw else {}
+    shared, names = grid(raw["grid"], path, "grid") if "grid" in raw else ({}, {})
     policies_raw = raw.get("policies", [base.controller.policy])
-    per_policy: dict[str, dict[str, list[Any]]] | None
-    if isinstance(policies_raw, list):
-        per_policy = {p: {} for p in policies_raw} if policies_raw else None
-    elif isinstance(policies_raw, Mapping):
-        per_policy = {p: (_grid(g, path, f"policies.{p}") if g else {})
-                      for p, g in policies_raw.items()} if policies_raw else None
-    else:
-        per_policy = None
+    per_policy: dict[str, dict[str, list[Any]]] | None = None
+    named_by_policy: dict[str, dict[str, list[str]]] = {}
+    if isinstance(policies_raw, list) and policies_raw:
+        per_policy = {p: {} for p in policies_raw}
+    elif isinstance(policies_raw, dict) and policies_raw:
+        per_policy = {}
+        for p, g in policies_raw.items():
+            per_policy[p], own_names = grid(g, path, f"policies.{p}") if g else ({}, {})
+            named_by_policy[p] = {**names, **own_names}
     if not per_policy:
         raise ScenarioError(path, "policies", policies_raw, "must list at least one of "
                             + ", ".join(registry.names()) + " (a list, or policy: {key: [values]})")
-    for policy, grid in per_policy.items():
+    for policy, own in per_policy.items():
         if policy not in registry.names():
             raise ScenarioError(path, "policies", policy,
                                 "must be one of " + ", ".join(registry.names()))
-        for key in set(grid) & set(shared):
+        for key in set(own) & set(shared):
             raise ScenarioError(path, f"policies.{policy}", key,
                                 "varied both in 'grid' and under the policy; keep one")
 
-    replications = _whole(raw, "replications", None, 1, path)
-    seed = _whole(raw, "seed", base.run.seed, 0, path)
-    batch = _whole(raw, "batch", min(20, replications), 1, path)
+    replications, precision = read_replications(raw, path)
+    seed = whole(raw, "seed", base.run.seed, 0, path)
+    batch = whole(raw, "batch", min(20, precision.min_n if precision else replications), 1, path)
 
     keys = tuple(dict.fromkeys(itertools.chain(shared, *per_policy.values())))
     points: list[Point] = []
     for policy, own in per_policy.items():
-        grid = {**shared, **own}
-        for i, combo in enumerate(itertools.product(*grid.values())):
-            values = tuple(zip(grid, combo, strict=True))
+        combined = {**shared, **own}
+        for i, combo in enumerate(itertools.product(*(range(len(v)) for v in combined.values()))):
+            values = tuple((k, combined[k][j]) for k, j in zip(combined, combo, strict=True))
+            own_names = named_by_policy.get(policy, names)
+            named = tuple((k, own_names[k][j]) for k, j in zip(combined, combo, strict=True)
+                          if k in own_names)
             scenario = base.with_overrides(
                 {**fixed, "controller.policy": policy, **dict(values)}, file=path)
             _check_point(scenario, path)
-            points.append(Point(policy, i, values, scenario))
+            points.append(Point(policy, i, values, scenario, named))
 
     name = raw.get("name", path.stem)
-    return Sweep(str(path), str(name), str(raw.get("description", "")), base,
-                 tuple(fixed.items()), keys, tuple(points), replications, seed, batch)
+    sweep = Sweep(str(path), str(name), str(raw.get("description", "")), base,
+                  tuple(fixed.items()), keys, tuple(points), replications, seed, batch,
+                  precision)
+    if "baseline" in raw:
+        baseline = read_baseline(raw["baseline"], sweep, path)
+        sweep = dataclasses.replace(sweep, baseline=baseline)
+    return sweep
 
 
 def _check_point(scenario: Scenario, file: object) -> None:
@@ -240,3 +295,15 @@ def _check_point(scenario: Scenario, file: object) -> None:
         raise ScenarioError(file, exc.key, exc.value, exc.why) from None
 
 
+def comparison(a: Scenario, b: Scenario, labels: tuple[str, str], replications: int, seed: int,
+               batch: int = 20) -> Sweep:
+    """Two scenarios as a sweep of two points, varying the pseudo-key ``scenario`` (their
+    labels): ``a`` against ``b`` (the baseline), with common random numbers."""
+    la, lb = labels if labels[0] != labels[1] else (f"A: {labels[0]}", f"B: {labels[1]}")
+    pa = Point(a.controller.policy, 0, (("scenario", la),), a)
+    pb = Point(b.controller.policy, int(b.controller.policy == a.controller.policy),
+               (("scenario", lb),), b)
+    return Sweep(f"{la} against {lb}", "compare", f"{la} against {lb}", a, (), ("scenario",),
+                 (pa, pb), replications, seed, min(batch, replications),
+                 baseline=Baseline(b.controller.policy, (("scenario", lb),),
+                                   text=f"{lb} ({b.controller.policy})"))

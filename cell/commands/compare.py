@@ -1,0 +1,138 @@
+"""``cell compare A B [--replications N] [--seed S] [--workers N] [--out DIR]``.
+
+Two scenarios (files or built-in names) run side by side with common random
+numbers: replication r of both draws the same parts, so their difference is
+taken replication by replication (a paired t interval).  Prints, per headline
+measure, which is better, by how much, and whether the interval excludes zero;
+``--out DIR`` writes the report (as ``cell sweep --report``) and the
+replications, as a unit.
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import TYPE_CHECKING
+
+from cell.commands import set_argument
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from cell.sweep import Sweep
+
+HELP = "compare two scenarios, paired over common random numbers"
+DESCRIPTION = ("Run scenarios A and B with the same replications (common random numbers) and "
+               "say, per headline measure, which is better, by how much (paired confidence "
+               "interval of A - B) and whether the interval excludes zero.")
+DEFAULT_REPLICATIONS = 100
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("a", metavar="A", help="a scenario file, or a built-in name (baseline)")
+    p.add_argument("b", metavar="B", help="the scenario to compare A with")
+    p.add_argument("--replications", type=int, default=DEFAULT_REPLICATIONS,
+                   help=f"replications of each (default {DEFAULT_REPLICATIONS})")
+    p.add_argument("--seed", type=int, default=None,
+                   help="root seed of the replications' streams (default: A's run.seed)")
+    p.add_argument("--workers", type=int, default=None,
+                   help="local worker processes (default: number of cores)")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="write report.md, summary.csv, differences.csv, figures and "
+                        "replications.csv into DIR")
+    set_argument(p)
+
+
+def _label(arg: str) -> str:
+    from pathlib import Path
+
+    return Path(arg).stem if arg.endswith((".yaml", ".yml")) else Path(arg).name
+
+
+def main(args: argparse.Namespace) -> int:
+    import tempfile
+    from pathlib import Path
+
+    from cell.errors import CellError
+    from cell.overrides import parse_sets
+    from cell.scenario import load_scenario
+    from cell.sweep import run_sweep, simulate_summary
+    from cell.sweep.spec import comparison
+
+    sets = parse_sets(args.sets)
+    a, b = load_scenario(args.a, sets), load_scenario(args.b, sets)
+    if args.replications < 2:
+        raise CellError(f"--replications {args.replications}: must be at least 2 "
+                        "(a confidence interval needs two)")
+    if args.seed is not None and not 0 <= args.seed < 2**63:
+        raise CellError(f"--seed {args.seed}: must be a whole number from 0 to 2**63 - 1")
+    if args.workers is not None and args.workers < 1:
+        raise CellError(f"--workers {args.workers}: must be at least 1")
+    seed = a.run.seed if args.seed is None else args.seed
+    sweep = comparison(a, b, (_label(args.a), _label(args.b)), args.replications, seed)
+    target = None
+    if args.out:
+        from cell.output import OutputDir
+        from cell.reporting.experiment import REPORT_FILES, Target
+
+        names = (*REPORT_FILES, "replications.csv")
+        OutputDir.check(args.out, names)  # before anything runs
+        target = Target(Path(args.out), names, False)
+    with tempfile.TemporaryDirectory(prefix="cell-compare-") as work:
+        outcome = run_sweep(sweep, work, workers=args.workers, replicate=simulate_summary)
+        replications = outcome.replications
+    from cell.reporting.experiment import difference_table, summary_table
+
+    print(verdict(summary_table(replications, sweep), difference_table(replications, sweep),
+                  sweep))
+    if target is not None:
+        from cell.reporting.experiment import write_report
+
+        command = (f"cell compare {args.a} {args.b} --replications {args.replications} "
+                   f"--seed {seed}")
+        write_report(replications, sweep, target, command)
+        print(f"wrote {args.out}/: report.md, summary.csv, differences.csv, figures, "
+              "replications.csv")
+    return 0
+
+
+def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> str:
+    """A few lines: per headline measure, which is better and by how much (A - B)."""
+    from cell.reporting.headlines import HEADLINES, better, decimals, number
+
+    (la, a), (lb, b) = ((dict(p.values)["scenario"], p) for p in sweep.points)
+    parts = a.scenario.run.parts if a.scenario.run.parts == b.scenario.run.parts else None
+    level = f"{sweep.confidence * 100:g} %"
+    lines = [f"{la} ({a.policy}) against {lb} ({b.policy}): {sweep.replications} replications"
+             + (f" of {parts} parts" if parts else "") + f", seed {sweep.seed}, common random "
+             f"numbers; A - B with its paired {level} confidence interval"]
+    width = max(len(h.title) for h in HEADLINES)
+    for h in HEADLINES:
+        d = differences[differences["measure"] == h.column]
+        if d.empty:
+            continue
+        row = d.iloc[0]
+        means = summary[summary["measure"] == h.column].set_index("scenario")["mean"]
+        mean, sd, lo, hi = (float(row[k]) for k in ("mean", "sd", "ci_low", "ci_high"))
+        word = h.words[0] if mean >= 0 else h.words[1]
+        unit = f" {h.unit}" if h.unit else ""
+        per = f" per {parts}-part run" if h.per_run and parts else ""
+        if sd == 0.0:
+            what = ("equal in every replication" if mean == 0 else
+                    f"{number(abs(mean))}{unit} {word}{per} in every replication")
+            judged = bool(mean != 0)
+        elif not (lo <= 0.0 <= hi):
+            p = decimals((hi - lo) / 2)
+            what = (f"{abs(mean):.{p}f} ± {(hi - lo) / 2:.{p}f}{unit} {word}{per} "
+                    "(interval excludes 0)")
+            judged = True
+        else:
+            p = decimals((hi - lo) / 2)
+            what = (f"{abs(mean):.{p}f} ± {(hi - lo) / 2:.{p}f}{unit} {word}{per} "
+                    "(interval includes 0: no difference shown)")
+            judged = False
+        side = better(h, float(means[la]), float(means[lb])) if judged else 0
+        who = {1: f"{la} better", -1: f"{lb} better", 0: "neither"}[side]
+        if h.better == "one" and side:
+            who += " (nearer 1)"
+        lines.append(f"  {h.title:<{width}}  {who}: {what}")
+    return "\n".join(lines)

@@ -1,0 +1,118 @@
+"""Any sweep's report: ``cell sweep SWEEP --report DIR`` and ``cell compare --out DIR``.
+
+From a sweep's ``replications.csv`` (:mod:`cell.sweep.runner`) this writes, as
+one unit (:class:`cell.output.OutputDir`: the whole set appears at once or not
+at all):
+
+- ``summary.csv``: tidy long form, one row per (grid point, policy, measure) for
+  every numeric column of the runs' summaries: the grid's columns, ``policy``,
+  ``measure``, ``n``, ``mean``, ``sd``, the confidence interval of the mean
+  ``ci_low``/``ci_high`` (Student t) and ``run_p2_5``/``run_p97_5``, where
+  95 % of single runs fall (:func:`cell.analysis.stats.summarise`);
+- ``differences.csv``: the paired comparisons of :meth:`cell.sweep.Sweep.pairs`
+  -- replication r of both points drew the same parts (common random numbers),
+  so the difference is taken replication by replication: the grid's columns,
+  ``policy``, ``versus``, ``measure``, ``n``, ``mean``, ``sd``, ``ci_low``,
+  ``ci_high``, ``p_value`` (:func:`cell.analysis.stats.paired_difference`);
+- ``report.md``: a table, a figure and the paired differences per headline
+  measure (:mod:`cell.reporting.headlines`), and a reading drawn from the numbers
+  (:mod:`cell.reporting.experiment_text`);
+- ``fig_<measure>.png`` per headline measure (:mod:`cell.reporting.experiment_plots`);
+- for a sweep laid out like Table 7.1, ``table_7_1.csv`` and ``table_7_1.md``
+  (:mod:`cell.reporting.table_7_1`).
+
+A ``--report DIR`` that already holds files the report does not write (a shared
+folder such as the repository's ``reports/``) is left as it is: the report goes
+to ``DIR/<sweep name>/``, and Table 7.1's two files, for a sweep laid out like
+it, into ``DIR`` itself beside the others (each replaced atomically).
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import os
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from cell.output import OutputDir, check_file
+from cell.reporting.experiment_data import difference_table, measures, summary_table
+from cell.reporting.experiment_plots import figures
+from cell.reporting.experiment_text import markdown
+from cell.reporting.table_7_1 import is_table_7_1, table_7_1_files, write_table_7_1
+from cell.sweep import Sweep
+
+REPORT_FILES = ("report.md", "summary.csv", "differences.csv", "fig_*.png")
+TABLE_7_1_FILES = ("table_7_1.csv", "table_7_1.md")
+__all__ = ["Target", "difference_table", "measures", "plan_report", "summary_table",
+           "write_report"]
+
+
+@dataclass(frozen=True)
+class Target:
+    """Where a report goes: the unit's directory and files, and where Table 7.1's own
+    two files go when they cannot be part of the unit (None: inside it, or none)."""
+
+    directory: Path
+    names: tuple[str, ...]
+    table_7_1: bool
+    beside: Path | None = None
+
+
+def plan_report(sweep: Sweep, target: str | os.PathLike[str], option: str = "--report") -> Target:
+    """Check, before anything runs, where the report can go (see the module's docstring)."""
+    t71 = is_table_7_1(sweep)
+    names = REPORT_FILES + (TABLE_7_1_FILES if t71 else ())
+    path = Path(target)
+    if not _shared(path, names):
+        OutputDir.check(path, names, option)
+        return Target(path, names, t71)
+    sub = path / (re.sub(r"[^A-Za-z0-9._-]+", "_", sweep.name).strip("._") or "sweep")
+    OutputDir.check(sub, REPORT_FILES, option)
+    if t71:
+        for name in TABLE_7_1_FILES:
+            check_file(path / name)
+    return Target(sub, REPORT_FILES, t71, path if t71 else None)
+
+
+def _shared(path: Path, names: Sequence[str]) -> bool:
+    """Whether ``path`` is a directory holding entries the report does not write."""
+    try:
+        entries = [e.name for e in os.scandir(path)]
+    except OSError:
+        return False
+    return any(not e.startswith(".") and not any(fnmatch.fnmatchcase(e, n) for n in names)
+               for e in entries)
+
+
+def write_report(replications: pd.DataFrame, sweep: Sweep, target: Target,
+                 command: str) -> list[Path]:
+    """Write the report (see the module's docstring); return the paths written.
+    A target that names ``replications.csv`` gets the replications too."""
+    summary = summary_table(replications, sweep)
+    differences = difference_table(replications, sweep)
+    pngs = figures(summary, replications, sweep)
+    text = markdown(summary, differences, replications, sweep, command, list(pngs))
+    written = []
+    with OutputDir(target.directory, target.names, "--report") as out:
+        out.write_text("report.md", text)
+        out.write_csv("summary.csv", summary)
+        out.write_csv("differences.csv", differences)
+        for name, data in pngs.items():
+            out.write_bytes(name, data)
+        written = ["report.md", "summary.csv", "differences.csv", *pngs]
+        if "replications.csv" in target.names:
+            out.write_csv("replications.csv", replications)
+            written.append("replications.csv")
+        if target.table_7_1 and target.beside is None:
+            table, t71_text = table_7_1_files(replications, sweep)
+            out.write_csv("table_7_1.csv", table)
+            out.write_text("table_7_1.md", t71_text)
+            written += list(TABLE_7_1_FILES)
+    paths = [target.directory / name for name in written]
+    if target.table_7_1 and target.beside is not None:
+        paths += write_table_7_1(replications, sweep, target.beside)
+    return paths

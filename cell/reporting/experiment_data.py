@@ -1,0 +1,99 @@
+"""The numbers of an experiment's report: ``summary.csv`` and ``differences.csv``
+(:mod:`cell.reporting.experiment`), from a sweep's ``replications.csv``.
+
+Every interval comes from :mod:`cell.analysis.stats` (Student t, scipy.stats):
+:func:`~cell.analysis.stats.summarise` per point, and
+:func:`~cell.analysis.stats.paired_difference` per pair of points, replication r
+against replication r (common random numbers).
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pandas as pd
+
+from cell.analysis.stats import PAIRED_KEYS, SUMMARY_KEYS, paired_difference, summarise
+from cell.sweep import Sweep, grid_columns
+
+#: Columns of replications.csv that are not measures.
+NOT_MEASURES = {"policy", "point", "seed", "replication"}
+
+
+def measures(replications: pd.DataFrame, sweep: Sweep) -> list[str]:
+    """The numeric columns of the runs' summaries, in their order."""
+    grid = {c.name for c in grid_columns(sweep)}
+    return [c for c in replications.columns
+            if c not in NOT_MEASURES and c not in grid
+            and pd.api.types.is_numeric_dtype(replications[c])]
+
+
+def runs_of(replications: pd.DataFrame, sweep: Sweep, i: int) -> pd.DataFrame:
+    """Point ``i``'s replications, in replication order."""
+    p = sweep.points[i]
+    rows = replications[(replications["policy"] == p.policy) & (replications["point"] == p.index)]
+    return rows.sort_values("replication")
+
+
+def grid_values(replications: pd.DataFrame, sweep: Sweep, i: int) -> dict[str, object]:
+    """Point ``i``'s value in each grid column, as ``replications.csv`` holds it."""
+    rows = runs_of(replications, sweep, i)
+    first = rows.iloc[0] if len(rows) else None
+    return {c.name: (None if first is None else _plain(first[c.name]))
+            for c in grid_columns(sweep)}
+
+
+def _plain(value: object) -> object:
+    return value.item() if hasattr(value, "item") else value
+
+
+def _exact(stats: dict[str, float], x: np.ndarray) -> dict[str, float]:
+    """Values (or differences) all equal: no variation, exactly -- the sd the mean's
+    rounding leaves (1e-15 of it) is not a spread between replications."""
+    x = x[~np.isnan(x)]
+    if x.size >= 2 and np.all(x == x[0]) and stats["sd"] != 0.0:
+        stats = {**stats, "mean": float(x[0]), "sd": 0.0, "ci_low": float(x[0]),
+                 "ci_high": float(x[0])}
+        if "p_value" in stats:
+            stats["p_value"] = float("nan")
+    return stats
+
+
+def summary_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
+    """``summary.csv``: every point, policy and measure with its statistics."""
+    cols = [c.name for c in grid_columns(sweep)]
+    rows = []
+    for i, p in enumerate(sweep.points):
+        runs, keys = runs_of(replications, sweep, i), grid_values(replications, sweep, i)
+        for m in measures(replications, sweep):
+            x = runs[m].to_numpy(dtype=float)
+            s = _exact(summarise(x, sweep.confidence), x)
+            rows.append({**keys, "policy": p.policy, "measure": m, **s})
+    return pd.DataFrame(rows, columns=[*cols, "policy", "measure", *SUMMARY_KEYS])
+
+
+def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
+    """``differences.csv``: each pair of points, replication by replication, per measure.
+
+    The grid columns hold the compared point's values, or its partner's for a key
+    only the partner varies.
+    """
+    columns = grid_columns(sweep)
+    rows = []
+    for pair in sweep.pairs():
+        a, b = sweep.points[pair.point], sweep.points[pair.versus]
+        mine, theirs = grid_values(replications, sweep, pair.point), \
+            grid_values(replications, sweep, pair.versus)
+        keys = {c.name: theirs[c.name] if c.key in dict(b.values) and c.key not in dict(a.values)
+                else mine[c.name] for c in columns}
+        both = runs_of(replications, sweep, pair.point).merge(
+            runs_of(replications, sweep, pair.versus), on="replication", suffixes=("", "@b"))
+        for m in measures(replications, sweep):
+            with warnings.catch_warnings():  # nearly equal pairs: scipy warns, the sd says it
+                warnings.filterwarnings("ignore", "Precision loss", RuntimeWarning)
+                x, y = both[m].to_numpy(dtype=float), both[m + "@b"].to_numpy(dtype=float)
+                d = _exact(paired_difference(x, y, sweep.confidence), x - y)
+            rows.append({**keys, "policy": a.policy, "versus": pair.label, "measure": m, **d})
+    return pd.DataFrame(rows, columns=[*[c.name for c in columns], "policy", "versus", "measure",
+                                       *PAIRED_KEYS])

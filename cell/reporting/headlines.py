@@ -1,0 +1,97 @@
+"""The headline measures of an experiment's report, and how to say a difference in words.
+
+A report summarises every numeric column of the runs' summaries (new columns of
+:class:`cell.records.RunSummary` flow through untouched); these few get a table,
+a figure and sentences of their own.  Which direction is better is part of the
+measure: more parts delivered, fewer lost, a shorter cycle, an IP nearer 1
+(eq. 5.1: deliveries keeping pace with arrivals).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Headline:
+    """A measure the report leads with."""
+
+    column: str
+    title: str
+    """As a heading: ``Parts delivered``."""
+    sentence: str
+    """``{a} ... {x} ... {dir} than {b}``: how a paired difference reads."""
+    words: tuple[str, str]
+    """The words for a positive and a negative difference: ``more``/``fewer``."""
+    better: str
+    """``higher``, ``lower`` or ``one`` (nearer 1 is better)."""
+    per_run: bool = False
+    """A count per run: the sentence says ``per N-part run``."""
+    unit: str = ""
+
+
+HEADLINES: tuple[Headline, ...] = (
+    Headline("parts_delivered", "Parts delivered", "{a} delivers {x} parts {dir} than {b}",
+             ("more", "fewer"), "higher", per_run=True, unit="parts"),
+    Headline("parts_missed", "Parts lost (wall clock)", "{a} loses {x} parts {dir} than {b}",
+             ("more", "fewer"), "lower", per_run=True, unit="parts"),
+    Headline("parts_per_hr_wallclock", "Parts per hour (wall clock)",
+             "{a} delivers {x} parts/hr {dir} than {b} on the wall clock",
+             ("more", "fewer"), "higher", unit="parts/hr"),
+    Headline("actual_cycle_wallclock_s", "Actual cycle (wall clock, s)",
+             "{a} runs a wall-clock actual cycle {x} s {dir} than {b}",
+             ("longer", "shorter"), "lower", unit="s"),
+    Headline("ip_wallclock", "IP (wall clock, eq. 5.1)",
+             "{a} reaches a wall-clock IP {x} {dir} than {b}", ("higher", "lower"), "one"),
+    Headline("spacing_outside_tol", "Spacings outside 45 ± 0.25 in",
+             "{a} leaves {x} {dir} spacings outside 45 ± 0.25 in than {b}",
+             ("more", "fewer"), "lower", per_run=True, unit="spacings"),
+)
+BY_COLUMN = {h.column: h for h in HEADLINES}
+
+
+def headline(column: str) -> Headline:
+    """The measure's headline, or a plain one for any other column."""
+    return BY_COLUMN.get(column) or Headline(
+        column, column, "{a} has a " + column + " {x} {dir} than {b}", ("higher", "lower"),
+        "higher")
+
+
+def decimals(half: float) -> int:
+    """Decimals that show a confidence half-width to two significant figures (0 to 6)."""
+    if not math.isfinite(half) or half <= 0:
+        return 4
+    return min(6, max(0, 1 - math.floor(math.log10(half))))
+
+
+#: Beyond this magnitude figures are printed in exponent form.
+HUGE = 1e7
+
+
+def number(value: float, places: int | None = None) -> str:
+    """A figure for the text: ``places`` decimals, or six significant figures."""
+    if not math.isfinite(value):
+        return "—"
+    if places is None or abs(value) >= HUGE:
+        return f"{value:.6g}" if places is None else f"{value:.3g}"
+    return f"{value:.{places}f}"
+
+
+def plus_minus(mean: float, half: float, signed: bool = False) -> str:
+    """``mean ± half`` to the half-width's two significant figures (exponent form if huge)."""
+    sign = "+" if signed else ""
+    if max(abs(mean), abs(half)) >= HUGE:
+        return f"{mean:{sign}.3g} ± {half:.2g}"
+    d = decimals(half)
+    return f"{mean:{sign}.{d}f} ± {half:.{d}f}"
+
+
+def better(h: Headline, a: float, b: float) -> int:
+    """+1 if ``a`` is better than ``b`` on this measure, -1 if worse, 0 if level."""
+    if not (math.isfinite(a) and math.isfinite(b)) or a == b:
+        return 0
+    if h.better == "one":
+        da, db = abs(a - 1.0), abs(b - 1.0)
+        return 0 if da == db else (1 if da < db else -1)
+    return (1 if a > b else -1) * (1 if h.better == "higher" else -1)

@@ -1,0 +1,130 @@
+"""``cell compare A B``: two scenarios under common random numbers, paired."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import scipy.stats
+import yaml
+from test_sweep import write_sweep
+
+from cell.cli import main
+from cell.reporting.experiment import difference_table
+from cell.sweep import load_sweep, run_sweep
+
+
+def scenario(tmp_path: Path, name: str, **settings) -> Path:
+    doc = {"run": {"parts": 40}, "controller": {"policy": "adaptive"}}
+    for key, value in settings.items():
+        section, field = key.split("__")
+        doc.setdefault(section, {})[field] = value
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(yaml.safe_dump(doc))
+    return path
+
+
+def test_compare_agrees_with_the_sweeps_paired_differences(tmp_path, capsys):
+    a = scenario(tmp_path, "adaptive")
+    b = scenario(tmp_path, "fixed", controller__policy="non-adaptive")
+    code = main(["compare", str(a), str(b), "--replications", "6", "--seed", "11",
+                 "--workers", "1", "--out", str(tmp_path / "cmp")])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    ours = pd.read_csv(tmp_path / "cmp" / "differences.csv")
+
+    sweep = load_sweep(write_sweep(tmp_path, base=str(a), set={"run.parts": 40},
+                                   policies=["non-adaptive", "adaptive"], replications=6,
+                                   seed=11, batch=3))
+    frame = run_sweep(sweep, tmp_path / "sweep", workers=1, progress=False).replications
+    theirs = difference_table(frame, sweep)
+    assert set(theirs["policy"]) == {"adaptive"} and set(theirs["versus"]) == {"non-adaptive"}
+    merged = ours.merge(theirs, on="measure", suffixes=("", "_sweep"))
+    assert len(merged) == len(theirs) > 20
+    for col in ("n", "mean", "sd", "ci_low", "ci_high", "p_value"):
+        pd.testing.assert_series_equal(merged[col], merged[col + "_sweep"], check_names=False,
+                                       rtol=1e-9)
+    # the verdict: A (adaptive) delivers more and loses fewer, the interval excluding zero
+    delivered = ours[ours["measure"] == "parts_delivered"].iloc[0]
+    assert delivered["ci_low"] > 0
+    line = next(x for x in out.splitlines() if x.strip().startswith("Parts delivered"))
+    half = (delivered["ci_high"] - delivered["ci_low"]) / 2
+    assert "adaptive better" in line and "interval excludes 0" in line
+    assert f"{delivered['mean']:.1f}" in line or f"{delivered['mean']:.2f}" in line
+    assert f"{half:.1f}" in line or f"{half:.2f}" in line
+    assert "6 replications of 40 parts, seed 11" in out.splitlines()[0]
+    files = {p.name for p in (tmp_path / "cmp").iterdir()}
+    assert {"report.md", "summary.csv", "differences.csv", "replications.csv"} <= files
+
+
+def test_compare_paired_interval_is_scipys(tmp_path, capsys):
+    a = scenario(tmp_path, "slow", belts__output_nominal_in_s=2.0)
+    b = scenario(tmp_path, "fast", belts__output_nominal_in_s=2.5)
+    assert main(["compare", str(a), str(b), "--replications", "5", "--workers", "1",
+                 "--out", str(tmp_path / "cmp")]) == 0
+    reps = pd.read_csv(tmp_path / "cmp" / "replications.csv")
+    diffs = pd.read_csv(tmp_path / "cmp" / "differences.csv")
+    x = reps[reps["scenario"] == "slow"].sort_values("replication")["spacing_max_in"]
+    y = reps[reps["scenario"] == "fast"].sort_values("replication")["spacing_max_in"]
+    row = diffs[diffs["measure"] == "spacing_max_in"].iloc[0]
+    if (x.to_numpy() - y.to_numpy()).std() > 0:
+        ci = scipy.stats.ttest_rel(x, y).confidence_interval(0.95)
+        assert (row["ci_low"], row["ci_high"]) == pytest.approx((ci.low, ci.high), rel=1e-9)
+    assert row["mean"] == pytest.approx((x.to_numpy() - y.to_numpy()).mean(), rel=1e-9)
+    assert set(reps["seed"]) == {1984}  # A's run.seed
+
+
+def test_verdict_says_which_is_better_on_each_measure():
+    from cell.commands.compare import verdict
+    from cell.scenario import load_scenario
+    from cell.sweep.spec import comparison
+
+    a = load_scenario("baseline")
+    sweep = comparison(a, a.with_overrides({"controller.policy": "non-adaptive"}),
+                       ("a", "b"), 10, 1)
+    summary = pd.DataFrame([
+        {"scenario": s, "policy": p, "measure": m, "n": 10, "mean": v, "sd": 1.0,
+         "ci_low": v - 1, "ci_high": v + 1, "run_p2_5": v - 2, "run_p97_5": v + 2}
+        for s, p, vals in (("a", "adaptive", (500, 0, 1.01, 30.0)),
+                           ("b", "non-adaptive", (400, 100, 0.80, 30.5)))
+        for m, v in zip(("parts_delivered", "parts_missed", "ip_wallclock",
+                         "actual_cycle_wallclock_s"), vals, strict=True)])
+    diffs = pd.DataFrame([
+        {"scenario": "a", "policy": "adaptive", "versus": "b", "measure": m, "n": 10,
+         "mean": d, "sd": s, "ci_low": lo, "ci_high": hi, "p_value": 0.01}
+        for m, d, s, lo, hi in (("parts_delivered", 100.0, 3.0, 98.0, 102.0),
+                                ("parts_missed", -100.0, 3.0, -102.0, -98.0),
+                                ("ip_wallclock", 0.21, 0.01, 0.20, 0.22),
+                                ("actual_cycle_wallclock_s", -0.5, 2.0, -1.9, 0.9))])
+    text = verdict(summary, diffs, sweep)
+    lines = {line.split("  ")[1].strip(): line for line in text.splitlines()[1:]}
+    assert "a better: 100.0 ± 2.0 parts more" in lines["Parts delivered"]
+    assert "a better: 100.0 ± 2.0 parts fewer" in lines["Parts lost (wall clock)"]
+    assert "a better (nearer 1)" in lines["IP (wall clock, eq. 5.1)"]
+    assert "neither" in lines["Actual cycle (wall clock, s)"]
+    assert "interval includes 0: no difference shown" in lines["Actual cycle (wall clock, s)"]
+
+
+@pytest.mark.parametrize(("args", "shows"), [
+    (["nowhere.yaml", "baseline"], "nowhere.yaml"),
+    (["baseline", "non_adaptive", "--replications", "1"], "--replications 1"),
+    (["baseline", "non_adaptive", "--workers", "0"], "--workers 0"),
+    (["baseline", "non_adaptive", "--seed", "-4"], "--seed -4"),
+    (["baseline", "non_adaptive", "--set", "run.partz=3"], "run.partz"),
+    (["baseline", "non_adaptive", "--set", "run.parts=-3"], "run.parts"),
+])
+def test_bad_compare_input_one_line_exit_2_nothing_written(tmp_path, capsys, args, shows):
+    code = main(["compare", *args, "--out", str(tmp_path / "cmp")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and shows in err, err
+    assert not (tmp_path / "cmp").exists()
+
+
+def test_compare_refuses_an_out_that_is_a_file_before_running(tmp_path, capsys):
+    blocker = tmp_path / "taken"
+    blocker.write_text("x")
+    code = main(["compare", "baseline", "non_adaptive", "--out", str(blocker)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and "taken" in err
+    assert blocker.read_text() == "x"
