@@ -12,7 +12,7 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 
 from cell.assembly import step_table
-from cell.figures import arrivals, layout, motion, runs
+from cell.figures import arrivals, layout, motion, runs, tip
 from cell.figures.style import style
 from cell.scenario import Scenario
 
@@ -87,7 +87,7 @@ def make_figures(scenario: Scenario, out: str | Path, *, parts: int | None = Non
         if wanted & set(range(22, 31)):
             sims = runs.simulate_runs(scenario)
             if 22 in wanted:
-                done(runs.fig22_tip_velocity(sims, table, scenario, path[22]))
+                done(tip.fig22_tip_velocity(sims, table, scenario, path[22]))
             if 23 in wanted:
                 done(runs.fig23_lumped(sims, scenario, path[23]))
             if 24 in wanted:

@@ -1,7 +1,7 @@
 """One transfer in time: Fig. 15-21 (thesis §7.1).
 
-The path is timed at its nominal regime velocities (SPEC §6): R I and R III
-locked to their belts (each move takes its advance along the belt over the belt
+The path is timed at its nominal regime velocities (``docs/model.md``, "The
+nominal cycle"): R I and R III locked to their belts (each move takes its advance along the belt over the belt
 speed), R IV at the base's nominal rate and R II the rest of the 22.5872 s
 ideal cycle.  No move is ever shorter than its motors allow (§6.1): after LO
 the loaded shoulder cannot quite keep up with the 3 in/s belt (§4.3 c), so R I
@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 from cell.assembly import motors_of
 from cell.figures.style import LIMIT_COLOUR, REGIME_LABELS, mark_events, new_figure, save, shade_regimes
 from cell.kinematics import JOINT_NAMES
-from cell.motors import max_rates, move_times, velocity_for_time
+from cell.motors import max_rates, min_move_times, move_times, velocity_for_time
 from cell.scenario import Scenario
 from cell.steptable import SEGMENTS, StepTable
 
@@ -44,21 +44,53 @@ class Timeline:
                 4: g["r4"]}
 
 
-def timeline(table: StepTable, segment_s: dict[str, float]) -> Timeline:
-    """Spread each segment's time over its moves: one velocity per segment, every
-    move max(ℓ/v, t_min) at the motors' peak rates (§6.1)."""
+def joint_travel_min_times(table: StepTable) -> NDArray[np.float64]:
+    """(N,) each move's shortest time over the joints' travel |Δθ|·k at their peak rates
+    (§6.1), without rounding each path point to whole steps (row 0: 0).
+
+    The simulation times a move by its whole steps, round(θ·k) at each point, so a
+    motor at its limit alternates moves of, say, 10 and 11 steps over equal lengths;
+    a whole regime's steps add up to its travel either way.
+    """
+    k = np.asarray(table.motors.steps_per_rad, dtype=float)
+    travel = np.vstack([np.zeros((1, 5)), np.diff(table.path.q_rad, axis=0) * k])
+    return min_move_times(travel, table.path.load_oz, table.motors)
+
+
+def spread(lengths: NDArray[np.float64], floors: NDArray[np.float64],
+           total_s: float) -> NDArray[np.float64]:
+    """Each move's time when ``total_s`` is spread over moves of these lengths: one
+    velocity v for all, every move max(ℓ/v, t_min) (§6.1).
+
+    At or below the floors' sum every move runs at its floor, scaled to ``total_s``;
+    a stretch with no length (v undefined) shares its time in proportion to the floors.
+    """
+    fsum = float(floors.sum())
+    if total_s <= fsum or not np.any(lengths > 0):
+        if fsum > 0:
+            return floors * (total_s / fsum)
+        return np.full(len(floors), total_s / max(len(floors), 1))
+    return move_times(lengths, floors, velocity_for_time(lengths, floors, total_s))
+
+
+def timeline(table: StepTable, segment_s: dict[str, float],
+             floors: NDArray[np.float64] | None = None) -> Timeline:
+    """Spread each segment's time over its moves (:func:`spread`).
+
+    ``floors``: each move's shortest time; the simulation's whole-step ones
+    (``table.peak_min_times``) unless given, e.g. :func:`joint_travel_min_times`.
+    Each segment then lasts exactly its given time.
+    """
     ell = table.velocity_lengths
-    floor = table.peak_min_times
+    floor = table.peak_min_times if floors is None else np.asarray(floors, dtype=float)
     dt = np.zeros(table.path.n_points)
     for name, rows in table.segment_rows().items():
-        total = max(float(segment_s[name]), float(floor[rows].sum()))
-        v = velocity_for_time(ell[rows], floor[rows], total)
-        dt[rows] = move_times(ell[rows], floor[rows], v)
+        dt[rows] = spread(ell[rows], floor[rows], float(segment_s[name]))
     return Timeline(np.cumsum(dt), dt, {k: float(segment_s[k]) for k in SEGMENTS})
 
 
 def nominal_timeline(table: StepTable, s: Scenario) -> Timeline:
-    """One transfer at the nominal velocities, as the controllers plan it (SPEC §6):
+    """One transfer at the nominal velocities, as the controllers plan it (``docs/model.md``):
     R I and R III locked to their belts at nominal speed, R IV at the nominal (75 %)
     motor rates, and R II the rest of the ideal cycle (the thesis's
     22.5872 - 8/3 - 4 - 9.9855 = 5.935 s if R I took exactly 8/3 s)."""
