@@ -113,6 +113,28 @@ def test_no_joint_beyond_its_maximum_rate() -> None:
     assert np.all(rate <= limit * (1 + 1e-9))
 
 
+def test_no_joint_travel_beyond_its_maximum_rate() -> None:
+    """Fig. 17-21's black traces: each move's joint travel |Δθ|·k over its drawn time is
+    within the motor's rate at the move's load, the rate linear in the load (§6.1).
+    Over the whole-step times the loaded shoulder's travel would exceed it by 8 %."""
+    from cell.figures.motion import joint_travel_min_times
+
+    s = default_scenario()
+    m = s.robot.motors
+    table = step_table(s)
+    tl = nominal_timeline(table, s, joint_travel_min_times(table))
+    k = np.array(m.steps_per_rad)
+    travel = np.abs(np.diff(table.path.q_rad, axis=0)) * k
+    load = table.path.load_oz[1:, None]
+    no_load, full = np.array(m.max_rate_no_load_rad_s), np.array(m.max_rate_full_load_rad_s)
+    limit = k * (no_load + (full - no_load) * load / m.full_load_oz)
+    assert np.all(travel / tl.dt_s[1:, None] <= limit * (1 + 1e-9))
+    steps_tl = nominal_timeline(table, s)
+    assert np.max(travel / steps_tl.dt_s[1:, None] / limit) > 1.05
+    np.testing.assert_allclose(tl.t_s[[table.path.lo, table.path.td, -1]],
+                               steps_tl.t_s[[table.path.lo, table.path.td, -1]], atol=1e-9)
+
+
 def test_bad_scenario_is_one_line_and_writes_nothing(tmp_path: Path, capsys) -> None:
     bad = tmp_path / "bad.yaml"
     bad.write_text("belts:\n  input_nominal_in_s: -3\n")
