@@ -215,7 +215,7 @@ def fig22() -> tuple[Figure, Any, Any]:
     from cell.figures.style import style
     from cell.figures.tip import fig22_figure, pick_transfer
 
-    s = default_scenario()                    # the committed figure's run
+    s = load_scenario("baseline")             # the committed figure's run
     runs = simulate_runs(s, cycles=(22.5872,))
     with style():
         fig = fig22_figure(runs, step_table(s), s)
