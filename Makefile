@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-stamp
 WORKERS ?= 2
 
-.PHONY: all venv test sweep sweep-mintime whatif figures bench lint clean
+.PHONY: all venv test sweep sweep-mintime whatif figures animation bench lint clean
 
 all: test
 
@@ -32,6 +32,9 @@ whatif: $(STAMP)
 figures: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m cell figures --out reports/figures
 	$(PY) -m cell.reporting.mintime
+
+animation: $(STAMP)
+	$(PY) -m cell.animation reports/animation/both.gif
 
 bench: $(STAMP)
 	$(PY) -m cell bench --out reports/bench.json

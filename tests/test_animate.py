@@ -174,6 +174,78 @@ def test_both_policies_see_the_same_parts(scenes: list[Scene]) -> None:
     np.testing.assert_array_equal(scenes[0].data.arrival_s, scenes[1].data.arrival_s)
 
 
+def test_the_belts_are_the_runs_recorded_history(scenes: list[Scene], scenario: Scenario) -> None:
+    """The animation's belts are the run's own speed changes (belts.csv), nothing recomputed."""
+    from cell.simulation import simulate
+
+    for sc in scenes:
+        d = sc.data
+        run = simulate(scenario.with_overrides({"controller.policy": d.policy,
+                                                "run.parts": len(d.part)}))
+        for belt, history in (("input", d.input_belt), ("output", d.output_belt)):
+            rows = sorted((c.from_s, c.speed_in_s) for c in run.belt_changes if c.belt == belt)
+            np.testing.assert_array_equal(history, np.array(rows))
+        assert len(np.unique(d.input_belt[:, 1])) > 2 or d.policy == "non-adaptive"
+
+
+def square_centres(collection) -> np.ndarray:  # noqa: ANN001
+    """Centres of the squares a PolyCollection draws."""
+    return np.array([p.vertices[:4].mean(axis=0) for p in collection.get_paths()]).reshape(-1, 2)
+
+
+@pytest.mark.parametrize("policy", [0, 1], ids=["adaptive", "non-adaptive"])
+def test_drawn_parts_sit_where_the_belts_travel_puts_them(scenes: list[Scene], scenario: Scenario,
+                                                          policy: int) -> None:
+    """At sampled frames, the squares drawn on the two belt strips are exactly the parts the
+    records put there, each where the belt's integrated travel has carried it: dropped
+    ``input_length`` upstream of B, fallen off at F (lying just past it), or set down at TD."""
+    from cell.animation.render import build_figure, draw_frame
+    from cell.animation.scene import FALL_S
+
+    panel = build_figure(scenes, dpi=20.0)[1][policy]
+    sc = scenes[policy]
+    d = sc.data
+    times = sample_times(scenes)[::8]
+    x_of = integrated(d.input_belt, times[-1] + 1)
+    y_of = integrated(d.output_belt, times[-1] + 1)
+    b, f, td = (named_points(scenario)[k] for k in ("B", "F", "TD"))
+    length = 2 * scenario.belts.input_nominal_in_s * scenario.controller.nominal_cycle_s
+    grid = np.arange(0.0, times[-1] + 1, 1e-3)
+    fall = np.interp(x_of(d.arrival_s) + length + (f[0] - b[0]), x_of(grid), grid)
+    drawn_in = drawn_out = 0
+    for t in times:
+        draw_frame(panel, float(t))
+        riding = (d.arrival_s <= t) & np.where(d.picked, t < d.pick_s, t < fall)
+        fallen = ~d.picked & (t >= fall) & (t < fall + FALL_S)
+        expected_in = np.sort(np.r_[b[0] - length + x_of(t) - x_of(d.arrival_s[riding]),
+                                    np.full(fallen.sum(), f[0] + scenario.part.size_in / 2)])
+        centres = square_centres(panel.parts_in)
+        assert np.sort(centres[:, 0]) == pytest.approx(expected_in, abs=0.02), t
+        assert centres[:, 1] == pytest.approx(np.full(len(centres), b[1]))
+        set_down = d.picked & (d.touchdown_s <= t)
+        expected_out = np.sort(td[1] + y_of(t) - y_of(d.touchdown_s[set_down]))
+        assert np.sort(square_centres(panel.parts_out)[:, 0]) == pytest.approx(expected_out,
+                                                                               abs=0.02), t
+        drawn_in, drawn_out = drawn_in + len(expected_in), drawn_out + len(expected_out)
+        # the belt speeds written on the frame are the recorded ones at t
+        v_in = [v for start, v in d.input_belt if start <= t][-1]
+        v_out = [v for start, v in d.output_belt if start <= t][-1]
+        assert panel.texts["belts"].get_text().split() == [
+            "input", "belt", f"{v_in:.2f}", "in/s", "output", "belt", f"{v_out:.2f}", "in/s"]
+    assert drawn_in > 40 and drawn_out > 40
+
+
+def test_the_demo_shows_a_part_the_fixed_cycle_loses_and_the_adaptive_saves() -> None:
+    from cell.animation import DEMO_FIRST, DEMO_PARTS
+    from cell.scenario import load_scenario
+
+    adaptive, fixed = simulate_scenes(load_scenario("baseline"), ["adaptive", "non-adaptive"],
+                                      DEMO_FIRST, DEMO_PARTS)
+    shown = slice(DEMO_FIRST - 1, DEMO_FIRST - 1 + DEMO_PARTS)
+    assert adaptive.data.picked[shown].all()
+    assert (~fixed.data.picked[shown]).sum() >= 2
+
+
 # --------------------------------------------------------------------------- the arm
 def test_the_arm_tip_passes_the_named_points_at_the_recorded_instants(
         scenes: list[Scene], scenario: Scenario) -> None:
@@ -218,7 +290,7 @@ def test_the_arm_tip_is_on_the_path_at_every_path_point(scenes: list[Scene],
 
 
 def test_the_links_keep_their_lengths(scenes: list[Scene], scenario: Scenario) -> None:
-    """Upper arm and forearm 7 in (SPEC §2), shoulder 7.68 in above the base (§6.1), and the
+    """Upper arm and forearm 7 in (docs/model.md), shoulder 7.68 in above the base (§6.1), and the
     hand 3.5498 in long while it holds the 2 in cube (eq. 6.2)."""
     sc = scenes[0]
     d = sc.data

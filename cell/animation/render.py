@@ -318,7 +318,7 @@ def render(scenes: list[Scene], times: Floats, out: Path, *, fps: int, dpi: floa
 
     ``out`` is written as given; making it atomic is the caller's business.
     """
-    from tqdm import tqdm
+    from cell.progress import progress as counted
 
     gif = out.suffix.lower() == ".gif"
     with style():
@@ -336,8 +336,8 @@ def render(scenes: list[Scene], times: Floats, out: Path, *, fps: int, dpi: floa
             else FFMpegWriter(fps=fps, codec="h264")
         label = " | ".join(sc.data.policy for sc in scenes)
         with writer.saving(fig, str(out), dpi):
-            for t in tqdm(times, desc=f"cell animate ({label})", unit="frame", file=sys.stderr,
-                          disable=not progress, leave=False):
+            for t in counted(times, f"cell animate ({label})", "frames", file=sys.stderr,
+                             enabled=progress):
                 for panel in panels:
                     draw_frame(panel, float(t))
                 if gif:  # ffmpeg's writer redraws the whole figure itself

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from cell.conveyors import speed_at
 from cell.kinematics import Arm, forward, hand_frame
 from cell.scenario import Scenario
 from cell.steptable import SEGMENTS, StepTable
@@ -68,12 +69,20 @@ class AnimationInput:
     """Feeder drop point to B."""
 
 
+def belt_history(result: Any, belt: str) -> Floats:
+    """(m, 2) rows (from_s, speed_in_s) of one belt's speed changes, as the run recorded
+    them (``SimResult.belt_changes``, the rows of ``belts.csv``), in time order."""
+    rows = [(c.from_s, c.speed_in_s) for c in result.belt_changes if c.belt == belt]
+    return np.array(sorted(rows), dtype=float).reshape(-1, 2)
+
+
 def frames_input(result: Any, table: StepTable, scenario: Scenario) -> AnimationInput:
     """The run's part records and belt changes as plain arrays.
 
     ``start_s`` is ``at_bot_s`` for a picked part (the robot starts its cycle the
     moment the part reaches B); each regime's time is the record's ``rN_s``; the
-    drop point is the cell's ``input_length``.
+    belts' speeds are the run's recorded changes (:func:`belt_history`); the drop
+    point is the cell's ``input_length``.
     """
     from cell.assembly import constants, robot_timing
 
@@ -92,8 +101,8 @@ def frames_input(result: Any, table: StepTable, scenario: Scenario) -> Animation
         touchdown_s=d["touchdown_s"].to_numpy(dtype=float),
         regime_s=np.where(picked[:, None],
                           d[[f"r{r}_s" for r in (1, 2, 3, 4)]].to_numpy(dtype=float), np.nan),
-        input_belt=np.array(result.belts["input"], dtype=float).reshape(-1, 2),
-        output_belt=np.array(result.belts["output"], dtype=float).reshape(-1, 2),
+        input_belt=belt_history(result, "input"),
+        output_belt=belt_history(result, "output"),
         input_length_in=float(constants(scenario, robot_timing(scenario)).input_length))
 
 
@@ -123,12 +132,10 @@ def time_at(history: ArrayLike, x: ArrayLike) -> Floats:
     return start[k] + (x - knots[k]) / h[k, 1]
 
 
-def belt_speed(history: ArrayLike, t: ArrayLike) -> Floats:
-    """The belt's speed at t (a change at t already holds)."""
+def belt_speed(history: ArrayLike, t: float) -> float:
+    """The belt's speed at t (a change at t already holds): the conveyors' own lookup."""
     h = np.asarray(history, dtype=float).reshape(-1, 2)
-    k = np.clip(np.searchsorted(h[:, 0], np.asarray(t, dtype=float), side="right") - 1, 0,
-                len(h) - 1)
-    return h[k, 1]
+    return speed_at(h[:, 0].tolist(), h[:, 1].tolist(), float(t))
 
 
 # --------------------------------------------------------------------------- the scene

@@ -12,7 +12,7 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 
 from cell.assembly import step_table
-from cell.figures import arrivals, layout, motion, runs
+from cell.figures import arrivals, layout, motion, runs, tip
 from cell.figures.style import style
 from cell.scenario import Scenario
 
@@ -76,18 +76,21 @@ def make_figures(scenario: Scenario, out: str | Path, *, parts: int | None = Non
                 done(arrivals.fig13_pdf(scenario, x, path[13]))
             if 14 in wanted:
                 done(arrivals.fig14_cdf(scenario, x, path[14]))
-        tl = motion.nominal_timeline(table, scenario)
+        # drawn on the joints' travel; Fig. 17-21's whole steps on the simulation's own timing
+        tl = motion.nominal_timeline(table, scenario, motion.joint_travel_min_times(table))
+        steps_tl = motion.nominal_timeline(table, scenario)
         if 15 in wanted:
             done(motion.fig15_coordinates(table, tl, path[15]))
         if 16 in wanted:
             done(motion.fig16_joint_angles(table, tl, path[16]))
         for joint in range(5):
             if 17 + joint in wanted:
-                done(motion.fig_joint_rate(table, tl, scenario, joint, path[17 + joint]))
+                done(motion.fig_joint_rate(table, tl, steps_tl, scenario, joint,
+                                            path[17 + joint]))
         if wanted & set(range(22, 31)):
             sims = runs.simulate_runs(scenario)
             if 22 in wanted:
-                done(runs.fig22_tip_velocity(sims, table, scenario, path[22]))
+                done(tip.fig22_tip_velocity(sims, table, scenario, path[22]))
             if 23 in wanted:
                 done(runs.fig23_lumped(sims, scenario, path[23]))
             if 24 in wanted:

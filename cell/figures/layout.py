@@ -3,12 +3,24 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+from matplotlib.figure import Figure
 from matplotlib.patches import Circle, FancyArrow, Rectangle
+from matplotlib.transforms import Bbox
+from mpl_toolkits.mplot3d import proj3d  # type: ignore[import-untyped]
 
 from cell.assembly import geometry_of
-from cell.figures.style import REGIME_COLOURS, REGIME_LABELS, new_figure, save
+from cell.figures.style import (
+    REGIME_COLOURS,
+    REGIME_LABELS,
+    Label,
+    freeze_layout,
+    new_figure,
+    place_clear,
+    save,
+)
 from cell.kinematics import hand_length
 from cell.scenario import Scenario
 from cell.steptable import StepTable
@@ -72,6 +84,11 @@ def fig08_working_environment(s: Scenario, table: StepTable, out: Path) -> Path:
 
 
 def fig09_path(s: Scenario, table: StepTable, out: Path) -> Path:
+    return save(fig09_figure(s, table), out)
+
+
+def fig09_figure(s: Scenario, table: StepTable) -> Figure:
+    """Fig. 9, drawn and laid out (not saved); every name placed where nothing covers it."""
     fig, ax = new_figure(9, "Path Definition for the Robot", size=(8.0, 6.8), projection="3d")
     w = s.cell.belt_width_in
     (x0, x1), (y0, y1) = _belt_extent(s)
@@ -80,19 +97,19 @@ def fig09_path(s: Scenario, table: StepTable, out: Path) -> Path:
         gx, gy = np.meshgrid(xs, ys)
         ax.plot_surface(gx, gy, np.zeros_like(gx), color=BELT_COLOUR, alpha=0.45, lw=0)
     bx, by, bz = s.cell.robot_base_in
-    ax.plot([bx, bx], [by, by], [bz, bz + s.cell.shoulder_height_in], color="0.25", lw=4)
-    ax.text(bx, by, bz + s.cell.shoulder_height_in + 0.5, "shoulder", fontsize=8.5)
+    top = (bx, by, bz + s.cell.shoulder_height_in)
+    curves = ax.plot([bx, bx], [by, by], [bz, top[2]], color="0.25", lw=4)
     p = table.path
     for reg in (1, 2, 3, 4):
         idx = np.flatnonzero(p.regime == reg)
         idx = np.concatenate([[idx[0] - 1], idx]) if idx[0] > 0 else idx
         xyz = p.xyz_in[idx]
-        ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], color=REGIME_COLOURS[reg], lw=2.6,
-                label=f"{REGIME_LABELS[reg]} ({idx.size - 1} moves, "
-                      f"{table.regime_length(reg):.3f} in)")
-    for name, pt in _named_points(s, table).items():
+        curves += ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], color=REGIME_COLOURS[reg], lw=2.6,
+                          label=f"{REGIME_LABELS[reg]} ({idx.size - 1} moves, "
+                                f"{table.regime_length(reg):.3f} in)")
+    named = _named_points(s, table)
+    for pt in named.values():
         ax.scatter(*pt, color="black", s=14, depthshade=False)
-        ax.text(pt[0], pt[1], pt[2] - 0.9, name, fontsize=9, fontweight="bold")
     ax.set_xlabel("x (in)")
     ax.set_ylabel("y (in)")
     ax.set_zlabel("z (in)", labelpad=2)
@@ -102,7 +119,41 @@ def fig09_path(s: Scenario, table: StepTable, out: Path) -> Path:
     ax.set_box_aspect((w / 2 - x0, y1 + w / 2, 8 * 2.2), zoom=1.0)
     ax.view_init(elev=24, azim=-128)
     ax.legend(loc="upper left", fontsize=8.5)
-    return save(fig, out)
+    _label_points(fig, ax, named, top, curves)
+    return fig
+
+
+#: Text offsets (points) tried for a point's name, nearest first.
+AROUND = [(dx, dy) for r in (5, 9, 14) for dx, dy in
+          ((r, -r - 6), (r, r - 3), (-r - 12, -r - 6), (-r - 12, r - 3), (r + 2, -4), (-r - 14, -4),
+           (-5, r), (-5, -r - 10))]
+
+
+def _label_points(fig: Figure, ax: Any, named: dict[str, np.ndarray], shoulder: tuple,
+                  curves: list) -> None:
+    """Name the points in 2-D, each where no curve, point or other name covers it.
+
+    The view is fixed, so each point's projection is computed once the figure is
+    laid out; the names are then ordinary annotations of the projected plane.
+    """
+    freeze_layout(fig)
+
+    def at(xyz: tuple | np.ndarray) -> tuple[float, float]:
+        x, y, _ = proj3d.proj_transform(*(np.atleast_1d(float(c)) for c in xyz), ax.get_proj())
+        return float(x[0]), float(y[0])
+
+    marks = []
+    for pt in named.values():
+        cx, cy = ax.transData.transform(at(pt))
+        marks.append(Bbox.from_extents(cx - 3, cy - 3, cx + 3, cy + 3))
+    labels = [Label(ax.annotate("shoulder", at(shoulder), xytext=(-20, 6),
+                                textcoords="offset points", fontsize=8.5, zorder=20),
+                    [(-20, 6), (4, 4), (-50, 4)])]
+    for name, pt in named.items():
+        text = ax.annotate(name, at(pt), xytext=AROUND[0], textcoords="offset points",
+                           fontsize=9, fontweight="bold", zorder=20)
+        labels.append(Label(text, AROUND))
+    place_clear(ax, labels, avoid=curves, avoid_boxes=marks)
 
 
 def fig12_hand_length(s: Scenario, out: Path) -> Path:

@@ -1,13 +1,18 @@
 """One transfer in time: Fig. 15-21 (thesis §7.1).
 
-The path is timed at its nominal regime velocities (SPEC §6): R I and R III
-locked to their belts (each move takes its advance along the belt over the belt
-speed), R IV at the base's nominal rate and R II the rest of the 22.5872 s
-ideal cycle.  No move is ever shorter than its motors allow (§6.1): after LO
-the loaded shoulder cannot quite keep up with the 3 in/s belt (§4.3 c), so R I
-takes 2.729 s rather than 8/3 s and R II 5.867 s rather than the thesis's
-5.935 s, as in the simulation.  The same spreading of segment times over moves
-draws one simulated transfer in Fig. 22.
+The path is timed at its nominal regime velocities (``docs/model.md``, "The
+nominal cycle"): R I and R III locked to their belts (each move takes its
+advance along the belt over the belt speed), R IV at the base's nominal rate and
+R II the rest of the 22.5872 s ideal cycle.  No move is ever shorter than its
+motors allow (§6.1): after LO the loaded shoulder cannot quite keep up with the
+3 in/s belt (§4.3 c), so R I takes 2.729 s rather than 8/3 s and R II 5.867 s
+rather than the thesis's 5.935 s, as in the simulation.
+
+Each regime's time is the simulation's; the figures spread it over the moves on
+the joints' travel (:func:`joint_travel_min_times`), what the motors do, rather
+than on the whole steps the simulation counts, whose 10- and 11-step moves would
+make the rates flicker by a step per move.  Fig. 22 draws one simulated transfer
+the same way.
 """
 
 from __future__ import annotations
@@ -21,7 +26,7 @@ from numpy.typing import NDArray
 from cell.assembly import motors_of
 from cell.figures.style import LIMIT_COLOUR, REGIME_LABELS, mark_events, new_figure, save, shade_regimes
 from cell.kinematics import JOINT_NAMES
-from cell.motors import max_rates, move_times, velocity_for_time
+from cell.motors import max_rates, min_move_times, move_times, velocity_for_time
 from cell.scenario import Scenario
 from cell.steptable import SEGMENTS, StepTable
 
@@ -44,29 +49,64 @@ class Timeline:
                 4: g["r4"]}
 
 
-def timeline(table: StepTable, segment_s: dict[str, float]) -> Timeline:
-    """Spread each segment's time over its moves: one velocity per segment, every
-    move max(ℓ/v, t_min) at the motors' peak rates (§6.1)."""
+def joint_travel_min_times(table: StepTable) -> NDArray[np.float64]:
+    """(N,) each move's shortest time over the joints' travel |Δθ|·k at their peak rates
+    (§6.1), without rounding each path point to whole steps (row 0: 0).
+
+    The simulation times a move by its whole steps, round(θ·k) at each point, so a
+    motor at its limit alternates moves of, say, 10 and 11 steps over equal lengths;
+    a whole regime's steps add up to its travel either way.
+    """
+    k = np.asarray(table.motors.steps_per_rad, dtype=float)
+    travel = np.vstack([np.zeros((1, 5)), np.diff(table.path.q_rad, axis=0) * k])
+    return min_move_times(travel, table.path.load_oz, table.motors)
+
+
+def spread(lengths: NDArray[np.float64], floors: NDArray[np.float64],
+           total_s: float) -> NDArray[np.float64]:
+    """Each move's time when ``total_s`` is spread over moves of these lengths: one
+    velocity v for all, every move max(ℓ/v, t_min) (§6.1).
+
+    At or below the floors' sum every move runs at its floor, scaled to ``total_s``;
+    a stretch with no length (v undefined) shares its time in proportion to the floors.
+    """
+    fsum = float(floors.sum())
+    if total_s <= fsum or not np.any(lengths > 0):
+        if fsum > 0:
+            return floors * (total_s / fsum)
+        return np.full(len(floors), total_s / max(len(floors), 1))
+    return move_times(lengths, floors, velocity_for_time(lengths, floors, total_s))
+
+
+def timeline(table: StepTable, segment_s: dict[str, float],
+             floors: NDArray[np.float64] | None = None) -> Timeline:
+    """Spread each segment's time over its moves (:func:`spread`).
+
+    ``floors``: each move's shortest time; the simulation's whole-step ones
+    (``table.peak_min_times``) unless given, e.g. :func:`joint_travel_min_times`.
+    Each segment then lasts exactly its given time.
+    """
     ell = table.velocity_lengths
-    floor = table.peak_min_times
+    floor = table.peak_min_times if floors is None else np.asarray(floors, dtype=float)
     dt = np.zeros(table.path.n_points)
     for name, rows in table.segment_rows().items():
-        total = max(float(segment_s[name]), float(floor[rows].sum()))
-        v = velocity_for_time(ell[rows], floor[rows], total)
-        dt[rows] = move_times(ell[rows], floor[rows], v)
+        dt[rows] = spread(ell[rows], floor[rows], float(segment_s[name]))
     return Timeline(np.cumsum(dt), dt, {k: float(segment_s[k]) for k in SEGMENTS})
 
 
-def nominal_timeline(table: StepTable, s: Scenario) -> Timeline:
-    """One transfer at the nominal velocities, as the controllers plan it (SPEC §6):
+def nominal_timeline(table: StepTable, s: Scenario,
+                     floors: NDArray[np.float64] | None = None) -> Timeline:
+    """One transfer at the nominal velocities, as the controllers plan it (``docs/model.md``):
     R I and R III locked to their belts at nominal speed, R IV at the nominal (75 %)
     motor rates, and R II the rest of the ideal cycle (the thesis's
-    22.5872 - 8/3 - 4 - 9.9855 = 5.935 s if R I took exactly 8/3 s)."""
+    22.5872 - 8/3 - 4 - 9.9855 = 5.935 s if R I took exactly 8/3 s).  ``floors`` as
+    in :func:`timeline`."""
     from cell.assembly import constants, robot_timing
 
     k = constants(s, robot_timing(s))
     return timeline(table, {"r1_pre": k.r1_pre_nom, "r1_post": k.r1_post_nom, "r2": k.r2_nom,
-                            "r3_pre": k.r3_pre_nom, "r3_post": k.r3_post_nom, "r4": k.r4_nom})
+                            "r3_pre": k.r3_pre_nom, "r3_post": k.r3_post_nom, "r4": k.r4_nom},
+                    floors)
 
 
 def _events(table: StepTable, tl: Timeline) -> dict[str, float]:
@@ -109,14 +149,21 @@ def fig16_joint_angles(table: StepTable, tl: Timeline, out: Path) -> Path:
     return save(fig, out)
 
 
-def fig_joint_rate(table: StepTable, tl: Timeline, s: Scenario, joint: int, out: Path) -> Path:
-    """Fig. 17-21: joint ``joint`` (0..4) rate in steps/s with its maximum rates (§6.1)."""
+def fig_joint_rate(table: StepTable, tl: Timeline, steps_tl: Timeline, s: Scenario, joint: int,
+                   out: Path) -> Path:
+    """Fig. 17-21: joint ``joint`` (0..4) rate in steps/s with its maximum rates (§6.1).
+
+    Black: the joint's travel over each move's time on the joints' travel (``tl``,
+    :func:`joint_travel_min_times`), what the motor does; grey: the whole steps the
+    simulation counts over its whole-step move times (``steps_tl``).  Neither exceeds
+    the maximum rate.
+    """
     p = table.path
     number = 17 + joint
     fig, ax = new_figure(number, f"Theta {joint + 1} Joint Rates")
     shade_regimes(ax, tl.t_s, p.regime)
     with np.errstate(invalid="ignore", divide="ignore"):
-        rate = np.where(tl.dt_s[1:] > 0, table.steps[1:, joint] / tl.dt_s[1:], 0.0)
+        rate = np.where(steps_tl.dt_s[1:] > 0, table.steps[1:, joint] / steps_tl.dt_s[1:], 0.0)
     peak = max_rates(p.load_oz[1:], motors_of(s), 1.0)[:, joint]
     nominal = peak * s.robot.motors.nominal_fraction
     ax.stairs(peak, tl.t_s, baseline=None, color=LIMIT_COLOUR, lw=1.3,
@@ -128,8 +175,8 @@ def fig_joint_rate(table: StepTable, tl: Timeline, s: Scenario, joint: int, out:
     k = s.robot.motors.steps_per_rad[joint]
     with np.errstate(invalid="ignore", divide="ignore"):
         smooth = np.where(tl.dt_s[1:] > 0, np.diff(p.q_rad[:, joint]) * k / tl.dt_s[1:], 0.0)
-    ax.stairs(rate, tl.t_s, baseline=None, color="0.55", lw=0.8,
-              label="whole motor steps per move / move time")
+    ax.stairs(rate, steps_tl.t_s, baseline=None, color="0.55", lw=0.8,
+              label="whole motor steps per move / move time on whole steps")
     ax.stairs(smooth, tl.t_s, baseline=None, color="black", lw=1.5,
               label=f"θ{joint + 1} ({JOINT_NAMES[joint]}) rate, dθ/dt × {k:g} steps/rad")
     ax.axhline(0, color="0.5", lw=0.6)
@@ -140,7 +187,6 @@ def fig_joint_rate(table: StepTable, tl: Timeline, s: Scenario, joint: int, out:
     top = max(float(np.max(np.abs(rate))), float(peak.max()))
     ax.set_ylim(-1.08 * top, 1.08 * top)
     fig.legend(loc="outside lower center", fontsize=8.5, ncols=2)
-    ax.set_title(f"{k:g} steps/rad; peak |rate| {np.max(np.abs(rate)):.0f} steps/s",
+    ax.set_title(f"{k:g} steps/rad; peak |dθ/dt| {np.max(np.abs(smooth)):.0f} steps/s",
                  loc="left", fontsize=9, pad=16)
     return save(fig, out)
-

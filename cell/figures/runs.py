@@ -14,22 +14,17 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
 from cell.assembly import nominal_cycle
-from cell.conveyors import speed_at
-from cell.figures.motion import Timeline, timeline
 from cell.figures.style import (
     IDEAL_COLOUR,
     POLICY_COLOURS,
-    REGIME_LABELS,
-    mark_events,
     new_figure,
     save,
-    shade_regimes,
 )
 from cell.scenario import Scenario
-from cell.steptable import SEGMENTS, StepTable
 from cell.thesis import TABLE_7_1_CYCLES
 
 #: Parts per lot of Fig. 23's lumped averages (§7.2).
@@ -87,14 +82,42 @@ def running_mean(values: pd.Series) -> NDArray[np.float64]:
         return np.where(count > 0, np.cumsum(np.where(ok, v, 0.0)) / count, np.nan)
 
 
-#: The two accountings, drawn one above the other (SPEC §8): column of each measure.
+#: Where each accounting is defined (``docs/accounting.md``, by its GitHub anchors).
+DOCS = {"adaptive": "docs/accounting.md#the-adaptive-robot-in-the-thesiss-bookkeeping",
+        "non-adaptive": "docs/accounting.md#the-non-adaptive-robot-in-the-thesiss-bookkeeping"
+                        "-a-reconstruction-of-table-71",
+        "wallclock": "docs/accounting.md#on-the-wall-clock"}
+
+#: The two accountings, drawn one above the other: panel title, column of each measure.
 ACCOUNTS = (
-    ("as the thesis counted (adaptive: robot motion time, step 6.2; "
-     "non-adaptive: SPEC §8 reconstruction)", "thesis_interval_s", "ip_thesis",
-     "missed_thesis"),
-    ("on the wall clock (between consecutive set-downs; lost parts have none)",
-     "delivery_interval_s", "ip_wallclock", "missed"),
+    ("as the thesis counted: adaptive, the robot's motion time between set-downs (step 6.2) [1]; "
+     "non-adaptive, the bookkeeping\nthat reproduces Table 7.1: a part lost when its "
+     "inter-arrival time is shorter than the cycle, and booked as one more cycle (D = T + C) [2]",
+     "thesis_interval_s", "ip_thesis", "missed_thesis"),
+    ("on the wall clock: between consecutive set-downs on the output belt; "
+     "a lost part has none [3]", "delivery_interval_s", "ip_wallclock", "missed"),
 )
+
+
+def docs_footer(fig: Figure) -> None:
+    """The references [1]-[3] of the panel titles, under the figure."""
+    fig.supxlabel(f"[1] {DOCS['adaptive']}   [3] {DOCS['wallclock']}\n[2] {DOCS['non-adaptive']}",
+                  x=0.01, ha="left", fontsize=7.5, color="0.3")
+
+
+def mean_note(run: Run) -> str:
+    """Which non-adaptive mean the thesis panel draws, and why the summary's differs."""
+    d = run.parts
+    total = float(np.nansum(d["thesis_interval_s"]))
+    every = int(d["thesis_interval_s"].notna().sum())
+    delivered = every - int(d["missed_thesis"].sum())
+    return (f"non-adaptive, as the thesis counted:\n"
+            f"the mean drawn is over every part,\n"
+            f"lost ones (D = T + C) included:\n"
+            f"Σ D / {every} parts = {total / every:.3f} s.\n"
+            f"summary.csv's actual cycle divides\n"
+            f"the same Σ D by the {delivered} parts\n"
+            f"delivered: {run.summary['actual_cycle_thesis_s']:.3f} s [2].")
 
 
 def _interval_figure(runs: Runs, s: Scenario, number: int, caption: str, lumped: bool,
@@ -119,8 +142,12 @@ def _interval_figure(runs: Runs, s: Scenario, number: int, caption: str, lumped:
         ax.set_title(what, loc="left", fontsize=9)
         ax.set_ylabel(f"{LOT}-part lot mean (s)" if lumped else "running mean (s)")
         ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8.5)
+    axes[0].text(1.015, 0.0, mean_note(na), transform=axes[0].transAxes, ha="left", va="bottom",
+                 fontsize=8, color="0.15", linespacing=1.3,
+                 bbox={"fc": "#f4f4f4", "ec": "0.75", "lw": 0.6, "boxstyle": "round,pad=0.4"})
     axes[-1].set_xlabel(f"part number (end of each {LOT}-part lot)" if lumped else "part number")
     fig.supylabel("time between parts delivered")
+    docs_footer(fig)
     return save(fig, out)
 
 
@@ -170,86 +197,5 @@ def fig_ip(runs: Runs, cycle: float, number: int, out: Path) -> Path:
         ax.set_title(what, loc="left", fontsize=9)
         ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8.5)
     axes[-1].set_xlabel("part number")
-    return save(fig, out)
-
-
-# --------------------------------------------------------------------------- Fig. 22
-def part_segments(row: pd.Series) -> dict[str, float]:
-    """A simulated part's six segment times from its record: each regime's time, split
-    at lift-off (``pick_s``) in R I and at touch-down in R III."""
-    start = float(row["at_bot_s"])
-    r1_pre = float(row["pick_s"]) - start
-    r3_pre = float(row["touchdown_s"]) - start - float(row["r1_s"]) - float(row["r2_s"])
-    seg = {"r1_pre": r1_pre, "r1_post": float(row["r1_s"]) - r1_pre, "r2": float(row["r2_s"]),
-           "r3_pre": r3_pre, "r3_post": float(row["r3_s"]) - r3_pre, "r4": float(row["r4_s"])}
-    return {k: seg[k] for k in SEGMENTS}
-
-
-def belt_speed_at(history: list[tuple[float, float]], when: float) -> float:
-    """Speed of a belt at an instant, from its (instant, speed) changes."""
-    return speed_at([t for t, _ in history], [v for _, v in history], when + 1e-9)
-
-
-def pick_transfer(run: Run) -> int:
-    """Row of the adaptive part to draw: of the parts whose input belt speeds up at
-    LO (the next part is late, step 3.1), the one with the longest lag before it
-    may, as in the thesis's example (§7.1)."""
-    d = run.parts
-    hist = run.belts["input"]
-    best, lag = 0, -np.inf
-    for i in np.flatnonzero(d["picked"].to_numpy(dtype=bool))[1:-1]:
-        row = d.iloc[i]
-        up = belt_speed_at(hist, row["pick_s"]) - belt_speed_at(hist, row["pick_s"] - 1e-6)
-        this = float(row["pick_s"] - row["at_bot_s"])
-        if up > 1e-6 and this > lag:
-            best, lag = int(i), this
-    return best
-
-
-def fig22_tip_velocity(runs: Runs, table: StepTable, s: Scenario, out: Path) -> Path:
-    fig, ax = new_figure(22, "Robot Tip Velocity of a Transfer", size=(9.0, 5.2))
-    run = runs.adaptive
-    i = pick_transfer(run)
-    row = run.parts.iloc[i]
-    tl: Timeline = timeline(table, part_segments(row))
-    lag = tl.segment_s["r1_pre"]
-    t = tl.t_s - lag  # 0 at LO: from here on the input belt may change (§5.3 3.1)
-    p = table.path
-    shade_regimes(ax, t, p.regime)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        tip = np.where(tl.dt_s[1:] > 0, p.move_in[1:] / tl.dt_s[1:], 0.0)
-    ax.stairs(tip, t, baseline=None, color="black", lw=1.5, label="tool-centre speed along the path")
-    for r in (1, 2, 3, 4):
-        rows = table.regime_rows(r)
-        v = float(row[f"v_r{r}_in_s"])
-        ax.hlines(v, t[np.flatnonzero(rows)[0] - 1], t[np.flatnonzero(rows)[-1]],
-                  colors="0.45", linestyles=":", lw=1.3,
-                  label="regime's average tip velocity (velocity state vector)" if r == 1 else None)
-        ax.text(t[np.flatnonzero(rows)[-1]], v, f"{REGIME_LABELS[r]} {v:.3f} ", fontsize=8,
-                color="0.3", ha="right", va="bottom")
-    hist = run.belts["input"]
-    at_b, pick = float(row["at_bot_s"]), float(row["pick_s"])
-    before, after = belt_speed_at(hist, pick - 1e-6), belt_speed_at(hist, pick)
-    end = at_b + float(tl.t_s[-1])
-    changes = [(at_b, before)] + [(w, v) for w, v in hist if at_b < w <= end + 1e-9]
-    bt = np.array([w for w, _ in changes] + [end]) - pick
-    bv = np.array([v for _, v in changes])
-    ax.stairs(bv, bt, baseline=None, color=POLICY_COLOURS["non-adaptive"], lw=1.4, ls="--",
-              label="input belt speed")
-    ax.axvspan(-lag, 0, facecolor="none", hatch="///", edgecolor="0.6", lw=0)
-    ax.annotate(f"◀ look-ahead lag {lag:.4f} s: B → LO at {before:.3f} in/s;\n"
-                f"   the input belt may change only from LO on",
-                xy=(0.15, 0.97), xycoords=("data", "axes fraction"), ha="left", va="top",
-                fontsize=8.5, bbox={"fc": "white", "ec": "0.6", "lw": 0.6})
-    mark_events(ax, {"LO": 0.0, "TD": float(tl.t_s[p.td] - lag)})
-    nxt = float(run.parts["interarrival_s"].iloc[i + 1]) if i + 1 < len(run.parts) else np.nan
-    ax.set_title(f"adaptive run, part {int(row['part'])}: next part {nxt:.3f} s behind "
-                 f"(ideal {nominal_cycle(s):g} s); input belt {before:.3f} → "
-                 f"{after:.3f} in/s at LO; cycle {tl.t_s[-1]:.3f} s", loc="left", fontsize=9,
-                 pad=16)
-    ax.set_xlabel("time from lift-off LO (s); negative: the look-ahead lag")
-    ax.set_ylabel("velocity (in/s)")
-    ax.set_xlim(-lag, t[-1])
-    ax.set_ylim(0, 1.3 * max(float(tip.max()), float(bv.max())))
-    fig.legend(loc="outside lower center", ncols=3, fontsize=8.5)
+    docs_footer(fig)
     return save(fig, out)
