@@ -24,7 +24,7 @@ def main(args: argparse.Namespace) -> int:
     from cell.scenario import json_schema
 
     text = json.dumps(json_schema(), indent=2, ensure_ascii=False) + "\n"
-    if args.out:
+    if args.out is not None:
         write_text(text, args.out)
         print(f"wrote {args.out}")
     else:
