@@ -18,6 +18,7 @@ import errno
 import importlib
 import os
 import sys
+import warnings
 from collections.abc import Sequence
 from typing import Any, NoReturn
 
@@ -89,6 +90,17 @@ def _memory() -> str:
     return f" (this machine has {total / 2**30:.0f} GiB)"
 
 
+def _run(args: argparse.Namespace) -> int:
+    """The command; a warning that a finished command met is one line each (a refused one's are
+    dropped: its error says what went wrong)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("default")
+        code = int(_module(args.command).main(args) or 0)
+    for text in dict.fromkeys(f"{w.message} ({w.category.__name__})" for w in caught):
+        print(f"cell: warning: {one_line(text, 300)}", file=sys.stderr)
+    return code
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one command; the exit code (0 done, 2 refused, 130 interrupted)."""
     parser = build_parser()
@@ -99,7 +111,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SystemExit as exc:  # --help, --version: printed, done
         return exc.code if isinstance(exc.code, int) else 0
     try:
-        return int(_module(args.command).main(args) or 0)
+        return _run(args)
     except CellError as exc:
         return _fail(str(exc))
     except MemoryError:

@@ -58,20 +58,31 @@ def main(args: argparse.Namespace) -> int:
     import numpy as np
 
     from cell.assembly import geometry_of, motors_of, planner_bounds, step_table
-    from cell.errors import CellError, NoMotionError
+    from cell.errors import CellError, InfeasibleError, NoMotionError, ScenarioError
     from cell.mintime.regimes import plan_regimes, summary
     from cell.output import OutputDir
     from cell.overrides import parse_sets
-    from cell.scenario import load_scenario
+    from cell.scenario import MAX_TIME_S, load_scenario
 
     check_out(args.out)  # before any work
     scenario = load_scenario(args.scenario, parse_sets(args.sets))
     step_table(scenario)  # reach and motor checks, naming their keys
     bounds = planner_bounds(scenario)
+    rates = "robot.motors.max_rate_no_load_rad_s"
     try:
         results = plan_regimes(geometry_of(scenario), motors_of(scenario), bounds)
     except NoMotionError as exc:
         raise CellError(f"{scenario.source}: mintime: {exc}") from None
+    except InfeasibleError as exc:  # the drives cannot turn at the motors' rates (dynamics file)
+        raise ScenarioError(scenario.source, rates, list(scenario.get(rates)),
+                            f"{exc} (drives of {scenario.mintime.dynamics_file})") from None
+    slowest = max(results, key=lambda r: results[r].profile.time_s)
+    if not results[slowest].profile.time_s <= MAX_TIME_S:  # the schema's bound on any time
+        key = "mintime.rate_fraction" if scenario.mintime.rate_fraction < 1 else rates
+        value = scenario.get(key)
+        raise ScenarioError(scenario.source, key, list(value) if isinstance(value, tuple) else value,
+                            f"{slowest} would take {results[slowest].profile.time_s:.4g} s, more "
+                            f"than {MAX_TIME_S:g} s")
     table = frame(results)
     doc = json.dumps(summary(results, bounds), indent=2, allow_nan=False) + "\n"
     with OutputDir(args.out, FILES) as out:
