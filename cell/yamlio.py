@@ -299,6 +299,8 @@ def _syntax_error(src: _Source, path: KeyPath, exc: yaml.MarkedYAMLError) -> NoR
         problem = f"{context}, {problem}"
     elif context and cmark and (cmark.line, cmark.column) != (mark.line, mark.column):
         problem += f" ({context} from {src.where(cmark.line, cmark.column)})"
+    if problem.startswith("mapping values are not allowed") and mark.column > 1024:
+        problem += " (a key without quotes may have at most 1024 characters)"
     where = src.where(mark.line, mark.column)
     src.fail(path, src.line_text(mark.line), f"invalid YAML at {where}: {problem or context}", "(syntax)")
 
