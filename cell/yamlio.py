@@ -232,7 +232,11 @@ class _Builder:
             key = self.build(key_node)
             if not isinstance(key, Hashable) or isinstance(key, list):
                 self.src.fail_at(self.path, key_node.start_mark, "a key must be a plain value, not a list")
-            part, line = key if isinstance(key, str) else str(key), key_node.start_mark.line + 1
+            if not isinstance(key, str):  # every key of these files is a name
+                kind = "null" if key is None else "a boolean" if isinstance(key, bool) else "a number"
+                self.src.fail_at(self.path + [key_node.value], key_node.start_mark,
+                                 f"a key must be a name, not {kind} ({_oneline(key_node.value or '~', 40)})")
+            part, line = key, key_node.start_mark.line + 1
             if key == "<<" and not key_node.style:
                 self.src.fail_at(self.path + [part], key_node.start_mark,
                                  "merge keys (<<) are YAML 1.1, not supported; write the keys out")
