@@ -20,7 +20,7 @@ from typing import Any
 
 import pytest
 from annotated_types import Ge, Gt, Le, Lt
-from harness import cell, ran_sanely, refused
+from harness import cli, ran_sanely, refused
 from pydantic import BaseModel
 
 from cell.scenario import Scenario, default_scenario
@@ -83,7 +83,10 @@ WRONG_TYPES: list[tuple[str, Any]] = [("true", True), ("false", False), ("text",
                                       ("numeric-text", "1.5"), ("list", [1.0]), ("mapping", {"a": 1.0})]
 
 
-def number_values(b: Bounds, default: float, whole: bool) -> tuple[list[tuple[str, Any]], list[tuple[str, Any]]]:
+Values = list[tuple[str, Any]]
+
+
+def number_values(b: Bounds, default: float, whole: bool) -> tuple[Values, Values]:
     """(refuse, either) values for a number with bounds ``b``."""
     refuse = list(WRONG_TYPES) + [("inf", math.inf), ("-inf", -math.inf), ("nan", math.nan),
                                    ("1e300", 1e300), ("-1e300", -1e300), ("45-digit int", 10**45)]
@@ -133,7 +136,8 @@ def cases() -> Iterator[Any]:
             else:
                 refuse.append(("null", None))
         elif ann is bool:
-            refuse = [("1", 1), ("0", 0), ("yes", "yes"), ("quoted", "true"), ("null", None), ("list", [True])]
+            refuse = [("1", 1), ("0", 0), ("yes", "yes"), ("quoted", "true"), ("null", None),
+                      ("list", [True])]
             either = [("true", True), ("false", False)]
         elif origin is tuple:
             n = len(args)
@@ -199,7 +203,7 @@ def _parts(key: str, value: Any) -> int:
 def _check_set(tmp: Path, case: Case) -> None:
     """``cell run baseline --set KEY=VALUE``: refused in one line naming the key, or a sane run."""
     out = tmp / f"out-{abs(hash((case.key, case.label)))}"
-    res = cell("run", "baseline", "--set", f"run.parts={PARTS}", "--set",
+    res = cli("run", "baseline", "--set", f"run.parts={PARTS}", "--set",
                f"{case.key}={yaml_text(case.value)}", "--out", out)
     if case.must_refuse:
         refused(res, case.key, nothing_in=out)
@@ -217,7 +221,7 @@ def _check_file(tmp: Path, case: Case) -> None:
     doc.setdefault("run", {})["parts"] = doc.get("run", {}).get("parts", PARTS)
     scenario.write_text("\n".join(f"{k}: {yaml_text(v)}" for k, v in doc.items()) + "\n", encoding="utf-8")
     out = tmp / "out"
-    refused(cell("run", scenario, "--out", out), str(scenario), case.key, nothing_in=out)
+    refused(cli("run", scenario, "--out", out), str(scenario), case.key, nothing_in=out)
 
 
 def _nested(key: str, value: Any) -> dict[str, Any]:

@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 
 import pytest
-from harness import cell, ran_sanely, refused
+from harness import cli, ran_sanely, refused
 
 BOMB = "a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
     f"{chr(98 + i)}: &{chr(98 + i)} [{', '.join([f'*{chr(97 + i)}'] * 10)}]\n" for i in range(8))
@@ -94,7 +94,7 @@ def test_hostile_files(tmp_path: Path, command: str) -> None:
         scenario.write_bytes(data)
         out = tmp_path / f"out{i}"
         start = time.perf_counter()
-        res = cell(command, scenario, "--out", out)
+        res = cli(command, scenario, "--out", out)
         try:
             assert time.perf_counter() - start < 2.0, "slow"
             refused(res, str(scenario), *words, nothing_in=out)
@@ -106,12 +106,13 @@ def test_hostile_files(tmp_path: Path, command: str) -> None:
 def test_encodings_yaml_allows_are_read(tmp_path: Path) -> None:
     """UTF-8 with a BOM, UTF-16 and UTF-32 (with and without BOM) are YAML text: they run."""
     text = "name: encoded\nrun: {parts: 3}\n"
-    for i, data in enumerate([codecs.BOM_UTF8 + text.encode(), text.encode("utf-16"), text.encode("utf-16-le"),
-                              text.encode("utf-16-be"), text.encode("utf-32"), text.encode("utf-32-be")]):
+    kinds = ("utf-16", "utf-16-le", "utf-16-be", "utf-32", "utf-32-be")
+    encoded = [codecs.BOM_UTF8 + text.encode()] + [text.encode(e) for e in kinds]
+    for i, data in enumerate(encoded):
         scenario = tmp_path / f"enc{i}.yaml"
         scenario.write_bytes(data)
         out = tmp_path / f"out{i}"
-        ran_sanely(cell("run", scenario, "--out", out), out, 3)
+        ran_sanely(cli("run", scenario, "--out", out), out, 3)
 
 
 def test_yaml_12_numbers_are_read(tmp_path: Path) -> None:
@@ -120,7 +121,7 @@ def test_yaml_12_numbers_are_read(tmp_path: Path) -> None:
     scenario.write_text("controller: {policy: non-adaptive, ideal_cycle_s: 2.25872e1}\n"
                         "belts: {spacing_in: 45e0, spacing_tol_in: +.25}\nrun: {parts: 0x4}\n")
     out = tmp_path / "out"
-    summary = ran_sanely(cell("run", scenario, "--out", out), out, 4)
+    summary = ran_sanely(cli("run", scenario, "--out", out), out, 4)
     assert summary.ideal_cycle_s == pytest.approx(22.5872)
 
 
@@ -133,7 +134,7 @@ def test_files_that_are_not_files(tmp_path: Path) -> None:
              (fifo, "not a regular file"), (Path("/dev/zero"), "not a regular file")]
     for path, words in cases:
         out = tmp_path / "out"
-        refused(cell("run", path, "--out", out), str(path), words, nothing_in=out)
+        refused(cli("run", path, "--out", out), str(path), words, nothing_in=out)
 
 
 def test_unreadable_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -149,7 +150,7 @@ def test_unreadable_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Non
 
     monkeypatch.setattr("builtins.open", denying)
     out = tmp_path / "out"
-    refused(cell("run", scenario, "--out", out), str(scenario), "permission denied", nothing_in=out)
+    refused(cli("run", scenario, "--out", out), str(scenario), "permission denied", nothing_in=out)
 
 
 #: (id, --set arguments, words)
@@ -183,7 +184,7 @@ def test_hostile_set_values(tmp_path: Path) -> None:
     for i, (label, sets, words) in enumerate(SETS):
         out = tmp_path / f"out{i}"
         args = [a for s in sets for a in ("--set", s)]
-        res = cell("run", "baseline", *args, "--out", out)
+        res = cli("run", "baseline", *args, "--out", out)
         try:
             if label == "section to null":  # an empty section keeps its defaults
                 ran_sanely(res, out, 3)
@@ -198,7 +199,7 @@ def test_set_into_an_empty_section_of_a_file(tmp_path: Path) -> None:
     scenario = tmp_path / "empty_run.yaml"
     scenario.write_text("run:\nmintime:\n")
     out = tmp_path / "out"
-    ran_sanely(cell("run", scenario, "--set", "run.parts=4", "--out", out), out, 4)
+    ran_sanely(cli("run", scenario, "--set", "run.parts=4", "--out", out), out, 4)
 
 
 def test_errors_name_the_file_once_and_quote_no_foreign_file(tmp_path: Path) -> None:
@@ -207,6 +208,6 @@ def test_errors_name_the_file_once_and_quote_no_foreign_file(tmp_path: Path) -> 
     secret.write_text("root:x:0:0:the password is swordfish\nmore: [\n")
     sweep = tmp_path / "sweep.yaml"
     sweep.write_text(f"base: {secret}\nreplications: 2\n")
-    res = cell("sweep", sweep, "--workers", "1", "--out", tmp_path / "out")
+    res = cli("sweep", sweep, "--workers", "1", "--out", tmp_path / "out")
     line = refused(res, str(secret), nothing_in=tmp_path / "out")
     assert "swordfish" not in line and "root:x" not in line
