@@ -224,7 +224,7 @@ class OutputDir(contextlib.AbstractContextManager["OutputDir"]):
                 (self.stage / name).parent.mkdir(parents=True, exist_ok=True)
         return self.stage / name
 
-    def open(self, name: str, mode: str = "w", **kwargs: Any) -> IO[Any]:
+    def open(self, name: str, mode: str = "w", **kwargs: Any) -> Any:  # TextIO or BinaryIO, by mode
         """The file ``name`` opened for writing (``"w"``, ``"wb"``...) in the stage; text is UTF-8."""
         if "r" in mode or "+" in mode:
             raise ValueError(f"mode {mode!r}: OutputDir files are opened for writing")
