@@ -12,7 +12,7 @@ def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter) -> None:
             f"hostile inputs: {COUNT['in-process'] + COUNT['subprocess']} cases "
             f"({COUNT['in-process']} in-process, {COUNT['subprocess']} in subprocesses): "
             f"{COUNT['refused']} refused in one line, {COUNT['ran']} ran sanely, "
-            f"{COUNT['other']} checked otherwise")
+            f"{COUNT['other']} checked otherwise (kill steps, --help)")
 
 
 @pytest.fixture(autouse=True)
