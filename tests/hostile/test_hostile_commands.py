@@ -10,7 +10,9 @@ line and exit 2; an unexpected exception keeps its traceback.
 from __future__ import annotations
 
 import errno
+import importlib
 import os
+import pkgutil
 import subprocess
 import sys
 from pathlib import Path
@@ -40,7 +42,19 @@ COMMANDS: dict[str, tuple[list[str], str, str]] = {
 OR = {"animate": (".gif or .mp4",), "fit": ("its directory does not exist",)}
 
 
+def _import_everything() -> None:
+    """Every module of the package imported now, so that none binds a forbidden stand-in by
+    ``from ... import`` while it is patched in."""
+    import cell
+
+    for module in pkgutil.walk_packages(cell.__path__, "cell."):
+        if not module.name.endswith("__main__"):
+            importlib.import_module(module.name)
+
+
 def _forbid(monkeypatch: pytest.MonkeyPatch, dotted: str) -> None:
+    _import_everything()
+
     def work(*args: Any, **kwargs: Any) -> Any:
         raise AssertionError(f"{dotted} ran before the output was checked")
 
