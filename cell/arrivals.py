@@ -23,6 +23,8 @@ from cell.errors import ScenarioError
 
 #: The feeder's child stream of the root SeedSequence (other streams take other keys).
 FEEDER_STREAM = 0
+#: No inter-arrival time (a trace's) or mean (a distribution's) may exceed this, s.
+MAX_INTERARRIVAL_S = 1e6
 
 
 class ArrivalSpec(Protocol):
@@ -105,9 +107,13 @@ def check_arrivals(arrivals: ArrivalSpec, base_dir: Path, file: object) -> None:
     except (TypeError, ValueError) as exc:
         raise ScenarioError(file, "arrivals.params", params,
                             f"not accepted by scipy.stats.{arrivals.distribution}: {exc}") from None
-    if not math.isfinite(mean) or not low >= 0:
+    if not math.isfinite(mean) or not low >= 0 or not mean > 0:
         raise ScenarioError(file, "arrivals.params", params,
-                            "inter-arrival times must be non-negative with a finite mean")
+                            "inter-arrival times must be non-negative with a finite, positive mean")
+    if mean > MAX_INTERARRIVAL_S:
+        raise ScenarioError(file, "arrivals.params", params,
+                            f"the mean inter-arrival time would be {mean:.4g} s; at most "
+                            f"{MAX_INTERARRIVAL_S:g} s")
 
 
 def read_trace(path: Path, file: object = None) -> NDArray[np.float64]:
@@ -130,16 +136,17 @@ def _parse_trace(path: Path) -> Any:
     import pandas as pd
 
     try:
-        frame = pd.read_csv(path)
-    except Exception as exc:  # pandas raises many kinds
-        return f"not a readable CSV: {exc}"
+        frame = pd.read_csv(path, dtype=str, keep_default_na=False, encoding="utf-8")
+    except Exception as exc:  # noqa: BLE001 - pandas and the decoder raise many kinds
+        return f"not a readable CSV: {' '.join(str(exc).split())[:120]}"
     if "interarrival_s" not in frame.columns:
         return "needs a column named interarrival_s"
-    times = pd.to_numeric(frame["interarrival_s"], errors="coerce").to_numpy(dtype=float)
-    bad = np.flatnonzero(~np.isfinite(times) | (times <= 0))
+    text = frame["interarrival_s"].str.strip()
+    times = pd.to_numeric(text, errors="coerce").to_numpy(dtype=float)
+    bad = np.flatnonzero(~np.isfinite(times) | (times <= 0) | (times > MAX_INTERARRIVAL_S))
     if bad.size:
-        return (f"row {bad[0] + 1} has inter-arrival time "
-                f"{frame['interarrival_s'].iloc[bad[0]]}; times must be positive")
+        return (f"row {bad[0] + 1} has inter-arrival time {text.iloc[bad[0]][:40]!r}; times "
+                f"must be positive numbers of seconds, at most {MAX_INTERARRIVAL_S:g}")
     if times.size == 0:
         return "has no inter-arrival times"
     times.setflags(write=False)

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from cell import registry
+from cell.arrivals import mean_interarrival
 from cell.cache import memo
 from cell.errors import CellError, InfeasibleError, NoMotionError, ScenarioError, UnreachableError
 from cell.kinematics import JOINT_NAMES, Arm, Hand, Placement
@@ -183,20 +184,54 @@ def constants(s: Scenario, timing: RobotTiming) -> CellConstants:
     t = timing
     r1a, r1b = t.r1_time(b.input_nominal_in_s)
     r3a, r3b = t.r3_time(b.output_nominal_in_s)
+    mean = mean_interarrival(s.arrivals, s.base_dir)
+    cycle, source = (c.nominal_cycle_s, "scenario") if c.nominal_cycle_s is not None else \
+        (mean, "arrivals")
+    # The nominal split (docs/model.md): R IV at the base's nominal rate, R II the rest of
+    # the cycle; a cycle too short for that takes R IV down toward its peak-rate time,
+    # and one shorter than the robot's fastest is the fastest.
     r4 = max(t.r4_nominal_s, t.r4_min_s)
-    r2 = c.nominal_cycle_s - r1a - r1b - r3a - r3b - r4
+    r2 = cycle - r1a - r1b - r3a - r3b - r4
     if r2 < t.r2_min_s:
-        raise ScenarioError(file, "controller.nominal_cycle_s", c.nominal_cycle_s,
-                            f"leaves {r2:.4f} s for R II, which takes at least "
-                            f"{t.r2_min_s:.4f} s at the motors' peak rates")
+        r2 = t.r2_min_s
+        r4 = cycle - r1a - r1b - r3a - r3b - r2
+        if r4 < t.r4_min_s:
+            r4, source = t.r4_min_s, "fastest"
+            cycle = r1a + r1b + r2 + r3a + r3b + r4
     length = b.input_length_in if b.input_length_in is not None else \
-        b.input_nominal_in_s * c.nominal_cycle_s * 2
+        b.input_nominal_in_s * cycle * 2
     return CellConstants(
         timing=t, v_nom=b.input_nominal_in_s, u_nom=b.output_nominal_in_s,
-        cycle_nom=c.nominal_cycle_s, input_max=min(b.input_max_in_s, 1e9),
+        cycle_nom=cycle, input_max=min(b.input_max_in_s, 1e9),
         output_max=b.output_max_in_s, spacing=b.spacing_in, tol=b.spacing_tol_in,
         input_length=length, r1_pre_nom=r1a, r1_post_nom=r1b, r3_pre_nom=r3a,
-        r3_post_nom=r3b, r4_nom=r4, r2_nom=r2, r1_nom=r1a + r1b)
+        r3_post_nom=r3b, r4_nom=r4, r2_nom=r2, r1_nom=r1a + r1b,
+        input_min=b.input_min_in_s, output_min=b.output_min_in_s, part_size=s.part.size_in,
+        input_absorb=_absorbable(t, b.input_nominal_in_s, r1a + r1b + (r2 - t.r2_min_s)),
+        mean_interarrival_s=mean, nominal_from=source)
+
+
+def _absorbable(t: RobotTiming, v_nom: float, r1_most_s: float) -> float:
+    """The slowest belt speed at which R I (B → F, tracking) takes at most ``r1_most_s``:
+    R I only lengthens as the belt slows, so bisect on the speed (to 1e-9 relative)."""
+    def r1(v: float) -> float:
+        return sum(t.r1_time(v))
+
+    if r1(v_nom) >= r1_most_s:
+        return v_nom
+    lo, hi = v_nom * 1e-6, v_nom
+    if r1(lo) <= r1_most_s:
+        return lo
+    while hi - lo > 1e-9 * hi:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if r1(mid) <= r1_most_s else (mid, hi)
+    return hi
+
+
+def nominal_cycle(s: Scenario) -> float:
+    """The ideal cycle the controller aims at: ``controller.nominal_cycle_s``, else the
+    arrivals' mean (or the robot's fastest cycle if the arrivals come faster)."""
+    return constants(s, robot_timing(s)).cycle_nom
 
 
 # --------------------------------------------------------------------------- the whole cell

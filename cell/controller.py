@@ -15,14 +15,14 @@ import simpy
 
 from cell.conveyors import EPS_S, InputConveyor, OutputConveyor
 from cell.policies.base import CellConstants, Policy
-from cell.records import PartRecord
+from cell.records import LET_GO, PartRecord
 from cell.robot import Order, Robot
-
-MISSED_NOTE = "reached B while the robot was busy: fell off at F"
 
 
 class RunLog(Protocol):
-    """Where finished parts go: ``missed`` for a part lost at B."""
+    """Where a part's limits are noted, and where a part lost at B goes."""
+
+    def flag(self, part: PartRecord, limits: int) -> None: ...
 
     def missed(self, part: PartRecord) -> None: ...
 
@@ -54,8 +54,8 @@ class View:
             if f > now + lag:
                 return (f - now, length)
             x_fed = x_fed_of.get(j)
-            if x_fed is None:  # dropped between now and LO: not on the belt yet
-                x_fed = x_now + v * (f - now)
+            if x_fed is None:  # dropped between now and LO (or held back): not on the belt yet
+                x_fed = x_now + v * (max(f, now) - now)
             d = x_fed + length - (x_now + v * lag)
             if d > 0:
                 return (lag, d)
@@ -84,7 +84,7 @@ class Controller:
             now = env.now
             if not robot.is_free(now):
                 part.missed = True
-                part.note = MISSED_NOTE
+                log.flag(part, LET_GO)
                 log.missed(part)
                 continue
             view.part = part.part - 1
@@ -100,7 +100,8 @@ class Controller:
             part.r1_s, part.r2_s, part.r3_s, part.r4_s = r1, plan.r2, r3, plan.r4
             part.v_r1_in_s, part.v_r2_in_s = l1 / r1, l2 / plan.r2
             part.v_r3_in_s, part.v_r4_in_s = l3 / r3, l4 / plan.r4
-            part.note = plan.note
+            if plan.limits:
+                log.flag(part, plan.limits)
             # step 6.2: motion time to TD plus the previous cycle's residual
             part.thesis_interval_s = plan.to_g + plan.r3_pre + self.residual_s
             self.residual_s = plan.r3_post + plan.r4

@@ -48,6 +48,8 @@ class Belt:
         """Told (instant, speed) of every change once it is final."""
         self.max_speed_in_s = speed_in_s
         """The fastest of the settled speeds (of all of them once closed)."""
+        self.min_speed_in_s = speed_in_s
+        """The slowest of them."""
 
     def speed(self, t: float) -> float:
         return speed_at(self._t, self._v, t)
@@ -89,9 +91,11 @@ class Belt:
             del ts[:n], xs[:n], vs[:n]
 
     def _emit(self, n: int) -> None:
-        top = max(self._v[:n])
+        top, bottom = max(self._v[:n]), min(self._v[:n])
         if top > self.max_speed_in_s:
             self.max_speed_in_s = top
+        if bottom < self.min_speed_in_s:
+            self.min_speed_in_s = bottom
         if self.on_change is not None:
             for t, v in zip(self._t[:n], self._v[:n]):
                 self.on_change(t, v)
@@ -133,12 +137,15 @@ class InputConveyor:
         self.x_fed: dict[int, float] = {}
         """Belt travel at the instant each part on the belt was dropped (by index)."""
         self._timing = False
+        self.feeder: Any = None
+        """The feeder, told of a replan while it holds a part back."""
         self.process = env.process(self.run())
 
-    def drop(self, part: Any) -> None:
-        """The feeder puts a part (its record) on the belt now."""
-        self.x_fed[part.part - 1] = self.belt.travel(self.env.now)
+    def drop(self, part: Any) -> float:
+        """The feeder puts a part (its record) on the belt now; returns the belt's travel."""
+        x = self.x_fed[part.part - 1] = self.belt.travel(self.env.now)
         self.loaded.put(part)
+        return x
 
     def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
         """New speed plan from the controller (see :meth:`Belt.plan`).
@@ -150,6 +157,9 @@ class InputConveyor:
         self.belt.plan(t1, v1, t2, v2)
         if self._timing:
             self.process.interrupt()
+        feeder = self.feeder
+        if feeder is not None and feeder.holding:
+            feeder.process.interrupt()
 
     def run(self):  # noqa: ANN201 (SimPy generator)
         env, get, timeout = self.env, self.loaded.get, self.env.timeout

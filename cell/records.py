@@ -17,6 +17,29 @@ from typing import Any
 
 NAN = math.nan
 
+#: The limits a part's cycle can hit, as bits of a flag word and as names in parts.csv's
+#: ``limits`` column (docs/model.md, "Departures from the thesis's controller"):
+LIMITS = (
+    "input_floor",      # the input belt held at belts.input_min_in_s (step 3.2 asked slower)
+    "input_ceiling",    # the input belt held at belts.input_max_in_s (step 3.1 asked faster)
+    "input_tracking",   # the input belt held to the fastest the robot can track (step 6.3)
+    "output_floor",     # the output belt held at belts.output_min_in_s: spacing off (step 5.0)
+    "output_ceiling",   # the output belt held at belts.output_max_in_s: spacing off (step 5.0)
+    "r2_peak",          # R II at the motors' peak rates (steps 2.1-2.3)
+    "r4_peak",          # R IV at the base's peak rate (step 3.2)
+    "let_go",           # reached B while the robot was busy: fell off at F (§6.3)
+    "spacing_off",      # set down outside the spacing tolerance (§4.3 f)
+    "held_at_feeder",   # dropped later than it came: the belt had not cleared a part's size
+)
+LIMIT_BIT = {name: 1 << i for i, name in enumerate(LIMITS)}
+(INPUT_FLOOR, INPUT_CEILING, INPUT_TRACKING, OUTPUT_FLOOR, OUTPUT_CEILING, R2_PEAK, R4_PEAK,
+ LET_GO, SPACING_OFF, HELD_AT_FEEDER) = (1 << i for i in range(len(LIMITS)))
+
+
+def limit_names(flags: int) -> str:
+    """The names of the limits in a flag word, space-separated, in :data:`LIMITS` order."""
+    return " ".join(name for i, name in enumerate(LIMITS) if flags >> i & 1)
+
 
 @dataclass(slots=True)
 class PartRecord:
@@ -72,8 +95,10 @@ class PartRecord:
     """Time in R III (G → K)."""
     r4_s: float = NAN
     """Time in R IV (K → B)."""
-    note: str = ""
-    """Limits hit, or why the part was lost."""
+    feed_delay_s: float = 0.0
+    """How long the feeder held the part back, the belt not having cleared a part's size."""
+    limits: str = ""
+    """The limits this part's cycle hit (names from :data:`LIMITS`, space-separated)."""
 
 
 @dataclass(slots=True)
@@ -124,10 +149,28 @@ class RunSummary:
     """Widest spacing on the output belt."""
     spacing_outside_tol: int = 0
     """Spacings outside 45 ± 0.25 in (§4.3 f)."""
-    parts_noted: int = 0
-    """Parts with a note (limits hit, lost)."""
+    limit_input_floor: int = 0
+    """Parts whose input belt was held at its floor (the part was let go early)."""
+    limit_input_ceiling: int = 0
+    """Parts whose input belt was held at its ceiling (the robot waited)."""
+    limit_input_tracking: int = 0
+    """Parts after which the input belt was held to the robot's tracking limit."""
+    limit_output_floor: int = 0
+    """Parts whose output belt was held at its floor (spacing off)."""
+    limit_output_ceiling: int = 0
+    """Parts whose output belt was held at its ceiling (spacing off)."""
+    limit_r2_peak: int = 0
+    """Parts with R II at the motors' peak rates."""
+    limit_r4_peak: int = 0
+    """Parts with R IV at the base's peak rate."""
+    parts_held: int = 0
+    """Parts the feeder held back until the belt had cleared a part's size."""
+    feed_delay_max_s: float = NAN
+    """The longest such hold."""
     input_speed_max_in_s: float = NAN
     """Fastest the input belt ran."""
+    input_speed_min_in_s: float = NAN
+    """Slowest the input belt ran."""
     output_speed_min_in_s: float = NAN
     """Slowest output belt speed asked before G."""
     output_speed_max_in_s: float = NAN
@@ -138,6 +181,19 @@ class RunSummary:
     """R II's share of the nominal cycle."""
     r4_s: float = NAN
     """Mean R IV time of the parts picked."""
+    nominal_cycle_s: float = NAN
+    """The ideal cycle the controller aimed at (§5.3)."""
+    nominal_from: str = ""
+    """``scenario`` (controller.nominal_cycle_s), ``arrivals`` (their mean), or ``fastest``
+    (the arrivals come faster than the robot's fastest cycle)."""
+    mean_interarrival_s: float = NAN
+    """The arrivals' mean inter-arrival time (the distribution's or the trace's)."""
+    fastest_cycle_s: float = NAN
+    """The robot's fastest cycle: R II and R IV at the motors' peak."""
+    utilisation: float = NAN
+    """Fastest cycle over mean inter-arrival time: 1 or more, the cell cannot keep up."""
+    warmup_parts: int = 0
+    """Parts left out of every measure above as warm-up (run.warmup_parts)."""
     thesis_slack_s: float = NAN
     """The calibrated slack of the thesis's bookkeeping (non-adaptive), s."""
     sim_end_s: float = NAN

@@ -190,8 +190,14 @@ class BeltSettings(Section):
     """Required spacing of parts on the output belt (§4.3 f)."""
     spacing_tol_in: float = _num(0.25, ge=0.0, le=MAX_LENGTH_IN)
     """Tolerance on that spacing (§4.3 f)."""
+    input_min_in_s: float = _num(1.5, gt=0.0, le=MAX_SPEED_IN_S)
+    """Slowest the adaptive controller may run the input belt; ASSUMED: half the nominal
+    speed (§6.2 a gives belts unlimited range; docs/assumptions.md)."""
     input_max_in_s: float = _num(12.0, gt=0.0, le=MAX_SPEED_IN_S)
-    """Fastest the input belt may run; ASSUMED (§6.2 a gives belts infinite range)."""
+    """Fastest the input belt may run; ASSUMED (§6.2 a gives belts unlimited range)."""
+    output_min_in_s: float = _num(0.25, gt=0.0, le=MAX_SPEED_IN_S)
+    """Slowest the output belt may run; ASSUMED: a set-down part then clears a 2 in part's
+    size before the next touch-down even at the robot's shortest cycle (docs/assumptions.md)."""
     output_max_in_s: float = _num(12.0, gt=0.0, le=MAX_SPEED_IN_S)
     """Fastest the output belt may run; ASSUMED, as the input's."""
     input_length_in: float | None = _num(None, gt=0.0, le=MAX_LENGTH_IN * 10)
@@ -224,8 +230,9 @@ class ControllerSettings(Section):
 
     policy: str = "adaptive"
     """A registered policy: ``adaptive`` (§5.3), ``non-adaptive`` (§6.3), or a plug-in."""
-    nominal_cycle_s: float = _num(22.5872, gt=0.0, le=MAX_TIME_S)
-    """Mean inter-arrival time: the ideal transfer time of §5.3."""
+    nominal_cycle_s: float | None = _num(None, gt=0.0, le=MAX_TIME_S)
+    """The ideal transfer time of §5.3, the mean inter-arrival time.  Empty: the mean of
+    the arrivals (the distribution's, or the trace's); the thesis quotes 22.5872 s."""
     ideal_cycle_s: float | None = _num(None, gt=0.0, le=MAX_TIME_S)
     """The robot's fixed cycle for the non-adaptive policy (Table 7.1, column 1);
     shortened in R IV only.  Empty: the nominal cycle."""
@@ -243,6 +250,9 @@ class RunSettings(Section):
 
     parts: int = Field(500, strict=True, ge=1, le=MAX_PARTS)
     """Parts to arrive (§6.3: 500)."""
+    warmup_parts: Annotated[int, Field(strict=True, ge=0, le=MAX_PARTS)] | Literal["auto"] = 0
+    """Parts left out of every measure as warm-up: a number, or ``auto`` (MSER-5 on the
+    delivery intervals).  The thesis's terminating 500-part runs keep 0."""
     seed: int = Field(1984, strict=True, ge=0, lt=MAX_SEED)
     """Root of every random stream (numpy SeedSequence)."""
 
@@ -376,13 +386,19 @@ def _cross_checks(s: Scenario, file: object) -> None:
         if (g - h.g0_in) ** 2 / 2 > h.l2_in ** 2:
             raise ScenarioError(file, key, g, "finger opening beyond what the hand linkage "
                                 "allows (eq. 6.2: (G - G0)^2 / 2 must not exceed L2^2)")
+    w = s.run.warmup_parts
+    if isinstance(w, int) and w >= s.run.parts:
+        raise ScenarioError(file, "run.warmup_parts", w,
+                            f"must be fewer than run.parts ({s.run.parts})")
     b = s.belts
-    if b.input_max_in_s < b.input_nominal_in_s:
-        raise ScenarioError(file, "belts.input_max_in_s", b.input_max_in_s,
-                            "must be at least belts.input_nominal_in_s")
-    if b.output_max_in_s < b.output_nominal_in_s:
-        raise ScenarioError(file, "belts.output_max_in_s", b.output_max_in_s,
-                            "must be at least belts.output_nominal_in_s")
+    for belt in ("input", "output"):
+        lo, nom, hi = (getattr(b, f"{belt}_{k}_in_s") for k in ("min", "nominal", "max"))
+        if hi < nom:
+            raise ScenarioError(file, f"belts.{belt}_max_in_s", hi,
+                                f"must be at least belts.{belt}_nominal_in_s ({nom:g})")
+        if lo > nom:
+            raise ScenarioError(file, f"belts.{belt}_min_in_s", lo,
+                                f"must be at most belts.{belt}_nominal_in_s ({nom:g})")
     from cell.arrivals import check_arrivals
 
     check_arrivals(s.arrivals, s.base_dir, file)

@@ -31,7 +31,7 @@ from cell.controller import Controller, View
 from cell.conveyors import InputConveyor, OutputConveyor
 from cell.feeder import Feeder
 from cell.policies.base import Accounting
-from cell.records import BeltChange, PartRecord, RunSummary
+from cell.records import LIMIT_BIT, SPACING_OFF, BeltChange, PartRecord, RunSummary, limit_names
 from cell.robot import Robot
 from cell.scenario import Scenario
 
@@ -71,27 +71,32 @@ class RunLog:
 
     Parts finish out of order (a part can fall off at F while the one before it
     is still in the hand), so a finished part waits here until those before it
-    are done; at most a few do.  What the summary needs is kept in flat arrays.
+    are done; at most a few do.  What the summary needs is kept per part in flat
+    arrays (a few dozen bytes a part), so a warm-up can be cut off at the end.
     """
 
-    def __init__(self, t: list[float], acct: Accounting, sinks: list[PartSink]):
+    def __init__(self, t: list[float], acct: Accounting, sinks: list[PartSink],
+                 spacing_in: float, tol_in: float):
         self.t = t
         """T_1 … T_{n+1}: the last is only part n's "next arrival"."""
         self.acct, self.sinks = acct, sinks
+        self.spacing_in, self.tol_in = spacing_in, tol_in
         self.waiting: dict[int, PartRecord] = {}
+        self.flags: dict[int, int] = {}
+        """Limit bits of parts not yet handed on."""
         self.next = 1
-        self.delivered = 0
-        self.first_td = self.last_td = math.nan
+        self.td = array("d")
+        self.picked = array("b")
+        self.r4 = array("d")
+        self.out_speed = array("d")
         self.ip_wall = array("d")
-        self.picked_r4 = array("d")
-        self.picked_out = array("d")
-        self.spacing_min = math.inf
-        self.spacing_max = -math.inf
-        self.spacings = 0
-        self.outside = 0
-        self.noted = 0
-        self.missed_count = 0
-        self.spacing_in, self.tol_in = 45.0, 0.25
+        self.interval = array("d")
+        self.spacing = array("d")
+        self.limits = array("l")
+        self.feed_delay = array("d")
+
+    def flag(self, part: PartRecord, limits: int) -> None:
+        self.flags[part.part] = self.flags.get(part.part, 0) | limits
 
     def missed(self, part: PartRecord) -> None:
         self._done(part)
@@ -110,29 +115,38 @@ class RunLog:
     def _emit(self, p: PartRecord) -> None:
         t_next = self.t[p.part]
         p.ip_wallclock = t_next / p.delivery_interval_s
-        self.ip_wall.append(p.ip_wallclock)
         self.acct.part(p, t_next)
-        if p.picked:
-            self.picked_r4.append(p.r4_s)
-            self.picked_out.append(p.output_speed_in_s)
-        else:
-            self.missed_count += 1
-        td = p.touchdown_s
-        if td == td:
-            if self.delivered == 0:
-                self.first_td = td
-            self.last_td = td
-            self.delivered += 1
+        flags = self.flags.pop(p.part, 0)
         sp = p.spacing_in
-        if sp == sp:
-            self.spacings += 1
-            self.spacing_min = min(self.spacing_min, sp)
-            self.spacing_max = max(self.spacing_max, sp)
-            self.outside += abs(sp - self.spacing_in) > self.tol_in + 1e-9
-        self.noted += bool(p.note)
+        if sp == sp and abs(sp - self.spacing_in) > self.tol_in + 1e-9:
+            flags |= SPACING_OFF
+        p.limits = limit_names(flags) if flags else ""
+        self.td.append(p.touchdown_s)
+        self.picked.append(p.picked)
+        self.r4.append(p.r4_s)
+        self.out_speed.append(p.output_speed_in_s)
+        self.ip_wall.append(p.ip_wallclock)
+        self.interval.append(p.delivery_interval_s)
+        self.spacing.append(sp)
+        self.limits.append(flags)
+        self.feed_delay.append(p.feed_delay_s)
         for sink in self.sinks:
             sink(p)
         self.next += 1
+
+    def warmup(self, setting: int | str) -> int:
+        """The number of leading parts to leave out: ``setting``, or for ``auto`` the
+        MSER-5 truncation point of the delivery intervals (White 1997)."""
+        if setting != "auto":
+            return int(setting)
+        from cell.analysis.stats import mser5
+
+        interval = np.frombuffer(self.interval)
+        delivered = np.flatnonzero(np.isfinite(interval))
+        if delivered.size < 10:
+            return 0
+        cut = mser5(interval[delivered])
+        return int(delivered[cut]) if cut < delivered.size else 0
 
 
 def _seed_value(seed: Any) -> Any:
@@ -178,13 +192,12 @@ def simulate(scenario: Scenario | AssembledCell,
 
     acct = policy.accounting()
     env = simpy.Environment()
-    feeder_t = t_all
-    log = RunLog(feeder_t.tolist(), acct, sinks)
-    log.spacing_in, log.tol_in = k.spacing, k.tol
+    log = RunLog(t_all.tolist(), acct, sinks, k.spacing, k.tol)
     conveyor = InputConveyor(env, k.v_nom, k.input_length, belt_sink("input"))
     output = OutputConveyor(env, k.u_nom, log.delivered_part, belt_sink("output"))
     robot = Robot(env, output.placed)
-    feeder = Feeder(env, feeder_t, conveyor, n)
+    feeder = Feeder(env, t_all, conveyor, n, k.part_size, log.flag)
+    conveyor.feeder = feeder
     view = View(env, k, feeder.fed_s, n, conveyor, output)
     Controller(env, k, policy, view, conveyor, output, robot, log)
     env.run()
@@ -195,30 +208,53 @@ def simulate(scenario: Scenario | AssembledCell,
     summary = _summary(cell, log, acct, t_all, n, env.now)
     summary.seed = _seed_value(seed)
     summary.input_speed_max_in_s = conveyor.belt.max_speed_in_s
+    summary.input_speed_min_in_s = conveyor.belt.min_speed_in_s
     return SimResult(summary, records, changes)
 
 
 def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, n: int,
              end_s: float) -> RunSummary:
+    """The run's measures over the parts after the warm-up (all of them by default)."""
     s, k = cell.scenario, cell.k
-    picked_r4 = np.frombuffer(log.picked_r4) if len(log.picked_r4) else np.empty(0)
-    vout = np.frombuffer(log.picked_out) if len(log.picked_out) else np.empty(0)
-    ip_wall = np.frombuffer(log.ip_wall) if len(log.ip_wall) else np.empty(0)
-    d = log.delivered
-    actual_wall = float((log.last_td - log.first_td) / (d - 1)) if d > 1 else math.nan
+    w = log.warmup(s.run.warmup_parts)
+    td = np.frombuffer(log.td)[w:]
+    picked = np.frombuffer(log.picked, dtype=np.int8)[w:].astype(bool)
+    vout = np.frombuffer(log.out_speed)[w:][picked]
+    ip_wall = np.frombuffer(log.ip_wall)[w:]
+    sp = np.frombuffer(log.spacing)[w:]
+    sp = sp[np.isfinite(sp)]
+    limits = np.frombuffer(log.limits, dtype=np.int_)[w:] if len(log.limits) else \
+        np.zeros(0, dtype=np.int_)
+    delay = np.frombuffer(log.feed_delay)[w:]
+    done = td[np.isfinite(td)]
+    d = done.size
+    missed = int((~picked).sum())
+
+    def count(name: str) -> int:
+        return int(np.count_nonzero(limits & LIMIT_BIT[name]))
+
+    held = limits & LIMIT_BIT["held_at_feeder"] != 0
     r = RunSummary(
         scenario=s.name, policy=cell.policy.name, ideal_cycle_s=cell.policy.ideal_cycle_s,
-        parts_arrived=n, parts_delivered=d, parts_missed=log.missed_count,
-        parts_in_cell=n - d - log.missed_count,
-        actual_cycle_wallclock_s=actual_wall,
+        parts_arrived=n - w, parts_delivered=d, parts_missed=missed,
+        parts_in_cell=n - w - d - missed,
+        actual_cycle_wallclock_s=float((done[-1] - done[0]) / (d - 1)) if d > 1 else math.nan,
         ip_wallclock=float(np.nanmean(ip_wall)) if np.isfinite(ip_wall).any() else math.nan,
-        spacing_min_in=log.spacing_min if log.spacings else math.nan,
-        spacing_max_in=log.spacing_max if log.spacings else math.nan,
-        spacing_outside_tol=int(log.outside), parts_noted=int(log.noted),
+        spacing_min_in=float(sp.min()) if sp.size else math.nan,
+        spacing_max_in=float(sp.max()) if sp.size else math.nan,
+        spacing_outside_tol=count("spacing_off"),
+        limit_input_floor=count("input_floor"), limit_input_ceiling=count("input_ceiling"),
+        limit_input_tracking=count("input_tracking"), limit_output_floor=count("output_floor"),
+        limit_output_ceiling=count("output_ceiling"), limit_r2_peak=count("r2_peak"),
+        limit_r4_peak=count("r4_peak"), parts_held=int(held.sum()),
+        feed_delay_max_s=float(delay[held].max()) if held.any() else 0.0,
         output_speed_min_in_s=float(vout.min()) if vout.size else math.nan,
         output_speed_max_in_s=float(vout.max()) if vout.size else math.nan,
-        r1_nominal_s=k.r1_nom, r2_nominal_s=k.r2_nom, sim_end_s=end_s)
-    acct.finish(r, picked_r4, t[1:])
+        r1_nominal_s=k.r1_nom, r2_nominal_s=k.r2_nom, nominal_cycle_s=k.cycle_nom,
+        nominal_from=k.nominal_from, mean_interarrival_s=k.mean_interarrival_s,
+        fastest_cycle_s=k.fastest_cycle_s, utilisation=k.utilisation, warmup_parts=w,
+        sim_end_s=end_s)
+    acct.finish(r, w, np.frombuffer(log.r4)[w:][picked], t[1:])
     r.parts_per_hr_wallclock = float(accounting.parts_per_hr(r.actual_cycle_wallclock_s))
     r.parts_per_hr_thesis = float(accounting.parts_per_hr(r.actual_cycle_thesis_s))
     r.vavg_r4_in_s = k.timing.r4.length_in / r.r4_s if r.r4_s == r.r4_s else math.nan

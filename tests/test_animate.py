@@ -44,7 +44,7 @@ FIRST, COUNT = 2, 6
 
 @pytest.fixture(scope="module")
 def scenario() -> Scenario:
-    return default_scenario()
+    return default_scenario().with_overrides({"controller.nominal_cycle_s": 22.5872})
 
 
 @pytest.fixture(scope="module")

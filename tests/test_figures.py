@@ -14,7 +14,7 @@ from cell.cli import main
 from cell.figures import FILES, make_figures
 from cell.figures.motion import nominal_timeline
 from cell.motors import max_rates
-from cell.scenario import default_scenario
+from cell.scenario import default_scenario, load_scenario
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -59,7 +59,7 @@ def test_nominal_transfer_keeps_the_thesis_split() -> None:
     """The ideal 22.5872 s cycle split as in SPEC §6: R I and R III at belt pace
     (8/3 s and 4 s, plus what the motors add after LO/TD), R IV at the base's
     nominal rate (thesis 9.9855 s), R II the rest (thesis 5.935 s at R I = 8/3 s)."""
-    s = default_scenario()
+    s = load_scenario("baseline")
     table = step_table(s)
     tl = nominal_timeline(table, s)
     assert tl.t_s[-1] == pytest.approx(22.5872, abs=1e-9)

@@ -16,6 +16,7 @@ from cell.errors import ScenarioError
 from cell.policies import Plan, Policy
 from cell.policies.adaptive import adaptive_plan
 from cell.policies.fixed import fixed_plan
+from cell.records import INPUT_FLOOR, OUTPUT_CEILING, OUTPUT_FLOOR, R2_PEAK, R4_PEAK
 from cell.simulation import simulate
 
 #: Table 7.1: ideal cycle -> Vavg R IV (in/s).
@@ -55,7 +56,7 @@ def test_on_time_part_keeps_everything_nominal(k):
     assert plan.cycle == pytest.approx(k.cycle_nom)
     assert plan.input_after_lo == pytest.approx(3.0)
     assert plan.output_to_g == pytest.approx(2.0)
-    assert plan.note == ""
+    assert plan.limits == 0
 
 
 def test_late_part_speeds_the_input_belt_after_the_lag(k):
@@ -85,6 +86,32 @@ def test_very_early_part_uses_the_base_maximum_then_slows_the_belt(k):
     assert plan.input_after_lo < 3.0
     assert lag + b / plan.input_after_lo == pytest.approx(plan.cycle)
     assert plan.input_next == plan.input_after_lo     # 6.3: below nominal, left alone
+    assert plan.limits == R4_PEAK
+
+
+def test_no_slower_than_the_floor_and_a_too_early_part_is_let_go(k):
+    """Departure: step 3.2 stops at belts.input_min_in_s; the part comes early (and the
+    controller, which aimed it at B for the robot's return, says so)."""
+    lag = k.timing.r1_pre.time(3.0)
+    b = 4.0                                      # the next part is right behind
+    plan = adaptive_plan(k, 3.0, (lag, b), None)
+    assert plan.input_after_lo == k.input_min
+    assert lag + b / plan.input_after_lo < plan.cycle           # it will reach B early
+    assert plan.limits & INPUT_FLOOR and plan.limits & R4_PEAK
+
+
+def test_a_belt_left_slower_than_r2_can_absorb_is_raised(k):
+    """Departure in step 6.3: below ``input_absorb`` the next R I would outgrow R II's slack
+    (step 2.2) and lengthen the cycle; the belt is raised to that speed.  At it, R II takes
+    exactly its fastest time."""
+    lag = k.timing.r1_pre.time(3.0)
+    b = (k.input_min + 0.05) * (k.shortest_cycle_s - lag)   # slowed to just above the floor
+    plan = adaptive_plan(k, 3.0, (lag, b), None)
+    assert k.input_min < plan.input_after_lo < k.input_absorb
+    assert plan.input_next == k.input_absorb
+    after = adaptive_plan(k, plan.input_next, None, None)
+    assert after.r2 == pytest.approx(k.timing.r2_min_s, rel=1e-6)
+    assert after.cycle == pytest.approx(k.cycle_nom, rel=1e-9)
 
 
 def test_fast_input_belt_gives_its_time_to_r2(k):
@@ -110,18 +137,19 @@ def test_output_speed_is_the_average_of_the_spacing_limits(k):
 @given(v=st.floats(0.3, 4.3), a=st.floats(0.0, 40.0), b=st.floats(0.01, 200.0),
        gap=st.one_of(st.none(), st.floats(0.0, 60.0)))
 def test_plans_never_ask_more_than_the_motors_and_belts_can_do(k, v, a, b, gap):
-    v = min(v, k.timing.input_track_max_in_s)
+    v = min(max(v, k.input_min), k.timing.input_track_max_in_s)   # a belt is never outside them
     plan = adaptive_plan(k, v, (a, b), gap)
     t = k.timing
     assert plan.r1_pre >= t.r1_pre.floor_s - 1e-12
     assert plan.r1_post >= t.r1_post.floor_s - 1e-12
     assert plan.r2 >= t.r2_min_s - 1e-12
     assert plan.r4 >= t.r4_min_s - 1e-12
-    assert 0 < plan.input_after_lo <= k.input_max
-    assert 0 < plan.input_next <= t.input_track_max_in_s
-    assert 0 < plan.output_to_g <= k.output_max
-    assert math.isfinite(plan.cycle) and plan.cycle > 0
-    if "output belt" not in plan.note and gap is not None:
+    assert k.input_min <= plan.input_after_lo <= k.input_max
+    assert min(v, k.input_absorb) <= plan.input_next <= t.input_track_max_in_s
+    assert k.output_min <= plan.output_to_g <= k.output_max
+    assert math.isfinite(plan.cycle) and 0 < plan.cycle <= k.cycle_nom + 1e-9 or \
+        plan.limits & R2_PEAK
+    if not plan.limits & (OUTPUT_FLOOR | OUTPUT_CEILING) and gap is not None:
         spacing = gap + plan.output_to_g * plan.to_g + k.u_nom * plan.r3_pre
         assert spacing == pytest.approx(45.0, abs=1e-9)
 
@@ -135,7 +163,7 @@ class AlwaysNominal(Policy):
     def plan(self, view):
         k = self.k
         return Plan(k.r1_pre_nom, k.r1_post_nom, k.r2_nom, k.r3_pre_nom, k.r3_post_nom, k.r4_nom,
-                    k.v_nom, k.v_nom, k.v_nom, k.u_nom, k.r1_nom + k.r2_nom, k.cycle_nom, "",
+                    k.v_nom, k.v_nom, k.v_nom, k.u_nom, k.r1_nom + k.r2_nom, k.cycle_nom,
                     steers_belts=False)
 
 

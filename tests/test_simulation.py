@@ -116,9 +116,22 @@ def test_same_seed_gives_byte_identical_csvs(tmp_path, capsys):
     for name in ("parts.csv", "summary.csv"):
         assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes()
     text = capsys.readouterr().out
-    assert "1.0214" in text and "2.1 %" in text        # the thesis's figures printed beside
-    frame = pd.read_csv(tmp_path / "a" / "parts.csv")
+    assert "1.0214" not in text and "only beside a run of its own scenario" in text
+    frame = pd.read_csv(tmp_path / "a" / "parts.csv", keep_default_na=False)
     assert list(frame.columns) == PART_COLUMNS and len(frame) == 80
+
+
+def test_the_thesis_figures_are_printed_beside_the_thesis_run_only(tmp_path, capsys):
+    assert main(["run", "baseline", "--out", str(tmp_path / "a")]) == 0
+    text = capsys.readouterr().out
+    assert "(thesis: 1.0214)" in text and "within 2.1 %" in text
+    assert main(["run", "non_adaptive", "--set", "controller.ideal_cycle_s=21.0",
+                 "--out", str(tmp_path / "b")]) == 0
+    text = capsys.readouterr().out
+    assert "(thesis: 25.8622)" in text and "(thesis: 35)" in text      # Table 7.1, 21.0 s row
+    assert main(["run", "baseline", "--set", "belts.output_nominal_in_s=2.5",
+                 "--out", str(tmp_path / "c")]) == 0
+    assert "(thesis:" not in capsys.readouterr().out
 
 
 def test_other_seed_other_parts(tmp_path):
@@ -206,7 +219,7 @@ def test_invariants_hold_for_any_seed(seed, policy, ideal, input_max):
     assert (done["touchdown_s"] > done["pick_s"]).all()
     assert (p["missed"] == ~p["picked"]).all()
     if policy == "adaptive":
-        clean = p["note"].fillna("").str.contains("output belt") == False  # noqa: E712
+        clean = ~p["limits"].str.contains("output_")
         sp = p.loc[clean, "spacing_in"].dropna()
         assert ((sp - 45.0).abs() <= 0.25 + 1e-9).all()
         assert max(v for _, v in r.belts["input"]) <= input_max + 1e-12

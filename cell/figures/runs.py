@@ -16,6 +16,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from cell.assembly import nominal_cycle
 from cell.conveyors import speed_at
 from cell.figures.motion import Timeline, timeline
 from cell.figures.style import (
@@ -56,7 +57,7 @@ def simulate_runs(s: Scenario, cycles: tuple[float, ...] = TABLE_7_1_CYCLES) -> 
     """The adaptive run and the non-adaptive run at each cycle, same seed throughout."""
     from cell.simulation import simulate
 
-    ideal = s.controller.nominal_cycle_s
+    ideal = nominal_cycle(s)
     a = simulate(s.with_overrides({"controller.policy": "adaptive"}))
     adaptive = Run("adaptive", ideal, a.parts, a.summary.as_dict(), a.belts)
     non = {}
@@ -99,7 +100,7 @@ ACCOUNTS = (
 def _interval_figure(runs: Runs, s: Scenario, number: int, caption: str, lumped: bool,
                      out: Path) -> Path:
     fig, axes = new_figure(number, caption, nrows=2, size=(10.0, 7.4), sharex=True)
-    ideal = s.controller.nominal_cycle_s
+    ideal = nominal_cycle(s)
     na = runs.non_adaptive[TABLE_7_1_CYCLES[0]]
     for ax, (what, col, _, _) in zip(axes, ACCOUNTS, strict=True):
         for run in (na, runs.adaptive):
@@ -243,7 +244,7 @@ def fig22_tip_velocity(runs: Runs, table: StepTable, s: Scenario, out: Path) -> 
     mark_events(ax, {"LO": 0.0, "TD": float(tl.t_s[p.td] - lag)})
     nxt = float(run.parts["interarrival_s"].iloc[i + 1]) if i + 1 < len(run.parts) else np.nan
     ax.set_title(f"adaptive run, part {int(row['part'])}: next part {nxt:.3f} s behind "
-                 f"(ideal {s.controller.nominal_cycle_s:g} s); input belt {before:.3f} → "
+                 f"(ideal {nominal_cycle(s):g} s); input belt {before:.3f} → "
                  f"{after:.3f} in/s at LO; cycle {tl.t_s[-1]:.3f} s", loc="left", fontsize=9,
                  pad=16)
     ax.set_xlabel("time from lift-off LO (s); negative: the look-ahead lag")

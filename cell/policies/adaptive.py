@@ -16,6 +16,10 @@ One part ahead:
      cycle's residual (TD → K and R IV), idle waits not counted;
 6.3  after the cycle, an input speed above nominal becomes (current + nominal)/2.
 
+Where the thesis's rules alone would let the cell run away on other arrivals, the
+plan adds floors and one restoring rule (see :func:`adaptive_plan`); the limits a
+cycle hits are flagged for its part's record.
+
 Targets are physical: the controller knows the belts' schedules, so it aims
 the next part at B for the instant the robot gets back, and the spacing at 45 in,
 exactly; only motor and belt limits can make it miss, and then it says so.
@@ -31,15 +35,21 @@ import numpy as np
 from cell import accounting
 from cell.errors import ScenarioError
 from cell.policies.base import CellConstants, CellView, MotionTimeAccounting, Plan, Policy
-from cell.records import RunSummary
-
-#: The output belt never runs backwards; this is its crawl when asked to stop (in/s).
-OUTPUT_MIN_IN_S = 0.01
+from cell.records import (
+    INPUT_CEILING,
+    INPUT_FLOOR,
+    INPUT_TRACKING,
+    OUTPUT_CEILING,
+    OUTPUT_FLOOR,
+    R2_PEAK,
+    R4_PEAK,
+    RunSummary,
+)
 
 
 def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
                   gap_in: float | None, lag: float | None = None) -> Plan:
-    """Thesis §5.3 steps 2.0-6.3 for one part (pure).
+    """Thesis §5.3 steps 2.0-6.3 for one part (pure), within the belts' and motors' limits.
 
     ``v``: input belt speed now (R I tracks it).  ``nxt = (a, b)``: the next part
     reaches B a + b/w seconds from now if the input belt runs at w from LO on
@@ -48,15 +58,21 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
     None if no part is coming.  ``gap_in``: how far the last part set down has
     travelled on the output belt (None before the first).  ``lag``: B → LO at v,
     if the caller has it already.
+
+    Departures from the thesis (docs/model.md), none of which binds on its arrivals:
+    step 3.2 slows the input belt no further than its floor (a part still too early
+    is let go: it reaches B while the robot is busy); step 6.3 also raises a belt left
+    slower than R II can absorb (``k.input_absorb``), so a slowed belt never lengthens
+    the next cycle; step 5.0 keeps the output belt within its floor and ceiling.
     """
     t = k.timing
-    notes = []
+    flags = 0
     r1a = t.r1_pre.time(v) if lag is None else lag
     r1b = t.r1_post.time(v)
     # 2.1-2.3: R I's difference from nominal goes to R II.
     r2 = k.r2_nom + (k.r1_nom - r1a - r1b)
     if r2 < t.r2_min_s:
-        notes.append("R II at its fastest")
+        flags |= R2_PEAK
         r2 = t.r2_min_s
     r3a, r3b, r4 = k.r3_pre_nom, k.r3_post_nom, k.r4_nom
     cycle = r1a + r1b + r2 + r3a + r3b + r4
@@ -68,7 +84,7 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
             w = b / (cycle - a) if cycle > a else math.inf
             if w > k.input_max:
                 w = k.input_max
-                notes.append("input belt at its maximum: robot waits")
+                flags |= INPUT_CEILING
         elif eta < cycle:                     # 3.2: early; R IV first, then the belt
             need = cycle - eta
             if r4 - need >= t.r4_min_s:
@@ -77,12 +93,16 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
             else:
                 cycle -= r4 - t.r4_min_s
                 r4 = t.r4_min_s
+                flags |= R4_PEAK
                 w = b / (cycle - a)
-    # 6.3: decay toward nominal after the cycle.
-    v_next = 0.5 * (w + k.v_nom) if w > k.v_nom else w
+                if w < k.input_min:           # departure: the belt's floor
+                    w = k.input_min
+                    flags |= INPUT_FLOOR
+    # 6.3: decay toward nominal after the cycle; departure: never below what R II absorbs.
+    v_next = 0.5 * (w + k.v_nom) if w > k.v_nom else max(w, k.input_absorb)
     if v_next > t.input_track_max_in_s:
         v_next = t.input_track_max_in_s
-        notes.append("input belt held to the robot's tracking limit")
+        flags |= INPUT_TRACKING
     # 5.0: output belt until G, between the 44.75 and 45.25 in limits.
     u = k.u_nom
     if gap_in is not None:
@@ -91,11 +111,13 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
         lo = (k.spacing - k.tol - rest) / ttsot
         hi = (k.spacing + k.tol - rest) / ttsot
         u = 0.5 * (lo + hi)
-        if not OUTPUT_MIN_IN_S <= u <= k.output_max:
-            u = min(max(u, OUTPUT_MIN_IN_S), k.output_max)
-            notes.append("output belt at its limit: spacing off")
-    return Plan(r1a, r1b, r2, r3a, r3b, r4, v, w, v_next, u, r1a + r1b + r2, cycle,
-                "; ".join(notes))
+        if u < k.output_min:
+            u = k.output_min
+            flags |= OUTPUT_FLOOR
+        elif u > k.output_max:
+            u = k.output_max
+            flags |= OUTPUT_CEILING
+    return Plan(r1a, r1b, r2, r3a, r3b, r4, v, w, v_next, u, r1a + r1b + r2, cycle, flags)
 
 
 class Adaptive(Policy):
@@ -125,10 +147,12 @@ class AdaptiveAccounting(MotionTimeAccounting):
     """Step 6.2, and beside it the memoryless reading that reproduces the published IP
     (each next arrival counted from the current pick-up; docs/accounting.md)."""
 
-    def finish(self, s: RunSummary, picked_r4_s: np.ndarray, t_next: np.ndarray) -> None:
-        super().finish(s, picked_r4_s, t_next)
+    def finish(self, s: RunSummary, start: int, picked_r4_s: np.ndarray,
+               t_next: np.ndarray) -> None:
+        super().finish(s, start, picked_r4_s, t_next)
         k = self.policy.k
-        memo = accounting.thesis_adaptive_memoryless(t_next, k.cycle_nom, k.shortest_cycle_s)
+        memo = accounting.thesis_adaptive_memoryless(t_next[start:], k.cycle_nom,
+                                                     k.shortest_cycle_s)
         s.ip_thesis_memoryless = float(memo.mean_ip)
         s.cycle_vs_nominal_memoryless_pct = \
             100.0 * (float(memo.actual_cycle_s) - k.cycle_nom) / k.cycle_nom

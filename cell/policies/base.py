@@ -34,7 +34,8 @@ class CellConstants:
     u_nom: float
     """Nominal output belt speed, in/s (§5.2)."""
     cycle_nom: float
-    """The ideal cycle, mean inter-arrival time (§5.3)."""
+    """The ideal cycle the policies aim at (§5.3): the mean inter-arrival time, or the
+    robot's fastest cycle when the arrivals are faster than that."""
     input_max: float
     output_max: float
     spacing: float
@@ -50,11 +51,36 @@ class CellConstants:
     """R II's share of the ideal cycle: what the other regimes leave of it."""
     r1_nom: float
     """R I at the nominal input belt: belt pace to LO plus the motor floor after it."""
+    input_min: float = 0.0
+    """Slowest input belt speed the controller may ask (``belts.input_min_in_s``)."""
+    output_min: float = 0.0
+    """Slowest output belt speed (``belts.output_min_in_s``)."""
+    part_size: float = 2.0
+    """Cube edge: parts on a belt are never closer than this (centre to centre)."""
+    input_absorb: float = 0.0
+    """The slowest input belt whose longer R I tracking R II can still absorb (step 2.2):
+    a belt left slower than this would lengthen the next cycle (docs/model.md)."""
+    mean_interarrival_s: float = float("nan")
+    """Mean inter-arrival time of the arrivals (the distribution's or the trace's)."""
+    nominal_from: str = "scenario"
+    """Where ``cycle_nom`` came from: ``scenario`` (``controller.nominal_cycle_s``),
+    ``arrivals`` (their mean) or ``fastest`` (the arrivals are faster than the robot)."""
 
     @property
     def shortest_cycle_s(self) -> float:
         """The nominal cycle with R IV at the base's peak rate (Table 7.1's last row)."""
         return self.cycle_nom - (self.r4_nom - self.timing.r4_min_s)
+
+    @property
+    def fastest_cycle_s(self) -> float:
+        """The robot's fastest cycle: R II and R IV at the motors' peak, belts at nominal."""
+        t = self.timing
+        return self.r1_nom + t.r2_min_s + self.r3_pre_nom + self.r3_post_nom + t.r4_min_s
+
+    @property
+    def utilisation(self) -> float:
+        """Fastest cycle over mean inter-arrival time: 1 or more, the cell cannot keep up."""
+        return self.fastest_cycle_s / self.mean_interarrival_s
 
 
 class Plan(NamedTuple):
@@ -78,7 +104,8 @@ class Plan(NamedTuple):
     """TTSOT counted from the start of this cycle: R I + R II (step 5.0)."""
     cycle: float
     """The robot's motion time for the whole cycle B → B."""
-    note: str
+    limits: int = 0
+    """The limits hit (bits of :data:`cell.records.LIMIT_BIT`)."""
     steers_belts: bool = True
     """Whether the belt speeds above are commands (False: the belts are left alone)."""
 
@@ -135,13 +162,20 @@ class Accounting:
         self.policy = policy
         self.interval = array("d")
         self.ip = array("d")
-        self.missed = 0
+        self.lost = array("b")
 
     def part(self, rec: PartRecord, next_interarrival_s: float) -> None:
         raise NotImplementedError
 
-    def finish(self, s: RunSummary, picked_r4_s: np.ndarray, t_next: np.ndarray) -> None:
+    def finish(self, s: RunSummary, start: int, picked_r4_s: np.ndarray,
+               t_next: np.ndarray) -> None:
+        """Fill ``s``'s thesis columns from part ``start`` on (after the warm-up);
+        ``t_next``: every part's next inter-arrival time, ``picked_r4_s``: the R IV times
+        of the parts picked after the warm-up."""
         raise NotImplementedError
+
+    def _lost_after(self, start: int) -> int:
+        return int(np.frombuffer(self.lost, dtype=np.int8)[start:].sum()) if len(self.lost) else 0
 
 
 class MotionTimeAccounting(Accounting):
@@ -155,12 +189,13 @@ class MotionTimeAccounting(Accounting):
         rec.thesis_interval_s = d
         rec.ip_thesis = next_interarrival_s / d
         self.interval.append(d)
-        self.missed += not rec.picked
+        self.lost.append(not rec.picked)
 
-    def finish(self, s: RunSummary, picked_r4_s: np.ndarray, t_next: np.ndarray) -> None:
+    def finish(self, s: RunSummary, start: int, picked_r4_s: np.ndarray,
+               t_next: np.ndarray) -> None:
         k = self.policy.k
-        thesis = accounting.thesis_adaptive(t_next, np.frombuffer(self.interval))
-        s.parts_missed_thesis = self.missed
+        thesis = accounting.thesis_adaptive(t_next[start:], np.frombuffer(self.interval)[start:])
+        s.parts_missed_thesis = self._lost_after(start)
         s.actual_cycle_thesis_s = float(thesis.actual_cycle_s)
         s.ip_thesis = float(thesis.mean_ip)
         s.cycle_vs_nominal_pct = 100.0 * (s.actual_cycle_thesis_s - k.cycle_nom) / k.cycle_nom

@@ -15,7 +15,7 @@ import numpy as np
 from cell import accounting
 from cell.errors import ScenarioError
 from cell.policies.base import Accounting, CellConstants, CellView, Plan, Policy
-from cell.records import PartRecord, RunSummary
+from cell.records import R4_PEAK, PartRecord, RunSummary
 
 #: The thesis's figures are rounded to 4 decimals: a requested R IV this much
 #: below the motors' minimum is taken as the minimum (20.0907 s in Table 7.1 is
@@ -37,7 +37,8 @@ def fixed_plan(k: CellConstants, ideal_cycle_s: float, file: object = None) -> P
     to_g = k.r1_pre_nom + k.r1_post_nom + k.r2_nom
     return Plan(k.r1_pre_nom, k.r1_post_nom, k.r2_nom, k.r3_pre_nom, k.r3_post_nom, r4,
                 k.v_nom, k.v_nom, k.v_nom, k.u_nom, to_g,
-                to_g + k.r3_pre_nom + k.r3_post_nom + r4, "", steers_belts=False)
+                to_g + k.r3_pre_nom + k.r3_post_nom + r4, R4_PEAK if r4 <= t.r4_min_s else 0,
+                steers_belts=False)
 
 
 class FixedCycle(Policy):
@@ -79,13 +80,15 @@ class ReconstructedAccounting(Accounting):
         rec.ip_thesis = next_interarrival_s / (2.0 * d)
         self.interval.append(d)
         self.ip.append(rec.ip_thesis)
-        self.missed += lost
+        self.lost.append(lost)
 
-    def finish(self, s: RunSummary, picked_r4_s: np.ndarray, t_next: np.ndarray) -> None:
-        d, ip = np.frombuffer(self.interval), np.frombuffer(self.ip)
+    def finish(self, s: RunSummary, start: int, picked_r4_s: np.ndarray,
+               t_next: np.ndarray) -> None:
+        d, ip = np.frombuffer(self.interval)[start:], np.frombuffer(self.ip)[start:]
         ideal = self.policy.ideal_cycle_s
-        s.parts_missed_thesis = self.missed
-        s.actual_cycle_thesis_s = float(d.sum() / (len(d) - self.missed)) if len(d) > self.missed \
+        missed = self._lost_after(start)
+        s.parts_missed_thesis = missed
+        s.actual_cycle_thesis_s = float(d.sum() / (len(d) - missed)) if len(d) > missed \
             else math.nan
         s.ip_thesis = float(ip.mean()) if len(ip) else math.nan
         s.cycle_vs_nominal_pct = 100.0 * (s.actual_cycle_thesis_s - ideal) / ideal

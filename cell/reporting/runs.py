@@ -1,0 +1,128 @@
+"""One run's summary for people: what ran, whether the cell can keep up, the
+results beside the thesis's where the run is the thesis's own, and the limits hit."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from cell import thesis as published
+from cell.assembly import AssembledCell
+from cell.policies.base import CellConstants
+from cell.records import RunSummary
+from cell.scenario import Scenario, load_scenario
+
+#: Relative difference between the nominal cycle and the arrivals' mean worth a warning.
+NOMINAL_MISMATCH = 0.01
+
+IP_LINE = ("IP (eq. 5.1) = the next part's inter-arrival time / the time between deliveries: "
+           "1 means the cell keeps pace with its parts.  The thesis's accounting is how the "
+           "thesis counted (docs/accounting.md); the wall clock is what a stopwatch shows.")
+
+#: Summary fields of the limits, as printed.
+LIMIT_FIELDS = (("limit_r4_peak", "R IV at the base's peak rate"),
+                ("limit_r2_peak", "R II at the motors' peak"),
+                ("limit_input_floor", "input belt at its floor (part let go)"),
+                ("limit_input_ceiling", "input belt at its ceiling (robot waited)"),
+                ("limit_input_tracking", "input belt held to the robot's tracking limit"),
+                ("limit_output_floor", "output belt at its floor"),
+                ("limit_output_ceiling", "output belt at its ceiling"),
+                ("parts_held", "held at the feeder (belt not clear)"))
+
+
+def run_heading(cell: AssembledCell) -> str:
+    """What runs, and at which ideal cycle, said before the run starts."""
+    s, k = cell.scenario, cell.k
+    source = {"scenario": "controller.nominal_cycle_s",
+              "arrivals": "the arrivals' mean",
+              "fastest": "the robot's fastest cycle: the arrivals come faster"}[k.nominal_from]
+    return (f"cell run: {s.name} ({cell.policy.name}), {s.run.parts} parts, seed {s.run.seed}\n"
+            f"nominal cycle {k.cycle_nom:.4f} s ({source}); mean inter-arrival "
+            f"{k.mean_interarrival_s:.4f} s; the robot's fastest cycle {k.fastest_cycle_s:.4f} s: "
+            f"utilisation {k.utilisation:.3f}")
+
+
+def warnings(k: CellConstants) -> list[str]:
+    """One line each: the cell cannot keep up on average; the nominal cycle is not the
+    arrivals' mean."""
+    out = []
+    if k.utilisation >= 1:
+        out.append(f"utilisation {k.utilisation:.3f}: the robot's fastest cycle "
+                   f"({k.fastest_cycle_s:.2f} s) is not shorter than the mean inter-arrival time "
+                   f"({k.mean_interarrival_s:.2f} s); the cell cannot keep up on average and "
+                   "every policy will lose parts")
+    gap = k.cycle_nom / k.mean_interarrival_s - 1
+    if k.nominal_from == "scenario" and abs(gap) > NOMINAL_MISMATCH:
+        out.append(f"controller.nominal_cycle_s ({k.cycle_nom:.4f} s) is {gap:+.1%} off the "
+                   f"arrivals' mean ({k.mean_interarrival_s:.4f} s): the controller aims at it, "
+                   "not at the arrivals; set it to null to follow them")
+    return out
+
+
+def thesis_figures(s: Scenario) -> dict[str, str] | None:
+    """The thesis's published figures for this run, as printed, if it is the thesis's own
+    run: the built-in baseline (eq. 6.9 arrivals, 500 parts), either policy, a Table 7.1
+    cycle for the non-adaptive robot; None otherwise."""
+    c = s.controller
+    base = load_scenario("baseline").with_overrides(
+        {"controller.policy": c.policy, "controller.ideal_cycle_s": c.ideal_cycle_s,
+         "run.seed": s.run.seed})
+    if _comparable(s) != _comparable(base):
+        return None
+    if c.policy == "adaptive":
+        return {"parts_missed": f"{published.ADAPTIVE_PARTS_MISSED}",
+                "ip_thesis": f"{published.ADAPTIVE_IP}",
+                "cycle_vs_nominal_pct": f"within {published.ADAPTIVE_CYCLE_PCT} %"}
+    ideal = c.ideal_cycle_s if c.ideal_cycle_s is not None else base.controller.nominal_cycle_s
+    row = published.TABLE_7_1.get(round(float(ideal or math.nan), 4))
+    if row is None or c.policy != "non-adaptive":
+        return None
+    actual, missed, per_hr, vavg, ip = row
+    return {"parts_missed_thesis": f"{missed:.0f}", "actual_cycle_thesis_s": f"{actual:.4f}",
+            "parts_per_hr_thesis": f"{per_hr:.4f}", "vavg_r4_in_s": f"{vavg:.4f}",
+            "ip_thesis": f"{ip:.4f}"}
+
+
+def _comparable(s: Scenario) -> dict[str, Any]:
+    d = s.to_dict()
+    for key in ("name", "description", "mintime"):
+        d.pop(key, None)
+    return d
+
+
+def format_summary(r: RunSummary, thesis: dict[str, str] | None = None) -> str:
+    """The summary as a two-column table; the thesis's figures beside ours when given."""
+    rows: list[tuple[str, str]] = []
+
+    def add(label: str, value: Any, fmt: str = "{:.4f}", field: str = "") -> None:
+        text = fmt.format(value) if isinstance(value, (int, float)) and value == value \
+            else str(value)
+        shown = (thesis or {}).get(field)
+        rows.append((label, text + (f"   (thesis: {shown})" if shown else "")))
+
+    add("policy", r.policy, "{}")
+    add("ideal cycle, s", r.ideal_cycle_s)
+    add("parts arrived / delivered", f"{r.parts_arrived} / {r.parts_delivered}", "{}")
+    add("parts lost (wall clock)", r.parts_missed, "{:d}", "parts_missed")
+    add("parts lost (thesis's accounting)", r.parts_missed_thesis, "{:d}", "parts_missed_thesis")
+    add("actual cycle, wall clock, s", r.actual_cycle_wallclock_s)
+    add("actual cycle, thesis's accounting, s", r.actual_cycle_thesis_s, field="actual_cycle_thesis_s")
+    add("parts/hr, wall clock", r.parts_per_hr_wallclock)
+    add("parts/hr, thesis's accounting", r.parts_per_hr_thesis, field="parts_per_hr_thesis")
+    add("Vavg R IV, in/s", r.vavg_r4_in_s, field="vavg_r4_in_s")
+    add("IP, wall clock", r.ip_wallclock)
+    add("IP, thesis's accounting", r.ip_thesis, field="ip_thesis")
+    add("cycle (thesis's accounting) vs ideal, %", r.cycle_vs_nominal_pct, "{:+.2f}",
+        "cycle_vs_nominal_pct")
+    if r.ip_thesis_memoryless == r.ip_thesis_memoryless:
+        add("IP, next arrivals counted from each pick-up", r.ip_thesis_memoryless, field="ip_thesis")
+    add("spacing min / max, in", f"{r.spacing_min_in:.3f} / {r.spacing_max_in:.3f}", "{}")
+    add("spacings outside 45 ± 0.25 in", r.spacing_outside_tol, "{:d}")
+    hit = [f"{label} {getattr(r, field)}" for field, label in LIMIT_FIELDS if getattr(r, field)]
+    add("limits hit (parts)", "; ".join(hit) if hit else "none", "{}")
+    if r.warmup_parts:
+        add("warm-up left out, parts", r.warmup_parts, "{:d}")
+    width = max(len(label) for label, _ in rows)
+    table = "\n".join(f"{label:<{width}}  {text}" for label, text in rows)
+    note = "" if thesis else "\n(the thesis's figures are shown only beside a run of its own scenario)"
+    return f"{table}\n{IP_LINE}{note}"
