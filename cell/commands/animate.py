@@ -37,11 +37,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 #: Bounds on the options: each beyond them is refused before anything is simulated.
 LIMITS = {"parts": (1, 10_000), "from_part": (1, 10_000_000), "speed": (0.01, 1e4),
           "fps": (1, 120), "dpi": (10, 1000)}
-#: The most frames an animation may have (at the scenario's nominal cycle per part).
+#: The most frames an animation may have (a part every nominal cycle or mean inter-arrival time).
 MAX_FRAMES = 100_000
 
 
-def check_options(args: argparse.Namespace, nominal_cycle_s: float) -> None:
+def check_options(args: argparse.Namespace, cycle_s: float) -> None:
     """Every option within its bounds, and a frame count that can be drawn, or one line."""
     import math
 
@@ -52,7 +52,7 @@ def check_options(args: argparse.Namespace, nominal_cycle_s: float) -> None:
         if not (math.isfinite(value) and lo <= value <= hi):
             option = "--" + key.replace("_", "-")
             raise CellError(f"{option} {value:g}: must be between {lo:g} and {hi:g}")
-    frames = (args.parts + 1) * nominal_cycle_s / args.speed * args.fps
+    frames = (args.parts + 1) * cycle_s / args.speed * args.fps
     if frames > MAX_FRAMES:
         raise CellError(f"--parts {args.parts} --speed {args.speed:g} --fps {args.fps}: about "
                         f"{frames:,.0f} frames, more than {MAX_FRAMES:,}; raise --speed or "
@@ -69,7 +69,10 @@ def main(args: argparse.Namespace) -> int:
     from cell.scenario import load_scenario
 
     scenario = load_scenario(args.scenario, parse_sets(args.sets))
-    check_options(args, scenario.controller.nominal_cycle_s)
+    from cell.arrivals import mean_interarrival
+
+    check_options(args, max(scenario.controller.nominal_cycle_s or 0.0,
+                            mean_interarrival(scenario.arrivals, scenario.base_dir)))
     done = animate(scenario, args.out, policy=args.policy, parts=args.parts, first=args.from_part,
                    speed=args.speed, fps=args.fps, dpi=args.dpi)
     print(f"wrote {done.path}: {done.frames} frames, simulated {done.t0_s:.1f}-{done.t1_s:.1f} s, "

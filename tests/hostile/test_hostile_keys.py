@@ -150,6 +150,16 @@ def cases() -> Iterator[Any]:
             refuse += [(f"all {label}", [v] * n) for label, v in el_refuse[6:11]]
             either = [(f"[0] {label}", [v, *default[1:]]) for label, v in el_either]
             either += [(f"all {label}", [v] * n) for label, v in el_either]
+        elif origin is not None and any(typing.get_origin(a) is typing.Literal for a in args):
+            # a number or a word (run.warmup_parts: 4 or auto)
+            number = next(a for a in args if typing.get_origin(a) is typing.Annotated)
+            word = next(a for a in args if typing.get_origin(a) is typing.Literal)
+            refuse, either = number_values(bounds_of(typing.get_args(number)[1].metadata), 1.0, whole=True)
+            refuse = [(label, v) for label, v in refuse if label not in ("text",)] + [
+                ("other word", "bogus"), ("word in capitals", str(typing.get_args(word)[0]).upper()),
+                ("null", None)]
+            either = [(label, v) for label, v in either if label != "highest"]
+            either += [(w, w) for w in typing.get_args(word)] + [("some", 3)]
         elif origin is typing.Literal:
             refuse = [("bogus", "bogus"), ("empty", ""), ("number", 1), ("null", None), ("list", list(args))]
             either = [(v, v) for v in args if v != default]
