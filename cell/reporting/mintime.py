@@ -13,7 +13,7 @@ import json
 import sys
 from pathlib import Path
 
-from cell.assembly import geometry_of, motors_of, planner_bounds, step_table
+from cell.assembly import geometry_of, motors_of, nominal_cycle, planner_bounds, step_table
 from cell.mintime.regimes import plan_regimes, summary
 from cell.output import OutputDir
 from cell.scenario import load_scenario
@@ -32,7 +32,7 @@ def cycles(docs: dict[str, dict] | None = None) -> dict:
     r1 = 8.0 / base.belts.input_nominal_in_s           # tracking 8 in at the nominal speeds (§4.3)
     r3 = 8.0 / base.belts.output_nominal_in_s
     r4_nominal = table.regime_min_time("R4", nominal=True)
-    r2_nominal = base.controller.nominal_cycle_s - r1 - r3 - r4_nominal   # what the cycle leaves R II
+    r2_nominal = nominal_cycle(base) - r1 - r3 - r4_nominal   # what the nominal cycle leaves R II
     const = {"R2": table.regime_min_time("R2"), "R4": table.regime_min_time("R4")}
     rows = {"constant-rate": const}
     for label, name in SCENARIOS.items():
