@@ -2,8 +2,11 @@
 
 Each subcommand is a module of :mod:`cell.commands` (its arguments and its
 ``main``).  This is the one place where failures become what the user sees:
-any anticipated failure (:class:`~cell.errors.CellError`: bad input, an output
-that cannot be written) is one line on stderr and exit code 2; Ctrl-C is exit
+every anticipated failure is one line on stderr and exit code 2 — bad input or
+an output that cannot be written (:class:`~cell.errors.CellError`), a usage
+error, memory running out, input nested past Python's recursion limit, and an
+operating-system refusal to write (permission, read-only file system, full
+disk, name too long) that got past the commands' own checks.  Ctrl-C is exit
 130; a closed pipe (``cell run ... | head``) ends quietly.  Anything else is a
 bug and keeps its traceback.
 """
@@ -11,18 +14,43 @@ bug and keeps its traceback.
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
 import os
 import sys
+import warnings
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, NoReturn
 
 from cell import __version__
-from cell.errors import CellError
+from cell.errors import CellError, one_line, shown_path
 
 #: Subcommands in the order ``cell --help`` lists them; each is cell.commands.<name>.
 COMMANDS = ("run", "sweep", "compare", "fit", "figures", "animate", "path", "mintime",
             "scenarios", "schema", "bench")
+
+#: Errors of the operating system that a command's output can meet however well it checks.
+OUTPUT_ERRNOS = frozenset({errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOSPC, errno.EDQUOT,
+                           errno.EFBIG, errno.ENAMETOOLONG, errno.ENOTDIR, errno.EISDIR,
+                           errno.ELOOP, errno.EIO, errno.EXDEV})
+
+#: What to make smaller when a command runs out of memory.
+MEMORY_HINTS = {
+    "run": "run.parts", "sweep": "the grid, replications or run.parts",
+    "mintime": "mintime.grid_points", "figures": "run.parts",
+    "animate": "--parts or --dpi", "fit": "the trace", "path": "path.moves",
+}
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with usage errors on one line (``cell run: error: ...``) and no exit."""
+
+    def error(self, message: str) -> NoReturn:
+        raise _UsageError(f"{self.prog}: {message} (see {self.prog} --help)")
+
+
+class _UsageError(Exception):
+    pass
 
 
 def _module(name: str) -> Any:
@@ -30,7 +58,7 @@ def _module(name: str) -> Any:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="cell",
         description="Simulate King's (1984) robotic transfer station: what-if studies of an "
                     "adaptive robot cell.")
@@ -43,14 +71,56 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
+def _fail(message: str) -> int:
+    print(f"cell: error: {one_line(message, 1000)}", file=sys.stderr)
+    return 2
+
+
+def _outputs(args: argparse.Namespace) -> str:
+    """The outputs a command was asked to write, to name when the system refuses a write."""
+    given = [str(v) for v in (getattr(args, k, None) for k in ("out", "report", "figure")) if v]
+    return " or ".join(given) or "the output"
+
+
+def _memory() -> str:
     try:
-        return int(_module(args.command).main(args) or 0)
+        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):  # not every system tells
+        return ""
+    return f" (this machine has {total / 2**30:.0f} GiB)"
+
+
+def _run(args: argparse.Namespace) -> int:
+    """The command; a warning that a finished command met is one line each (a refused one's are
+    dropped: its error says what went wrong)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("default")
+        code = int(_module(args.command).main(args) or 0)
+    for text in dict.fromkeys(f"{w.message} ({w.category.__name__})" for w in caught):
+        print(f"cell: warning: {one_line(text, 300)}", file=sys.stderr)
+    return code
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run one command; the exit code (0 done, 2 refused, 130 interrupted)."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except _UsageError as exc:
+        return _fail(str(exc))
+    except SystemExit as exc:  # --help, --version: printed, done
+        return exc.code if isinstance(exc.code, int) else 0
+    try:
+        return _run(args)
     except CellError as exc:
-        print(f"cell: error: {exc}", file=sys.stderr)
-        return 2
+        return _fail(str(exc))
+    except MemoryError:
+        hint = MEMORY_HINTS.get(args.command)
+        return _fail(f"cell {args.command}: ran out of memory{_memory()}"
+                     + (f"; try a smaller {hint}" if hint else ""))
+    except RecursionError:
+        return _fail(f"cell {args.command}: input nested too deeply to process "
+                     f"(Python's recursion limit, {sys.getrecursionlimit():,} levels)")
     except KeyboardInterrupt:
         print("cell: interrupted", file=sys.stderr)
         return 130
@@ -59,6 +129,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return 0
+    except OSError as exc:
+        if exc.errno not in OUTPUT_ERRNOS:
+            raise
+        reason = (exc.strerror or os.strerror(exc.errno or 0)).lower()
+        if exc.filename is None:
+            return _fail(f"{_outputs(args)}: cannot write: {reason}")
+        return _fail(f"{shown_path(exc.filename)}: {reason}")
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 from collections.abc import Sized
 
 
@@ -47,10 +48,24 @@ class NoMotionError(CellError):
 
 
 # --------------------------------------------------------------------------- messages
-def _line(text: str, limit: int = 200) -> str:
+def one_line(text: str, limit: int = 200) -> str:
     """``text`` without line breaks, cut to ``limit`` characters."""
     text = " ".join(str(text).splitlines())
     return text if len(text) <= limit else text[:limit - 1] + "…"
+
+
+_line = one_line
+
+
+def shown_path(path: object, limit: int = 160) -> str:
+    """A path as a message shows it: printable (else its repr), a very long one cut in the middle."""
+    text = os.fsdecode(path) if isinstance(path, (str, bytes, os.PathLike)) else str(path)
+    if not (text.isprintable() and text):
+        text = repr(text)
+    if len(text) <= limit:
+        return text
+    keep = (limit - 1) // 2
+    return f"{text[:keep]}…{text[-(limit - 1 - keep):]}"
 
 
 def short(value: object, limit: int = 80) -> str:

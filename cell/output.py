@@ -25,6 +25,7 @@ from types import TracebackType
 from typing import IO, TYPE_CHECKING, Any
 
 from cell.errors import CellError
+from cell.errors import shown_path as _show
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -41,11 +42,6 @@ _JUNK = frozenset({".DS_Store", "Thumbs.db", "desktop.ini"})  # an OS's, never t
 _DISK_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS, errno.EIO})
 
 _open: Any = open  # every file written goes through here (tests simulate a full disk with it)
-
-
-def _show(path: str | os.PathLike[str]) -> str:
-    text = os.fspath(path)
-    return text if text.isprintable() and text else repr(text)
 
 
 def _reason(exc: OSError) -> str:  # "permission denied", "no space left on device"...
@@ -80,13 +76,24 @@ def _absolute(target: str | os.PathLike[str], what: str) -> Path:
     return Path(os.path.realpath(os.path.abspath(target)))
 
 
+_TEMP_EXTRA = 27  # what a temporary name adds: .NAME.cell-tmp-PID-XXXXXXXX, .NAME.cell-PID-XXXXXXXX.tmp
+
+
 def _check_parent(shown: str, path: Path) -> None:
-    """``path`` can be created: its nearest existing ancestor is a directory we may write in."""
+    """``path`` can be created: its nearest existing ancestor is a directory we may write in,
+    and no name on the way (nor the temporary name beside it) is too long for the file system."""
     ancestor = path.parent
     while not os.path.lexists(ancestor) and ancestor != ancestor.parent:
         ancestor = ancestor.parent
     if not ancestor.is_dir():
         raise CellError(f"{shown}: not a directory ({_show(ancestor)} is a file)")
+    try:
+        name_max, path_max = os.pathconf(ancestor, "PC_NAME_MAX"), os.pathconf(ancestor, "PC_PATH_MAX")
+    except (OSError, ValueError, AttributeError):  # not every system tells
+        name_max, path_max = 255, 4096
+    names = [p.name for p in path.parents if ancestor in p.parents] + [path.name + "." * _TEMP_EXTRA]
+    if any(len(os.fsencode(n)) > name_max for n in names) or len(os.fsencode(str(path))) + 128 > path_max:
+        raise CellError(f"{shown}: file name too long (at most {name_max - _TEMP_EXTRA} bytes a name here)")
     if hasattr(os, "statvfs") and os.statvfs(ancestor).f_flag & os.ST_RDONLY:
         raise CellError(f"{shown}: cannot write in {_show(ancestor)}: read-only file system")
     if not os.access(ancestor, os.W_OK | os.X_OK):
@@ -217,7 +224,7 @@ class OutputDir(contextlib.AbstractContextManager["OutputDir"]):
                 (self.stage / name).parent.mkdir(parents=True, exist_ok=True)
         return self.stage / name
 
-    def open(self, name: str, mode: str = "w", **kwargs: Any) -> IO[Any]:
+    def open(self, name: str, mode: str = "w", **kwargs: Any) -> Any:  # TextIO or BinaryIO, by mode
         """The file ``name`` opened for writing (``"w"``, ``"wb"``...) in the stage; text is UTF-8."""
         if "r" in mode or "+" in mode:
             raise ValueError(f"mode {mode!r}: OutputDir files are opened for writing")
@@ -229,10 +236,6 @@ class OutputDir(contextlib.AbstractContextManager["OutputDir"]):
     def write_text(self, name: str, text: str) -> None:
         with _failing(f"{self.target}/{name}"), self.open(name, "w", newline="") as stream:
             stream.write(text)
-
-    def write_bytes(self, name: str, data: bytes) -> None:
-        with _failing(f"{self.target}/{name}"), self.open(name, "wb") as stream:
-            stream.write(data)
 
     def write_csv(self, name: str, frame: pd.DataFrame, float_format: str = FLOAT_FORMAT) -> None:
         """A DataFrame as CSV with a fixed float format (byte-identical reruns)."""

@@ -19,7 +19,9 @@ from __future__ import annotations
 
 import codecs
 import math
+import os
 import re
+import stat
 from collections.abc import Callable, Hashable, Iterable
 from pathlib import Path
 from typing import Any, NoReturn
@@ -147,10 +149,11 @@ def _dotted(path: Iterable[str | int | None], limit: int = 80) -> str:
 
 
 class _Source:
-    """A text being read: its name, and how to name a place in it."""
+    """A text being read: its name, and how to name a place in it.  ``echo``: whether errors
+    may quote its lines (not for a file that does not look like YAML: ``/etc/passwd``)."""
 
-    def __init__(self, name: str, text: str, inline: bool = False):
-        self.name, self.text, self.inline = _oneline(name), text, inline
+    def __init__(self, name: str, text: str, inline: bool = False, echo: bool = True):
+        self.name, self.text, self.inline, self.echo = _oneline(name), text, inline, echo
         self.lines = text.splitlines() or [""]
 
     def line_text(self, line: int) -> str:
@@ -158,7 +161,7 @@ class _Source:
         line = min(line, len(self.lines) - 1)
         while line > 0 and not self.lines[line].strip():
             line -= 1
-        return _oneline(self.lines[line].strip(), 60)
+        return _oneline(self.lines[line].strip(), 60) if self.echo else f"<line {line + 1}>"
 
     def where(self, line: int, column: int) -> str:
         end = line >= len(self.lines) or (line == len(self.lines) - 1 and column >= len(self.lines[line]))
@@ -229,7 +232,11 @@ class _Builder:
             key = self.build(key_node)
             if not isinstance(key, Hashable) or isinstance(key, list):
                 self.src.fail_at(self.path, key_node.start_mark, "a key must be a plain value, not a list")
-            part, line = key if isinstance(key, str) else str(key), key_node.start_mark.line + 1
+            if not isinstance(key, str):  # every key of these files is a name
+                kind = "null" if key is None else "a boolean" if isinstance(key, bool) else "a number"
+                self.src.fail_at(self.path + [key_node.value], key_node.start_mark,
+                                 f"a key must be a name, not {kind} ({_oneline(key_node.value or '~', 40)})")
+            part, line = key, key_node.start_mark.line + 1
             if key == "<<" and not key_node.style:
                 self.src.fail_at(self.path + [part], key_node.start_mark,
                                  "merge keys (<<) are YAML 1.1, not supported; write the keys out")
@@ -296,6 +303,8 @@ def _syntax_error(src: _Source, path: KeyPath, exc: yaml.MarkedYAMLError) -> NoR
         problem = f"{context}, {problem}"
     elif context and cmark and (cmark.line, cmark.column) != (mark.line, mark.column):
         problem += f" ({context} from {src.where(cmark.line, cmark.column)})"
+    if problem.startswith("mapping values are not allowed") and mark.column > 1024:
+        problem += " (a key without quotes may have at most 1024 characters)"
     where = src.where(mark.line, mark.column)
     src.fail(path, src.line_text(mark.line), f"invalid YAML at {where}: {problem or context}", "(syntax)")
 
@@ -308,6 +317,8 @@ def load_mapping(path: str | Path, what: str = "scenario") -> dict[Any, Any]:
     """
     name = _oneline(str(path))
     try:
+        if not stat.S_ISREG(os.stat(path).st_mode) and not os.path.isdir(path):
+            raise ScenarioError(name, "(file)", name, f"not a regular file: not a {what} file")
         with open(path, "rb") as stream:
             data = stream.read(MAX_BYTES + 1)
     except OSError as exc:
@@ -316,11 +327,12 @@ def load_mapping(path: str | Path, what: str = "scenario") -> dict[Any, Any]:
         raise ScenarioError(name, "(file)", name, reason) from None
     if len(data) > MAX_BYTES:
         raise ScenarioError(name, "(file)", name, f"larger than {MAX_BYTES >> 10} KiB: not a {what} file")
-    src = _Source(name, _decode(data, name))
+    src = _Source(name, _decode(data, name), echo=Path(path).suffix.lower() in (".yaml", ".yml"))
     raw = _parse(src)
     if raw is not None and not isinstance(raw, dict):
         kind = "a list" if isinstance(raw, list) else f"a single value ({type(raw).__name__})"
-        src.fail([], src.line_text(0), f"the top level must be a mapping of keys, not {kind}", "(top level)")
+        src.fail([], src.line_text(0), f"the top level must be a mapping of keys, not {kind}: not a {what} "
+                 "file", "(top level)")
     return raw or {}
 
 

@@ -64,14 +64,15 @@ def test_times_are_cached_per_scenario():
 
 
 @pytest.mark.parametrize("scenario,torque", [(KIN, False), (BASE, True)])
-def test_cli_writes_csv_and_json(tmp_path, scenario, torque):
+def test_cli_writes_profile_and_summary(tmp_path, scenario, torque):
     out = tmp_path / "mt"
     assert main(["mintime", scenario, "--out", str(out)]) == 0
-    doc = json.loads((tmp_path / "mt.json").read_text())
+    doc = json.loads((out / "summary.json").read_text())
+    assert sorted(p.name for p in out.iterdir()) == ["profile.csv", "summary.json"]
     assert set(doc["regimes"]) == {"R2", "R4"}
     assert doc["limits"]["torque"] is torque
     assert len(doc["limits"]["qdot_max_rad_s"]) == 5 and len(doc["limits"]["qddot_max_rad_s2"]) == 5
-    frame = pd.read_csv(tmp_path / "mt.csv")
+    frame = pd.read_csv(out / "profile.csv")
     assert list(frame.columns) == ["regime", "s", "theta1_rad", "theta2_rad", "theta3_rad",
                                    "theta4_rad", "theta5_rad", "sdot", "sdot_limit"]
     assert (frame.groupby("regime").size() == 460).all()
@@ -97,3 +98,25 @@ def test_no_bounds_at_all_is_refused(tmp_path, capsys):
                  "--out", str(tmp_path / "x")])
     assert code == 2 and "infinite acceleration" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("name", ["mt.csv", "mt.json"])
+def test_out_is_a_directory_not_the_old_stem(tmp_path, capsys, name):
+    """``--out x.csv`` (the old STEM form) is refused before any work, naming what --out is now."""
+    code = main(["mintime", KIN, "--out", str(tmp_path / name)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "profile.csv and summary.json" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_rerun_replaces_the_set_and_foreign_files_are_kept(tmp_path, capsys):
+    out = tmp_path / "mt"
+    assert main(["mintime", KIN, "--set", "mintime.grid_points=50", "--out", str(out)]) == 0
+    first = (out / "profile.csv").read_text()
+    assert main(["mintime", KIN, "--set", "mintime.grid_points=60", "--out", str(out)]) == 0
+    assert (out / "profile.csv").read_text() != first
+    assert len(pd.read_csv(out / "profile.csv")) == 120
+    (out / "notes.txt").write_text("mine")
+    capsys.readouterr()
+    assert main(["mintime", KIN, "--out", str(out)]) == 2
+    assert "notes.txt" in capsys.readouterr().err and len(pd.read_csv(out / "profile.csv")) == 120

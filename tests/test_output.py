@@ -132,7 +132,7 @@ def test_whole_set_appears_with_ordinary_modes(tmp_path):
     target = tmp_path / "new" / "run"
     with OutputDir(target, NAMES) as out:
         out.write_csv("parts.csv", pd.DataFrame({"x": [1.5, 2.0]}))
-        out.write_bytes("belts.csv", b"b\n")
+        out.open("belts.csv", "wb").write(b"b\n")
         with out.open("summary.csv") as stream:
             stream.write("s\n")
         assert not target.exists()  # nothing visible before the end
@@ -289,7 +289,7 @@ def test_what_cell_may_replace(tmp_path):
     names = ["table.md", "fig_*.png", "tasks/task-*.csv"]
     with OutputDir(target, names) as out:
         out.write_text("table.md", "t\n")
-        out.write_bytes("fig_1.png", b"\x89PNG")
+        out.open("fig_1.png", "wb").write(b"\x89PNG")
         out.write_text("tasks/task-0001.csv", "x\n")
         with pytest.raises(ValueError):
             out.path("notes.txt")
@@ -425,3 +425,4 @@ def test_single_file_killed_at_any_step_is_old_or_new(tmp_path):
         target.write_text("old\n")
     else:
         pytest.fail("the child never finished")
+

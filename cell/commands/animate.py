@@ -34,14 +34,45 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--dpi", type=float, default=100.0, help="resolution (default 100)")
 
 
+#: Bounds on the options: each beyond them is refused before anything is simulated.
+LIMITS = {"parts": (1, 10_000), "from_part": (1, 10_000_000), "speed": (0.01, 1e4),
+          "fps": (1, 120), "dpi": (10, 1000)}
+#: The most frames an animation may have (a part every nominal cycle or mean inter-arrival time).
+MAX_FRAMES = 100_000
+
+
+def check_options(args: argparse.Namespace, cycle_s: float) -> None:
+    """Every option within its bounds, and a frame count that can be drawn, or one line."""
+    import math
+
+    from cell.errors import CellError
+
+    for key, (lo, hi) in LIMITS.items():
+        value = getattr(args, key)
+        if not (math.isfinite(value) and lo <= value <= hi):
+            option = "--" + key.replace("_", "-")
+            raise CellError(f"{option} {value:g}: must be between {lo:g} and {hi:g}")
+    frames = (args.parts + 1) * cycle_s / args.speed * args.fps
+    if frames > MAX_FRAMES:
+        raise CellError(f"--parts {args.parts} --speed {args.speed:g} --fps {args.fps}: about "
+                        f"{frames:,.0f} frames, more than {MAX_FRAMES:,}; raise --speed or "
+                        "lower --parts or --fps")
+
+
 def main(args: argparse.Namespace) -> int:
     from cell.animation import animate, check_output
+    from cell.output import check_file
 
     check_output(args.out)  # before anything is simulated
+    check_file(args.out)
     from cell.overrides import parse_sets
     from cell.scenario import load_scenario
 
     scenario = load_scenario(args.scenario, parse_sets(args.sets))
+    from cell.arrivals import mean_interarrival
+
+    check_options(args, max(scenario.controller.nominal_cycle_s or 0.0,
+                            mean_interarrival(scenario.arrivals, scenario.base_dir)))
     done = animate(scenario, args.out, policy=args.policy, parts=args.parts, first=args.from_part,
                    speed=args.speed, fps=args.fps, dpi=args.dpi)
     print(f"wrote {done.path}: {done.frames} frames, simulated {done.t0_s:.1f}-{done.t1_s:.1f} s, "

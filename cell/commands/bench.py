@@ -18,8 +18,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     from cell.bench import TARGET_PARTS_PER_S, benchmarks
     from cell.mintime.bench import benchmarks as planner_benchmarks
-    from cell.output import write_text
+    from cell.output import check_file, write_text
 
+    check_file(args.out)  # before any work
     results: dict[str, Any] = benchmarks()
     results.update(planner_benchmarks())
     results["machine"] = f"{platform.machine()} {platform.python_implementation()} " \

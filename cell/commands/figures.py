@@ -1,4 +1,8 @@
-"""``cell figures [--out DIR] [--scenario FILE]``: the thesis's Fig. 8-30 as PNG."""
+"""``cell figures [--out DIR] [--scenario FILE]``: the thesis's Fig. 8-30 as PNG.
+
+The PNGs are one set (:class:`~cell.output.OutputDir`): DIR is checked before
+anything is drawn, and the new figures replace the old ones together.
+"""
 
 from __future__ import annotations
 
@@ -18,14 +22,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from cell.errors import CellError
-    from cell.figures import make_figures
+    from cell.figures import FILES, make_figures
+    from cell.output import OutputDir
     from cell.overrides import parse_sets
     from cell.scenario import load_scenario
 
+    names = [f"{stem}.png" for stem in FILES.values()]
+    OutputDir.check(args.out, names)  # before any work
     scenario = load_scenario(args.scenario, parse_sets(getattr(args, "sets", None)))
-    try:
-        make_figures(scenario, args.out, progress=lambda p: print(f"wrote {p}"))
-    except OSError as exc:
-        raise CellError(f"cannot write figures into {args.out}: {exc.strerror or exc}") from None
+    with OutputDir(args.out, names) as out:
+        drawn = make_figures(scenario, out.stage, progress=lambda p: print(f"drew {p.name}"))
+    print(f"wrote {len(drawn)} figures into {out.target}")
     return 0

@@ -9,9 +9,8 @@ with a histogram of the data and the fitted densities.
 from __future__ import annotations
 
 import argparse
-import os
-import tempfile
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
+from contextlib import ExitStack
 from pathlib import Path
 
 from cell.errors import ScenarioError
@@ -35,13 +34,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _destination(path: str | Path, option: str, taken: Sequence[Path]) -> Path:
+    """An output file that can be written and overwrites neither the trace nor the other output."""
+    from cell.output import check_file
+
     p = Path(path)
-    why = ("its directory does not exist" if not p.parent.is_dir() else
-           "is a directory; give a file name" if p.is_dir() else
-           "would overwrite the trace or the other output" if p.resolve() in {t.resolve() for t in taken}
-           else "")
+    why = ("its directory does not exist" if str(path) and not p.parent.is_dir() else
+           "would overwrite the trace or the other output" if str(path) and
+           p.resolve() in {t.resolve() for t in taken} else "")
     if why:
         raise ScenarioError(p, option, str(p), why)
+    check_file(path)
     return p
 
 
@@ -59,9 +61,10 @@ def main(args: argparse.Namespace) -> int:
     )
 
     trace = Path(args.trace)
-    out = _destination(args.out, "--out", [trace]) if args.out else None
-    figure_arg = args.figure or (out.with_suffix(".png") if out else None)
-    figure = _destination(figure_arg, "--figure", [trace, *([out] if out else [])]) if figure_arg else None
+    out = _destination(args.out, "--out", [trace]) if args.out is not None else None
+    figure_arg = args.figure if args.figure is not None else out.with_suffix(".png") if out else None
+    figure = _destination(figure_arg, "--figure", [trace, *([out] if out else [])]) \
+        if figure_arg is not None else None
     chosen_families = args.families if args.families is not None else ",".join(DEFAULT_FAMILIES)
     families = [f.strip() for f in str(chosen_families).split(",") if f.strip()]
     for family in families or [""]:
@@ -82,26 +85,14 @@ def main(args: argparse.Namespace) -> int:
     table = format_table(fits)
     if chosen is not fits[0]:
         table += f"\nChosen: {chosen.family}, the best fit that allows no negative times."
-    jobs: list[tuple[Path | None, str, Callable[[Path], object]]] = [
-        (figure, "--figure", lambda tmp: draw(values, fits, tmp, best=chosen, xlabel=args.column)),
-        (out, "--out", lambda tmp: tmp.write_text(block, encoding="utf-8"))]
-    staged: list[tuple[Path, Path]] = []
-    try:  # every file staged beside its destination first, then all moved into place
-        for dest, option, write in jobs:
-            if dest is None:
-                continue
-            try:
-                fd, name = tempfile.mkstemp(dir=dest.parent, prefix=f".{dest.name}.", suffix=".tmp")
-                os.close(fd)
-                staged.append((Path(name), dest))
-                write(Path(name))
-            except OSError as exc:
-                raise ScenarioError(dest, option, str(dest), f"cannot write: {exc.strerror or exc}") from None
-        for tmp, dest in staged:
-            os.replace(tmp, dest)
-    finally:
-        for tmp, _ in staged:
-            tmp.unlink(missing_ok=True)
+    from cell.output import atomic_path
+
+    with ExitStack() as stack:  # both written in full, then renamed: the figure first, the YAML last
+        out_tmp = stack.enter_context(atomic_path(out)) if out is not None else None
+        if figure is not None:
+            draw(values, fits, stack.enter_context(atomic_path(figure)), best=chosen, xlabel=args.column)
+        if out_tmp is not None:
+            out_tmp.write_text(block, encoding="utf-8")
     comment = "# " if out is None else ""  # printed table and block together are valid YAML
     print("\n".join(comment + line for line in table.splitlines()))
     print(block.rstrip("\n") if out is None else f"wrote {out}")

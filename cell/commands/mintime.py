@@ -1,8 +1,9 @@
-"""``cell mintime SCENARIO --out STEM``: the minimum-time R II and R IV (Shin & McKay 1983).
+"""``cell mintime SCENARIO --out DIR``: the minimum-time R II and R IV (Shin & McKay 1983).
 
-Writes STEM.csv (one row per grid point of each regime: regime, s, the joint
-angles, ṡ and the velocity-limit curve) and STEM.json (each regime's time and
-switching points, and the limits used), both whole or not at all.
+Writes DIR/profile.csv (one row per grid point of each regime: regime, s, the
+joint angles, ṡ and the velocity-limit curve) and DIR/summary.json (each
+regime's time and switching points, and the limits used) as one set: both
+appear together or neither does.
 """
 
 from __future__ import annotations
@@ -15,10 +16,12 @@ from typing import Any
 from cell.commands import scenario_arguments
 
 HELP = "minimum-time motion along the path (Shin & McKay)"
-DESCRIPTION = ("Phase-plane minimum-time parameterisation of R II and R IV; writes STEM.csv "
-               "and STEM.json.")
+DESCRIPTION = ("Phase-plane minimum-time parameterisation of R II and R IV; writes "
+               "DIR/profile.csv and DIR/summary.json.")
 COLUMNS = ["regime", "s", "theta1_rad", "theta2_rad", "theta3_rad", "theta4_rad", "theta5_rad",
            "sdot", "sdot_limit"]
+#: The files of ``cell mintime``, written as one set.
+FILES = ("profile.csv", "summary.json")
 
 
 def frame(results: dict[str, Any]) -> Any:
@@ -36,37 +39,55 @@ def frame(results: dict[str, Any]) -> Any:
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     scenario_arguments(p)
-    p.add_argument("--out", required=True, help="output stem: STEM.csv and STEM.json")
+    p.add_argument("--out", required=True, metavar="DIR",
+                   help="directory for profile.csv and summary.json")
 
 
-def stem(out: str) -> Path:
-    path = Path(out)
-    return path.with_suffix("") if path.suffix in (".csv", ".json") else path
+def check_out(out: str) -> None:
+    """Refuse, before any work, an ``--out`` that cannot take the set (or names a file the old way)."""
+    from cell.errors import CellError
+    from cell.output import OutputDir
+
+    if Path(out).suffix.lower() in (".csv", ".json") and not Path(out).is_dir():
+        raise CellError(f"{out}: --out names a directory (it gets {' and '.join(FILES)}); "
+                        f"drop the {Path(out).suffix}")
+    OutputDir.check(out, FILES)
 
 
 def main(args: argparse.Namespace) -> int:
     import numpy as np
 
     from cell.assembly import geometry_of, motors_of, planner_bounds, step_table
-    from cell.errors import CellError, NoMotionError
+    from cell.errors import CellError, InfeasibleError, NoMotionError, ScenarioError
     from cell.mintime.regimes import plan_regimes, summary
-    from cell.output import write_csv, write_text
+    from cell.output import OutputDir
     from cell.overrides import parse_sets
-    from cell.scenario import load_scenario
+    from cell.scenario import MAX_TIME_S, load_scenario
 
+    check_out(args.out)  # before any work
     scenario = load_scenario(args.scenario, parse_sets(args.sets))
     step_table(scenario)  # reach and motor checks, naming their keys
     bounds = planner_bounds(scenario)
+    rates = "robot.motors.max_rate_no_load_rad_s"
     try:
         results = plan_regimes(geometry_of(scenario), motors_of(scenario), bounds)
     except NoMotionError as exc:
         raise CellError(f"{scenario.source}: mintime: {exc}") from None
+    except InfeasibleError as exc:  # the drives cannot turn at the motors' rates (dynamics file)
+        raise ScenarioError(scenario.source, rates, list(scenario.get(rates)),
+                            f"{exc} (drives of {scenario.mintime.dynamics_file})") from None
+    slowest = max(results, key=lambda r: results[r].profile.time_s)
+    if not results[slowest].profile.time_s <= MAX_TIME_S:  # the schema's bound on any time
+        key = "mintime.rate_fraction" if scenario.mintime.rate_fraction < 1 else rates
+        value = scenario.get(key)
+        raise ScenarioError(scenario.source, key, list(value) if isinstance(value, tuple) else value,
+                            f"{slowest} would take {results[slowest].profile.time_s:.4g} s, more "
+                            f"than {MAX_TIME_S:g} s")
     table = frame(results)
     doc = json.dumps(summary(results, bounds), indent=2, allow_nan=False) + "\n"
-    base = stem(args.out)
-    csv_path, json_path = base.parent / (base.name + ".csv"), base.parent / (base.name + ".json")
-    write_csv(table.replace([np.inf], np.nan), csv_path)
-    write_text(doc, json_path)
+    with OutputDir(args.out, FILES) as out:
+        out.write_csv("profile.csv", table.replace([np.inf], np.nan))
+        out.write_text("summary.json", doc)
     times = ", ".join(f"{r} {res.profile.time_s:.4f} s" for r, res in results.items())
-    print(f"wrote {csv_path} and {json_path}: {times}")
+    print(f"wrote {out.target}/profile.csv and summary.json: {times}")
     return 0

@@ -18,10 +18,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     from cell.assembly import step_table
-    from cell.output import write_csv
+    from cell.output import check_file, write_csv
     from cell.overrides import parse_sets
     from cell.scenario import load_scenario
 
+    check_file(args.out)  # before any work
     scenario = load_scenario(args.scenario, parse_sets(args.sets))
     table = step_table(scenario)
     write_csv(table.to_frame(), args.out)

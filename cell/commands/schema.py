@@ -20,11 +20,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     import json
 
-    from cell.output import write_text
+    from cell.output import check_file, write_text
     from cell.scenario import json_schema
 
+    if args.out is not None:
+        check_file(args.out)  # before any work
     text = json.dumps(json_schema(), indent=2, ensure_ascii=False) + "\n"
-    if args.out:
+    if args.out is not None:
         write_text(text, args.out)
         print(f"wrote {args.out}")
     else:

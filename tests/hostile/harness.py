@@ -1,0 +1,118 @@
+"""The hostile-input suite's harness: run ``cell`` in-process and hold it to its promise.
+
+The promise (README, docs/): bad input is one line on stderr naming the file, the key and
+the value, exit code 2, and nothing written; accepted input runs sanely (exit 0, no Python
+warning or traceback, parts conserved, every summary value finite where it is defined); outputs appear
+whole or not at all.  Each call of :func:`cli` is one case; the session's count is printed
+at the end of the run (``hostile inputs: N cases ...``), after pytest's own summary line.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import math
+import os
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from cell.cli import main
+
+COUNT: Counter[str] = Counter()
+
+
+@dataclass
+class Result:
+    argv: list[str]
+    code: int
+    out: str
+    err: str
+
+    @property
+    def err_lines(self) -> list[str]:
+        return self.err.splitlines()
+
+
+def cli(*argv: object) -> Result:
+    """``cell ARGV`` in this process: exit code, stdout and stderr; one case of the suite."""
+    args = [os.fspath(a) if isinstance(a, os.PathLike) else str(a) for a in argv]
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(args)
+    COUNT["in-process"] += 1
+    return Result(args, code, out.getvalue(), err.getvalue())
+
+
+def tree(path: Path) -> dict[str, bytes] | None:
+    """Every file under ``path`` with its bytes (None if ``path`` does not exist)."""
+    try:
+        if not path.exists():
+            return None
+    except OSError:  # a name too long to exist
+        return None
+    if path.is_file():
+        return {"": path.read_bytes()}
+    return {str(p.relative_to(path)): p.read_bytes() for p in sorted(path.rglob("*")) if p.is_file()}
+
+
+def refused(res: Result, *needles: str, nothing_in: Path | None = None,
+            before: dict[str, bytes] | None = None) -> str:
+    """Exit 2, exactly one line on stderr (``cell: error: ...``) holding every needle, no
+    traceback; ``nothing_in`` absent, or unchanged from ``before``."""
+    COUNT["refused"] += 1
+    assert res.code == 2, f"{res.argv}: exit {res.code}\n{res.err[-2000:]}"
+    lines = res.err_lines
+    assert len(lines) == 1, f"{res.argv}: {len(lines)} lines on stderr:\n{res.err[:3000]}"
+    line = lines[0]
+    assert line.startswith("cell: error: ") and "Traceback" not in res.err, line
+    assert len(line) <= 1100, f"a {len(line)}-character line"
+    for needle in needles:
+        assert needle in line, f"{needle!r} not in: {line}"
+    if nothing_in is not None:
+        assert tree(nothing_in) == before, f"{nothing_in} changed by a refused command"
+        parent = nothing_in.parent
+        leftovers = [p.name for p in parent.iterdir() if ".cell-" in p.name] if tree(parent) is not None \
+            and parent.is_dir() else []
+        assert not leftovers, leftovers
+    return line
+
+
+#: Summary columns that may be empty (NaN): undefined for a policy or for too few parts.
+MAY_BE_UNDEFINED = {"ip_wallclock", "ip_thesis", "cycle_vs_nominal_pct", "ip_thesis_memoryless",
+                    "cycle_vs_nominal_memoryless_pct", "thesis_slack_s", "actual_cycle_wallclock_s",
+                    "parts_per_hr_wallclock", "spacing_min_in", "spacing_max_in", "vavg_r4_in_s",
+                    "r4_s", "output_speed_min_in_s", "output_speed_max_in_s",
+                    "actual_cycle_thesis_s", "parts_per_hr_thesis"}
+#: No quantity of this model comes near this (times up to 1e6 s a part, 1e7 parts).
+SANE = 1e14
+
+
+def ran_sanely(res: Result, out: Path, parts: int) -> pd.Series:
+    """Exit 0, nothing on stderr but the command's own one-line warnings, the whole set, ``parts``
+    conserved, summary values finite and sane."""
+    COUNT["ran"] += 1
+    assert res.code == 0, f"{res.argv}: exit {res.code}: {res.err[-2000:]}"
+    noise = [line for line in res.err_lines if not line.startswith("cell: warning: ")]
+    assert not noise, f"{res.argv}: stderr of an accepted run: {res.err[:2000]}"
+    assert sorted(p.name for p in out.iterdir()) == ["belts.csv", "parts.csv", "summary.csv"]
+    summary = pd.read_csv(out / "summary.csv").iloc[0]
+    rows = pd.read_csv(out / "parts.csv")
+    warmup = int(summary.get("warmup_parts", 0))  # parts left out of the measures
+    assert len(rows) == parts and summary.parts_arrived == parts - warmup
+    assert summary.parts_arrived == summary.parts_delivered + summary.parts_missed + summary.parts_in_cell
+    for name, value in summary.items():
+        if name in ("scenario", "policy", "seed", "nominal_from") or isinstance(value, str):
+            continue
+        value = float(value)
+        if math.isnan(value):
+            assert name in MAY_BE_UNDEFINED, f"{res.argv}: summary {name} is empty"
+        else:
+            assert math.isfinite(value) and abs(value) < SANE, f"{res.argv}: summary {name} = {value}"
+    numbers = rows.select_dtypes("number").to_numpy(dtype=float)
+    finite = numbers[~pd.isna(numbers)]
+    assert (abs(finite) < SANE).all(), f"{res.argv}: parts.csv holds {finite[abs(finite) >= SANE][:3]}"
+    assert (rows.arrival_s.diff().dropna() >= 0).all()
+    return summary

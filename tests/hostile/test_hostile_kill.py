@@ -1,0 +1,135 @@
+"""Kill tests through the real commands: SIGKILL at every file-system step of ``cell run`` and of
+the planner's report directory leaves the old set or the new one, never a mixed or partial one.
+
+Each child is a fork of this process running the command's ``main`` (the planner's results,
+already solved here, are shared), with every open, mkdir, fsync, rename, exchange, unlink,
+rmdir and link counted; at the k-th it kills itself, for k = 1, 2, ... until it finishes.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import os
+import shutil
+import signal
+from pathlib import Path
+
+import pytest
+from harness import COUNT
+
+import cell.output as output
+from cell.output import OutputDir
+
+NAMES = ["parts.csv", "summary.csv", "belts.csv"]
+
+
+def _run_killed_at(k: int, job, fallback: bool) -> int:
+    """Fork; the child runs ``job()`` and SIGKILLs itself at its ``k``-th file-system step (open,
+    mkdir, fsync, rename, exchange, unlink, rmdir).  The child's wait status."""
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - the child never returns
+        try:
+            calls = [0]
+
+            def trap(function):
+                def trapped(*args, **kwargs):
+                    calls[0] += 1
+                    if calls[0] == k:
+                        os.kill(os.getpid(), signal.SIGKILL)
+                    return function(*args, **kwargs)
+                return trapped
+
+            if fallback:
+                output._exchange = lambda a, b: False
+            output._exchange, output._open = trap(output._exchange), trap(output._open)
+            for name in ("rename", "replace", "unlink", "rmdir", "mkdir", "fsync", "link"):
+                setattr(os, name, trap(getattr(os, name)))
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, 1)
+            os.dup2(devnull, 2)
+            job()
+        finally:
+            os._exit(0)
+    _, status = os.waitpid(pid, 0)
+    return status
+
+
+def _files(path: Path) -> dict[str, bytes] | None:
+    if not path.exists():
+        return None
+    return {str(p.relative_to(path)): p.read_bytes() for p in sorted(path.rglob("*")) if p.is_file()}
+
+
+def _every_kill(tmp_path: Path, target: Path, write_old, job, names, fallback: bool) -> set[str]:
+    """Kill ``job`` at step 1, 2, ... until it finishes: each time ``target`` holds the old set or
+    the new one whole (absent too, with the fallback, until the next run puts the old one back)."""
+    write_old()
+    old = _files(target)
+    job()
+    new = _files(target)
+    assert old != new and old is not None and new is not None
+    seen = set()
+    for k in range(1, 200):
+        write_old()
+        status = _run_killed_at(k, job, fallback)
+        state = {_key(old): "old", _key(new): "new"}.get(_key(_files(target)), "mixed")
+        seen.add(state if _files(target) is not None else "absent")
+        assert state in ("old", "new") or fallback and _files(target) is None, \
+            f"killed at step {k}: {target} holds {sorted(_files(target) or [])}"
+        OutputDir(target, names).discard()  # what the next run does first: clean up, put back
+        assert _key(_files(target)) in (_key(old), _key(new))
+        assert sorted(p.name for p in target.parent.iterdir() if p.name.startswith("." + target.name)) == []
+        if os.WIFEXITED(status):
+            assert _files(target) == new
+            break
+    else:
+        pytest.fail("the command never finished")
+    COUNT["other"] += k
+    assert k > 10 and {"old", "new"} <= seen
+    print(f"{target.name}: finished at step {k}; seen {sorted(seen)}")
+    return seen
+
+
+def _key(files: dict[str, bytes] | None) -> tuple | None:
+    return None if files is None else tuple(sorted(files.items()))
+
+
+@pytest.mark.parametrize("fallback", [False, True], ids=["exchange", "fallback"])
+def test_cell_run_killed_at_any_step_leaves_the_old_set_or_the_new(tmp_path, fallback):
+    """The real ``cell run`` (a forked process), SIGKILLed at each file-system step in turn."""
+    if not fallback and output._renameat2 is None:
+        pytest.skip("no renameat2 here")
+    from cell.cli import main
+
+    target = tmp_path / "run"
+    argv = ["run", "baseline", "--set", "run.parts=8", "--out", str(target)]
+    seen = _every_kill(tmp_path, target, lambda: _quiet(main, argv + ["--set", "run.seed=1"]),
+                       lambda: _quiet(main, argv + ["--set", "run.seed=2"]), NAMES, fallback)
+    assert seen <= {"old", "new", "absent"}
+
+
+def test_mintime_report_killed_at_any_step_keeps_the_sweep_tables(tmp_path):
+    """``reports/mintime`` written by the planner's report, killed at each step: its files are the
+    old set or the new, and the Table 7.1 files of the sweep report there are never lost."""
+    from cell.reporting import mintime as report
+
+    target = tmp_path / "mintime"
+    tables = {"table_7_1.md": b"| the sweep's table |\n", "table_7_1.csv": b"a,b\n1,2\n"}
+
+    def write_old():
+        shutil.rmtree(target, ignore_errors=True)
+        target.mkdir()
+        for name in report.FILES:
+            (target / name).write_text(f"old {name}\n")
+        for name, data in tables.items():
+            (target / name).write_bytes(data)
+
+    _every_kill(tmp_path, target, write_old, lambda: report.write(target), report.FILES + report.SHARED,
+                fallback=False)
+    assert {n: (target / n).read_bytes() for n in tables} == tables
+
+
+def _quiet(main, argv):
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        assert main(argv) == 0
