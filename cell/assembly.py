@@ -27,7 +27,7 @@ from cell.motors import Motors, max_rates
 from cell.path import CellGeometry, Route, build_path
 from cell.policies.base import CellConstants, Policy
 from cell.robot import RobotTiming, build_timing
-from cell.scenario import Scenario, default_scenario
+from cell.scenario import MAX_TIME_S, Scenario, default_scenario
 from cell.steptable import StepTable
 
 
@@ -147,16 +147,41 @@ def robot_timing(s: Scenario) -> RobotTiming:
     """The robot's regime segments (§6.1), floored by the planner under minimum-time timing."""
     step_table(s)  # reach and motor checks, with their keys
     if s.robot.timing != "minimum-time":
-        return _timing(geometry_of(s), motors_of(s), None)
+        return _checked(s, _timing(geometry_of(s), motors_of(s), None))
     bounds = planner_bounds(s)
     try:
-        return _timing(geometry_of(s), motors_of(s), bounds)
+        return _checked(s, _timing(geometry_of(s), motors_of(s), bounds))
     except InfeasibleError as exc:
-        j = getattr(exc, "joint", 0)
-        raise ScenarioError(s.base_dir / str(s.mintime.dynamics_file),
-                            f"drives.viscous_nm_s_rad[{j}]", None, str(exc)) from None
+        key = "robot.motors.max_rate_no_load_rad_s"
+        if s.get(key) == _THESIS.get(key):
+            key = "mintime.dynamics_file"
+        raise ScenarioError(s.source, key, _shown(s.get(key)),
+                            f"{exc} of the dynamic model ({s.mintime.dynamics_file})") from None
     except NoMotionError as exc:
         raise CellError(f"{s.source}: robot.timing = 'minimum-time': {exc}") from None
+
+
+#: The thesis's cell, against which a changed key is blamed.
+_THESIS = default_scenario()
+#: Keys that set how fast the robot can move, in the order blame is given.
+SPEED_KEYS = ("mintime.rate_fraction", "robot.motors.max_rate_no_load_rad_s",
+              "robot.motors.max_rate_full_load_rad_s", "robot.motors.nominal_fraction",
+              "robot.motors.full_load_oz", "part.weight_oz", "robot.motors.steps_per_rad")
+
+
+def _checked(s: Scenario, t: RobotTiming) -> RobotTiming:
+    """Refuse motors so slow that a regime would take longer than any time the tool
+    handles (scenario times are bounded by 10⁶ s), naming the key that slowed them."""
+    longest = max(t.r2_min_s, t.r4_min_s, t.r4_nominal_s, t.r1_pre.floor_s + t.r1_post.floor_s,
+                  t.r3_pre.floor_s + t.r3_post.floor_s)
+    if longest <= MAX_TIME_S:
+        return t
+    key = next((k for k in SPEED_KEYS if s.get(k) != _THESIS.get(k)
+                and (k != "mintime.rate_fraction" or s.robot.timing == "minimum-time")),
+               "robot.motors.max_rate_no_load_rad_s")
+    raise ScenarioError(s.source, key, _shown(s.get(key)),
+                        f"the motors would take {longest:.4g} s over one regime; at most "
+                        f"{MAX_TIME_S:g} s")
 
 
 @memo(maxsize=16)
@@ -172,15 +197,14 @@ def _timing(geometry: CellGeometry, motors: Motors, bounds: Any) -> RobotTiming:
 def constants(s: Scenario, timing: RobotTiming) -> CellConstants:
     """The policies' constants; a cell that cannot run its nominal cycle is an error."""
     b, c = s.belts, s.controller
-    file = s.source
-    if b.input_nominal_in_s > timing.input_track_max_in_s:
-        raise ScenarioError(file, "belts.input_nominal_in_s", b.input_nominal_in_s,
-                            f"the robot can follow the input belt down to LO at no more "
-                            f"than {timing.input_track_max_in_s:.4f} in/s")
-    if b.output_nominal_in_s > timing.output_track_max_in_s:
-        raise ScenarioError(file, "belts.output_nominal_in_s", b.output_nominal_in_s,
-                            f"the robot can follow the output belt down to TD at no more "
-                            f"than {timing.output_track_max_in_s:.4f} in/s")
+    for belt, where, most in (("input", "LO", timing.input_track_max_in_s),
+                              ("output", "TD", timing.output_track_max_in_s)):
+        speed = getattr(b, f"{belt}_nominal_in_s")
+        if speed > most:
+            key, value = _tracking_blame(s, belt, speed)
+            raise ScenarioError(s.source, key, value,
+                                f"the robot can follow the {belt} belt ({speed:g} in/s) down to "
+                                f"{where} at no more than {most:.4f} in/s")
     t = timing
     r1a, r1b = t.r1_time(b.input_nominal_in_s)
     r3a, r3b = t.r3_time(b.output_nominal_in_s)
@@ -226,6 +250,21 @@ def _absorbable(t: RobotTiming, v_nom: float, r1_most_s: float) -> float:
         mid = 0.5 * (lo + hi)
         lo, hi = (lo, mid) if r1(mid) <= r1_most_s else (mid, hi)
     return hi
+
+
+def _tracking_blame(s: Scenario, belt: str, speed: float) -> tuple[str, Any]:
+    """The belt's speed, unless a changed motor or load key alone makes it untrackable."""
+    for key in SPEED_KEYS[1:-1]:
+        if s.get(key) == _THESIS.get(key):
+            continue
+        trial = _with(s, key, _THESIS.get(key))
+        if trial is None:
+            continue
+        t = robot_timing(trial)
+        most = t.input_track_max_in_s if belt == "input" else t.output_track_max_in_s
+        if speed <= most:
+            return key, _shown(s.get(key))
+    return f"belts.{belt}_nominal_in_s", speed
 
 
 def nominal_cycle(s: Scenario) -> float:

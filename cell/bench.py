@@ -4,7 +4,7 @@ Measured in one run: simulated parts per second for a 500-part adaptive and a
 500-part non-adaptive run (best of several, the path already solved, as in a
 sweep), and a bare SimPy process doing ``yield env.timeout(1)`` in a loop
 (events per second) for scale.  The planner's figures from
-``cell.mintime.bench.benchmarks()`` are merged in by ``cell bench``.
+``cell.bench_planner.benchmarks()`` are merged in by ``cell bench``.
 """
 
 from __future__ import annotations

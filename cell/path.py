@@ -173,7 +173,7 @@ def build_path(g: CellGeometry = CellGeometry()) -> TransferPath:
 
     def label(i: int) -> str:
         return (f"path point {i} ({REGIMES[regime[i] - 1]}) at "
-                f"({xyz[i, 0]:.3f}, {xyz[i, 1]:.3f}, {xyz[i, 2]:.3f})")
+                f"({xyz[i, 0]:.4g}, {xyz[i, 1]:.4g}, {xyz[i, 2]:.4g})")
 
     q = inverse_kinematics(arm_target(xyz, phi, opening, g.placement, g.hand), g.arm,
                            label=label)

@@ -51,6 +51,8 @@ Point = tuple[Coord, Coord, Coord]
 Positive = Annotated[float, Field(strict=True, allow_inf_nan=False, gt=0.0, le=1e9)]
 NonNegative = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=0.0, le=1e9)]
 Five = tuple[Positive, Positive, Positive, Positive, Positive]
+#: A motor makes at least one step per radian, or it cannot follow any path.
+StepsPerRad = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=1.0, le=1e7)]
 Angle = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=-360.0, le=360.0)]
 Range = tuple[Angle, Angle]
 
@@ -150,7 +152,8 @@ class HandSettings(Section):
 class MotorSettings(Section):
     """Stepper drives (thesis §6.1): rates linear in the load, 75 % nominal."""
 
-    steps_per_rad: Five = (1125.0, 1125.0, 672.0, 241.0, 241.0)
+    steps_per_rad: tuple[StepsPerRad, StepsPerRad, StepsPerRad, StepsPerRad, StepsPerRad] = (
+        1125.0, 1125.0, 672.0, 241.0, 241.0)
     """TeachMover half-steps per radian: base, shoulder, elbow, pitch, roll."""
     max_rate_no_load_rad_s: Five = (0.4194527, 0.36, 0.82, 2.02, 2.02)
     """TeachMover no-load speeds, except the base: CALIBRATED to 0.4194527 rad/s
@@ -374,29 +377,44 @@ def known_key(dotted: str) -> bool:
 
 def _cross_checks(s: Scenario, file: object) -> None:
     """Checks that need more than one value but no maths."""
-    p = s.path
-    window_in = math.dist(p.f_in, p.bot_in)
-    if not p.lo_from_bot_in < window_in:
-        raise ScenarioError(file, "path.lo_from_bot_in", p.lo_from_bot_in,
-                            f"must lie inside the input window B-F ({window_in:g} in)")
-    window_out = math.dist(p.eot_in, p.g_in)
-    if not p.td_from_g_in < window_out:
-        raise ScenarioError(file, "path.td_from_g_in", p.td_from_g_in,
-                            f"must lie inside the output window G-K ({window_out:g} in)")
-    for i, (lo, hi) in enumerate(s.robot.joint_limits_deg.as_list()):
-        if not lo < hi:
-            raise ScenarioError(file, f"robot.joint_limits_deg.theta{i + 1}", [lo, hi],
-                                "lower limit must be below the upper")
     h = s.robot.hand
     for key, g in (("robot.hand.open_in", h.open_in), ("part.size_in", s.part.size_in)):
         if (g - h.g0_in) ** 2 / 2 > h.l2_in ** 2:
             raise ScenarioError(file, key, g, "finger opening beyond what the hand linkage "
                                 "allows (eq. 6.2: (G - G0)^2 / 2 must not exceed L2^2)")
+    p, m = s.path, s.path.moves
+    for (start, end), (key, value), moves in (
+            (("bot_in", "f_in"), ("lo_from_bot_in", p.lo_from_bot_in), m.R1),
+            (("g_in", "eot_in"), ("td_from_g_in", p.td_from_g_in), m.R3)):
+        window = math.dist(getattr(p, start), getattr(p, end))
+        if window < s.part.size_in:
+            if window >= _DEFAULTS.part.size_in:   # the window is the thesis's; the part grew
+                raise ScenarioError(file, "part.size_in", s.part.size_in, f"longer than the "
+                                    f"{window:.4g} in tracking window from path.{start} to path.{end}")
+            moved, other = (start, end) if getattr(p, start) != getattr(_DEFAULTS.path, start) \
+                else (end, start)
+            raise ScenarioError(file, f"path.{moved}", list(getattr(p, moved)),
+                                f"lies {window:.4g} in from path.{other}: a tracking window must "
+                                f"be at least a part's size ({s.part.size_in:g} in) long")
+        step = window / moves
+        if not step <= value <= window - step:
+            raise ScenarioError(file, f"path.{key}", value,
+                                f"must leave at least one move ({step:.4g} in) of the "
+                                f"{window:g} in window on each side")
+    for i, (lo, hi) in enumerate(s.robot.joint_limits_deg.as_list()):
+        if not lo < hi:
+            raise ScenarioError(file, f"robot.joint_limits_deg.theta{i + 1}", [lo, hi],
+                                "lower limit must be below the upper")
+    b = s.belts
+    if b.spacing_in - b.spacing_tol_in < s.part.size_in:
+        key, value = ("belts.spacing_tol_in", b.spacing_tol_in) if b.spacing_tol_in > 0 and \
+            b.spacing_in >= s.part.size_in else ("belts.spacing_in", b.spacing_in)
+        raise ScenarioError(file, key, value, f"parts {s.part.size_in:g} in long set down "
+                            f"{b.spacing_in:g} ± {b.spacing_tol_in:g} in apart could overlap")
     w = s.run.warmup_parts
     if isinstance(w, int) and w >= s.run.parts:
         raise ScenarioError(file, "run.warmup_parts", w,
                             f"must be fewer than run.parts ({s.run.parts})")
-    b = s.belts
     for belt in ("input", "output"):
         lo, nom, hi = (getattr(b, f"{belt}_{k}_in_s") for k in ("min", "nominal", "max"))
         if hi < nom:

@@ -11,8 +11,8 @@ import pytest
 
 from cell.cli import build_parser, main
 
-SUBCOMMANDS = ["path", "run", "sweep", "figures", "mintime", "bench", "fit", "animate",
-               "scenarios", "schema"]
+SUBCOMMANDS = ["path", "run", "sweep", "compare", "figures", "mintime", "bench", "fit",
+               "animate", "scenarios", "schema"]
 
 
 def test_help_lists_the_subcommands():
@@ -34,7 +34,8 @@ def test_parser_knows_every_subcommand():
     for name in SUBCOMMANDS:
         argv = {"path": ["x", "--out", "y"], "run": ["x", "--out", "y"],
                 "mintime": ["x", "--out", "y"], "sweep": ["x", "--out", "y"],
-                "fit": ["x"], "animate": ["x", "--out", "y.gif"]}.get(name, [])
+                "fit": ["x"], "animate": ["x", "--out", "y.gif"],
+                "compare": ["a", "b"]}.get(name, [])
         assert parser.parse_args([name, *argv]).command == name
 
 

@@ -94,7 +94,7 @@ BAD = [
     ({"arrivals": {"distribution": "norm", "params": {"loc": 20, "scale": 1}}},
      "arrivals.params", "non-negative"),
     ({"arrivals": {"trace_csv": "missing.csv"}}, "arrivals.trace_csv", "no such file"),
-    ({"path": {"lo_from_bot_in": 9.0}}, "path.lo_from_bot_in", "inside the input window"),
+    ({"path": {"lo_from_bot_in": 9.0}}, "path.lo_from_bot_in", "one move"),
     ({"robot": {"hand": {"open_in": 5.0}}}, "robot.hand.open_in", "linkage"),
     ({"path": "x"}, "path", "mapping"),
 ]

@@ -119,7 +119,7 @@ BAD = [
     ({"replicates": 5}, "replicates", "unknown key"),
     ({"seed": -3}, "seed", "at least 0"),
     ({"set": {"run.part": 10}}, "run.part", "unknown key"),
-    ({"base": "nowhere.yaml"}, "(file)", "no such scenario file"),
+    ({"base": "nowhere.yaml"}, "base", "no such scenario file"),
     ({"replications": {"precision": 0, "measure": "parts_missed", "max": 50}},
      "replications.precision", "above 0"),
     ({"replications": {"precision": 0.01, "measure": "parts_mised", "max": 50}},

@@ -17,7 +17,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     from cell.bench import TARGET_PARTS_PER_S, benchmarks
-    from cell.mintime.bench import benchmarks as planner_benchmarks
+    from cell.bench_planner import benchmarks as planner_benchmarks
     from cell.output import check_file, write_text
 
     check_file(args.out)  # before any work

@@ -47,7 +47,9 @@ def main(args: argparse.Namespace) -> int:
 def _sweep(args: argparse.Namespace) -> int:
     from cell.errors import CellError
     from cell.sweep import load_sweep, run_sweep, simulate_summary
+    from cell.sweep.runner import check_out
 
+    check_out(args.out)  # before the sweep file's points are built and checked
     sweep = load_sweep(args.sweep)
     if args.workers is not None and args.workers < 1:
         raise CellError(f"--workers {args.workers}: must be at least 1")

@@ -102,7 +102,8 @@ def write_report(replications: pd.DataFrame, sweep: Sweep, target: Target,
         out.write_csv("summary.csv", summary)
         out.write_csv("differences.csv", differences)
         for name, data in pngs.items():
-            out.write_bytes(name, data)
+            with out.open(name, "wb") as fh:
+                fh.write(data)
         written = ["report.md", "summary.csv", "differences.csv", *pngs]
         if "replications.csv" in target.names:
             out.write_csv("replications.csv", replications)

@@ -219,15 +219,44 @@ def _close(executor: cf.Executor | None, client: Any, wait: bool) -> None:
         client.close()
 
 
+#: At most this many local worker processes per core.
+WORKERS_PER_CORE = 4
+
+
+def check_out(out: str | Path) -> Path:
+    """Refuse, before any work, a sweep directory that cannot be used: an empty name, a
+    file, a directory under a file, or one holding a ``sweep.json`` that is not a sweep's."""
+    if str(out) == "":
+        raise CellError("--out '': an empty path; give a directory for the sweep's results")
+    path = Path(out)
+    for parent in (path, *path.parents):
+        if parent.exists() and not parent.is_dir():
+            raise CellError(f"--out {out}: {parent} is not a directory")
+    manifest = path / MANIFEST
+    if manifest.exists():
+        if not manifest.is_file() or not isinstance(_manifest(manifest), dict):
+            raise CellError(f"--out {out}: {manifest} is not a sweep's manifest; choose another "
+                            "--out")
+    return path
+
+
+def _manifest(path: Path) -> Any:
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError, UnicodeDecodeError):
+        return None
+
+
 def _prepare(sweep: Sweep, out: Path, resume: bool) -> None:
-    """Check a resumed directory is this sweep's, or clear a fresh one; write the manifest."""
+    """Check a resumed directory is this sweep's, or clear a fresh one; write the manifest.
+    Either way the temporary files of a killed run are removed."""
     task_dir, manifest = out / TASK_DIR, out / MANIFEST
     fingerprint = sweep.fingerprint()
+    for leftover in task_dir.glob(".task-*.tmp") if task_dir.is_dir() else ():
+        leftover.unlink(missing_ok=True)
     if resume and manifest.is_file():
-        try:
-            previous = json.loads(manifest.read_text()).get("fingerprint")
-        except (OSError, ValueError):
-            previous = None
+        found = _manifest(manifest)
+        previous = found.get("fingerprint") if isinstance(found, dict) else None
         if previous != fingerprint:
             raise CellError(f"--resume: {out} holds the results of a different sweep "
                             f"(or of {sweep.source} before it was edited); "
@@ -257,10 +286,14 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
 
     from cell.analysis.stats import next_round, precision_reached
 
-    out = Path(out)
-    workers = (os.cpu_count() or 1) if workers is None else workers
+    out = check_out(out)
+    cores = os.cpu_count() or 1
+    workers = cores if workers is None else workers
     if workers < 1:
         raise CellError(f"--workers {workers}: must be at least 1")
+    if workers > WORKERS_PER_CORE * cores and not scheduler:
+        raise CellError(f"--workers {workers}: at most {WORKERS_PER_CORE * cores} on this "
+                        f"machine ({cores} cores)")
     executor, client = _open_executor(workers, scheduler)
     window = CLUSTER_WINDOW if scheduler else 2 * workers
     columns = grid_columns(sweep)

@@ -37,6 +37,7 @@ import dataclasses
 import hashlib
 import itertools
 import json
+import math
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,6 +47,7 @@ import numpy as np
 
 from cell import registry
 from cell.errors import ScenarioError
+from cell.progress import Progress
 from cell.scenario import Scenario, known_key, load_scenario
 from cell.sweep.options import (
     RESERVED,
@@ -59,6 +61,12 @@ from cell.sweep.options import (
     summary_measures,
     whole,
 )
+
+#: At most this many grid points, and this many runs (points x replications), in a sweep.
+MAX_POINTS = 100_000
+MAX_RUNS = 10_000_000
+#: Checking this many points or more shows progress.
+SHOW_CHECKING = 1_000
 
 SWEEP_KEYS = ("name", "description", "base", "set", "grid", "policies",
               "replications", "seed", "batch", "baseline")
@@ -222,7 +230,10 @@ def load_sweep(path: str | Path) -> Sweep:
     if "base" not in raw or not isinstance(raw["base"], str):
         raise ScenarioError(path, "base", raw.get("base"),
                             "name the base scenario file (relative to the sweep file)")
-    base = load_scenario(path.parent / raw["base"])
+    base_path = path.parent / raw["base"]
+    if not base_path.is_file():
+        raise ScenarioError(path, "base", raw["base"], f"no such scenario file ({base_path})")
+    base = load_scenario(base_path)
 
     fixed = raw.get("set") or {}
     if not isinstance(fixed, dict):
@@ -261,7 +272,18 @@ def load_sweep(path: str | Path) -> Sweep:
     batch = whole(raw, "batch", min(20, precision.min_n if precision else replications), 1, path)
 
     keys = tuple(dict.fromkeys(itertools.chain(shared, *per_policy.values())))
+    n_points = sum(math.prod(len(v) for v in {**shared, **own}.values())
+                   for own in per_policy.values())
+    if n_points > MAX_POINTS:
+        raise ScenarioError(path, "grid", f"{n_points:,} points", f"at most {MAX_POINTS:,} grid "
+                            "points in one sweep (split it into several)")
+    if n_points * replications > MAX_RUNS:
+        raise ScenarioError(path, "replications", replications,
+                            f"{n_points:,} points x {replications:,} replications: at most "
+                            f"{MAX_RUNS:,} runs in one sweep")
     points: list[Point] = []
+    checking = Progress(n_points, f"checking {path.name}", "points",
+                        enabled=n_points >= SHOW_CHECKING)
     for policy, own in per_policy.items():
         combined = {**shared, **own}
         for i, combo in enumerate(itertools.product(*(range(len(v)) for v in combined.values()))):
@@ -273,6 +295,8 @@ def load_sweep(path: str | Path) -> Sweep:
                 {**fixed, "controller.policy": policy, **dict(values)}, file=path)
             _check_point(scenario, path)
             points.append(Point(policy, i, values, scenario, named))
+            checking.update()
+    checking.close()
 
     name = raw.get("name", path.stem)
     sweep = Sweep(str(path), str(name), str(raw.get("description", "")), base,

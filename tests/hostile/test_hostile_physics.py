@@ -62,46 +62,26 @@ REFUSE = [
                                          "mintime.acceleration_bounds=false"], ("minimum-time",)),
     ("minimum-time, dynamics file missing", ["robot.timing=minimum-time", "mintime.dynamics_file=no.yaml"],
      ("mintime.dynamics_file", "no such file")),
-    pytest.param("minimum-time, planner too slow",
-                 ["robot.timing=minimum-time", "mintime.rate_fraction=1e-9"],
-                 ("mintime.rate_fraction",), marks=_hole(
-                     "cell/assembly.py robot_timing: R II planned at 3.9e9 s and R IV at 7.5e9 s (beyond the "
-                     "schema's 1e6 s bound on times) are accepted with a utilisation warning, the cycle set "
-                     "to 1.1e10 s; refuse a regime time above 1e6 s naming mintime.rate_fraction, as cell "
-                     "mintime does")),
+    ("minimum-time, planner too slow", ["robot.timing=minimum-time", "mintime.rate_fraction=1e-9"],
+     ("mintime.rate_fraction", "at most")),
     ("arrivals 1e300 s apart", ["arrivals.params={c: 4.9, loc: 1e300, scale: 5.4}"], ("arrivals.params",)),
     ("arrivals 1e9 s apart", ["arrivals.params={c: 4.9, loc: 1e9, scale: 5.4}"], ("arrivals.params",)),
     ("trace value 1e308", ["arrivals.trace_csv={trace:1e308}"], ("arrivals.trace_csv", "row 2")),
     ("trace value 2e6", ["arrivals.trace_csv={trace:2e6}"], ("arrivals.trace_csv", "row 2")),
-    pytest.param("spacing smaller than a part", ["belts.spacing_in=1.0"], ("belts.spacing_in",),
-                 marks=_hole("cell/scenario.py _cross_checks: parts 2 in long set down 1 in apart overlap on "
-                             "the output belt; refuse spacing_in - spacing_tol_in below part.size_in")),
-    pytest.param("tolerance wider than the spacing", ["belts.spacing_tol_in=250"], ("belts.spacing_tol_in",),
-                 marks=_hole("cell/scenario.py _cross_checks: 45 ± 250 in accepts parts on top of each "
-                             "other; refuse a tolerance that lets parts overlap")),
-    pytest.param("base motor too coarse for the path",
-                 ["robot.motors.steps_per_rad=[1e-9, 1125, 672, 241, 241]"],
-                 ("robot.motors.steps_per_rad",), marks=_hole(
-                     "cell/assembly.py / cell/steptable.py: R IV's 180 degrees of base turn round to 0 "
-                     "steps, so R IV takes 0.93 s instead of 9.99 s; refuse a motor that cannot resolve a "
-                     "regime")),
-    pytest.param("a heavier part", ["part.weight_oz=8"], ("part.weight_oz",), marks=_hole(
-        "cell/assembly.py constants: refused as 'belts.output_nominal_in_s = 2.0: the robot can follow the "
-        "output belt down to TD at no more than 1.9496 in/s', without naming part.weight_oz, the value "
-        "that was changed and slowed the loaded motors")),
-    pytest.param("LO at B", ["path.lo_from_bot_in=1e-300"], ("path.lo_from_bot_in",), marks=_hole(
-        "cell/path.py / cell/assembly.py: the spline from B to LO overshoots to z = -1e300 (numpy warns "
-        "of overflows) and the error quotes that coordinate with 300 digits; refuse LO closer to B than "
-        "the path can bend")),
-    pytest.param("B on F", ["path.bot_in=[-8.0, 0.0, 3.0]"], ("path.bot_in",), marks=_hole(
-        "cell/scenario.py _cross_checks: the error blames path.lo_from_bot_in ('must lie inside the input "
-        "window B-F (0 in)') and does not name path.bot_in or path.f_in, the keys that collapse the window")),
-    pytest.param("drives too weak for the rates",
-                 ["robot.timing=minimum-time", "robot.motors.max_rate_no_load_rad_s=[1e9, 1, 1, 3, 3]"],
-                 ("robot.motors.max_rate_no_load_rad_s",), marks=_hole(
-                     "cell/assembly.py robot_timing: blames 'microbot_dynamics.yaml: "
-                     "drives.viscous_nm_s_rad[0] = None' for friction at the no-load rate; name "
-                     "robot.motors.max_rate_no_load_rad_s and its value (as cell mintime does)")),
+    ("spacing smaller than a part", ["belts.spacing_in=1.0"], ("belts.spacing_in", "overlap")),
+    ("tolerance wider than the spacing", ["belts.spacing_tol_in=250"],
+     ("belts.spacing_tol_in", "overlap")),
+    ("base motor too coarse for the path", ["robot.motors.steps_per_rad=[1e-9, 1125, 672, 241, 241]"],
+     ("robot.motors.steps_per_rad",)),
+    ("a part too heavy to track the output belt", ["part.weight_oz=10"], ("part.weight_oz", "TD")),
+    ("a part too heavy for the shoulder", ["part.weight_oz=30"], ("part.weight_oz", "shoulder")),
+    ("LO at B", ["path.lo_from_bot_in=1e-300"], ("path.lo_from_bot_in", "one move")),
+    ("B on F", ["path.bot_in=[-8.0, 0.0, 3.0]"], ("path.bot_in", "window")),
+    ("drives too weak for the rates",
+     ["robot.timing=minimum-time", "robot.motors.max_rate_no_load_rad_s=[1e9, 1, 1, 3, 3]"],
+     ("robot.motors.max_rate_no_load_rad_s", "stall torque")),
+    ("motors too slow for any regime", ["robot.motors.max_rate_no_load_rad_s=[1e-9, 1, 1, 3, 3]"],
+     ("robot.motors.max_rate_no_load_rad_s", "at most")),
 ]
 
 
@@ -156,9 +136,7 @@ def _sweep(tmp: Path, text: str) -> Path:
 
 SWEEP_REFUSE = [
     ("no base", "replications: 2\n", ("base",)),
-    pytest.param("base missing", "base: nowhere.yaml\nreplications: 2\n", ("nowhere.yaml",), marks=_hole(
-        "cell/sweep/spec.py load_sweep: a missing base is named, but not the sweep file nor its key 'base' "
-        "(the line reads 'nowhere.yaml: (file) = ...: no such scenario file')")),
+    ("base missing", "base: nowhere.yaml\nreplications: 2\n", ("nowhere.yaml",)),
     ("unknown key", "base: base.yaml\nreplications: 2\nreplicas: 3\n", ("replicas",)),
     ("replications 0", "base: base.yaml\nreplications: 0\n", ("replications",)),
     ("replications text", "base: base.yaml\nreplications: many\n", ("replications",)),
@@ -177,15 +155,11 @@ SWEEP_REFUSE = [
     ("policy unknown", "base: base.yaml\nreplications: 2\npolicies: [sloppy]\n", ("sloppy",)),
     ("policies empty", "base: base.yaml\nreplications: 2\npolicies: []\n", ("policies",)),
     ("duplicate keys", "base: base.yaml\nreplications: 2\nreplications: 3\n", ("duplicate key",)),
-    pytest.param("a million points", "base: base.yaml\nreplications: 2\ngrid:\n" + "".join(
+    ("a million points", "base: base.yaml\nreplications: 2\ngrid:\n" + "".join(
         f"  {k}: [{', '.join(str(v) for v in vs)}]\n" for k, vs in (
             ("run.parts", range(1, 101)), ("belts.spacing_tol_in", [i / 10 for i in range(1, 101)]),
-            ("belts.spacing_in", range(40, 140)))), ("grid",), marks=_hole(
-        "cell/sweep/spec.py load_sweep: a 100 x 100 x 100 grid is assembled point by point for minutes "
-        "before anything is said; refuse a grid beyond a stated number of points at once (within seconds)")),
-    pytest.param("10^8 replications", "base: base.yaml\nreplications: 100000000\n", ("replications",),
-                 marks=_hole("cell/sweep: 10^8 replications: every seed spawned up front (minutes, "
-                             "gigabytes); refuse beyond a stated bound within seconds")),
+            ("belts.spacing_in", range(40, 140)))), ("grid",)),
+    ("10^8 replications", "base: base.yaml\nreplications: 100000000\n", ("replications",)),
 ]
 
 
@@ -214,12 +188,8 @@ SWEEP_OK = "base: base.yaml\npolicies: [adaptive]\nreplications: 2\n"
 @pytest.mark.parametrize("label,out,words", [
     ("out is a file", "a_file", "a_file"),
     ("out under a file", "a_file/out", "not a directory"),
-    pytest.param("out empty", "", "empty path", marks=_hole(
-        "cell/commands/sweep.py, cell/sweep/runner.py: --out '' writes replications.csv, sweep.json and "
-        "tasks/ into the current directory and exits 0; refuse it as cell run does (OutputDir)")),
-    pytest.param("report under a file", "out|a_file/r", "not a directory", marks=_hole(
-        "cell/commands/sweep.py: an unwritable --report is found only after every replication has run, "
-        "and the progress bar leaves a second line on stderr; check --report before any work")),
+    ("out empty", "", "empty path"),
+    ("report under a file", "out|a_file/r", "not a directory"),
 ])
 def test_sweep_outputs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, label: str, out: str,
                        words: str) -> None:
@@ -236,9 +206,6 @@ def test_sweep_outputs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, label: s
         {k: v for k, v in before.items() if k not in ("sweep.yaml", "base.yaml")}
 
 
-@_hole("cell/sweep/runner.py: with more --workers than the machine can hold (100,000 here) the runner "
-       "starts them all (the machine runs out of processes and memory); bound the pool (by the tasks "
-       "and the cores) or refuse the option")
 def test_sweep_workers_are_bounded(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     import concurrent.futures as cf
 
@@ -258,10 +225,7 @@ def test_sweep_workers_are_bounded(tmp_path: Path, monkeypatch: pytest.MonkeyPat
 
 
 @pytest.mark.parametrize("manifest", [
-    pytest.param("[1, 2]", marks=_hole("cell/sweep/runner.py: a sweep.json that is not cell's manifest (a "
-                                       "JSON list) is overwritten silently; refuse a --out holding it")),
-    pytest.param("garbage{", marks=_hole("cell/sweep/runner.py: a sweep.json that is not JSON is overwritten "
-                                         "silently; refuse a --out holding it")),
+    "[1, 2]", "garbage{",
 ])
 def test_sweep_foreign_manifest(tmp_path: Path, manifest: str) -> None:
     out = tmp_path / "out"
@@ -272,13 +236,11 @@ def test_sweep_foreign_manifest(tmp_path: Path, manifest: str) -> None:
             nothing_in=out, before=before)
 
 
-@_hole("cell/sweep/runner.py: --resume leaves the temporary files (.task-N.csv.cell-PID-*.tmp) of a killed "
-       "run's other tasks in OUT/tasks forever; remove those of dead processes when a run starts")
 def test_sweep_resume_removes_leftovers_of_killed_runs(tmp_path: Path) -> None:
     out = tmp_path / "out"
     sweep = _sweep(tmp_path, SWEEP_OK + "batch: 1\n")
     assert cli("sweep", sweep, "--workers", "1", "--out", out).code == 0
-    (out / "tasks" / ".task-00001.csv.cell-99999999-abcdefgh.tmp").write_text("half")
-    (out / "tasks" / "task-00000.csv").unlink()
+    (out / "tasks" / ".task-00000-0000000001.csv.cell-99999999-abcdefgh.tmp").write_text("half")
+    (out / "tasks" / "task-00000-0000000000.csv").unlink()
     assert cli("sweep", sweep, "--workers", "1", "--resume", "--out", out).code == 0
     assert not [p.name for p in (out / "tasks").iterdir() if p.name.endswith(".tmp")]

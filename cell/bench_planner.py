@@ -17,11 +17,9 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[2]
 RICHARDSON = tuple(460 * 2 ** k for k in range(5))
 
 
@@ -56,7 +54,7 @@ def benchmarks(repeat: int = 5) -> dict[str, float]:
     from cell.mintime.regimes import FREE_REGIMES, plan_regimes, regime_path, regime_rows
     from cell.scenario import load_scenario
 
-    kin = load_scenario(ROOT / "scenarios" / "mintime_kinematic.yaml")
+    kin = load_scenario("mintime_kinematic")
     table = step_table(kin)
     geometry, motors, bounds = geometry_of(kin), motors_of(kin), planner_bounds(kin)
     paths = [regime_path(table, r, geometry) for r in FREE_REGIMES]
@@ -89,7 +87,7 @@ def benchmarks(repeat: int = 5) -> dict[str, float]:
 
     # Torque (baseline dynamic model) on R IV at 460 points: toppra calls the same inverse
     # dynamics once per grid point and coefficient, the planner batches it.
-    base = load_scenario(ROOT / "scenarios" / "baseline.yaml")
+    base = load_scenario("baseline")
     base_geometry, base_motors, base_bounds = geometry_of(base), motors_of(base), planner_bounds(base)
     model = base_bounds.dynamics
     assert model is not None, "scenarios/baseline.yaml names a dynamics file"
