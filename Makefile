@@ -21,10 +21,10 @@ test: $(STAMP)
 	$(PY) -m pytest -q
 
 sweep: $(STAMP)
-	$(PY) -m cell sweep scenarios/table_7_1.yaml --out build/sweep --workers $(WORKERS) --report reports
+	$(PY) -m cell sweep scenarios/table_7_1.yaml --out build/sweep --workers $(WORKERS) --report reports/table_7_1
 
 sweep-mintime: $(STAMP)
-	$(PY) -m cell sweep scenarios/table_7_1_mintime.yaml --out build/sweep_mintime --workers $(WORKERS) --report reports/mintime
+	$(PY) -m cell sweep scenarios/table_7_1_mintime.yaml --out build/sweep_mintime --workers $(WORKERS) --report reports/table_7_1_mintime
 
 whatif: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m cell sweep scenarios/whatif.yaml --out build/whatif --workers $(WORKERS) --report reports/whatif
