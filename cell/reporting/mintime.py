@@ -63,10 +63,26 @@ def write(out_dir: str | Path = Path("reports") / "mintime") -> dict:
     c = cycles(docs)
     with OutputDir(out_dir, FILES, option="DIR") as out:
         for label, doc in docs.items():
-            out.write_text(f"{label}.json", json.dumps(doc, indent=2) + "\n")
-        out.write_text("cycles.json", json.dumps(c, indent=2) + "\n")
+            out.write_text(f"{label}.json", json.dumps(rounded(doc), indent=2) + "\n")
+        out.write_text("cycles.json", json.dumps(rounded(c), indent=2) + "\n")
         out.write_text("README.md", readme(c))
     return c
+
+
+#: Significant digits kept in the JSON files: far beyond the model's accuracy, and short of
+#: the last bits, which differ between CPUs (numpy's vectorised arctan2 in the kinematics).
+DIGITS = 12
+
+
+def rounded(doc: object) -> object:
+    """``doc`` with every float rounded to :data:`DIGITS` significant digits."""
+    if isinstance(doc, float):
+        return float(f"{doc:.{DIGITS}g}")
+    if isinstance(doc, dict):
+        return {k: rounded(v) for k, v in doc.items()}
+    if isinstance(doc, list):
+        return [rounded(v) for v in doc]
+    return doc
 
 
 def readme(c: dict) -> str:

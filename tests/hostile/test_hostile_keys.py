@@ -189,15 +189,8 @@ class Case:
     """True: the schema forbids it; False: refused in one line or a sane run."""
 
 
-#: Cases that break the promise today, in files this suite's owner does not edit: each is
-#: run on its own below, marked as an expected failure until its owner fixes it.
-#: (key, case) -> why it is still a hole, in the file that owns it (a strict xfail each).
-KNOWN_HOLES: dict[tuple[str, str], str] = {}
-
 KEYS = [key for key, _, _ in leaves(Scenario)]
-CASES = [c for c in cases() if (c.key, c.label) not in KNOWN_HOLES]
-HOLES = [c for c in cases() if (c.key, c.label) in KNOWN_HOLES]
-KEYS = [key for key, _, _ in leaves(Scenario)]
+CASES = list(cases())
 
 
 
@@ -262,12 +255,6 @@ def test_in_a_scenario_file(tmp_path: Path, key: str) -> None:
     _all(tmp_path, _check_file, [c for c in CASES if c.key == key and c.must_refuse][::2])
 
 
-@pytest.mark.parametrize("case", [pytest.param(c, id=f"{c.key}={c.label}", marks=pytest.mark.xfail(
-    strict=True, reason=KNOWN_HOLES[(c.key, c.label)])) for c in HOLES])
-def test_known_holes(tmp_path: Path, case: Case) -> None:
-    _check_set(tmp_path, case)
-
-
 def test_the_walk_covers_every_setting() -> None:
     """Each leaf of the schema has refused cases, and the numeric ones accepted cases too."""
     keys = {key for key, _, _ in leaves(Scenario)}
@@ -275,5 +262,3 @@ def test_the_walk_covers_every_setting() -> None:
     assert keys == {c.key for c in CASES} == set(KEYS)
     numeric = {key for key, ann, _ in leaves(Scenario) if ann in (float, int)}
     assert numeric <= {c.key for c in CASES if not c.must_refuse}
-    assert all((c.key, c.label) in {(h.key, h.label) for h in HOLES} for c in HOLES) and \
-        len(HOLES) == len(KNOWN_HOLES)
