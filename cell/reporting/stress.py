@@ -42,7 +42,9 @@ MARGIN_PARTS = 3
 def table(reps: pd.DataFrame) -> pd.DataFrame:
     """One row per (family, cv, mean, policy) with means, intervals and the paired advantage."""
     rows = []
-    for (family, cv, mean), point in reps.groupby(list(KEYS), sort=True):
+    for group, point in reps.groupby(list(KEYS), sort=True):
+        family, cv, mean = (group if isinstance(group, tuple) else (group,))
+        mean = float(mean)  # type: ignore[arg-type]
         by = {p: g.sort_values("replication") for p, g in point.groupby("policy")}
         fixed = by["non-adaptive"]
         for policy in POLICIES:
@@ -110,7 +112,8 @@ def reading(t: pd.DataFrame) -> list[str]:
     regular = ad[(ad["cv"] <= 0.1) & (ad["load"] >= 1.0)]
     if len(regular):
         lost_ad = regular["parts_lost"].max()
-        lost_fx = [fx.loc[(r.family, r.cv, r.mean_s), "parts_lost"] for r in regular.itertuples()]
+        lost_fx = [float(fx.at[(r.family, r.cv, r.mean_s), "parts_lost"])  # type: ignore[arg-type]
+                   for r in regular.itertuples()]
         out.append(
             f"**Regular parts (cv at most 0.1) with the robot fast enough (load 1 or more).** The "
             f"adaptive robot loses at most {lost_ad:.1f} parts per 500; the fixed-cycle robot, "
