@@ -1,11 +1,11 @@
-"""The two ways of counting a run's performance (thesis eq. 5.1, §6.3, §7.2; SPEC §8).
+"""The two ways of counting a run's performance (thesis eq. 5.1, §6.3, §7.2; docs/accounting.md).
 
 * Wall-clock: a delivery interval is the time between consecutive set-downs
   (TD) on the output belt; IP (eq. 5.1) = the next part's inter-arrival time
   over that interval; the actual cycle is the mean interval.
 * The thesis's: for the adaptive robot, step 6.2's "time between part
   deliveries" (motion time to TD plus the previous cycle's residual, idle waits
-  left out); for the non-adaptive table, SPEC §8's reconstruction of how Table
+  left out); for the non-adaptive table, docs/accounting.md's reconstruction of how Table
   7.1 was computed (:func:`thesis_non_adaptive`).
 
 All functions are pure and vectorised over leading axes (replications).
@@ -18,7 +18,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-#: Slack of SPEC §8's reconstruction: the thesis's non-adaptive robot lost part i
+#: Slack of docs/accounting.md's reconstruction: the thesis's non-adaptive robot lost part i
 #: when T_i < C - s.  CALIBRATED: fitted to Table 7.1's parts-missed column
 #: (95 % interval 0.11-0.36 s); not a physical quantity.
 THESIS_SLACK_S = 0.23
@@ -91,7 +91,7 @@ def _thesis_from_lost(t: NDArray[np.float64], cycle_s: float, lost: NDArray[np.b
 
 def thesis_non_adaptive(interarrival_s: ArrayLike, cycle_s: float,
                         slack_s: float = THESIS_SLACK_S) -> ThesisNonAdaptive:
-    """SPEC §8's reconstruction of Table 7.1 for a robot cycle C.
+    """docs/accounting.md's reconstruction of Table 7.1 for a robot cycle C.
 
     ``interarrival_s`` holds T_1 .. T_{n+1} (the last only as part n's "next").
     Part i is lost iff T_i < C - s, whatever the robot is doing; its delivery

@@ -1,8 +1,8 @@
-"""MICROBOT kinematics (thesis §3, §6.1; corrections in SPEC §2).
+"""MICROBOT kinematics (thesis §3, §6.1; corrections in docs/model.md).
 
 Forward kinematics is the product of the Denavit-Hartenberg A matrices
 (eq. 3.1-3.7, Table 3.1), vectorised over any number of configurations.  The
-inverse is the closed form of SPEC §2 (the scan's eq. 3.26-3.31 are garbled).
+inverse is the closed form of docs/model.md (the scan's eq. 3.26-3.31 are garbled).
 The cell's placement Z (eq. 6.1), the hand E (eq. 6.2), the part P and grasp PG
 (eq. 6.3-6.5) give the arm's target T5 = Z⁻¹ P PG E⁻¹ (eq. 6.7).
 """

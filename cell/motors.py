@@ -1,4 +1,4 @@
-"""Stepper drives and move times (thesis §6.1; SPEC §4).
+"""Stepper drives and move times (thesis §6.1; docs/model.md).
 
 Each joint's motor has a maximum step rate linear in the carried load, between
 its no-load and full-load figures.  Nominal operation runs the motors at 75 % of

@@ -1,4 +1,4 @@
-"""The transfer path B → F → G → K → B (thesis §4.2, Fig. 9; SPEC §3).
+"""The transfer path B → F → G → K → B (thesis §4.2, Fig. 9; docs/model.md).
 
 Four regimes:
 

@@ -50,7 +50,7 @@ class RobotTiming:
     """TD → K."""
     r4: Segment
     r4_nominal_s: float
-    """R IV at the nominal motor rates (the thesis's 9.9855 s; SPEC §4)."""
+    """R IV at the nominal motor rates (the thesis's 9.9855 s; docs/model.md)."""
     input_track_max_in_s: float
     """Fastest input belt the robot can follow before LO (grasp move excluded)."""
     output_track_max_in_s: float

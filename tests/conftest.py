@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
 import pytest
+import yaml
 
 from cell import catalog
 from cell.assembly import constants, robot_timing, step_table
@@ -36,3 +41,86 @@ def timing(thesis_cell):
 def k(thesis_cell, timing):
     """The policies' constants for the thesis's cell."""
     return constants(thesis_cell, timing)
+
+
+# --------------------------------------------------------------------------- sweep stand-ins
+# The sweep runner takes the replication as a function; these small deterministic stand-ins
+# draw from the stream they are given (module-level, so worker processes can run them).
+def weibull_interarrivals(rng: np.random.Generator, n: int) -> np.ndarray:
+    """Eq. 6.9 by inverse cdf: T = 17.6019 + 5.4342 (-ln(1 - u))^0.2038 (docs/model.md)."""
+    return 17.6019 + 5.4342 * (-np.log1p(-rng.random(n))) ** 0.2038
+
+
+def thesis_bookkeeping(scenario, seed) -> dict:
+    """A stand-in replication: the reconstruction (docs/accounting.md) of the thesis's bookkeeping
+    (lost when T_i < C - s, s = 0.23 s; D_i = T_i, + C when lost) beside a naive
+    wall clock (a part is lost when the robot is still busy), from the stream given."""
+    rng = np.random.default_rng(seed)
+    c = scenario.controller
+    cycle = c.ideal_cycle_s if c.ideal_cycle_s is not None else c.nominal_cycle_s
+    t = weibull_interarrivals(rng, scenario.run.parts)
+    adaptive = c.policy == "adaptive"
+    lost = np.zeros(t.size, bool) if adaptive else t < cycle - 0.23
+    d = t + cycle * lost
+    delivered = int((~lost).sum())
+    actual_t = d.sum() / delivered
+    ip_t = float(np.mean(t[1:] / (2 * d[:-1]))) if not adaptive else float(np.mean(t / t.mean()))
+    arrivals = np.cumsum(t)
+    ready, lost_w, done = 0.0, 0, []
+    for a in arrivals:
+        if a < ready and not adaptive:
+            lost_w += 1
+            continue
+        ready = max(a, ready) + cycle
+        done.append(ready)
+    gaps = np.diff(done)
+    actual_w = float(gaps.mean())
+    r4 = 35.5424 / (9.9855 - (c.nominal_cycle_s - cycle))
+    return {"policy": c.policy, "ideal_cycle_s": cycle, "parts_arrived": t.size,
+            "parts_delivered": delivered, "parts_missed": int(lost.sum()),
+            "actual_cycle_wallclock_s": actual_w, "actual_cycle_thesis_s": actual_t,
+            "parts_per_hr_wallclock": 3600 / actual_w, "parts_per_hr_thesis": 3600 / actual_t,
+            "vavg_r4_in_s": r4, "ip_wallclock": float(np.mean(t[1:] / gaps.mean())),
+            "ip_thesis": ip_t, "spacing_min_in": 45.0, "spacing_max_in": 45.0,
+            "first_u": np.random.default_rng(seed).random()}
+
+
+def first_draw(scenario, seed) -> dict:
+    """A tiny replication: the first uniform of the stream, and the cycle it ran at."""
+    c = scenario.controller
+    return {"u": np.random.default_rng(seed).random(), "cycle": c.ideal_cycle_s or -1.0,
+            "parts": scenario.run.parts}
+
+
+def write_sweep(tmp_path: Path, **fields) -> Path:
+    doc = {"base": str(catalog.path("baseline")), "set": {"run.parts": 20},
+           "policies": {"non-adaptive": {"controller.ideal_cycle_s": [22.0, 21.0]},
+                        "adaptive": {}},
+           "replications": 6, "seed": 7, "batch": 2}
+    doc.update(fields)
+    doc = {k: v for k, v in doc.items() if v is not None}
+    path = tmp_path / "sweep.yaml"
+    path.write_text(yaml.safe_dump(doc, sort_keys=False))
+    return path
+
+
+class Interrupt:
+    """A replication that is 'killed' (KeyboardInterrupt) after ``after`` runs of ``of``."""
+
+    def __init__(self, after: int, of=thesis_bookkeeping):
+        self.after, self.calls, self.of = after, 0, of
+
+    def __call__(self, scenario, seed):
+        self.calls += 1
+        if self.calls > self.after:
+            raise KeyboardInterrupt
+        return self.of(scenario, seed)
+
+
+@pytest.fixture(scope="session")
+def sweeps() -> SimpleNamespace:
+    """The sweep stand-ins: ``write(tmp_path, **fields)`` a sweep file over baseline.yaml,
+    ``bookkeeping`` and ``first_draw`` replications, ``Interrupt`` a replication killed
+    after some runs."""
+    return SimpleNamespace(write=write_sweep, bookkeeping=thesis_bookkeeping,
+                           first_draw=first_draw, Interrupt=Interrupt)

@@ -1,4 +1,4 @@
-"""The two accountings (cell.accounting) against closed forms and SPEC §8's figures."""
+"""The two accountings (cell.accounting) against closed forms and docs/accounting.md's figures."""
 
 from __future__ import annotations
 
@@ -15,8 +15,8 @@ from cell.accounting import (
     wallclock,
 )
 
-#: Table 7.1 (thesis §7.2) with SPEC §8's figures for the reconstruction held at
-#: the thesis's own miss counts: (ideal cycle, missed, actual cycle, IP, SPEC actual, SPEC IP).
+#: Table 7.1 (thesis §7.2) with docs/accounting.md's figures for the reconstruction held at
+#: the thesis's own miss counts: (ideal cycle, missed, actual cycle, IP, docs actual, docs IP).
 TABLE_7_1 = [
     (22.5872, 206, 54.1660, 0.3901, 54.22, 0.3900),
     (22.0000, 113, 35.6057, 0.4388, 35.64, 0.4390),
@@ -57,7 +57,7 @@ def test_slack_is_the_boundary():
 
 
 @pytest.mark.parametrize("row", TABLE_7_1, ids=[str(r[0]) for r in TABLE_7_1])
-def test_reconstruction_held_at_thesis_misses_gives_spec_figures(draws, row):
+def test_reconstruction_held_at_thesis_misses_gives_its_figures(draws, row):
     ideal, missed, thesis_actual, thesis_ip, spec_actual, spec_ip = row
     r = thesis_non_adaptive_held(draws, ideal, missed)
     assert (r.missed == missed).all()

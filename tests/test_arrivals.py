@@ -21,10 +21,10 @@ def test_default_is_eq_6_9_by_inverse_cdf():
     np.testing.assert_allclose(t, eq_6_9, rtol=1e-9)
 
 
-def test_weibull_moments_match_scipy_and_spec():
+def test_weibull_moments_match_scipy_and_the_thesis():
     t = interarrival_times(Arrivals(), 40_000, 3)
     mean, sd = WEIBULL.mean(), WEIBULL.std()
-    assert mean == pytest.approx(22.586, abs=1e-3)     # SPEC §5 (thesis quotes 22.5872)
+    assert mean == pytest.approx(22.586, abs=1e-3)     # docs/model.md (thesis quotes 22.5872)
     assert sd == pytest.approx(1.16, abs=5e-3)
     assert abs(t.mean() - mean) < 4 * sd / np.sqrt(t.size)
     assert t.std() == pytest.approx(sd, rel=0.03)

@@ -40,7 +40,7 @@ def test_parser_knows_every_subcommand():
 
 
 def test_cell_path_writes_the_thesis_table(tmp_path):
-    """Issue 2 must-show: 460 rows, angles in range, R IV 35.54 in and 1125π base steps,
+    """460 rows, angles in range, R IV 35.54 in and 1125π base steps,
     9.9855 s at the nominal rate and 7.489 s at the maximum."""
     out = tmp_path / "steps.csv"
     assert main(["path", "scenarios/baseline.yaml", "--out", str(out)]) == 0

@@ -8,7 +8,6 @@ import pandas as pd
 import pytest
 import scipy.stats
 import yaml
-from test_sweep import write_sweep
 
 from cell.cli import main
 from cell.reporting.experiment import difference_table
@@ -25,7 +24,7 @@ def scenario(tmp_path: Path, name: str, **settings) -> Path:
     return path
 
 
-def test_compare_agrees_with_the_sweeps_paired_differences(tmp_path, capsys):
+def test_compare_agrees_with_the_sweeps_paired_differences(sweeps, tmp_path, capsys):
     a = scenario(tmp_path, "adaptive")
     b = scenario(tmp_path, "fixed", controller__policy="non-adaptive")
     code = main(["compare", str(a), str(b), "--replications", "6", "--seed", "11",
@@ -34,7 +33,7 @@ def test_compare_agrees_with_the_sweeps_paired_differences(tmp_path, capsys):
     assert code == 0, err
     ours = pd.read_csv(tmp_path / "cmp" / "differences.csv")
 
-    sweep = load_sweep(write_sweep(tmp_path, base=str(a), set={"run.parts": 40},
+    sweep = load_sweep(sweeps.write(tmp_path, base=str(a), set={"run.parts": 40},
                                    policies=["non-adaptive", "adaptive"], replications=6,
                                    seed=11, batch=3))
     frame = run_sweep(sweep, tmp_path / "sweep", workers=1, progress=False).replications

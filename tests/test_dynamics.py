@@ -97,7 +97,7 @@ def test_batched_equals_single():
 
 @pytest.mark.parametrize("joint,rate", [(1, 0.15), (2, 0.23), (3, 1.31)])
 def test_torque_lines_reproduce_the_full_load_rates(joint, rate):
-    """Thesis §6.1 / SPEC §4: the top rate is linear in the load.  On each drive's line,
+    """Thesis §6.1 / docs/model.md: the top rate is linear in the load.  On each drive's line,
     the speed at which the spare torque equals the 1 lb payload's torque at full
     horizontal reach is the TeachMover's full-load rate (estimates: within 15 %)."""
     motors = default_scenario().robot.motors

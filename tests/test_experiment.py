@@ -16,8 +16,8 @@ import pandas as pd
 import pytest
 import scipy.stats
 import yaml
-from test_sweep import SCENARIOS, Interrupt, spec_bookkeeping, write_sweep
 
+from cell import catalog
 from cell.cli import main
 from cell.reporting.experiment import (
     difference_table,
@@ -54,18 +54,18 @@ def noisy(scenario, seed) -> dict:
             "ideal_cycle_s": c.ideal_cycle_s or c.nominal_cycle_s}
 
 
-def small_sweep(tmp_path: Path, **fields) -> Path:
+def small_sweep(sweeps, tmp_path: Path, **fields) -> Path:
     doc = {"grid": {"belts.output_nominal_in_s": [2.0, 2.5]},
            "policies": ["non-adaptive", "adaptive"], "replications": 12, "seed": 5, "batch": 4}
     doc.update(fields)
-    return write_sweep(tmp_path, **doc)
+    return sweeps.write(tmp_path, **doc)
 
 
 # --------------------------------------------------------------------------- intervals against scipy
 @pytest.fixture(scope="module")
-def known_report(tmp_path_factory):
+def known_report(sweeps, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("known")
-    sweep = load_sweep(small_sweep(tmp))
+    sweep = load_sweep(small_sweep(sweeps, tmp))
     frame = run_sweep(sweep, tmp / "out", workers=1, replicate=known, progress=False).replications
     target = plan_report(sweep, tmp / "rep")
     write_report(frame, sweep, target, "test")
@@ -134,13 +134,13 @@ def test_report_md_prints_the_tables_intervals(known_report):
 
 
 # --------------------------------------------------------------------------- replications to a precision
-def precision_sweep(tmp_path: Path, **fields) -> Path:
+def precision_sweep(sweeps, tmp_path: Path, **fields) -> Path:
     doc = {"policies": {"non-adaptive": {"controller.ideal_cycle_s": [22.0, 21.5, 21.0]}},
            "replications": {"precision": 0.01, "measure": "parts_per_hr_wallclock",
                             "min": 10, "max": 200},
            "seed": 3, "batch": 10}
     doc.update(fields)
-    return write_sweep(tmp_path, **doc)
+    return sweeps.write(tmp_path, **doc)
 
 
 def expected_stop(seed: int, sigma: float, precision: float, lo: int, hi: int, batch: int) -> int:
@@ -156,8 +156,8 @@ def expected_stop(seed: int, sigma: float, precision: float, lo: int, hi: int, b
         n = min(n + batch, hi)
 
 
-def test_precision_stops_where_the_rule_says_and_not_before(tmp_path):
-    sweep = load_sweep(precision_sweep(tmp_path))
+def test_precision_stops_where_the_rule_says_and_not_before(sweeps, tmp_path):
+    sweep = load_sweep(precision_sweep(sweeps, tmp_path))
     outcome = run_sweep(sweep, tmp_path / "o", workers=1, replicate=noisy, progress=False)
     counts = [outcome.counts[i] for i in range(3)]
     assert counts == [expected_stop(3, SIGMA[c], 0.01, 10, 200, 10) for c in (22.0, 21.5, 21.0)]
@@ -167,14 +167,14 @@ def test_precision_stops_where_the_rule_says_and_not_before(tmp_path):
     assert list(frame[frame["point"] == 1]["replication"]) == list(range(counts[1]))
 
 
-def test_precision_same_bytes_with_1_and_2_workers_and_after_resume(tmp_path):
-    sweep = load_sweep(precision_sweep(tmp_path))
+def test_precision_same_bytes_with_1_and_2_workers_and_after_resume(sweeps, tmp_path):
+    sweep = load_sweep(precision_sweep(sweeps, tmp_path))
     run_sweep(sweep, tmp_path / "w1", workers=1, replicate=noisy, progress=False)
     run_sweep(sweep, tmp_path / "w2", workers=2, replicate=noisy, progress=False)
     one = (tmp_path / "w1" / "replications.csv").read_bytes()
     assert one == (tmp_path / "w2" / "replications.csv").read_bytes()
     with pytest.raises(KeyboardInterrupt):  # killed in the middle of the rounds
-        run_sweep(sweep, tmp_path / "cut", workers=1, replicate=Interrupt(after=95, of=noisy),
+        run_sweep(sweep, tmp_path / "cut", workers=1, replicate=sweeps.Interrupt(after=95, of=noisy),
                   progress=False)
     outcome = run_sweep(sweep, tmp_path / "cut", workers=1, resume=True, replicate=noisy,
                         progress=False)
@@ -182,8 +182,8 @@ def test_precision_same_bytes_with_1_and_2_workers_and_after_resume(tmp_path):
     assert (tmp_path / "cut" / "replications.csv").read_bytes() == one
 
 
-def test_precision_report_says_per_point_whether_it_was_reached(tmp_path):
-    sweep = load_sweep(precision_sweep(tmp_path))
+def test_precision_report_says_per_point_whether_it_was_reached(sweeps, tmp_path):
+    sweep = load_sweep(precision_sweep(sweeps, tmp_path))
     frame = run_sweep(sweep, tmp_path / "o", workers=1, replicate=noisy,
                       progress=False).replications
     write_report(frame, sweep, plan_report(sweep, tmp_path / "rep"), "test")
@@ -193,9 +193,9 @@ def test_precision_report_says_per_point_whether_it_was_reached(tmp_path):
     assert "2 of 3 points reached the precision; 1 stopped at the maximum of 200" in text
 
 
-def test_a_fixed_count_draws_the_same_streams_whatever_the_count(tmp_path):
-    few = load_sweep(write_sweep(tmp_path, replications=3))
-    many = load_sweep(write_sweep(tmp_path, replications=3 * 10**6))    # the most allowed
+def test_a_fixed_count_draws_the_same_streams_whatever_the_count(sweeps, tmp_path):
+    few = load_sweep(sweeps.write(tmp_path, replications=3))
+    many = load_sweep(sweeps.write(tmp_path, replications=3 * 10**6))    # the most allowed
     for r in (0, 2):
         assert (few.stream(r).generate_state(4) == many.stream(r).generate_state(4)).all()
         assert (many.stream(r).generate_state(4)
@@ -204,14 +204,14 @@ def test_a_fixed_count_draws_the_same_streams_whatever_the_count(tmp_path):
 
 
 # --------------------------------------------------------------------------- tidy replications.csv
-def test_replications_csv_is_tidy(tmp_path):
-    path = write_sweep(tmp_path, grid={"arrivals.params": {
+def test_replications_csv_is_tidy(sweeps, tmp_path):
+    path = sweeps.write(tmp_path, grid={"arrivals.params": {
         "thesis": {"c": 4.906771344455348, "loc": 17.6019, "scale": 5.4342},
         "late": {"c": 4.906771344455348, "loc": 18.0, "scale": 5.4342}}},
         policies={"non-adaptive": {"controller.ideal_cycle_s": [22.0]}, "adaptive": {}},
         replications=2, batch=2)
     sweep = load_sweep(path)
-    frame = run_sweep(sweep, tmp_path / "o", workers=1, replicate=spec_bookkeeping,
+    frame = run_sweep(sweep, tmp_path / "o", workers=1, replicate=sweeps.bookkeeping,
                       progress=False).replications
     assert list(frame.columns[:9]) == [
         "policy", "point", "arrivals.params.name", "arrivals.params.c", "arrivals.params.loc",
@@ -231,10 +231,10 @@ def test_replications_csv_is_tidy(tmp_path):
         assert row["first_u"] == pytest.approx(np.random.default_rng(stream).random(), rel=1e-9)
 
 
-def test_a_trace_driven_sweep_says_no_variation(tmp_path):
+def test_a_trace_driven_sweep_says_no_variation(sweeps, tmp_path):
     trace = tmp_path / "trace.csv"
     trace.write_text("interarrival_s\n" + "\n".join(["22.1", "23.0", "21.7", "22.9"] * 5) + "\n")
-    path = write_sweep(tmp_path, set={"run.parts": 20, "arrivals.trace_csv": str(trace)},
+    path = sweeps.write(tmp_path, set={"run.parts": 20, "arrivals.trace_csv": str(trace)},
                        policies=["non-adaptive", "adaptive"], replications=3, batch=3)
     code = main(["sweep", str(path), "--out", str(tmp_path / "o"), "--workers", "1",
                  "--report", str(tmp_path / "rep")])
@@ -247,8 +247,8 @@ def test_a_trace_driven_sweep_says_no_variation(tmp_path):
 
 
 # --------------------------------------------------------------------------- a small real sweep
-def test_general_report_on_a_small_real_sweep(tmp_path, capsys):
-    path = small_sweep(tmp_path, set={"run.parts": 30}, replications=3, batch=3)
+def test_general_report_on_a_small_real_sweep(sweeps, tmp_path, capsys):
+    path = small_sweep(sweeps, tmp_path, set={"run.parts": 30}, replications=3, batch=3)
     code = main(["sweep", str(path), "--out", str(tmp_path / "o"), "--workers", "1",
                  "--report", str(tmp_path / "rep")])
     assert code == 0, capsys.readouterr().err
@@ -280,8 +280,8 @@ def test_general_report_on_a_small_real_sweep(tmp_path, capsys):
         assert title in text
 
 
-def test_a_sweep_of_only_the_policies_gets_a_point_per_policy(tmp_path):
-    sweep = load_sweep(write_sweep(tmp_path, policies=["non-adaptive", "adaptive"],
+def test_a_sweep_of_only_the_policies_gets_a_point_per_policy(sweeps, tmp_path):
+    sweep = load_sweep(sweeps.write(tmp_path, policies=["non-adaptive", "adaptive"],
                                    replications=4, batch=4))
     frame = run_sweep(sweep, tmp_path / "o", workers=1, replicate=known,
                       progress=False).replications
@@ -291,8 +291,8 @@ def test_a_sweep_of_only_the_policies_gets_a_point_per_policy(tmp_path):
     assert len(d) == 1 and d["mean"].iloc[0] == pytest.approx(10.0, abs=1.0)
 
 
-def test_baseline_point_differences(tmp_path):
-    path = small_sweep(tmp_path, baseline={"policy": "non-adaptive",
+def test_baseline_point_differences(sweeps, tmp_path):
+    path = small_sweep(sweeps, tmp_path, baseline={"policy": "non-adaptive",
                                            "belts.output_nominal_in_s": 2.0})
     sweep = load_sweep(path)
     frame = run_sweep(sweep, tmp_path / "o", workers=1, replicate=known,
@@ -306,11 +306,11 @@ def test_baseline_point_differences(tmp_path):
 
 
 # --------------------------------------------------------------------------- where the report goes
-def test_a_shared_report_folder_gets_a_subfolder_and_keeps_its_files(tmp_path):
+def test_a_shared_report_folder_gets_a_subfolder_and_keeps_its_files(sweeps, tmp_path):
     shared = tmp_path / "reports"
     shared.mkdir()
     (shared / "README.md").write_text("mine\n")
-    path = write_sweep(tmp_path, replications=2, batch=2)  # laid out like Table 7.1
+    path = sweeps.write(tmp_path, replications=2, batch=2)  # laid out like Table 7.1
     code = main(["sweep", str(path), "--out", str(tmp_path / "o"), "--workers", "1",
                  "--report", str(shared)])
     assert code == 0
@@ -320,8 +320,8 @@ def test_a_shared_report_folder_gets_a_subfolder_and_keeps_its_files(tmp_path):
     assert not (shared / "sweep" / "table_7_1.md").exists()
 
 
-def test_a_report_folder_of_its_own_holds_table_7_1_beside_the_rest(tmp_path):
-    path = write_sweep(tmp_path, replications=2, batch=2)
+def test_a_report_folder_of_its_own_holds_table_7_1_beside_the_rest(sweeps, tmp_path):
+    path = sweeps.write(tmp_path, replications=2, batch=2)
     assert main(["sweep", str(path), "--out", str(tmp_path / "o"), "--workers", "1",
                  "--report", str(tmp_path / "rep")]) == 0
     names = {p.name for p in (tmp_path / "rep").iterdir()}
@@ -330,11 +330,11 @@ def test_a_report_folder_of_its_own_holds_table_7_1_beside_the_rest(tmp_path):
 
 
 @pytest.mark.parametrize("make", ["file", "parent-file"])
-def test_bad_report_target_one_line_exit_2_nothing_written(tmp_path, capsys, make):
+def test_bad_report_target_one_line_exit_2_nothing_written(sweeps, tmp_path, capsys, make):
     blocker = tmp_path / "blocker"
     blocker.write_text("x")
     report = blocker if make == "file" else blocker / "rep"
-    code = main(["sweep", str(write_sweep(tmp_path)), "--out", str(tmp_path / "o"),
+    code = main(["sweep", str(sweeps.write(tmp_path)), "--out", str(tmp_path / "o"),
                  "--workers", "1", "--report", str(report)])
     err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1 and "blocker" in err
@@ -343,7 +343,7 @@ def test_bad_report_target_one_line_exit_2_nothing_written(tmp_path, capsys, mak
 
 # --------------------------------------------------------------------------- the what-if
 def test_whatif_arrivals_are_5_percent_faster_with_twice_the_spread():
-    doc = yaml.safe_load((SCENARIOS / "whatif.yaml").read_text())
+    doc = yaml.safe_load((catalog.BUILT_IN / "whatif.yaml").read_text())
     params = doc["grid"]["arrivals.params"]
     thesis = scipy.stats.weibull_min(**params["thesis"])
     assert params["thesis"] == {"c": 1 / 0.2038, "loc": 17.6019, "scale": 5.4342}  # eq. 6.9
@@ -352,7 +352,7 @@ def test_whatif_arrivals_are_5_percent_faster_with_twice_the_spread():
         assert params[name]["c"] == params["thesis"]["c"]  # the same shape
         assert d.mean() / thesis.mean() == pytest.approx(mean, rel=1e-12)
         assert d.std() / thesis.std() == pytest.approx(sd, rel=1e-12)
-    sweep = load_sweep(SCENARIOS / "whatif.yaml")
+    sweep = load_sweep(catalog.BUILT_IN / "whatif.yaml")
     assert {p.policy for p in sweep.points} == {"non-adaptive", "adaptive"}
     assert sweep.baseline is not None and sweep.baseline.names == (("arrivals.params", "thesis"),)
 
@@ -365,56 +365,8 @@ def _row(table: pd.DataFrame, **where) -> pd.Series:
     return sel.iloc[0]
 
 
-def test_whatif_numbers_quoted_in_the_readme_are_the_committed_reports():
-    """Every number of the README's what-if section, read from reports/whatif/."""
-    summary = pd.read_csv(WHATIF / "summary.csv")
-    diffs = pd.read_csv(WHATIF / "differences.csv")
-    text = (WHATIF / "report.md").read_text()
-
-    def mean_ci(row: pd.Series) -> tuple[float, float]:
-        return float(row["mean"]), float(row["ci_high"] - row["ci_low"]) / 2
-
-    name = "arrivals__params__name"
-    lost = {(p, a): mean_ci(_row(summary, measure="parts_missed", policy=p, **{name: a}))
-            for p in ("non-adaptive", "adaptive") for a in ("thesis", "faster", "wider", "both")}
-    assert f"{lost['non-adaptive', 'thesis'][0]:.1f}" == "162.1"
-    assert f"{lost['non-adaptive', 'both'][0]:.1f}" == "200.2"
-    assert f"{lost['non-adaptive', 'faster'][0]:.1f}" == "227.2"
-    extra = mean_ci(_row(diffs, measure="parts_missed", policy="non-adaptive", **{name: "both"}))
-    assert (f"{extra[0]:.1f}", f"{extra[1]:.1f}") == ("38.1", "0.7")
-    faster = mean_ci(_row(diffs, measure="parts_missed", policy="non-adaptive",
-                          **{name: "faster"}))
-    assert (f"{faster[0]:.1f}", f"{faster[1]:.1f}") == ("65.1", "0.8")
-    wider = _row(diffs, measure="parts_missed", policy="non-adaptive", **{name: "wider"})
-    assert f"{wider['mean']:.2f}" == "-0.02"  # 0.02 fewer lost
-    # the adaptive controller keeps up with either change alone: no part lost in any run
-    for arrivals in ("thesis", "faster", "wider"):
-        r = _row(summary, measure="parts_missed", policy="adaptive", **{name: arrivals})
-        assert (r["n"], r["mean"], r["sd"], r["run_p97_5"]) == (200, 0, 0, 0)
-    pph = {a: _row(summary, measure="parts_per_hr_wallclock", policy="adaptive", **{name: a})
-           for a in ("thesis", "faster", "both")}
-    assert [f"{pph[a]['mean']:.1f}" for a in ("thesis", "faster", "both")] == \
-        ["159.7", "167.7", "165.8"]
-    gain = mean_ci(_row(diffs, measure="parts_per_hr_wallclock", policy="adaptive",
-                        **{name: "faster"}))
-    assert (f"{gain[0]:.2f}", f"{gain[1]:.2f}") == ("8.02", "0.02")
-    cycle = _row(summary, measure="actual_cycle_wallclock_s", policy="adaptive",
-                 **{name: "faster"})
-    assert f"{cycle['mean']:.2f}" == "21.47"
-    both = mean_ci(_row(diffs, measure="parts_missed", policy="adaptive", **{name: "both"}))
-    assert (f"{both[0]:.1f}", f"{both[1]:.1f}") == ("5.3", "0.9")
-    runs = _row(summary, measure="parts_missed", policy="adaptive", **{name: "both"})
-    assert (runs["run_p2_5"], runs["run_p97_5"]) == (0, 24)
-    for phrase in ("non-adaptive loses 38.12 ± 0.73 parts more than at arrivals.params = thesis",
-                   "non-adaptive loses 65.11 ± 0.81 parts more than at arrivals.params = thesis",
-                   "adaptive loses 5.33 ± 0.95 parts more than at arrivals.params = thesis",
-                   "adaptive delivers 8.021 ± 0.017 parts/hr more than at arrivals.params = "
-                   "thesis"):
-        assert phrase in text
-
-
-def test_two_varied_keys_give_a_table_row_per_combination_and_panels(tmp_path):
-    path = write_sweep(tmp_path, grid={"belts.output_nominal_in_s": [2.0, 2.5],
+def test_two_varied_keys_give_a_table_row_per_combination_and_panels(sweeps, tmp_path):
+    path = sweeps.write(tmp_path, grid={"belts.output_nominal_in_s": [2.0, 2.5],
                                        "belts.input_nominal_in_s": [2.5, 3.0]},
                        policies=["non-adaptive", "adaptive"], replications=3, batch=3)
     sweep = load_sweep(path)

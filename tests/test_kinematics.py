@@ -1,4 +1,4 @@
-"""MICROBOT kinematics against the thesis's equations (§3, §6.1) and SPEC §2."""
+"""MICROBOT kinematics against the thesis's equations (§3, §6.1) and docs/model.md."""
 
 import numpy as np
 import pytest
@@ -83,7 +83,7 @@ def _regular(q):
 @settings(max_examples=400)
 @given(in_range_q())
 def test_ik_recovers_q_over_the_joint_ranges(q):
-    """IK(FK(q)) = q within 1e-9 rad (issue 2), away from the singular sets."""
+    """IK(FK(q)) = q within 1e-9 rad, away from the singular sets."""
     assume(_regular(q))
     back = inverse_kinematics(forward(q))
     np.testing.assert_allclose(back[:4], q[:4], atol=1e-9)
@@ -129,7 +129,7 @@ def test_placement_eq_6_1():
 
 
 def test_hand_length_eq_6_2_holding_a_cube():
-    # SPEC §2: holding a 2.0 in cube, w11 = 3.5498 in
+    # docs/model.md: holding a 2.0 in cube, w11 = 3.5498 in
     assert hand_length(2.0, HAND) == pytest.approx(3.5498, abs=5e-5)
     # at G = G0 the linkage is straight: L1 + L2
     assert hand_length(1.52, HAND) == pytest.approx(1.884 + 1.700)
@@ -140,7 +140,7 @@ def test_grasp_eq_6_4():
 
 
 def test_thesis_points_in_the_robot_frame_give_the_base_angles():
-    """SPEC §1: B at θ1 = -90°, F at -45°, G at +45°, K at +90°."""
+    """docs/model.md: B at θ1 = -90°, F at -45°, G at +45°, K at +90°."""
     pts = np.array([[-16, 0, 3], [-8, 0, 3], [0, 8, 3], [0, 16, 3]], dtype=float)
     q = inverse_kinematics(arm_target(pts, 0.0, 2.0, CELL, HAND))
     np.testing.assert_allclose(np.degrees(q[:, 0]), [-90, -45, 45, 90], atol=1e-9)

@@ -1,4 +1,4 @@
-"""The phase-plane planner against closed forms (SPEC §9), its failure modes, its grid and
+"""The phase-plane planner against closed forms (docs/model.md), its failure modes, its grid and
 its repeatability."""
 
 from __future__ import annotations
@@ -195,7 +195,7 @@ def _drive_time(length, inertia, viscous, slope, stall, v):
 @pytest.mark.parametrize("inertia", [0.002, 0.02])
 @pytest.mark.parametrize("fraction", [0.9, 0.999999])
 def test_a_drive_on_its_torque_speed_line_meets_the_closed_form(inertia, fraction):
-    """The dynamic model's case (SPEC §9): the drive reaches top speed in 0.3-3 ms, far inside
+    """The dynamic model's case (docs/model.md): the drive reaches top speed in 0.3-3 ms, far inside
     one grid step, and the velocity bound sits at (or just under) the torque balance."""
     length, viscous, slope, stall = 1.0, 0.4, 6.0, 3.0
     v = fraction * stall / (viscous + slope)

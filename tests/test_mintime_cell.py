@@ -18,7 +18,7 @@ BASELINE = SCENARIOS / "baseline.yaml"
 
 KIN = str(SCENARIOS / "mintime_kinematic.yaml")
 BASE = str(BASELINE)
-BASE_RATE = 0.4194527          # rad/s, robot.motors (calibrated, SPEC §4)
+BASE_RATE = 0.4194527          # rad/s, robot.motors (calibrated, docs/model.md)
 
 
 def fastest_regime_times(s):
@@ -26,7 +26,7 @@ def fastest_regime_times(s):
 
 
 def test_r4_kinematic_is_the_base_trapezoid():
-    """R IV is 180° of base (SPEC §3) at the base's peak no-load rate ω, |q̈| ≤ a:
+    """R IV is 180° of base (docs/model.md) at the base's peak no-load rate ω, |q̈| ≤ a:
     T = π/ω + ω/a, the closed form of a trapezoid."""
     s = load_scenario(KIN)
     a = s.mintime.qddot_max_rad_s2[0]

@@ -1,6 +1,6 @@
 """Agreement with TOPP-RA (the ``toppra`` package), an independent method, on the
 same spline path, the same grid, the same bounds and the same time formula
-(SPEC §9): within 0.5 % on the default grid, and both converging to the same value as
+(docs/model.md): within 0.5 % on the default grid, and both converging to the same value as
 the grid is refined.  Then the cell's R II and R IV: the planner on the default grid
 within 0.05 % of its converged value under every bound set the project uses.
 

@@ -1,4 +1,4 @@
-"""The transfer path against the thesis's geometry (§4.1-4.2, Fig. 8-9) and SPEC §3."""
+"""The transfer path against the thesis's geometry (§4.1-4.2, Fig. 8-9) and docs/model.md."""
 
 import numpy as np
 import pytest
@@ -69,7 +69,7 @@ def test_arcs_lie_on_circles_about_the_base_axis():
 
 
 def test_regime_lengths_closed_forms():
-    """SPEC §3: R II 12.566 in (arc), R IV 35.5424 in (150 chords of the 35.5431 in arc)."""
+    """docs/model.md: R II 12.566 in (arc), R IV 35.5424 in (150 chords of the 35.5431 in arc)."""
     ell = P.move_in
     r2 = ell[P.regime == 2].sum()
     r4 = ell[P.regime == 4].sum()
@@ -87,7 +87,7 @@ def test_every_point_is_reached_inside_the_joint_ranges():
 
 
 def test_base_angles_span_the_whole_range():
-    """SPEC §1: B at -90°, F at -45°, G at +45°, K at +90°."""
+    """docs/model.md: B at -90°, F at -45°, G at +45°, K at +90°."""
     g_idx = 96 + 117
     np.testing.assert_allclose(np.degrees(P.q_rad[[0, 96, g_idx, g_idx + 96], 0]),
                                [-90, -45, 45, 90], atol=1e-9)

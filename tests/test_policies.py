@@ -36,7 +36,7 @@ def test_fixed_cycle_shortens_r4_only_as_in_table_7_1(k, ideal):
 def test_nominal_regimes_add_up_to_the_ideal_cycle(k):
     assert k.r1_nom + k.r2_nom + k.r3_pre_nom + k.r3_post_nom + k.r4_nom == \
         pytest.approx(22.5872, abs=1e-9)
-    # SPEC §6 derives R II = 5.9350 s from an R I of exactly 8/3 s; the motor floor
+    # docs/model.md derives R II = 5.9350 s from an R I of exactly 8/3 s; the motor floor
     # after LO lengthens R I a little and R II gives that back.
     assert k.r2_nom == pytest.approx(5.9350, abs=0.1)
     assert k.r2_nom < 5.9350

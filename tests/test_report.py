@@ -10,8 +10,8 @@ import pytest
 import scipy.stats
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_sweep import SCENARIOS, spec_bookkeeping, write_sweep
 
+from cell import catalog
 from cell.errors import CellError
 from cell.reporting.table_7_1 import (
     COLUMNS,
@@ -84,17 +84,17 @@ def test_summary_columns_follow_the_simulation_names():
 
 
 @pytest.fixture(scope="module")
-def spec_table(tmp_path_factory):
+def thesis_table(sweeps, tmp_path_factory):
     """The Table 7.1 sweep on the reconstructed bookkeeping of docs/accounting.md (200 x 500 parts)."""
     tmp = tmp_path_factory.mktemp("t71")
-    sweep = load_sweep(SCENARIOS / "table_7_1.yaml")
-    frame = run_sweep(sweep, tmp / "out", workers=1, replicate=spec_bookkeeping,
+    sweep = load_sweep(catalog.BUILT_IN / "table_7_1.yaml")
+    frame = run_sweep(sweep, tmp / "out", workers=1, replicate=sweeps.bookkeeping,
                       progress=False).replications
     return sweep, frame, table_7_1(frame, sweep)
 
 
-def test_long_form_has_exactly_the_columns_and_rows(spec_table):
-    _sweep, _frame, table = spec_table
+def test_long_form_has_exactly_the_columns_and_rows(thesis_table):
+    _sweep, _frame, table = thesis_table
     assert list(table.columns) == COLUMNS
     assert len(table) == 7 * 2 * 5
     assert list(dict.fromkeys(table["policy"])) == ["non-adaptive", "adaptive"]
@@ -108,10 +108,10 @@ def test_long_form_has_exactly_the_columns_and_rows(spec_table):
     assert (table["mean"] <= table["ci_high"] + 1e-12).all()
 
 
-def test_spec_bookkeeping_puts_the_thesis_inside_single_run_ranges(spec_table):
+def test_the_thesis_bookkeeping_puts_the_thesis_inside_single_run_ranges(thesis_table):
     """docs/accounting.md: s = 0.23 s reproduces the random columns in all six rows; this checks
     the report matches each published figure to its own row and measure."""
-    _sweep, _frame, table = spec_table
+    _sweep, _frame, table = thesis_table
     t = table[(table["policy"] == "non-adaptive") & (table["accounting"] == "thesis")]
     for measure in ("parts_missed", "actual_cycle_s", "ip"):
         rows = t[t["measure"] == measure]
@@ -121,8 +121,8 @@ def test_spec_bookkeeping_puts_the_thesis_inside_single_run_ranges(spec_table):
     assert (abs(v["mean"] - v["thesis"]) < 2e-4).all()
 
 
-def test_markdown_puts_the_thesis_beside_ours_and_reads_from_the_numbers(spec_table):
-    sweep, _frame, table = spec_table
+def test_markdown_puts_the_thesis_beside_ours_and_reads_from_the_numbers(thesis_table):
+    sweep, _frame, table = thesis_table
     text = markdown(table, sweep)
     for cycle, actual, missed, pph, vavg, ip in PUBLISHED:
         row = next(line for line in text.splitlines() if line.startswith(f"| {cycle:.4f} |"))
@@ -161,9 +161,9 @@ def test_reading_follows_the_direction_of_the_numbers():
     assert "+66.7%" in more  # actual cycle 50 s against 30 s
 
 
-def test_write_table_7_1_writes_both_files(tmp_path):
-    sweep = load_sweep(write_sweep(tmp_path))
-    frame = run_sweep(sweep, tmp_path / "o", workers=1, replicate=spec_bookkeeping,
+def test_write_table_7_1_writes_both_files(sweeps, tmp_path):
+    sweep = load_sweep(sweeps.write(tmp_path))
+    frame = run_sweep(sweep, tmp_path / "o", workers=1, replicate=sweeps.bookkeeping,
                       progress=False).replications
     paths = write_table_7_1(frame, sweep, tmp_path / "rep")
     assert [p.name for p in paths] == ["table_7_1.csv", "table_7_1.md"]

@@ -3,7 +3,7 @@
 Each claim below is a phrase of the README with its numbers left open, and the
 place the numbers come from: the baseline scenario and its path, the figures'
 own runs (the seven simulations of Fig. 22-30), the committed
-``reports/table_7_1.csv`` (the thesis's published column) and, for the thesis's
+``reports/table_7_1/table_7_1.csv`` (the thesis's published column) and, for the thesis's
 example lag, ``docs/sources.md``.  A number must equal its source rounded to the
 digits printed.  Every number in the README's prose must belong to a claim or
 be a reference (Fig. 8, §4.2, eq. 6.2, step 6.2, Table 7.1): a number added to
@@ -104,7 +104,7 @@ class Sources:
 
     @cached_property
     def t71(self) -> pd.DataFrame:
-        return pd.read_csv(REPO / "reports" / "table_7_1.csv")
+        return pd.read_csv(REPO / "reports" / "table_7_1" / "table_7_1.csv")
 
     def published(self, measure: str, cycle: float = 22.5872, policy: str = "non-adaptive") -> float:
         """The thesis's figure as the committed report prints it beside ours."""

@@ -37,9 +37,9 @@ def test_segment_velocity_inverts_time(ms, factor):
 
 
 def test_r4_times_are_the_thesis_calibration(timing):
-    assert timing.r4_nominal_s == pytest.approx(9.9855, abs=1e-3)   # SPEC §4, §6
+    assert timing.r4_nominal_s == pytest.approx(9.9855, abs=1e-3)   # docs/model.md, §6
     assert timing.r4_min_s == pytest.approx(7.4890, abs=1e-3)       # 75 % of 9.9855
-    assert timing.r4.length_in == pytest.approx(35.5424, abs=1e-3)  # SPEC §3
+    assert timing.r4.length_in == pytest.approx(35.5424, abs=1e-3)  # docs/model.md
     assert timing.r2.length_in == pytest.approx(4 * np.pi, abs=1e-2)  # 90° at 8 in radius
 
 
@@ -48,12 +48,12 @@ def test_robot_tracks_the_nominal_belts_and_is_never_faster_than_them(timing):
     assert timing.output_track_max_in_s >= 2.0
     for v in (1.0, 2.0, 3.0, timing.input_track_max_in_s):
         pre, post = timing.r1_time(v)
-        assert pre >= 4.0 / v - 1e-12          # B → LO is 4 in of belt (SPEC §3)
+        assert pre >= 4.0 / v - 1e-12          # B → LO is 4 in of belt (docs/model.md)
         assert pre - 4.0 / v < 0.05            # only the grasp move may lag the belt
         assert post >= 4.0 / v - 1e-12         # never ahead of the belt's pace
     r1 = sum(timing.r1_time(3.0))
-    assert r1 >= 8.0 / 3.0                     # SPEC §6: 2.6667 s at exactly belt speed
-    assert sum(timing.r3_time(2.0)) >= 4.0     # SPEC §6: 4.0000 s
+    assert r1 >= 8.0 / 3.0                     # docs/model.md: 2.6667 s at exactly belt speed
+    assert sum(timing.r3_time(2.0)) >= 4.0     # docs/model.md: 4.0000 s
 
 
 def test_regime_floors_are_the_step_table_minima(timing, table):

@@ -1,4 +1,4 @@
-"""Whole runs (cell.simulation, ``cell run``): SPEC §7-8 facts, invariants, hostile input."""
+"""Whole runs (cell.simulation, ``cell run``): docs/model.md facts, invariants, hostile input."""
 
 from __future__ import annotations
 
@@ -95,10 +95,10 @@ def test_non_adaptive_loses_what_the_physics_says(fixed):
 def test_non_adaptive_loss_rate_matches_spec_8():
     s = load_scenario(NON_ADAPTIVE)
     lost = [simulate(s, seed=seed).summary["parts_missed"] for seed in range(12)]
-    assert np.mean(lost) == pytest.approx(162, abs=10)        # SPEC §8: about 162 of 500
+    assert np.mean(lost) == pytest.approx(162, abs=10)        # docs/accounting.md: about 162 of 500
     shortest = s.with_overrides({"controller.ideal_cycle_s": 20.0907})
     lost = [simulate(shortest, seed=seed).summary["parts_missed"] for seed in range(12)]
-    assert np.mean(lost) == pytest.approx(10, abs=4)          # SPEC §8: about 10
+    assert np.mean(lost) == pytest.approx(10, abs=4)          # docs/accounting.md: about 10
 
 
 def test_conservation_over_seeds_and_cycles():
@@ -194,7 +194,7 @@ def test_minimum_time_robot_takes_its_fastest_r4_from_the_planner():
     s = default_scenario().with_overrides({"robot.timing": "minimum-time", "run.parts": 60})
     fastest = fastest_regime_times(geometry_of(s), motors_of(s), planner_bounds(s))
     r = simulate(s)
-    t_r4 = r.parts["v_r4_in_s"].rdiv(35.5424)          # R IV times (SPEC §3 length)
+    t_r4 = r.parts["v_r4_in_s"].rdiv(35.5424)          # R IV times (docs/model.md length)
     assert (t_r4 >= fastest["R4"] - 1e-3).all()
     fixed = s.with_overrides({"controller.policy": "non-adaptive",
                               "controller.ideal_cycle_s": 22.5872 - (9.9855 - fastest["R4"])

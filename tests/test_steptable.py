@@ -1,4 +1,4 @@
-"""Joint-step table and motor model against thesis §6.1 and SPEC §4's figures."""
+"""Joint-step table and motor model against thesis §6.1 and docs/model.md's figures."""
 
 import numpy as np
 import pandas as pd
@@ -23,7 +23,7 @@ def test_r4_base_steps_are_1125_pi():
 
 
 def test_r4_times_reproduce_the_thesis():
-    """SPEC §4: R IV at the base's nominal rate 9.9855 s, at its maximum 7.489 s."""
+    """docs/model.md: R IV at the base's nominal rate 9.9855 s, at its maximum 7.489 s."""
     assert T.regime_min_time("R4", nominal=True) == pytest.approx(9.9855, rel=0.005)
     assert T.regime_min_time("R4") == pytest.approx(7.489, rel=0.005)
     # ... from which the thesis's minimum feasible cycle follows (Table 7.1, last row)

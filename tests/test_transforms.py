@@ -30,7 +30,7 @@ EQ_2_23 = np.array([[0, 0, 1, -10], [1, 0, 0, -3], [0, 1, 0, -5], [0, 0, 0, 1]],
 
 
 def test_inverse_of_eq_2_20_is_eq_2_23():
-    """eq. 2.23 as printed (eq. 2.22 has scan typos, SPEC §2) is the inverse of eq. 2.20."""
+    """eq. 2.23 as printed (eq. 2.22 has scan typos, docs/model.md) is the inverse of eq. 2.20."""
     np.testing.assert_allclose(inverse(EQ_2_20), EQ_2_23, atol=1e-15)
     np.testing.assert_allclose(EQ_2_23 @ EQ_2_20, np.eye(4), atol=1e-15)
 

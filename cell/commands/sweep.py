@@ -69,6 +69,29 @@ def _sweep(args: argparse.Namespace) -> int:
         from cell.reporting.experiment import write_report
 
         command = f"cell sweep {shlex.quote(sweep.source)} --report ..."
-        for path in write_report(outcome.replications, sweep, target, command):
-            print(f"wrote {path}")
+        written = list(write_report(outcome.replications, sweep, target, command))
+        folders = sorted({str(Path(p).parent) for p in written})
+        print(f"wrote {', '.join(folders)}: " + ", ".join(Path(p).name for p in written))
+        shown = next((Path(p) for p in written if Path(p).name == "table_7_1.md"), None) or \
+            next((Path(p) for p in written if Path(p).name == "report.md"), None)
+        if shown is not None:
+            print(f"\n{headline(shown.read_text(encoding='utf-8'))}\n(all of it: {shown})")
     return 0
+
+
+def headline(markdown: str, tables: int = 3) -> str:
+    """The first ``tables`` tables of a report, each under its heading, for the terminal."""
+    out: list[str] = []
+    heading, shown = "", 0
+    lines = markdown.splitlines()
+    for i, line in enumerate(lines):
+        if line.startswith("## "):
+            heading = line[3:]
+        elif line.startswith("|") and (i == 0 or not lines[i - 1].startswith("|")):
+            if shown == tables:
+                break
+            out += ["", heading] if heading else [""]
+            shown += 1
+        if line.startswith("|"):
+            out.append(line)
+    return "\n".join(out).strip("\n")

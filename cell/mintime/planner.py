@@ -1,4 +1,4 @@
-"""The phase-plane minimum-time planner (Shin & McKay 1983; SPEC §9).
+"""The phase-plane minimum-time planner (Shin & McKay 1983; docs/model.md).
 
 Along a fixed path q(s), 0 ≤ s ≤ 1, every joint bound becomes a bound on the
 path acceleration u = s̈ that depends on the state (s, ṡ).  Each bound is a
@@ -24,7 +24,7 @@ motor's torque-speed line).  The planner works in x = ṡ², where dx/ds = 2u:
 
 Both integrations are Heun's method (second order) on the grid, with an implicit
 Euler step where a drive settles on its torque balance within one step.  The time
-is T = Σ 2Δs / (ṡ_i + ṡ_{i+1}), the formula SPEC §9 fixes for comparisons: exact
+is T = Σ 2Δs / (ṡ_i + ṡ_{i+1}), the formula docs/model.md fixes for comparisons: exact
 where x is linear in s between grid points, which it is not where a fast drive
 reaches top speed inside one step (O(Δs) each start and stop on a uniform grid);
 :func:`path_grid` therefore grades the grid toward both ends.

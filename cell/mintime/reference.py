@@ -1,6 +1,6 @@
 """TOPP-RA (the ``toppra`` package) on the same path and bounds: the
 independent implementation the planner is checked and benchmarked against
-(SPEC §9).  Same spline, same grid, same time formula."""
+(docs/model.md).  Same spline, same grid, same time formula."""
 
 from __future__ import annotations
 
