@@ -117,10 +117,12 @@ class Robot:
     """The arm as a SimPy process: told an :class:`Order`, runs it, hands the part over.
 
     The robot owns its state: ``free_at_s``, when it will be back at B, is set the
-    moment it is told an order.  One timeout per order (B to TD): a regime's moves
-    are summed, never simulated one by one; lift-off is written when the order is
-    taken, and the way back (TD → K → B) needs no event, since no order comes
-    before ``free_at_s``.
+    moment it is told an order.  One event per order besides the order itself: a
+    regime's moves are summed, never simulated one by one; lift-off is written when
+    the order is taken, and the part is handed to the output conveyor due at
+    touch-down (:meth:`cell.mailbox.Mailbox.put_after`), the set-down being the
+    event that wakes the conveyor.  The way back (TD → K → B) needs no event, since
+    no order comes before ``free_at_s``.
     """
 
     def __init__(self, env: simpy.Environment, output: Mailbox):
@@ -142,11 +144,8 @@ class Robot:
         self.orders.put(order)
 
     def run(self):  # noqa: ANN201 (SimPy generator)
-        env, timeout, put, get = self.env, self.env.timeout, self.output.put, self.orders.get
+        env, set_down, get = self.env, self.output.put_after, self.orders.get
         while True:
-            order: Order = yield get()
-            part = order.part
-            part.pick_s = env.now + order.to_lo_s
-            yield timeout(order.to_td_s)
-            part.touchdown_s = env.now
-            put(part)
+            part, to_lo_s, to_td_s, _ = yield get()
+            part.pick_s = env.now + to_lo_s
+            set_down(part, to_td_s)  # touch-down: B + (B → TD), as a timeout would fall
