@@ -50,9 +50,11 @@ class Mailbox:
 
     def put(self, item: Any) -> None:
         getter = self._getter
-        if getter is not None:
+        if getter is not None:  # the receiver is waiting: its get() succeeds now
             self._getter = None
-            getter.succeed(item)
+            getter._ok = True
+            getter._value = item
+            self.env.schedule(getter)
         else:
             self.items.append(item)
 

@@ -18,8 +18,8 @@ and the move times are only floored by the motors (§4.3 c).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any, NamedTuple
+from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 import simpy
@@ -27,7 +27,9 @@ import simpy
 from cell.conveyors import EPS_S
 from cell.mailbox import Mailbox
 from cell.motors import Segment
-from cell.steptable import StepTable
+
+if TYPE_CHECKING:
+    from cell.steptable import StepTable
 
 
 @dataclass(frozen=True)
@@ -97,6 +99,43 @@ def build_timing(t: StepTable, fastest: dict[str, float] | None = None) -> Robot
         output_track_max_in_s=track3.max_tracking_velocity(),
         r1_length_in=t.regime_length("R1"), r3_length_in=t.regime_length("R3"),
         r2_min_s=r2_min, r4_min_s=r4_min)
+
+
+def timing_to_plain(t: RobotTiming) -> dict[str, Any]:
+    """The timing as plain JSON data (for the disk cache); every float kept exactly.
+
+    Raises TypeError if a value is not a float or a list of floats (then it is not stored).
+    """
+    def plain(value: Any) -> Any:
+        if type(value) is float or (type(value) is list and all(type(v) is float for v in value)):
+            return value
+        raise TypeError(f"not plain: {type(value).__name__}")
+
+    out: dict[str, Any] = {}
+    for f in fields(t):
+        value = getattr(t, f.name)
+        if isinstance(value, Segment):
+            out[f.name] = {"segment": {slot: plain(getattr(value, slot))
+                                       for slot in Segment.__slots__}}
+        else:
+            out[f.name] = plain(value)
+    return out
+
+
+def timing_from_plain(data: dict[str, Any]) -> RobotTiming:
+    """The timing back from :func:`timing_to_plain`'s data."""
+    values: dict[str, Any] = {}
+    for f in fields(RobotTiming):
+        value = data[f.name]
+        if isinstance(value, dict):
+            segment = Segment.__new__(Segment)
+            for slot in Segment.__slots__:
+                setattr(segment, slot, value["segment"][slot])
+            value = segment
+        elif type(value) is not float:
+            raise TypeError(f"{f.name}: not a float")
+        values[f.name] = value
+    return RobotTiming(**values)
 
 
 # --------------------------------------------------------------------------- process

@@ -66,7 +66,7 @@ def simulate_summary(scenario: Scenario, seed: np.random.SeedSequence) -> Mappin
     """The default replication: one run of the cell, its summary row."""
     from cell.simulation import simulate
 
-    return simulate(scenario, seed=seed, keep_parts=False).summary.as_dict()
+    return simulate(scenario, seed=seed, keep_parts=False, keep_belts=False).summary.as_dict()
 
 
 def run_task(replicate: Replicate, scenario: Scenario,
@@ -284,8 +284,6 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     """
     from tqdm import tqdm
 
-    from cell.analysis.stats import next_round, precision_reached
-
     out = check_out(out)
     cores = os.cpu_count() or 1
     workers = cores if workers is None else workers
@@ -329,6 +327,8 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
                     counts[p] = last
                 if sweep.precision is None:
                     break
+                from cell.analysis.stats import next_round, precision_reached
+
                 q = sweep.precision
                 for task in sweep.iter_tasks(ranges):
                     values[task.point] += _measure(sweep, task_dir, task, q.measure)
