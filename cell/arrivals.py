@@ -150,7 +150,7 @@ def closed_form_ppf(family: str, params: Mapping[str, float],
     n = u.size
     tail = -log1p_as_scipy(-u)
     if family == "weibull_min":
-        tail = pow(tail, 1.0 / np.full(n, float(c)))
+        tail = np.power(tail, 1.0 / np.full(n, float(c)))  # scipy's pow(...) on arrays
     return np.asarray(tail * np.full(n, float(scale)) + np.full(n, float(loc)), dtype=float)
 
 
@@ -190,6 +190,12 @@ def _remember(arrivals: ArrivalSpec, params: dict[str, float], mean: float, low:
     if key not in _FACTS:
         _FACTS[key] = (dict(params), mean, low)
         store("arrivals", _facts_key(arrivals), {"params": params, "mean": mean, "low": low})
+
+
+def _frozen(arrivals: ArrivalSpec) -> Any:
+    import scipy.stats
+
+    return getattr(scipy.stats, arrivals.distribution)(**parameters(arrivals))
 
 
 #: Families whose shape and scale follow from a mean and a coefficient of variation.

@@ -11,8 +11,8 @@ wakes when a part reaches B, or when a new plan moves that instant.
 
 from __future__ import annotations
 
-from bisect import bisect_right
 import math
+from bisect import bisect_right
 from collections.abc import Callable
 from typing import Any
 
@@ -220,9 +220,9 @@ class OutputConveyor:
             part = yield get()
             td = part.touchdown_s = env.now
             x = travel(td)
-            last_x = self.last_td_x
-            if last_x is not None:
+            last_x, last_td = self.last_td_x, self.last_td_s
+            if last_x is not None and last_td is not None:
                 part.spacing_in = x - last_x
-                part.delivery_interval_s = td - self.last_td_s
+                part.delivery_interval_s = td - last_td
             self.last_td_x, self.last_td_s = x, td
             delivered(part)
