@@ -34,14 +34,17 @@ class View:
                  n_parts: int, conveyor: InputConveyor, output: OutputConveyor):
         self.env, self.k, self.fed_s, self.n = env, k, fed_s, n_parts
         self.conveyor, self.output = conveyor, output
+        self._input_speed, self._output_travel = conveyor.belt.speed, output.belt.travel
         self.part = 0
         """Index of the part at B."""
 
     def input_speed(self) -> float:
-        return self.conveyor.belt.speed(self.env.now + EPS_S)
+        return self._input_speed(self.env.now + EPS_S)
 
     def output_gap(self) -> float | None:
-        return self.output.gap_now()
+        """How far the last part set down has travelled (:meth:`OutputConveyor.gap_now`)."""
+        last = self.output.last_td_x
+        return None if last is None else self._output_travel(self.env.now) - last
 
     def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
         """(a, b) of the first part after this one that can still be caught."""

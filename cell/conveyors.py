@@ -6,7 +6,8 @@ once (§6.2 a: negligible lag).  The controller writes the schedule ahead of
 time (a change at LO, the step 6.3 decay at the end of the cycle, the output
 belt back to nominal at G); a part's arrival is the instant the belt has
 carried it the required distance, so the input conveyor's SimPy process only
-wakes when a part reaches B, or when a new plan moves that instant.
+wakes when a part reaches B (the controller, which replans only then, having
+taken it first), and the output conveyor's when a part is set down.
 """
 
 from __future__ import annotations
@@ -53,7 +54,9 @@ class Belt:
         """The slowest of them."""
 
     def speed(self, t: float) -> float:
-        return speed_at(self._t, self._v, t)
+        """The speed at instant t (:func:`speed_at`)."""
+        k = bisect_right(self._t, t) - 1
+        return self._v[k if k > 0 else 0]
 
     def travel(self, t: float) -> float:
         """X(t): inches the belt has moved by time t (t ≥ the last settled change)."""

@@ -1,14 +1,21 @@
 """One run of the cell in simulated time (thesis §6).
 
-Five SimPy processes talk through one-event hand-offs: the feeder drops parts
-on the input conveyor; the conveyor hands each to the controller as it reaches
-B; the controller asks the scenario's policy for the part's cycle, sets the
-belts and sends the robot an order; the robot's touch-down hands the part to
-the output conveyor, which measures its spacing.  Each part's
-:class:`~cell.records.PartRecord` is filled in as these things happen; when a
-part is done (set down, or fallen off at F) the run's log completes its
-accounting and passes it on, in part order, to whoever asked for rows (a CSV
-writer, a list), keeping only a few numbers per part for the summary.
+Five SimPy processes talk through :class:`~cell.mailbox.Mailbox` hand-offs: the
+feeder drops parts on the input conveyor; the conveyor hands each to the
+controller due at the instant it reaches B; the controller asks the scenario's
+policy for the part's cycle, sets the belts and sends the robot an order; the
+robot hands the part to the output conveyor due at its touch-down, and the
+conveyor measures its spacing.  A part picked up costs about four SimPy events
+(its drop, its arrival at B, the order, the set-down), one fallen off at F two.
+Each part's :class:`~cell.records.PartRecord` is filled in as these things
+happen; when a part is done (set down, or fallen off at F) the run's log
+completes its accounting and passes it on, in part order, to whoever asked for
+rows (a CSV writer, a list), keeping only a few numbers per part for the summary.
+
+Nothing per part outlives its part unless the run keeps the rows, and those are
+kept as tuples of plain values, which Python's cyclic garbage collector stops
+tracking: its full collections then cost the same at any run length, so the
+cost per part does not grow with the run.
 
 :func:`simulate` is what ``cell run`` and every sweep replication call.
 """

@@ -32,9 +32,9 @@ def main(args: argparse.Namespace) -> int:
             (f"{value:.4g}" if isinstance(value, float) else str(value))
         print(f"{key:<36} {shown}")
     print()
-    print(f"{'target':<36} {'value':>12}  {'wanted':<12} met")
+    print(f"{'target':<40} {'value':>12}  {'wanted':<12} met")
     for name, value, wanted, met in verdicts(results):
-        print(f"{name:<36} {value:>12}  {wanted:<12} {'yes' if met else 'NO'}")
+        print(f"{name:<40} {value:>12}  {wanted:<12} {'yes' if met else 'NO'}")
     write_text(json.dumps(results, indent=2, sort_keys=True) + "\n", args.out)
     print(f"wrote {args.out}")
     return 0
