@@ -40,10 +40,12 @@ class RowWriter:
 
     def record(self, obj: Any) -> None:
         f = self.float_format
-        # plain floats and strings inline (a long run writes millions of rows); the rest
-        # as cell_text has them
+        # plain floats, strings, booleans and integers inline (a long run writes millions
+        # of rows); the rest as cell_text has them
         self._w.writerow([(f % v if v == v else "") if type(v) is float
-                          else v if type(v) is str else cell_text(v, f)
+                          else v if type(v) is str
+                          else str(v) if type(v) is bool or type(v) is int
+                          else cell_text(v, f)
                           for v in self._values(obj)])
         self.rows += 1
 
