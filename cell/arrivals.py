@@ -108,8 +108,12 @@ def log1p_as_scipy(x: NDArray[np.float64]) -> NDArray[np.float64]:
     z = 1.0 + x
     out = np.empty_like(x)
     far = (z < math.sqrt(0.5)) | (z > math.sqrt(2.0))
-    out[far] = [math.log(v) if v > 0 else (-math.inf if v == 0 else math.nan)
-                for v in z[far].tolist()]
+    zf = z[far]
+    if zf.size and zf.min() > 0:
+        out[far] = list(map(math.log, zf.tolist()))
+    else:  # math.log refuses what C's log maps to -inf or NaN
+        out[far] = [math.log(v) if v > 0 else (-math.inf if v == 0 else math.nan)
+                    for v in zf.tolist()]
     near = ~far
     xs = x[near]
     p = np.full_like(xs, _LOG1P_P[0])
