@@ -44,6 +44,7 @@ import numpy as np
 
 from cell.errors import CellError
 from cell.output import FLOAT_FORMAT, atomic_path, write_csv, write_text
+from cell.progress import Progress
 from cell.scenario import Scenario
 from cell.sweep.columns import Column, grid_columns, point_values
 from cell.sweep.spec import Sweep, Task
@@ -290,8 +291,6 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     ``replicate`` is what one replication does; the default simulates the cell.
     It must be a module-level function when tasks run in other processes.
     """
-    from tqdm import tqdm
-
     out = check_out(out)
     cores = os.cpu_count() or 1
     workers = cores if workers is None else workers
@@ -309,8 +308,8 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     run = reused = 0
     try:
         _prepare(sweep, out, resume)
-        bar = tqdm(total=sweep.total_replications, unit="rep", desc=sweep.name,
-                   disable=not progress, file=sys.stderr, dynamic_ncols=True)
+        bar = Progress(sweep.total_replications, sweep.name, "replications", file=sys.stderr,
+                       enabled=progress)
 
         def done(task: Task, rows: list[dict[str, Any]]) -> None:
             write_csv(_task_frame(sweep, columns, task, rows), task_dir / task.filename,
@@ -344,7 +343,9 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
                 more = next_round(counts, reached, sweep.batch, q.max_n)
                 ranges = {p: (counts[p], counts[p] + k) for p, k in more.items() if k}
                 bar.total += sum(more.values())
-                bar.refresh()
+                if bar.bar is not None:  # the terminal's bar grows with the round
+                    bar.bar.total = bar.total
+                    bar.bar.refresh()
     except BaseException:
         _close(executor, client, wait=False)
         raise
