@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-stamp
 WORKERS ?= 2
 
-.PHONY: all venv test sweep sweep-mintime whatif figures animation bench lint clean
+.PHONY: all venv test sweep sweep-mintime whatif stress figures animation bench lint clean
 
 all: test
 
@@ -28,6 +28,10 @@ sweep-mintime: $(STAMP)
 
 whatif: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m cell sweep scenarios/whatif.yaml --out build/whatif --workers $(WORKERS) --report reports/whatif
+
+stress: $(STAMP)
+	$(PY) -m cell sweep scenarios/stress.yaml --out build/stress --workers $(WORKERS)
+	MPLBACKEND=Agg $(PY) -m cell.reporting.stress build/stress/replications.csv reports/stress
 
 figures: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m cell figures --out reports/figures

@@ -60,8 +60,9 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
     if the caller has it already.
 
     Departures from the thesis (docs/model.md), none of which binds on its arrivals:
-    step 3.2 slows the input belt no further than its floor (a part still too early
-    is let go: it reaches B while the robot is busy); step 6.3 also raises a belt left
+    step 3.2 slows the input belt no further than its floor, taking time off R II
+    (down to its fastest) before that, and a part still too early is let go (it
+    reaches B while the robot is busy); step 6.3 also raises a belt left
     slower than R II can absorb (``k.input_absorb``), so a slowed belt never lengthens
     the next cycle; step 5.0 keeps the output belt within its floor and ceiling.
     """
@@ -95,9 +96,15 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
                 r4 = t.r4_min_s
                 flags |= R4_PEAK
                 w = b / (cycle - a)
-                if w < k.input_min:           # departure: the belt's floor
-                    w = k.input_min
-                    flags |= INPUT_FLOOR
+                if w < k.input_min:           # departure: the belt's floor, R II first
+                    spare = min(r2 - t.r2_min_s, cycle - (a + b / k.input_min))
+                    if spare > 0:
+                        r2 -= spare
+                        cycle -= spare
+                        w = b / (cycle - a)
+                    if w < k.input_min:
+                        w = k.input_min
+                        flags |= INPUT_FLOOR
     # 6.3: decay toward nominal after the cycle; departure: never below what R II absorbs.
     v_next = 0.5 * (w + k.v_nom) if w > k.v_nom else max(w, k.input_absorb)
     if v_next > t.input_track_max_in_s:
