@@ -2,7 +2,9 @@
 
 Times are drawn by inverse cdf: u ~ U(0, 1) from the feeder's own numpy stream,
 T = F⁻¹(u) with scipy.stats' ``ppf``.  For the default Weibull that is eq. 6.9,
-T = 17.6019 + 5.4342 (-ln(1 - u))^0.2038.  The stream is a child of the run's
+T = 17.6019 + 5.4342 (-ln(1 - u))^0.2038; it and the exponential are computed
+here with numpy, to the bit as scipy does (:func:`closed_form_ppf`), so a run of
+them needs no scipy.  The stream is a child of the run's
 SeedSequence that nothing else uses, so every policy run with the same seed sees
 the same parts (common random numbers).  A CSV trace of observed times replaces
 the distribution when given.
@@ -18,7 +20,7 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from cell.cache import file_key, memo
+from cell.cache import file_key, memo, store, stored
 from cell.errors import ScenarioError
 
 #: The feeder's child stream of the root SeedSequence (other streams take other keys).
@@ -72,7 +74,126 @@ def interarrival_times(arrivals: ArrivalSpec, n: int, seed: int | np.random.Seed
         trace = read_trace(Path(base_dir) / arrivals.trace_csv)
         return np.resize(trace, n).astype(float)
     u = stream(seed, FEEDER_STREAM).random(n)
-    return np.asarray(_frozen(arrivals).ppf(u), dtype=float)
+    facts = _known_facts(arrivals)
+    params = facts[0] if facts is not None else parameters(arrivals)
+    times = closed_form_ppf(arrivals.distribution, params, u)
+    if times is not None:
+        return times
+    import scipy.stats
+
+    frozen = getattr(scipy.stats, arrivals.distribution)(**params)
+    return np.asarray(frozen.ppf(u), dtype=float)
+
+
+# --------------------------------------------------------------------------- draws
+#: Cephes' log1p (scipy.special.log1p): log(1 + x) = x - x²/2 + x³ P(x)/Q(x) on
+#: [1/√2 - 1, √2 - 1], libm's log(1 + x) outside.
+_LOG1P_P = (4.5270000862445199635215e-5, 4.9854102823193375972212e-1,
+            6.5787325942061044846969e0, 2.9911919328553073277375e1,
+            6.0949667980987787057556e1, 5.7112963590585538103336e1,
+            2.0039553499201281259648e1)
+_LOG1P_Q = (1.5062909083469192043167e1, 8.3047565967967209469434e1,
+            2.2176239823732856465394e2, 3.0909872225312059774938e2,
+            2.1642788614495947685003e2, 6.0118660497603843919306e1)
+
+
+def log1p_as_scipy(x: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``scipy.special.log1p(x)`` bit for bit, with numpy and the C library's ``log``.
+
+    numpy's own ``log1p`` (and, on some CPUs, its vectorised ``log``) differs from
+    scipy's in the last bit on some inputs; this follows scipy's Cephes code step
+    by step: the same polynomial evaluated in the same order (IEEE arithmetic is
+    exact whatever the vectorisation), ``math.log`` where Cephes calls ``log``.
+    """
+    z = 1.0 + x
+    out = np.empty_like(x)
+    far = (z < math.sqrt(0.5)) | (z > math.sqrt(2.0))
+    zf = z[far]
+    if zf.size and zf.min() > 0:
+        out[far] = list(map(math.log, zf.tolist()))
+    else:  # math.log refuses what C's log maps to -inf or NaN
+        out[far] = [math.log(v) if v > 0 else (-math.inf if v == 0 else math.nan)
+                    for v in zf.tolist()]
+    near = ~far
+    xs = x[near]
+    p = np.full_like(xs, _LOG1P_P[0])
+    for c in _LOG1P_P[1:]:
+        p = p * xs + c
+    q = xs + _LOG1P_Q[0]
+    for c in _LOG1P_Q[1:]:
+        q = q * xs + c
+    zz = xs * xs
+    zz = -0.5 * zz + xs * (zz * p / q)
+    out[near] = xs + zz
+    return out
+
+
+#: Families whose inverse cdf is drawn here with numpy: eq. 6.9's Weibull and the
+#: exponential, as scipy.stats would (their parameters, in scipy's names).
+CLOSED_FORM = {"weibull_min": ("c", "loc", "scale"), "expon": ("loc", "scale")}
+
+
+def closed_form_ppf(family: str, params: Mapping[str, float],
+                    u: NDArray[np.float64]) -> NDArray[np.float64] | None:
+    """``scipy.stats.<family>(**params).ppf(u)`` to the bit, without scipy, for the
+    families of :data:`CLOSED_FORM` (None for others, or for what scipy would treat
+    specially: parameters out of range, u = 0).
+
+    scipy computes weibull_min's as ``pow(-log1p(-u), 1/c) * scale + loc`` and
+    expon's as ``-log1p(-u) * scale + loc``, each parameter broadcast to an array
+    the length of u; the same numpy operations on the same arrays give the same bits.
+    """
+    names = CLOSED_FORM.get(family)
+    if names is None or not set(params) <= set(names) or u.ndim != 1 or not u.size:
+        return None
+    c = params.get("c", math.nan if family == "weibull_min" else 1.0)
+    loc, scale = params.get("loc", 0.0), params.get("scale", 1.0)
+    if not all(type(v) in (float, int) and math.isfinite(v) for v in (c, loc, scale)) \
+            or not (c > 0 and scale > 0) or not bool(np.all((u > 0) & (u < 1))):
+        return None
+    n = u.size
+    tail = -log1p_as_scipy(-u)
+    if family == "weibull_min":
+        tail = np.power(tail, 1.0 / np.full(n, float(c)))  # scipy's pow(...) on arrays
+    return np.asarray(tail * np.full(n, float(scale)) + np.full(n, float(loc)), dtype=float)
+
+
+# --------------------------------------------------------------------------- facts
+def _facts_key(arrivals: ArrivalSpec) -> dict[str, Any]:
+    return {"distribution": arrivals.distribution, "params": dict(arrivals.params),
+            "mean_s": arrivals.mean_s, "cv": arrivals.cv}
+
+
+def _memo_key(arrivals: ArrivalSpec) -> tuple[Any, ...]:
+    return (arrivals.distribution, tuple(sorted(arrivals.params.items())), arrivals.mean_s,
+            arrivals.cv)
+
+
+_FACTS: dict[tuple[Any, ...], tuple[dict[str, float], float, float]] = {}
+
+
+def _known_facts(arrivals: ArrivalSpec) -> tuple[dict[str, float], float, float] | None:
+    """(scipy parameters, mean, lower end of the support) of arrivals that passed
+    :func:`check_arrivals` here or in an earlier process (the disk cache); None if unknown."""
+    key = _memo_key(arrivals)
+    found = _FACTS.get(key)
+    if found is not None:
+        return found
+    plain = stored("arrivals", _facts_key(arrivals))
+    try:
+        params = {str(k): float(v) for k, v in plain["params"].items()}
+        facts = (params, float(plain["mean"]), float(plain["low"]))
+    except (TypeError, KeyError, AttributeError, ValueError):
+        return None
+    _FACTS[key] = facts
+    return facts
+
+
+def _remember(arrivals: ArrivalSpec, params: dict[str, float], mean: float, low: float) -> None:
+    key = _memo_key(arrivals)
+    if key not in _FACTS:
+        _FACTS[key] = (dict(params), mean, low)
+        store("arrivals", _facts_key(arrivals), {"params": params, "mean": mean, "low": low})
 
 
 def _frozen(arrivals: ArrivalSpec) -> Any:
@@ -125,18 +246,29 @@ def mean_interarrival(arrivals: ArrivalSpec, base_dir: Path | str = ".") -> floa
     """The mean inter-arrival time (s): the distribution's, or the trace's."""
     if arrivals.trace_csv is not None:
         return float(np.mean(read_trace(Path(base_dir) / arrivals.trace_csv)))
+    facts = _known_facts(arrivals)
+    if facts is not None:
+        return facts[1]
     return float(_frozen(arrivals).mean())
 
 
 def check_arrivals(arrivals: ArrivalSpec, base_dir: Path, file: object) -> None:
     """Refuse a distribution scipy does not have, parameters it rejects, times that
-    can be negative or have no finite mean, and an unusable trace."""
-    import scipy.stats
+    can be negative or have no finite mean, and an unusable trace.
 
-    dist = getattr(scipy.stats, arrivals.distribution, None)
-    if not isinstance(dist, scipy.stats.rv_continuous):
-        raise ScenarioError(file, "arrivals.distribution", arrivals.distribution,
-                            "not a continuous distribution in scipy.stats")
+    What passed is remembered (:mod:`cell.cache`, on disk too), so a later start
+    checks the same arrivals without importing scipy.stats."""
+    if arrivals.trace_csv is None and _known_facts(arrivals) is not None:
+        return
+    family = {"distribution": arrivals.distribution}
+    if stored("family", family) is not True:
+        import scipy.stats
+
+        dist = getattr(scipy.stats, arrivals.distribution, None)
+        if not isinstance(dist, scipy.stats.rv_continuous):
+            raise ScenarioError(file, "arrivals.distribution", arrivals.distribution,
+                                "not a continuous distribution in scipy.stats")
+        store("family", family, True)
     if arrivals.trace_csv is not None:
         path = base_dir / arrivals.trace_csv
         if not path.is_file():
@@ -151,6 +283,9 @@ def check_arrivals(arrivals: ArrivalSpec, base_dir: Path, file: object) -> None:
     except ValueError as exc:
         raise ScenarioError(file, "arrivals.cv", arrivals.cv,
                             f"{arrivals.distribution}: {exc}") from None
+    import scipy.stats
+
+    dist = getattr(scipy.stats, arrivals.distribution)
     try:
         frozen = dist(**params)
         mean = float(frozen.mean())
@@ -165,6 +300,7 @@ def check_arrivals(arrivals: ArrivalSpec, base_dir: Path, file: object) -> None:
         raise ScenarioError(file, "arrivals.params", params,
                             f"the mean inter-arrival time would be {mean:.4g} s; at most "
                             f"{MAX_INTERARRIVAL_S:g} s")
+    _remember(arrivals, params, mean, low)
 
 
 def read_trace(path: Path, file: object = None) -> NDArray[np.float64]:

@@ -7,33 +7,41 @@ module builds those values from a :class:`~cell.scenario.Scenario`, checks what
 needs the robot's maths (reach, motor rates at the load, a nominal cycle the
 motors can make), and turns any maths error into a
 :class:`~cell.errors.ScenarioError` naming the key and file that caused it.
-Everything solved is cached on the plain values it depends on.
+Everything solved is cached on the plain values it depends on; the robot's
+timing on disk as well (:mod:`cell.cache`), so a start whose cell was solved
+before neither solves the path nor imports what solving needs (scipy's splines).
 """
 
 from __future__ import annotations
 
+import functools
+import hashlib
+import json
 import math
-from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from cell import registry
 from cell.arrivals import mean_interarrival
-from cell.cache import memo
+from cell.cache import memo, store, stored
 from cell.errors import CellError, InfeasibleError, NoMotionError, ScenarioError, UnreachableError
 from cell.kinematics import JOINT_NAMES, Arm, Hand, Placement
 from cell.motors import Motors, max_rates
-from cell.path import CellGeometry, Route, build_path
 from cell.policies.base import CellConstants, Policy
-from cell.robot import RobotTiming, build_timing
+from cell.robot import RobotTiming, build_timing, timing_from_plain, timing_to_plain
 from cell.scenario import MAX_TIME_S, Scenario, default_scenario
-from cell.steptable import StepTable
+
+if TYPE_CHECKING:
+    from cell.path import CellGeometry
+    from cell.steptable import StepTable
 
 
 # --------------------------------------------------------------------------- plain values
 def geometry_of(s: Scenario) -> CellGeometry:
     """Everything the path's shape and joint angles depend on."""
+    from cell.path import CellGeometry, Route
+
     p, r = s.path, s.robot
     m = p.moves
     h = r.hand
@@ -74,6 +82,8 @@ def planner_bounds(s: Scenario) -> Any:
 # --------------------------------------------------------------------------- the path
 def step_table(s: Scenario) -> StepTable:
     """The scenario's solved path; a point out of reach names the key that put it there."""
+    from cell.steptable import StepTable
+
     _check_motor_rates(s)
     geometry, motors = geometry_of(s), motors_of(s)
     try:
@@ -98,6 +108,8 @@ GEOMETRY_KEYS = (
 def _blame(s: Scenario, geometry: CellGeometry) -> tuple[str, Any, str]:
     """The key whose value makes the path unreachable: of the keys that differ from the
     thesis's cell, the first whose thesis value alone makes every point reachable."""
+    from cell.path import build_path
+
     thesis = default_scenario()
     changed = [k for k in GEOMETRY_KEYS if s.get(k) != thesis.get(k)]
     for key in changed:
@@ -145,12 +157,22 @@ def _check_motor_rates(s: Scenario) -> None:
 # --------------------------------------------------------------------------- timing
 def robot_timing(s: Scenario) -> RobotTiming:
     """The robot's regime segments (§6.1), floored by the planner under minimum-time timing."""
+    key = _timing_key(s)
+    timing = _known_timing(key) if key is not None else None
+    if timing is None:
+        timing = _solved_timing(s)
+        if key is not None:
+            _remember_timing(key, timing)
+    return _checked(s, timing)
+
+
+def _solved_timing(s: Scenario) -> RobotTiming:
     step_table(s)  # reach and motor checks, with their keys
     if s.robot.timing != "minimum-time":
-        return _checked(s, _timing(geometry_of(s), motors_of(s), None))
+        return _timing(geometry_of(s), motors_of(s), None)
     bounds = planner_bounds(s)
     try:
-        return _checked(s, _timing(geometry_of(s), motors_of(s), bounds))
+        return _timing(geometry_of(s), motors_of(s), bounds)
     except InfeasibleError as exc:
         key = "robot.motors.max_rate_no_load_rad_s"
         if s.get(key) == _THESIS.get(key):
@@ -159,6 +181,55 @@ def robot_timing(s: Scenario) -> RobotTiming:
                             f"{exc} of the dynamic model ({s.mintime.dynamics_file})") from None
     except NoMotionError as exc:
         raise CellError(f"{s.source}: robot.timing = 'minimum-time': {exc}") from None
+
+
+#: The scenario sections the robot's timing is solved from: the cell's layout, the path,
+#: the part, the arm with its motors and timing, the planner's settings (read only under
+#: minimum-time timing, which also reads the dynamics file: its bytes are in the key).
+TIMING_SECTIONS = ("cell", "path", "part", "robot", "mintime")
+
+
+def _timing_key(s: Scenario) -> dict[str, Any] | None:
+    """The plain values the robot's timing depends on (None: not to be cached)."""
+    try:
+        key: dict[str, Any] = {name: getattr(s, name).model_dump() for name in TIMING_SECTIONS}
+        if s.robot.timing == "minimum-time" and s.mintime.dynamics_file is not None:
+            path = s.base_dir / s.mintime.dynamics_file
+            key["dynamics_file_sha256"] = hashlib.sha256(path.read_bytes()).hexdigest()
+        json.dumps(key)
+    except (OSError, TypeError, ValueError):
+        return None
+    return key
+
+
+@functools.lru_cache(maxsize=16)
+def _timing_by_text(text: str) -> RobotTiming | None:
+    try:
+        return timing_from_plain(stored("timing", json.loads(text)))
+    except (TypeError, KeyError, AttributeError, ValueError):
+        return None
+
+
+def _known_timing(key: dict[str, Any]) -> RobotTiming | None:
+    """A timing solved before for these values, in this process or an earlier one."""
+    text = json.dumps(key, sort_keys=True)
+    timing = _SOLVED.get(text)
+    return timing if timing is not None else _timing_by_text(text)
+
+
+def _remember_timing(key: dict[str, Any], timing: RobotTiming) -> None:
+    text = json.dumps(key, sort_keys=True)
+    if text in _SOLVED:
+        return
+    _SOLVED[text] = timing
+    try:
+        store("timing", key, timing_to_plain(timing))
+    except TypeError:
+        pass
+
+
+#: Timings solved in this process, by their key's text.
+_SOLVED: dict[str, RobotTiming] = {}
 
 
 #: The thesis's cell, against which a changed key is blamed.
@@ -186,6 +257,8 @@ def _checked(s: Scenario, t: RobotTiming) -> RobotTiming:
 
 @memo(maxsize=16)
 def _timing(geometry: CellGeometry, motors: Motors, bounds: Any) -> RobotTiming:
+    from cell.steptable import StepTable
+
     table = StepTable.solve(geometry, motors)
     if bounds is None:
         return build_timing(table)
@@ -274,15 +347,20 @@ def nominal_cycle(s: Scenario) -> float:
 
 
 # --------------------------------------------------------------------------- the whole cell
-@dataclass(frozen=True)
 class AssembledCell:
-    """A scenario's cell, ready to run: its solved path, timing, constants and policy."""
+    """A scenario's cell, ready to run: its timing, constants and policy (and its solved
+    path, :attr:`table`, solved when first asked for)."""
 
-    scenario: Scenario
-    table: StepTable
-    timing: RobotTiming
-    k: CellConstants
-    policy: Policy
+    __slots__ = ("scenario", "timing", "k", "policy")
+
+    def __init__(self, scenario: Scenario, timing: RobotTiming, k: CellConstants,
+                 policy: Policy):
+        self.scenario, self.timing, self.k, self.policy = scenario, timing, k, policy
+
+    @property
+    def table(self) -> StepTable:
+        """The scenario's solved path (the joint-step table)."""
+        return step_table(self.scenario)
 
 
 def make_policy(s: Scenario, k: CellConstants) -> Policy:
@@ -298,4 +376,4 @@ def assemble(s: Scenario) -> AssembledCell:
     """Every check and every solved value the simulation needs, errors first."""
     timing = robot_timing(s)
     k = constants(s, timing)
-    return AssembledCell(s, step_table(s), timing, k, make_policy(s, k))
+    return AssembledCell(s, timing, k, make_policy(s, k))

@@ -5,12 +5,27 @@ dataclasses of the maths, numbers, tuples), or :func:`file_key` for something
 read from a file (its resolved path, size and modification time, so an edited
 file is read again).  Nothing is keyed on a whole scenario, so no cached value
 can silently carry another scenario's settings.
+
+What is slow to solve and needed at every start (the robot's timing, the
+arrivals' distribution facts) is also kept on disk (:func:`stored`,
+:func:`store`): one JSON file per value under ``$XDG_CACHE_HOME/cell/`` (or
+``~/.cache/cell/``), keyed on the plain values it depends on and on
+:func:`code_fingerprint` (this package's source, numpy's and scipy's versions),
+written atomically and checked by a checksum.  An entry that is missing,
+unreadable or damaged, or a cache directory that cannot be written, only means
+the value is computed again; ``CELL_NO_CACHE=1`` turns the disk cache off.  A
+stored value is exactly the computed one (floats round-trip through JSON), so
+the cache never changes a result.
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import hashlib
+import json
 import os
+import tempfile
 from collections import OrderedDict
 from collections.abc import Callable, Hashable
 from pathlib import Path
@@ -64,3 +79,104 @@ def file_key(path: str | Path) -> tuple[str, int, int]:
     p = Path(path).resolve()
     st = os.stat(p)
     return str(p), st.st_size, st.st_mtime_ns
+
+
+# --------------------------------------------------------------------------- on disk
+#: Set to anything but "" or "0" to turn the disk cache off.
+NO_CACHE_ENV = "CELL_NO_CACHE"
+_MAGIC = b"cell-cache 1\n"
+
+
+def cache_dir() -> Path | None:
+    """``$XDG_CACHE_HOME/cell`` (default ``~/.cache/cell``); None if ``CELL_NO_CACHE`` is set."""
+    if os.environ.get(NO_CACHE_ENV, "") not in ("", "0"):
+        return None
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "cell"
+
+
+@functools.lru_cache(maxsize=1)
+def code_fingerprint() -> str:
+    """What a stored value was computed with: this package's source (its version
+    included), numpy's version and scipy's, and Python's."""
+    import sys
+    from importlib.util import find_spec
+
+    import numpy as np
+
+    h = hashlib.sha256()
+    package = Path(__file__).resolve().parent
+    for path in sorted(package.rglob("*.py")):
+        h.update(str(path.relative_to(package)).encode() + b"\0" + path.read_bytes() + b"\0")
+    spec = find_spec("scipy")
+    if spec is not None and spec.origin is not None:
+        version = Path(spec.origin).with_name("version.py")
+        h.update(version.read_bytes() if version.is_file() else spec.origin.encode())
+    h.update(f"{np.__version__} {sys.version}".encode())
+    return h.hexdigest()
+
+
+def _key_text(kind: str, key: Any) -> tuple[str, str]:
+    """The key as text, and the whole of what an entry must match (the code's fingerprint too)."""
+    text = f"{kind}\n{json.dumps(key, sort_keys=True)}"
+    return text, f"{code_fingerprint()}\n{text}"
+
+
+def _entry(text: str, kind: str) -> Path | None:
+    """The entry's file: one per key, whatever the code's version (a new version's value
+    replaces the old one's), so the directory does not grow as the code changes."""
+    where = cache_dir()
+    if where is None:
+        return None
+    return where / f"{kind}-{hashlib.sha256(text.encode()).hexdigest()[:40]}.json"
+
+
+def stored(kind: str, key: Any) -> Any:
+    """The value stored under (``kind``, ``key``), or None: none stored, the cache off,
+    or an entry that cannot be read or fails its checksum (then it is recomputed).
+
+    ``key`` is plain JSON data (numbers, strings, lists, mappings): the values the
+    stored result depends on.  Floats are written and read back exactly.
+    """
+    try:
+        text, whole = _key_text(kind, key)
+        path = _entry(text, kind)
+        if path is None:
+            return None
+        data = path.read_bytes()
+        if not data.startswith(_MAGIC):
+            return None
+        digest, payload = data[len(_MAGIC):len(_MAGIC) + 64], data[len(_MAGIC) + 65:]
+        if hashlib.sha256(payload).hexdigest().encode() != digest:
+            return None
+        entry = json.loads(payload)
+        if not isinstance(entry, dict) or entry.get("key") != whole:
+            return None
+        return entry.get("value")
+    except Exception:  # noqa: BLE001 - an unusable cache is only a cache miss
+        return None
+
+
+def store(kind: str, key: Any, value: Any) -> None:
+    """Store ``value`` (plain JSON data) under (``kind``, ``key``), atomically; a cache
+    that cannot be written is left alone, silently."""
+    tmp = None
+    try:
+        text, whole = _key_text(kind, key)
+        path = _entry(text, kind)
+        if path is None:
+            return
+        payload = json.dumps({"key": whole, "value": value}).encode()
+        digest = hashlib.sha256(payload).hexdigest().encode()
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=".tmp-", dir=path.parent)
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(_MAGIC + digest + b"\n" + payload)
+        os.replace(tmp, path)
+        tmp = None
+    except Exception:  # noqa: BLE001 - an unwritable cache is only a cache miss next time
+        pass
+    finally:
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)

@@ -34,14 +34,17 @@ class View:
                  n_parts: int, conveyor: InputConveyor, output: OutputConveyor):
         self.env, self.k, self.fed_s, self.n = env, k, fed_s, n_parts
         self.conveyor, self.output = conveyor, output
+        self._input_speed, self._output_travel = conveyor.belt.speed, output.belt.travel
         self.part = 0
         """Index of the part at B."""
 
     def input_speed(self) -> float:
-        return self.conveyor.belt.speed(self.env.now + EPS_S)
+        return self._input_speed(self.env.now + EPS_S)
 
     def output_gap(self) -> float | None:
-        return self.output.gap_now()
+        """How far the last part set down has travelled (:meth:`OutputConveyor.gap_now`)."""
+        last = self.output.last_td_x
+        return None if last is None else self._output_travel(self.env.now) - last
 
     def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
         """(a, b) of the first part after this one that can still be caught."""
@@ -76,35 +79,35 @@ class Controller:
     def run(self):  # noqa: ANN201 (SimPy generator)
         env, robot, view, plan_for = self.env, self.robot, self.view, self.policy.plan
         replan_in, replan_out, u_nom = self.conveyor.replan, self.output.replan, self.k.u_nom
-        get, log = self.conveyor.at_bot.get, self.log
+        get, log, order = self.conveyor.at_bot.get, self.log, robot.order
         t = self.k.timing
         l1, l2, l3, l4 = t.r1_length_in, t.r2.length_in, t.r3_length_in, t.r4.length_in
+        residual = self.residual_s
         while True:
             part: Any = yield get()
             now = env.now
-            if not robot.is_free(now):
+            if not robot.free_at_s <= now + EPS_S:  # the robot is not back: the part rides on
                 part.missed = True
                 log.flag(part, LET_GO)
                 log.missed(part)
                 continue
             view.part = part.part - 1
-            plan = plan_for(view)
-            if plan.steers_belts:
-                replan_in(now + plan.r1_pre, plan.input_after_lo, now + plan.cycle,
-                          plan.input_next)
-                replan_out(now, plan.output_to_g, now + plan.to_g, u_nom)
-            r1, r3 = plan.r1_pre + plan.r1_post, plan.r3_pre + plan.r3_post
+            (r1_pre, r1_post, r2, r3_pre, r3_post, r4, input_speed, input_after_lo, input_next,
+             output_to_g, to_g, cycle, limits, steers_belts) = plan_for(view)
+            if steers_belts:
+                replan_in(now + r1_pre, input_after_lo, now + cycle, input_next)
+                replan_out(now, output_to_g, now + to_g, u_nom)
+            r1, r3 = r1_pre + r1_post, r3_pre + r3_post
             part.picked = True
-            part.motion_cycle_s = plan.cycle
-            part.input_speed_in_s, part.output_speed_in_s = plan.input_speed, plan.output_to_g
-            part.r1_s, part.r2_s, part.r3_s, part.r4_s = r1, plan.r2, r3, plan.r4
-            part.v_r1_in_s, part.v_r2_in_s = l1 / r1, l2 / plan.r2
-            part.v_r3_in_s, part.v_r4_in_s = l3 / r3, l4 / plan.r4
-            if plan.limits:
-                log.flag(part, plan.limits)
+            part.motion_cycle_s = cycle
+            part.input_speed_in_s, part.output_speed_in_s = input_speed, output_to_g
+            part.r1_s, part.r2_s, part.r3_s, part.r4_s = r1, r2, r3, r4
+            part.v_r1_in_s, part.v_r2_in_s = l1 / r1, l2 / r2
+            part.v_r3_in_s, part.v_r4_in_s = l3 / r3, l4 / r4
+            if limits:
+                log.flag(part, limits)
             # step 6.2: motion time to TD plus the previous cycle's residual
-            part.thesis_interval_s = plan.to_g + plan.r3_pre + self.residual_s
-            self.residual_s = plan.r3_post + plan.r4
+            part.thesis_interval_s = to_g + r3_pre + residual
+            self.residual_s = residual = r3_post + r4
             # B → TD summed as LO + (LO → TD), the order the robot's legs are timed in
-            to_td = plan.r1_pre + (plan.to_g - plan.r1_pre + plan.r3_pre)
-            robot.order(Order(part, plan.r1_pre, to_td, plan.cycle))
+            order(Order(part, r1_pre, r1_pre + (to_g - r1_pre + r3_pre), cycle))

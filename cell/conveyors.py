@@ -6,12 +6,14 @@ once (§6.2 a: negligible lag).  The controller writes the schedule ahead of
 time (a change at LO, the step 6.3 decay at the end of the cycle, the output
 belt back to nominal at G); a part's arrival is the instant the belt has
 carried it the required distance, so the input conveyor's SimPy process only
-wakes when a part reaches B, or when a new plan moves that instant.
+wakes when a part reaches B (the controller, which replans only then, having
+taken it first), and the output conveyor's when a part is set down.
 """
 
 from __future__ import annotations
 
-import bisect
+import math
+from bisect import bisect_right
 from collections.abc import Callable
 from typing import Any
 
@@ -25,7 +27,7 @@ EPS_S = 1e-6
 
 def speed_at(instants: list[float], speeds: list[float], t: float) -> float:
     """A piecewise-constant schedule's speed at t: the last change at or before t."""
-    return speeds[max(bisect.bisect_right(instants, t) - 1, 0)]
+    return speeds[max(bisect_right(instants, t) - 1, 0)]
 
 
 class Belt:
@@ -52,16 +54,18 @@ class Belt:
         """The slowest of them."""
 
     def speed(self, t: float) -> float:
-        return speed_at(self._t, self._v, t)
+        """The speed at instant t (:func:`speed_at`)."""
+        k = bisect_right(self._t, t) - 1
+        return self._v[k if k > 0 else 0]
 
     def travel(self, t: float) -> float:
         """X(t): inches the belt has moved by time t (t ≥ the last settled change)."""
-        k = bisect.bisect_right(self._t, t) - 1
+        k = bisect_right(self._t, t) - 1
         return self._x[k] + self._v[k] * (t - self._t[k])
 
     def time_at(self, x: float) -> float:
         """First instant at which the belt's travel reaches x (speeds are > 0)."""
-        k = max(bisect.bisect_right(self._x, x) - 1, 0)
+        k = max(bisect_right(self._x, x) - 1, 0)
         return self._t[k] + (x - self._x[k]) / self._v[k]
 
     def plan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
@@ -75,40 +79,41 @@ class Belt:
         if not v1 > 0 or (t2 is not None and not v2 > 0):
             raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}")
         ts, xs, vs = self._t, self._x, self._v
-        k = bisect.bisect_right(ts, t1 + EPS_S)
+        k = bisect_right(ts, t1 + EPS_S)
         if k < len(ts):
             del ts[k:], xs[k:], vs[k:]
-        self._settle(t1)
-        self._append(t1, v1)
-        if t2 is not None:
-            self._append(t2, v2)
-
-    def _settle(self, now: float) -> None:
-        ts, xs, vs = self._t, self._x, self._v
-        n = bisect.bisect_right(ts, now) - 1
-        if n > 0:
+        n = bisect_right(ts, t1) - 1
+        if n > 0:  # settle the changes whose successors have started
             self._emit(n)
             del ts[:n], xs[:n], vs[:n]
+        # run at v1 from t1 on (at or before the last change: that change's speed is v1)
+        if t1 <= ts[-1]:
+            vs[-1] = v1
+        else:
+            xs.append(xs[-1] + vs[-1] * (t1 - ts[-1]))
+            ts.append(t1)
+            vs.append(v1)
+        if t2 is not None:
+            if t2 <= ts[-1]:
+                vs[-1] = v2
+            else:
+                xs.append(xs[-1] + vs[-1] * (t2 - ts[-1]))
+                ts.append(t2)
+                vs.append(v2)
 
     def _emit(self, n: int) -> None:
-        top, bottom = max(self._v[:n]), min(self._v[:n])
-        if top > self.max_speed_in_s:
-            self.max_speed_in_s = top
-        if bottom < self.min_speed_in_s:
-            self.min_speed_in_s = bottom
-        if self.on_change is not None:
-            for t, v in zip(self._t[:n], self._v[:n]):
-                self.on_change(t, v)
-
-    def _append(self, t: float, v: float) -> None:
-        """Run at v from t on (t at or before the last change: that change's speed is v)."""
-        ts, xs, vs = self._t, self._x, self._v
-        if t <= ts[-1]:
-            vs[-1] = v
-        else:
-            xs.append(xs[-1] + vs[-1] * (t - ts[-1]))
-            ts.append(t)
-            vs.append(v)
+        vs = self._v
+        for i in range(n):
+            v = vs[i]
+            if v > self.max_speed_in_s:
+                self.max_speed_in_s = v
+            if v < self.min_speed_in_s:
+                self.min_speed_in_s = v
+        told = self.on_change
+        if told is not None:
+            ts = self._t
+            for i in range(n):
+                told(ts[i], vs[i])
 
     def close(self) -> None:
         """Hand every change still held (planned ones included) to ``on_change``."""
@@ -119,9 +124,15 @@ class Belt:
 class InputConveyor:
     """Carries parts from the feeder, ``length_in`` upstream of B, to B.
 
-    Its process takes each part the feeder drops (``loaded``), waits until the
-    belt has carried it to B, and puts it in ``at_bot`` for the controller.  A
-    part nobody picks up rides on to F and falls off (thesis §6.3).
+    Its process takes each part the feeder drops (``loaded``), works out when
+    the belt will have carried it to B, and hands it to the controller (``at_bot``)
+    due at that instant: one event, which wakes the controller and then this
+    process, so the controller plans (and may replan the belt) before the next
+    part is timed.  A part nobody picks up rides on to F and falls off (§6.3).
+
+    The controller replans the belt only when a part reaches B, so a part on its
+    way to B never has its arrival moved; a replan at any other instant while a
+    part is due is refused (it would need the part timed again).
     """
 
     def __init__(self, env: simpy.Environment, speed_in_s: float, length_in: float,
@@ -133,53 +144,45 @@ class InputConveyor:
         self.loaded: Mailbox = Mailbox(env)
         """Parts dropped on the belt by the feeder (their records)."""
         self.at_bot: Mailbox = Mailbox(env)
-        """Parts as they reach B."""
+        """Parts as they reach B (the controller waits on it)."""
         self.x_fed: dict[int, float] = {}
         """Belt travel at the instant each part on the belt was dropped (by index)."""
-        self._timing = False
+        self.due_s = -math.inf
+        """When the part on its way to B gets there (-inf: none is)."""
         self.feeder: Any = None
         """The feeder, told of a replan while it holds a part back."""
         self.process = env.process(self.run())
 
-    def drop(self, part: Any) -> float:
-        """The feeder puts a part (its record) on the belt now; returns the belt's travel."""
-        x = self.x_fed[part.part - 1] = self.belt.travel(self.env.now)
+    def drop(self, part: Any, x: float) -> None:
+        """The feeder puts a part (its record) on the belt now, the belt's travel being x."""
+        self.x_fed[part.part - 1] = x
         self.loaded.put(part)
-        return x
 
     def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
-        """New speed plan from the controller (see :meth:`Belt.plan`).
-
-        The controller plans when a part reaches B, before this process times the
-        next part (same-instant events run in order); should a plan ever arrive
-        while a part is being timed, the process is interrupted and re-times it.
-        """
+        """New speed plan from the controller (see :meth:`Belt.plan`), made as a part
+        reaches B: before the next part is timed."""
+        if self.env.now < self.due_s:
+            raise RuntimeError("the input belt was replanned while a part was on its way to B")
         self.belt.plan(t1, v1, t2, v2)
-        if self._timing:
-            self.process.interrupt()
         feeder = self.feeder
         if feeder is not None and feeder.holding:
             feeder.process.interrupt()
 
     def run(self):  # noqa: ANN201 (SimPy generator)
-        env, get, timeout = self.env, self.loaded.get, self.env.timeout
+        env, get, hand_over = self.env, self.loaded.get, self.at_bot.put_after
         time_at, x_fed, length = self.belt.time_at, self.x_fed, self.length_in
         while True:
             part = yield get()
-            x_at_bot = x_fed[part.part - 1] + length
-            self._timing = True
-            while True:
-                try:
-                    yield timeout(max(time_at(x_at_bot) - env.now, 0.0))
-                    break
-                except simpy.Interrupt:  # the plan changed: re-time the part
-                    pass
-            self._timing = False
-            del x_fed[part.part - 1]
-            part.at_bot_s = env.now
-            # The controller takes the part (and may replan the belt) before this
-            # process's next get() is served: same-instant events run in order.
-            self.at_bot.put(part)
+            i = part.part - 1
+            now = env.now
+            delay = time_at(x_fed[i] + length) - now
+            if delay < 0.0:
+                delay = 0.0
+            # the instant the part reaches B, as the event queue will have it
+            part.at_bot_s = self.due_s = now + delay
+            # the controller takes the part (and replans) before this process resumes
+            yield hand_over(part, delay)
+            del x_fed[i]
 
 
 class OutputConveyor:
@@ -187,7 +190,8 @@ class OutputConveyor:
 
     Spacing of a part = the output belt's travel between the previous part's
     touch-down and its own: the distance between the two on the belt.  Each part
-    set down is handed on to ``delivered`` (the run's log).
+    set down is handed on to ``delivered`` (the run's log).  The robot hands a part
+    over due at its touch-down (``placed``), so this process wakes once per part, at TD.
     """
 
     def __init__(self, env: simpy.Environment, speed_in_s: float,
@@ -196,7 +200,7 @@ class OutputConveyor:
         self.env = env
         self.belt = Belt(speed_in_s, on_change)
         self.placed: Mailbox = Mailbox(env)
-        """Parts set down by the robot."""
+        """Parts set down by the robot, each due at its touch-down."""
         self.delivered = delivered
         self.last_td_x: float | None = None
         """Belt travel at the last touch-down (None before the first)."""
@@ -217,10 +221,11 @@ class OutputConveyor:
         env, get, travel, delivered = self.env, self.placed.get, self.belt.travel, self.delivered
         while True:
             part = yield get()
-            td = part.touchdown_s
-            x = travel(env.now)
-            if self.last_td_x is not None:
-                part.spacing_in = x - self.last_td_x
-                part.delivery_interval_s = td - self.last_td_s
+            td = part.touchdown_s = env.now
+            x = travel(td)
+            last_x, last_td = self.last_td_x, self.last_td_s
+            if last_x is not None and last_td is not None:
+                part.spacing_in = x - last_x
+                part.delivery_interval_s = td - last_td
             self.last_td_x, self.last_td_s = x, td
             delivered(part)

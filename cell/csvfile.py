@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import math
 from collections.abc import Iterable, Sequence
+from operator import attrgetter
 from typing import Any, TextIO
 
 FLOAT_FORMAT = "%.10g"
@@ -33,11 +34,19 @@ class RowWriter:
         self.float_format = float_format
         self._w = csv.writer(fh, lineterminator="\n")
         self._w.writerow(self.columns)
+        self._values: Any = attrgetter(*self.columns) if len(self.columns) > 1 else \
+            (lambda obj: tuple(getattr(obj, c) for c in self.columns))
         self.rows = 0
 
     def record(self, obj: Any) -> None:
         f = self.float_format
-        self._w.writerow([cell_text(getattr(obj, c), f) for c in self.columns])
+        # plain floats, strings, booleans and integers inline (a long run writes millions
+        # of rows); the rest as cell_text has them
+        self._w.writerow([(f % v if v == v else "") if type(v) is float
+                          else v if type(v) is str
+                          else str(v) if type(v) is bool or type(v) is int
+                          else cell_text(v, f)
+                          for v in self._values(obj)])
         self.rows += 1
 
     def rows_of(self, objs: Iterable[Any]) -> None:

@@ -29,7 +29,7 @@ class Loadable(Protocol):
 
     belt: Any
 
-    def drop(self, part: Any) -> float: ...
+    def drop(self, part: Any, x: float) -> None: ...
 
 
 class Feeder:
@@ -38,10 +38,12 @@ class Feeder:
 
     def __init__(self, env: simpy.Environment, interarrival_s: NDArray[np.float64],
                  conveyor: Loadable, n_parts: int, part_size_in: float,
-                 flag: Any = None):
+                 flag: Any = None, interarrival_list: list[float] | None = None):
         self.env = env
-        self.interarrival_s = interarrival_s.tolist()
-        """All the run's draws; the one after the last part is the controller's look-ahead."""
+        self.interarrival_s = interarrival_s.tolist() if interarrival_list is None \
+            else interarrival_list
+        """All the run's draws; the one after the last part is the controller's look-ahead
+        (``interarrival_list``: the same as a list, if the caller has it already)."""
         self.fed_s: list[float] = np.cumsum(interarrival_s).tolist()
         """When each part comes (is due to be dropped): the upstream process's schedule."""
         self.n_parts = n_parts
@@ -55,21 +57,29 @@ class Feeder:
 
     def run(self):  # noqa: ANN201 (SimPy generator)
         env, drop, fed, t = self.env, self.conveyor.drop, self.fed_s, self.interarrival_s
-        belt, size = self.conveyor.belt, self.part_size_in
+        timeout, travel, flag = env.timeout, self.conveyor.belt.travel, self.flag
+        size = self.part_size_in
         clear_at = -float("inf")
         for i in range(self.n_parts):
-            yield env.timeout(max(fed[i] - env.now, 0.0))  # after a hold it may be due already
-            held = belt.travel(env.now) < clear_at - CLEAR_TOL_IN
-            while belt.travel(env.now) < clear_at - CLEAR_TOL_IN:
+            f = fed[i]
+            delay = f - env.now
+            yield timeout(delay if delay > 0.0 else 0.0)  # after a hold it may be due already
+            x = travel(env.now)
+            if x < clear_at - CLEAR_TOL_IN:
+                belt = self.conveyor.belt
                 self.holding = True
-                try:
-                    yield env.timeout(max(belt.time_at(clear_at) - env.now, EPS_S))
-                except simpy.Interrupt:  # the belt was replanned: time the wait again
-                    pass
-            self.holding = False
-            part = PartRecord(i + 1, env.now if held else fed[i], t[i])
-            if held:
-                part.feed_delay_s = env.now - fed[i]
-                if self.flag is not None:
-                    self.flag(part, HELD_AT_FEEDER)
-            clear_at = drop(part) + size
+                while x < clear_at - CLEAR_TOL_IN:
+                    try:
+                        yield timeout(max(belt.time_at(clear_at) - env.now, EPS_S))
+                    except simpy.Interrupt:  # the belt was replanned: time the wait again
+                        pass
+                    x = travel(env.now)
+                self.holding = False
+                part = PartRecord(i + 1, env.now, t[i])
+                part.feed_delay_s = env.now - f
+                if flag is not None:
+                    flag(part, HELD_AT_FEEDER)
+            else:
+                part = PartRecord(i + 1, f, t[i])
+            drop(part, x)
+            clear_at = x + size

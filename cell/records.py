@@ -38,7 +38,13 @@ LIMIT_BIT = {name: 1 << i for i, name in enumerate(LIMITS)}
 
 def limit_names(flags: int) -> str:
     """The names of the limits in a flag word, space-separated, in :data:`LIMITS` order."""
-    return " ".join(name for i, name in enumerate(LIMITS) if flags >> i & 1)
+    names = _NAMES.get(flags)
+    if names is None:
+        names = _NAMES[flags] = " ".join(name for i, name in enumerate(LIMITS) if flags >> i & 1)
+    return names
+
+
+_NAMES: dict[int, str] = {}
 
 
 @dataclass(slots=True)

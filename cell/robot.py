@@ -18,8 +18,8 @@ and the move times are only floored by the motors (§4.3 c).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any, NamedTuple
+from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 import simpy
@@ -27,7 +27,9 @@ import simpy
 from cell.conveyors import EPS_S
 from cell.mailbox import Mailbox
 from cell.motors import Segment
-from cell.steptable import StepTable
+
+if TYPE_CHECKING:
+    from cell.steptable import StepTable
 
 
 @dataclass(frozen=True)
@@ -99,6 +101,43 @@ def build_timing(t: StepTable, fastest: dict[str, float] | None = None) -> Robot
         r2_min_s=r2_min, r4_min_s=r4_min)
 
 
+def timing_to_plain(t: RobotTiming) -> dict[str, Any]:
+    """The timing as plain JSON data (for the disk cache); every float kept exactly.
+
+    Raises TypeError if a value is not a float or a list of floats (then it is not stored).
+    """
+    def plain(value: Any) -> Any:
+        if type(value) is float or (type(value) is list and all(type(v) is float for v in value)):
+            return value
+        raise TypeError(f"not plain: {type(value).__name__}")
+
+    out: dict[str, Any] = {}
+    for f in fields(t):
+        value = getattr(t, f.name)
+        if isinstance(value, Segment):
+            out[f.name] = {"segment": {slot: plain(getattr(value, slot))
+                                       for slot in Segment.__slots__}}
+        else:
+            out[f.name] = plain(value)
+    return out
+
+
+def timing_from_plain(data: dict[str, Any]) -> RobotTiming:
+    """The timing back from :func:`timing_to_plain`'s data."""
+    values: dict[str, Any] = {}
+    for f in fields(RobotTiming):
+        value = data[f.name]
+        if isinstance(value, dict):
+            segment = Segment.__new__(Segment)
+            for slot in Segment.__slots__:
+                setattr(segment, slot, value["segment"][slot])
+            value = segment
+        elif type(value) is not float:
+            raise TypeError(f"{f.name}: not a float")
+        values[f.name] = value
+    return RobotTiming(**values)
+
+
 # --------------------------------------------------------------------------- process
 class Order(NamedTuple):
     """One transfer cycle as the controller sends it (step 6.1), times from now (s)."""
@@ -117,10 +156,12 @@ class Robot:
     """The arm as a SimPy process: told an :class:`Order`, runs it, hands the part over.
 
     The robot owns its state: ``free_at_s``, when it will be back at B, is set the
-    moment it is told an order.  One timeout per order (B to TD): a regime's moves
-    are summed, never simulated one by one; lift-off is written when the order is
-    taken, and the way back (TD → K → B) needs no event, since no order comes
-    before ``free_at_s``.
+    moment it is told an order.  One event per order besides the order itself: a
+    regime's moves are summed, never simulated one by one; lift-off is written when
+    the order is taken, and the part is handed to the output conveyor due at
+    touch-down (:meth:`cell.mailbox.Mailbox.put_after`), the set-down being the
+    event that wakes the conveyor.  The way back (TD → K → B) needs no event, since
+    no order comes before ``free_at_s``.
     """
 
     def __init__(self, env: simpy.Environment, output: Mailbox):
@@ -142,11 +183,8 @@ class Robot:
         self.orders.put(order)
 
     def run(self):  # noqa: ANN201 (SimPy generator)
-        env, timeout, put, get = self.env, self.env.timeout, self.output.put, self.orders.get
+        env, set_down, get = self.env, self.output.put_after, self.orders.get
         while True:
-            order: Order = yield get()
-            part = order.part
-            part.pick_s = env.now + order.to_lo_s
-            yield timeout(order.to_td_s)
-            part.touchdown_s = env.now
-            put(part)
+            part, to_lo_s, to_td_s, _ = yield get()
+            part.pick_s = env.now + to_lo_s
+            set_down(part, to_td_s)  # touch-down: B + (B → TD), as a timeout would fall

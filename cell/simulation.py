@@ -1,24 +1,32 @@
 """One run of the cell in simulated time (thesis §6).
 
-Five SimPy processes talk through one-event hand-offs: the feeder drops parts
-on the input conveyor; the conveyor hands each to the controller as it reaches
-B; the controller asks the scenario's policy for the part's cycle, sets the
-belts and sends the robot an order; the robot's touch-down hands the part to
-the output conveyor, which measures its spacing.  Each part's
-:class:`~cell.records.PartRecord` is filled in as these things happen; when a
-part is done (set down, or fallen off at F) the run's log completes its
-accounting and passes it on, in part order, to whoever asked for rows (a CSV
-writer, a list), keeping only a few numbers per part for the summary.
+Five SimPy processes talk through :class:`~cell.mailbox.Mailbox` hand-offs: the
+feeder drops parts on the input conveyor; the conveyor hands each to the
+controller due at the instant it reaches B; the controller asks the scenario's
+policy for the part's cycle, sets the belts and sends the robot an order; the
+robot hands the part to the output conveyor due at its touch-down, and the
+conveyor measures its spacing.  A part picked up costs about four SimPy events
+(its drop, its arrival at B, the order, the set-down), one fallen off at F two.
+Each part's :class:`~cell.records.PartRecord` is filled in as these things
+happen; when a part is done (set down, or fallen off at F) the run's log
+completes its accounting and passes it on, in part order, to whoever asked for
+rows (a CSV writer, a list), keeping only a few numbers per part for the summary.
+
+Nothing per part outlives its part unless the run keeps the rows, and those are
+kept as tuples of plain values, which Python's cyclic garbage collector stops
+tracking: its full collections then cost the same at any run length, so the
+cost per part does not grow with the run.
 
 :func:`simulate` is what ``cell run`` and every sweep replication call.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from array import array
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from operator import attrgetter
 from typing import Any
 
 import numpy as np
@@ -31,30 +39,66 @@ from cell.controller import Controller, View
 from cell.conveyors import InputConveyor, OutputConveyor
 from cell.feeder import Feeder
 from cell.policies.base import Accounting
-from cell.records import LIMIT_BIT, SPACING_OFF, BeltChange, PartRecord, RunSummary, limit_names
+from cell.records import (
+    LIMIT_BIT,
+    PART_COLUMNS,
+    SPACING_OFF,
+    BeltChange,
+    PartRecord,
+    RunSummary,
+    limit_names,
+)
 from cell.robot import Robot
 from cell.scenario import Scenario
 
 PartSink = Callable[[PartRecord], Any]
 BeltSink = Callable[[BeltChange], Any]
+#: parts.csv's columns of a record, as a tuple.
+_row = attrgetter(*PART_COLUMNS)
+_BELTS = ("input", "output")
+#: What the run's log keeps of each part for the summary (flags and picked as floats).
+PER_PART = ("touchdown", "picked", "r4", "output_speed", "ip_wallclock", "interval",
+            "spacing", "limits", "feed_delay")
 
 
-@dataclass
 class SimResult:
-    """A run: its summary, and its part records and belt changes if they were kept."""
+    """A run: its summary, and its part records and belt changes if they were kept.
 
-    summary: RunSummary
-    records: list[PartRecord] | None = None
-    belt_changes: list[BeltChange] = field(default_factory=list)
+    Kept parts are held as tuples of plain values (which the cyclic garbage collector
+    stops tracking), belt changes as flat arrays; the record objects are made when
+    first asked for.
+    """
+
+    def __init__(self, summary: RunSummary, rows: list[tuple[Any, ...]] | None = None,
+                 belt_log: BeltLog | None = None):
+        self.summary = summary
+        self._rows = rows
+        self._belt_log = belt_log
+
+    @functools.cached_property
+    def records(self) -> list[PartRecord] | None:
+        """Every part's record, in part order (None if the run did not keep them)."""
+        return None if self._rows is None else [PartRecord(*row) for row in self._rows]
+
+    @functools.cached_property
+    def belt_changes(self) -> list[BeltChange]:
+        """Every belt speed change, the input belt's first, each belt's in time order."""
+        log = self._belt_log
+        if log is None:
+            return []
+        changes = [BeltChange(_BELTS[b], t, v) for b, t, v in zip(log.belt, log.t, log.v)]
+        changes.sort(key=lambda c: (c.belt != "input", c.from_s))
+        return changes
 
     @property
     def parts(self) -> Any:
         """The part records as a pandas DataFrame (the columns of parts.csv)."""
         import pandas as pd
 
-        from cell.records import PART_COLUMNS
-
-        rows = [[getattr(r, c) for c in PART_COLUMNS] for r in self.records or ()]
+        if "records" in self.__dict__ and self.records is not None:
+            rows: Any = [_row(r) for r in self.records]
+        else:
+            rows = self._rows or []
         return pd.DataFrame(rows, columns=PART_COLUMNS)
 
     @property
@@ -66,34 +110,61 @@ class SimResult:
         return out
 
 
+class BeltLog:
+    """Belt speed changes as they become final: kept in flat arrays, and/or handed on."""
+
+    def __init__(self, keep: bool, sink: BeltSink | None):
+        self.belt, self.t, self.v = array("b"), array("d"), array("d")
+        self.keep, self.sink = keep, sink
+
+    def told(self, belt: int) -> Callable[[float, float], None] | None:
+        """What a belt calls with (instant, speed) of each final change (None: nobody asks)."""
+        if not self.keep and self.sink is None:
+            return None
+        mark, times, speeds, sink = self.belt.append, self.t.append, self.v.append, self.sink
+        name = _BELTS[belt]
+        if sink is None:
+            def keep(t: float, v: float) -> None:
+                mark(belt)
+                times(t)
+                speeds(v)
+            return keep
+        if not self.keep:
+            return lambda t, v: sink(BeltChange(name, t, v))
+
+        def both(t: float, v: float) -> None:
+            mark(belt)
+            times(t)
+            speeds(v)
+            sink(BeltChange(name, t, v))
+        return both
+
+
 class RunLog:
     """Completes each part's record and hands the records on in part order.
 
     Parts finish out of order (a part can fall off at F while the one before it
     is still in the hand), so a finished part waits here until those before it
     are done; at most a few do.  What the summary needs is kept per part in flat
-    arrays (a few dozen bytes a part), so a warm-up can be cut off at the end.
+    arrays (a few dozen bytes a part), so a warm-up can be cut off at the end;
+    no per-part object outlives its part unless the run keeps the rows.
     """
 
     def __init__(self, t: list[float], acct: Accounting, sinks: list[PartSink],
-                 spacing_in: float, tol_in: float):
+                 spacing_in: float, tol_in: float, rows: list[tuple[Any, ...]] | None = None):
         self.t = t
         """T_1 … T_{n+1}: the last is only part n's "next arrival"."""
         self.acct, self.sinks = acct, sinks
         self.spacing_in, self.tol_in = spacing_in, tol_in
+        self.rows = rows
+        """The kept rows (parts.csv's columns), if the run keeps them."""
         self.waiting: dict[int, PartRecord] = {}
         self.flags: dict[int, int] = {}
         """Limit bits of parts not yet handed on."""
         self.next = 1
-        self.td = array("d")
-        self.picked = array("b")
-        self.r4 = array("d")
-        self.out_speed = array("d")
-        self.ip_wall = array("d")
-        self.interval = array("d")
-        self.spacing = array("d")
-        self.limits = array("l")
-        self.feed_delay = array("d")
+        self.per_part = array("d")
+        """What the summary needs of each part, :data:`PER_PART` values a part in that order."""
+        self._emit = self._emitter()
 
     def flag(self, part: PartRecord, limits: int) -> None:
         self.flags[part.part] = self.flags.get(part.part, 0) | limits
@@ -108,31 +179,44 @@ class RunLog:
         if part.part != self.next:
             self.waiting[part.part] = part
             return
-        self._emit(part)
-        while self.next in self.waiting:
-            self._emit(self.waiting.pop(self.next))
-
-    def _emit(self, p: PartRecord) -> None:
-        t_next = self.t[p.part]
-        p.ip_wallclock = t_next / p.delivery_interval_s
-        self.acct.part(p, t_next)
-        flags = self.flags.pop(p.part, 0)
-        sp = p.spacing_in
-        if sp == sp and abs(sp - self.spacing_in) > self.tol_in + 1e-9:
-            flags |= SPACING_OFF
-        p.limits = limit_names(flags) if flags else ""
-        self.td.append(p.touchdown_s)
-        self.picked.append(p.picked)
-        self.r4.append(p.r4_s)
-        self.out_speed.append(p.output_speed_in_s)
-        self.ip_wall.append(p.ip_wallclock)
-        self.interval.append(p.delivery_interval_s)
-        self.spacing.append(sp)
-        self.limits.append(flags)
-        self.feed_delay.append(p.feed_delay_s)
-        for sink in self.sinks:
-            sink(p)
+        emit = self._emit
+        emit(part)
         self.next += 1
+        waiting = self.waiting
+        while waiting and self.next in waiting:
+            emit(waiting.pop(self.next))
+            self.next += 1
+
+    def _emitter(self) -> Callable[[PartRecord], None]:
+        """Completes a part's record and hands it on (the log's hot path, locals bound)."""
+        t, acct_part, flags_of = self.t, self.acct.part, self.flags.pop
+        spacing_in, tol = self.spacing_in, self.tol_in + 1e-9
+        note = self.per_part.extend
+        sinks = tuple(self.sinks)
+        keep = self.rows.append if self.rows is not None else None
+
+        def emit(p: PartRecord) -> None:
+            t_next = t[p.part]
+            d = p.delivery_interval_s
+            p.ip_wallclock = ip = t_next / d
+            acct_part(p, t_next)
+            flags = flags_of(p.part, 0)
+            sp = p.spacing_in
+            if sp == sp and abs(sp - spacing_in) > tol:
+                flags |= SPACING_OFF
+            p.limits = limit_names(flags) if flags else ""
+            note((p.touchdown_s, p.picked, p.r4_s, p.output_speed_in_s, ip, d, sp, flags,
+                  p.feed_delay_s))
+            if keep is not None:
+                keep(_row(p))
+            for sink in sinks:
+                sink(p)
+        return emit
+
+    def column(self, name: str, start: int = 0) -> np.ndarray:
+        """One of :data:`PER_PART`'s values of every part from ``start`` on (a copy)."""
+        table = np.frombuffer(self.per_part).reshape(-1, len(PER_PART))
+        return np.ascontiguousarray(table[start:, PER_PART.index(name)])
 
     def warmup(self, setting: int | str) -> int:
         """The number of leading parts to leave out: ``setting``, or for ``auto`` the
@@ -141,7 +225,7 @@ class RunLog:
             return int(setting)
         from cell.analysis.stats import mser5
 
-        interval = np.frombuffer(self.interval)
+        interval = self.column("interval")
         delivered = np.flatnonzero(np.isfinite(interval))
         if delivered.size < 10:
             return 0
@@ -174,42 +258,31 @@ def simulate(scenario: Scenario | AssembledCell,
     n = s.run.parts
     # T_1 .. T_{n+1}: the last is only the last part's "next arrival".
     t_all = interarrival_times(s.arrivals, n + 1, seed, s.base_dir)
+    t_list: list[float] = t_all.tolist()
 
-    records: list[PartRecord] | None = [] if keep_parts else None
-    sinks: list[PartSink] = [records.append] if records is not None else []
-    if on_part is not None:
-        sinks.append(on_part)
-    changes: list[BeltChange] = []
-
-    def belt_sink(name: str) -> Callable[[float, float], None]:
-        def told(t: float, v: float) -> None:
-            change = BeltChange(name, t, v)
-            if keep_belts:
-                changes.append(change)
-            if on_belt is not None:
-                on_belt(change)
-        return told
+    rows: list[tuple[Any, ...]] | None = [] if keep_parts else None
+    sinks: list[PartSink] = [on_part] if on_part is not None else []
+    belts = BeltLog(keep_belts, on_belt)
 
     acct = policy.accounting()
     env = simpy.Environment()
-    log = RunLog(t_all.tolist(), acct, sinks, k.spacing, k.tol)
-    conveyor = InputConveyor(env, k.v_nom, k.input_length, belt_sink("input"))
-    output = OutputConveyor(env, k.u_nom, log.delivered_part, belt_sink("output"))
+    log = RunLog(t_list, acct, sinks, k.spacing, k.tol, rows)
+    conveyor = InputConveyor(env, k.v_nom, k.input_length, belts.told(0))
+    output = OutputConveyor(env, k.u_nom, log.delivered_part, belts.told(1))
     robot = Robot(env, output.placed)
-    feeder = Feeder(env, t_all, conveyor, n, k.part_size, log.flag)
+    feeder = Feeder(env, t_all, conveyor, n, k.part_size, log.flag, t_list)
     conveyor.feeder = feeder
     view = View(env, k, feeder.fed_s, n, conveyor, output)
     Controller(env, k, policy, view, conveyor, output, robot, log)
     env.run()
     conveyor.belt.close()
     output.belt.close()
-    changes.sort(key=lambda c: (c.belt != "input", c.from_s))
 
     summary = _summary(cell, log, acct, t_all, n, env.now)
     summary.seed = _seed_value(seed)
     summary.input_speed_max_in_s = conveyor.belt.max_speed_in_s
     summary.input_speed_min_in_s = conveyor.belt.min_speed_in_s
-    return SimResult(summary, records, changes)
+    return SimResult(summary, rows, belts if keep_belts else None)
 
 
 def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, n: int,
@@ -217,15 +290,14 @@ def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, 
     """The run's measures over the parts after the warm-up (all of them by default)."""
     s, k = cell.scenario, cell.k
     w = log.warmup(s.run.warmup_parts)
-    td = np.frombuffer(log.td)[w:]
-    picked = np.frombuffer(log.picked, dtype=np.int8)[w:].astype(bool)
-    vout = np.frombuffer(log.out_speed)[w:][picked]
-    ip_wall = np.frombuffer(log.ip_wall)[w:]
-    sp = np.frombuffer(log.spacing)[w:]
+    td = log.column("touchdown", w)
+    picked = log.column("picked", w) != 0
+    vout = log.column("output_speed", w)[picked]
+    ip_wall = log.column("ip_wallclock", w)
+    sp = log.column("spacing", w)
     sp = sp[np.isfinite(sp)]
-    limits = np.frombuffer(log.limits, dtype=np.int_)[w:] if len(log.limits) else \
-        np.zeros(0, dtype=np.int_)
-    delay = np.frombuffer(log.feed_delay)[w:]
+    limits = log.column("limits", w).astype(np.int_)
+    delay = log.column("feed_delay", w)
     done = td[np.isfinite(td)]
     d = done.size
     missed = int((~picked).sum())
@@ -254,7 +326,7 @@ def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, 
         nominal_from=k.nominal_from, mean_interarrival_s=k.mean_interarrival_s,
         fastest_cycle_s=k.fastest_cycle_s, utilisation=k.utilisation, warmup_parts=w,
         sim_end_s=end_s)
-    acct.finish(r, w, np.frombuffer(log.r4)[w:][picked], t[1:])
+    acct.finish(r, w, log.column("r4", w)[picked], t[1:])
     r.parts_per_hr_wallclock = float(accounting.parts_per_hr(r.actual_cycle_wallclock_s))
     r.parts_per_hr_thesis = float(accounting.parts_per_hr(r.actual_cycle_thesis_s))
     r.vavg_r4_in_s = k.timing.r4.length_in / r.r4_s if r.r4_s == r.r4_s else math.nan

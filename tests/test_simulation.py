@@ -223,3 +223,127 @@ def test_invariants_hold_for_any_seed(seed, policy, ideal, input_max):
         sp = p.loc[clean, "spacing_in"].dropna()
         assert ((sp - 45.0).abs() <= 0.25 + 1e-9).all()
         assert max(v for _, v in r.belts["input"]) <= input_max + 1e-12
+
+
+# --------------------------------------------------------------------------- to the bit
+def _bits(values) -> list[str]:
+    return [f"{v:.17g}" if isinstance(v, float) else repr(v) for v in values]
+
+
+@pytest.mark.parametrize("family, params", [
+    ("weibull_min", {"c": 1 / 0.2038, "loc": 17.6019, "scale": 5.4342}),       # eq. 6.9
+    ("weibull_min", {"c": 0.7, "scale": 20.0}),
+    ("weibull_min", {"c": 11.0, "loc": 2.5, "scale": 0.25}),
+    ("expon", {"loc": 5.0, "scale": 17.0}),
+    ("expon", {}),
+])
+def test_closed_form_draws_are_scipys_inverse_cdf_to_the_bit(family, params):
+    import scipy.stats
+
+    from cell.arrivals import closed_form_ppf, stream
+
+    for seed in range(4):
+        u = stream(seed, 0).random(250_000)
+        ours = closed_form_ppf(family, params, u)
+        theirs = np.asarray(getattr(scipy.stats, family)(**params).ppf(u), dtype=float)
+        assert np.array_equal(ours.view(np.int64), theirs.view(np.int64))
+
+
+def test_log1p_is_scipys_to_the_bit_at_the_branch_edges():
+    import scipy.special
+
+    from cell.arrivals import log1p_as_scipy
+
+    edge = np.sqrt(0.5) - 1.0
+    x = np.concatenate([np.nextafter(edge, -1) - np.arange(50) * 1e-17,
+                        edge + np.arange(-50, 50) * 1e-17, -np.geomspace(1e-300, 0.999, 2000),
+                        np.linspace(-0.9999999, 0.4, 20001), [0.0, -0.0]])
+    assert np.array_equal(log1p_as_scipy(x).view(np.int64), scipy.special.log1p(x).view(np.int64))
+
+
+def test_kept_and_streamed_runs_give_the_same_rows():
+    s = default_scenario().with_overrides({"run.parts": 400})
+    kept = simulate(s, seed=3)
+    streamed_parts, streamed_belts = [], []
+    streamed = simulate(s, seed=3, keep_parts=False, keep_belts=False,
+                        on_part=lambda r: streamed_parts.append(_bits(
+                            getattr(r, c) for c in PART_COLUMNS)),
+                        on_belt=streamed_belts.append)
+    assert streamed.records is None and streamed.belt_changes == []
+    assert [_bits(getattr(r, c) for c in PART_COLUMNS) for r in kept.records] == streamed_parts
+    assert sorted(kept.belt_changes, key=lambda c: (c.belt, c.from_s)) == \
+        sorted(streamed_belts, key=lambda c: (c.belt, c.from_s))
+    assert _bits(getattr(kept.summary, c) for c in SUMMARY_COLUMNS) == \
+        _bits(getattr(streamed.summary, c) for c in SUMMARY_COLUMNS)
+    frame = kept.parts
+    assert list(frame.columns) == PART_COLUMNS and len(frame) == 400
+
+
+def _reference_non_adaptive(s, seed):
+    """The non-adaptive cell as a plain loop, no SimPy: belts never change speed, so a part
+    reaches B when the belt has carried it the belt's length, the robot takes it if it is
+    back, sets it down B → TD later.  Each instant is computed with the same float
+    operations as the simulation's (a belt's time for a travel is t₀ + (x − x₀)/v, a
+    delay is added to the instant it is measured from)."""
+    from cell.accounting import THESIS_SLACK_S
+    from cell.arrivals import interarrival_times
+    from cell.assembly import assemble
+    from cell.records import LET_GO, R4_PEAK, SPACING_OFF, PartRecord, limit_names
+
+    cell = assemble(s)
+    k, plan, c = cell.k, cell.policy.cycle, cell.policy.ideal_cycle_s
+    n = s.run.parts
+    t = interarrival_times(s.arrivals, n + 1, seed)
+    fed = np.cumsum(t).tolist()
+    t = t.tolist()
+    v, u, length = k.v_nom, k.u_nom, k.input_length
+    tm = k.timing
+    r1, r3 = plan.r1_pre + plan.r1_post, plan.r3_pre + plan.r3_post
+    to_td = plan.r1_pre + (plan.to_g - plan.r1_pre + plan.r3_pre)
+    free_at, at_bot, last_x, last_td, clear = 0.0, -np.inf, None, None, -np.inf
+    out = []
+    for i in range(n):
+        x = 0.0 + v * (fed[i] - 0.0)
+        assert x >= clear - 1e-9                       # never held on these arrivals
+        clear = x + k.part_size
+        now = max(fed[i], at_bot)                      # the conveyor times it from here
+        delay = max((0.0 + (x + length - 0.0) / v) - now, 0.0)
+        at_bot = now + delay
+        p = PartRecord(i + 1, fed[i], t[i], at_bot_s=at_bot)
+        flags = 0
+        if free_at <= at_bot + 1e-6:
+            free_at = at_bot + plan.cycle
+            p.picked, p.motion_cycle_s = True, plan.cycle
+            p.input_speed_in_s, p.output_speed_in_s = plan.input_speed, plan.output_to_g
+            p.r1_s, p.r2_s, p.r3_s, p.r4_s = r1, plan.r2, r3, plan.r4
+            p.v_r1_in_s, p.v_r2_in_s = tm.r1_length_in / r1, tm.r2.length_in / plan.r2
+            p.v_r3_in_s, p.v_r4_in_s = tm.r3_length_in / r3, tm.r4.length_in / plan.r4
+            p.pick_s = at_bot + plan.r1_pre
+            p.touchdown_s = td = at_bot + to_td
+            x_td = 0.0 + u * (td - 0.0)
+            if last_x is not None:
+                p.spacing_in, p.delivery_interval_s = x_td - last_x, td - last_td
+            last_x, last_td = x_td, td
+            flags |= R4_PEAK if plan.limits else 0
+        else:
+            p.missed, flags = True, LET_GO
+        p.ip_wallclock = t[i + 1] / p.delivery_interval_s
+        lost = t[i] < c - THESIS_SLACK_S
+        p.missed_thesis, p.thesis_interval_s = lost, t[i] + c if lost else t[i]
+        p.ip_thesis = t[i + 1] / (2.0 * p.thesis_interval_s)
+        if p.spacing_in == p.spacing_in and abs(p.spacing_in - k.spacing) > k.tol + 1e-9:
+            flags |= SPACING_OFF
+        p.limits = limit_names(flags) if flags else ""
+        out.append(p)
+    return out
+
+
+@pytest.mark.parametrize("ideal, seed", [(22.5872, 1), (21.0, 2), (20.0907, 3)])
+def test_non_adaptive_run_is_the_plain_reference_to_the_bit(ideal, seed):
+    s = load_scenario(NON_ADAPTIVE, {"run.parts": 1500, "controller.ideal_cycle_s": ideal})
+    ours = simulate(s, seed=seed).records
+    ref = _reference_non_adaptive(s, seed)
+    assert len(ours) == len(ref) == 1500
+    for a, b in zip(ours, ref):
+        assert _bits(getattr(a, c) for c in PART_COLUMNS) == \
+            _bits(getattr(b, c) for c in PART_COLUMNS), a.part

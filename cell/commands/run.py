@@ -1,13 +1,16 @@
 """``cell run SCENARIO --out DIR``: one run; DIR/parts.csv, summary.csv and belts.csv.
 
 Part rows and belt changes are streamed to their files while the simulation
-runs, so a long run needs little memory; the three files appear together.
+runs, so a long run needs little memory; the three files appear together.  A
+long run shows its progress on stderr.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
+from typing import Any
 
 from cell.commands import scenario_arguments
 
@@ -23,6 +26,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 #: The files of a run, written as one set.
 RUN_FILES = ("parts.csv", "summary.csv", "belts.csv")
+#: Runs of at least this many parts show their progress on stderr (a bar on a terminal,
+#: a line every tenth of the run in a log).
+PROGRESS_FROM_PARTS = 50_000
 
 
 def main(args: argparse.Namespace) -> int:
@@ -30,6 +36,7 @@ def main(args: argparse.Namespace) -> int:
     from cell.csvfile import RowWriter
     from cell.output import OutputDir
     from cell.overrides import parse_sets
+    from cell.progress import Progress
     from cell.records import BELT_COLUMNS, PART_COLUMNS, SUMMARY_COLUMNS
     from cell.reporting.runs import format_summary, run_heading, thesis_figures, warnings
     from cell.scenario import load_scenario
@@ -41,11 +48,25 @@ def main(args: argparse.Namespace) -> int:
     print(run_heading(cell))
     for line in warnings(cell.k):
         print(f"cell: warning: {line}", file=sys.stderr)
-    with OutputDir(args.out, RUN_FILES) as out:
+    n = scenario.run.parts
+    with OutputDir(args.out, RUN_FILES) as out, \
+            Progress(n, "cell run", "parts", enabled=n >= PROGRESS_FROM_PARTS) as progress:
         with out.open("parts.csv", newline="") as pf, out.open("belts.csv", newline="") as bf:
             parts, belts = RowWriter(pf, PART_COLUMNS), RowWriter(bf, BELT_COLUMNS)
-            result = simulate(cell, keep_parts=False, on_part=parts.record,
+            on_part: Callable[[Any], None] = parts.record
+            if progress.enabled:  # counted in chunks: a call per part would show in the run's time
+                step, write = max(1, n // 200), parts.record
+
+                def counted(record: Any) -> None:
+                    write(record)
+                    if record.part % step == 0:
+                        progress.update(step)
+
+                on_part = counted
+
+            result = simulate(cell, keep_parts=False, on_part=on_part,
                               on_belt=belts.record, keep_belts=False)
+            progress.update(n - progress.n)
         with out.open("summary.csv", newline="") as sf:
             RowWriter(sf, SUMMARY_COLUMNS).record(result.summary)
     print(format_summary(result.summary, thesis_figures(scenario)))

@@ -70,8 +70,13 @@ class ReconstructedAccounting(Accounting):
 
     policy: FixedCycle
 
+    def __init__(self, policy: FixedCycle):
+        super().__init__(policy)
+        self.cycle_s = policy.ideal_cycle_s
+        """The robot's fixed cycle C."""
+
     def part(self, rec: PartRecord, next_interarrival_s: float) -> None:
-        c = self.policy.ideal_cycle_s
+        c = self.cycle_s
         t = rec.interarrival_s
         lost = t < c - accounting.THESIS_SLACK_S
         d = t + c if lost else t

@@ -38,16 +38,19 @@ import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from cell.errors import CellError
 from cell.output import FLOAT_FORMAT, atomic_path, write_csv, write_text
+from cell.progress import Progress
 from cell.scenario import Scenario
 from cell.sweep.columns import Column, grid_columns, point_values
 from cell.sweep.spec import Sweep, Task
+
+if TYPE_CHECKING:  # pandas is imported when first needed: local workers start without it
+    import pandas as pd
 
 #: A replication: (scenario, stream) -> the run's summary row.
 Replicate = Callable[[Scenario, np.random.SeedSequence], Mapping[str, Any]]
@@ -66,7 +69,7 @@ def simulate_summary(scenario: Scenario, seed: np.random.SeedSequence) -> Mappin
     """The default replication: one run of the cell, its summary row."""
     from cell.simulation import simulate
 
-    return simulate(scenario, seed=seed, keep_parts=False).summary.as_dict()
+    return simulate(scenario, seed=seed, keep_parts=False, keep_belts=False).summary.as_dict()
 
 
 def run_task(replicate: Replicate, scenario: Scenario,
@@ -90,6 +93,8 @@ def _plain(value: Any) -> Any:
 
 def _task_frame(sweep: Sweep, columns: Sequence[Column], task: Task,
                 rows: Sequence[Mapping[str, Any]]) -> pd.DataFrame:
+    import pandas as pd
+
     point = sweep.points[task.point]
     records = []
     for r, summary in zip(range(task.first, task.last), rows, strict=True):
@@ -106,6 +111,8 @@ def _read_task(sweep: Sweep, path: Path, task: Task) -> pd.DataFrame | None:
     """A finished task's rows, or None if the file is missing or not this task's."""
     if not path.is_file():
         return None
+    import pandas as pd
+
     try:
         frame = pd.read_csv(path)
     except (OSError, ValueError):
@@ -131,6 +138,8 @@ class Outcome:
 
     @functools.cached_property
     def replications(self) -> pd.DataFrame:
+        import pandas as pd
+
         return pd.read_csv(self.path)
 
 
@@ -282,10 +291,6 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     ``replicate`` is what one replication does; the default simulates the cell.
     It must be a module-level function when tasks run in other processes.
     """
-    from tqdm import tqdm
-
-    from cell.analysis.stats import next_round, precision_reached
-
     out = check_out(out)
     cores = os.cpu_count() or 1
     workers = cores if workers is None else workers
@@ -303,8 +308,8 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     run = reused = 0
     try:
         _prepare(sweep, out, resume)
-        bar = tqdm(total=sweep.total_replications, unit="rep", desc=sweep.name,
-                   disable=not progress, file=sys.stderr, dynamic_ncols=True)
+        bar = Progress(sweep.total_replications, sweep.name, "replications", file=sys.stderr,
+                       enabled=progress)
 
         def done(task: Task, rows: list[dict[str, Any]]) -> None:
             write_csv(_task_frame(sweep, columns, task, rows), task_dir / task.filename,
@@ -329,6 +334,8 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
                     counts[p] = last
                 if sweep.precision is None:
                     break
+                from cell.analysis.stats import next_round, precision_reached
+
                 q = sweep.precision
                 for task in sweep.iter_tasks(ranges):
                     values[task.point] += _measure(sweep, task_dir, task, q.measure)
@@ -336,7 +343,9 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
                 more = next_round(counts, reached, sweep.batch, q.max_n)
                 ranges = {p: (counts[p], counts[p] + k) for p, k in more.items() if k}
                 bar.total += sum(more.values())
-                bar.refresh()
+                if bar.bar is not None:  # the terminal's bar grows with the round
+                    bar.bar.total = bar.total
+                    bar.bar.refresh()
     except BaseException:
         _close(executor, client, wait=False)
         raise
@@ -354,29 +363,28 @@ def _measure(sweep: Sweep, task_dir: Path, task: Task, measure: str) -> list[flo
     if measure not in frame.columns:
         raise CellError(f"{sweep.source}: replications.measure = {measure!r}: the replications "
                         "have no such column")
+    import pandas as pd
+
     return [float(v) for v in pd.to_numeric(frame[measure], errors="coerce")]
 
 
 def _assemble(sweep: Sweep, task_dir: Path, tasks: Sequence[Task], target: Path) -> Path:
-    """``replications.csv`` from the task files, in the tasks' order, one task at a time.
+    """``replications.csv`` from the task files, in the tasks' order (each file read once).
 
-    Assembled from the files, never from memory: a resumed sweep and an
-    uninterrupted one go through the same bytes.
+    Assembled from the files, never from the results in memory: a resumed sweep and
+    an uninterrupted one go through the same bytes.
     """
+    frames = []
     names: dict[str, None] = {}
     for task in tasks:
-        path = task_dir / task.filename
-        try:
-            names.update(dict.fromkeys(pd.read_csv(path, nrows=0).columns))
-        except (OSError, ValueError):
-            raise CellError(f"{path}: missing or damaged; rerun the sweep") from None
+        frame = _read_task(sweep, task_dir / task.filename, task)
+        if frame is None:
+            raise CellError(f"{task_dir / task.filename}: missing or damaged; rerun the sweep")
+        names.update(dict.fromkeys(frame.columns))
+        frames.append(frame)
     with atomic_path(target) as tmp, open(tmp, "w", encoding="utf-8", newline="") as stream:
-        for i, task in enumerate(tasks):
-            frame = _read_task(sweep, task_dir / task.filename, task)
-            if frame is None:  # pragma: no cover - written above
-                raise CellError(f"{task_dir / task.filename}: missing or damaged; rerun the sweep")
+        for i, frame in enumerate(frames):
             frame.reindex(columns=list(names)).to_csv(
                 stream, header=i == 0, index=False, float_format=FLOAT_FORMAT,
                 lineterminator="\n")
     return target
-

@@ -1,0 +1,110 @@
+"""The hand-off between the cell's processes (cell.mailbox) against simpy.Store's order."""
+
+from __future__ import annotations
+
+import pytest
+import simpy
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from cell.mailbox import Mailbox
+
+
+def _deliveries(box_factory, puts: list[tuple[float, int]], pause: float) -> list[tuple[float, int]]:
+    """(instant, item) of each item a consumer takes, items put at the given instants; the
+    consumer works ``pause`` s after each item."""
+    env = simpy.Environment()
+    box = box_factory(env)
+    got: list[tuple[float, int]] = []
+
+    def producer():  # noqa: ANN202
+        for at, item in puts:
+            yield env.timeout(at - env.now)
+            box.put(item)
+
+    def consumer():  # noqa: ANN202
+        while True:
+            item = yield box.get()
+            got.append((env.now, item))
+            if pause:
+                yield env.timeout(pause)
+
+    env.process(producer())
+    env.process(consumer())
+    env.run(until=puts[-1][0] + pause * (len(puts) + 1) + 1)
+    return got
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.integers(0, 5), min_size=1, max_size=30), st.sampled_from([0.0, 0.5, 2.0]))
+def test_items_arrive_in_order_when_simpy_store_would_deliver_them(gaps, pause):
+    """Same items, same instants as simpy.Store (the reference); only the events differ."""
+    at, puts = 0.0, []
+    for i, gap in enumerate(gaps):
+        at += gap
+        puts.append((at, i))
+    assert _deliveries(Mailbox, puts, pause) == _deliveries(simpy.Store, puts, pause)
+
+
+def test_a_queued_item_is_taken_without_an_event():
+    env = simpy.Environment()
+    box = Mailbox(env)
+    for item in "abc":
+        box.put(item)
+    log = []
+
+    def other():  # noqa: ANN202  (scheduled before the consumer's takes)
+        yield env.timeout(0)
+        log.append("other")
+
+    def consumer():  # noqa: ANN202
+        for _ in range(3):
+            log.append((yield box.get()))
+
+    env.process(other())
+    env.process(consumer())
+    env.step()  # other's start
+    env.step()  # consumer's start: takes all three at once, before other's timeout
+    assert log == ["a", "b", "c"]
+    env.run()
+    assert log == ["a", "b", "c", "other"] and len(box) == 0
+
+
+def test_put_after_wakes_the_receiver_then_the_sender_at_the_instant():
+    env = simpy.Environment()
+    box = Mailbox(env)
+    log = []
+
+    def receiver():  # noqa: ANN202
+        while True:
+            item = yield box.get()
+            log.append(("received", item, env.now))
+
+    def sender():  # noqa: ANN202
+        yield env.timeout(1.0)
+        event = box.put_after("part", 2.5)
+        got = yield event
+        log.append(("sender resumed", got, env.now))
+
+    env.process(receiver())
+    env.process(sender())
+    env.run()
+    assert log == [("received", "part", 3.5), ("sender resumed", "part", 3.5)]
+
+
+def test_put_after_needs_a_waiting_receiver_and_an_empty_box():
+    env = simpy.Environment()
+    box = Mailbox(env)
+    with pytest.raises(RuntimeError):
+        box.put_after("x", 1.0)            # nobody waits
+    box.put("queued")
+    with pytest.raises(RuntimeError):
+        box.put_after("x", 1.0)            # an item is queued
+
+
+def test_one_waiting_process_at_a_time():
+    env = simpy.Environment()
+    box = Mailbox(env)
+    box.get()
+    with pytest.raises(RuntimeError):
+        box.get()
