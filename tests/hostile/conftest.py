@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from harness import COUNT
+from .harness import COUNT
 
 
 def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter) -> None:

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from harness import COUNT, Result, cli, ran_sanely, refused, tree
+from .harness import COUNT, Result, cli, ran_sanely, refused, tree
 
 ROOT = Path(__file__).resolve().parents[2]
 TRACE = "interarrival_s\n" + "".join(f"{22 + (i * 7919 % 13) / 5:.3f}\n" for i in range(60))

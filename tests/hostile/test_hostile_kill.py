@@ -16,7 +16,7 @@ import signal
 from pathlib import Path
 
 import pytest
-from harness import COUNT
+from .harness import COUNT
 
 import cell.output as output
 from cell.output import OutputDir

@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 
 import pytest
-from harness import cli, ran_sanely, refused
+from .harness import cli, ran_sanely, refused
 
 BOMB = "a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
     f"{chr(98 + i)}: &{chr(98 + i)} [{', '.join([f'*{chr(97 + i)}'] * 10)}]\n" for i in range(8))
