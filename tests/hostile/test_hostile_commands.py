@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+
 from .harness import COUNT, Result, cli, ran_sanely, refused, tree
 
 ROOT = Path(__file__).resolve().parents[2]

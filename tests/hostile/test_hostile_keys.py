@@ -20,10 +20,11 @@ from typing import Any
 
 import pytest
 from annotated_types import Ge, Gt, Le, Lt
-from .harness import cli, ran_sanely, refused
 from pydantic import BaseModel
 
 from cell.scenario import Scenario, default_scenario
+
+from .harness import cli, ran_sanely, refused
 
 PARTS = 6
 DEFAULTS = default_scenario()

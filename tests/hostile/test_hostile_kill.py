@@ -16,10 +16,11 @@ import signal
 from pathlib import Path
 
 import pytest
-from .harness import COUNT
 
 import cell.output as output
 from cell.output import OutputDir
+
+from .harness import COUNT
 
 NAMES = ["parts.csv", "summary.csv", "belts.csv"]
 

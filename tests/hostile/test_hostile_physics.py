@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 import pytest
+
 from .harness import COUNT, cli, ran_sanely, refused, tree
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -13,6 +13,7 @@ import time
 from pathlib import Path
 
 import pytest
+
 from .harness import cli, ran_sanely, refused
 
 BOMB = "a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
