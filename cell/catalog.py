@@ -28,20 +28,55 @@ def resolve(name_or_path: str | Path) -> Path:
     return built_in if built_in.is_file() else given
 
 
+#: Keys only a sweep file has, and keys only a dynamics file has.
+SWEEP_ONLY = frozenset({"base", "grid", "policies", "replications", "baseline", "batch", "set"})
+DYNAMICS_ONLY = frozenset({"links", "drives", "gravity_m_s2"})
+
+#: What each kind of file is for, for messages.
+USE = {"scenario": "run it with `cell run`, `cell compare` or `cell animate`",
+       "sweep": "run it with `cell sweep`",
+       "dynamics": "name it in a scenario's mintime.dynamics_file"}
+
+
+def kind(raw: object) -> str:
+    """``scenario``, ``sweep`` or ``dynamics``: what a file's top-level mapping is, by its keys."""
+    keys = set(raw) if isinstance(raw, dict) else set()
+    if keys & DYNAMICS_ONLY:
+        return "dynamics"
+    if keys & SWEEP_ONLY:
+        return "sweep"
+    return "scenario"
+
+
+def refuse_other_kind(raw: object, path: Path | str, wanted: str) -> None:
+    """Raise a one-line error when a ``wanted`` file is really another kind of file."""
+    from cell.errors import ScenarioError
+
+    found = kind(raw)
+    if found != wanted:
+        raise ScenarioError(path, "(file)", str(path), f"this is a {found} file, not a {wanted} "
+                            f"file: {USE[found]}")
+
+
 def names() -> list[str]:
     """Every built-in file's name, without ``.yaml``."""
     return sorted(p.stem for p in BUILT_IN.glob("*.yaml"))
 
 
-def describe(name: str) -> str:
-    """A built-in file's ``description``, or its first comment line."""
+def read(name: str) -> object:
+    """A built-in file's top-level document (None if it is not YAML)."""
     import yaml
 
-    text = path(name).read_text(encoding="utf-8")
     try:
-        doc = yaml.safe_load(text)
+        return yaml.safe_load(path(name).read_text(encoding="utf-8"))
     except yaml.YAMLError:  # pragma: no cover - the files are the project's own
-        doc = None
+        return None
+
+
+def describe(name: str) -> str:
+    """A built-in file's ``description``, or its first comment line."""
+    doc = read(name)
+    text = path(name).read_text(encoding="utf-8")
     if isinstance(doc, dict) and doc.get("description"):
         return str(doc["description"])
     first = next((line for line in text.splitlines() if line.startswith("#")), "# ")

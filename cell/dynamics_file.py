@@ -66,9 +66,11 @@ def load_dynamics(path: str | Path) -> DynamicsModel:
 
 @memo(key=lambda path: file_key(path))
 def _load(path: Path) -> DynamicsModel:
+    from cell import catalog
     from cell.yamlio import load_mapping
 
     raw = load_mapping(path, "dynamics")
+    catalog.refuse_other_kind(raw, path, "dynamics")
     try:
         f = DynamicsFile.model_validate(raw)
     except ValidationError as exc:

@@ -200,7 +200,9 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
     from cell.yamlio import load_mapping
 
     path = catalog.resolve(path)
-    raw = merge(_DEFAULTS.to_dict(), load_mapping(path, "scenario"), (), is_section)
+    given = load_mapping(path, "scenario")
+    catalog.refuse_other_kind(given, path, "scenario")
+    raw = merge(_DEFAULTS.to_dict(), given, (), is_section)
     raw = apply_overrides(raw, overrides or {}, path, is_section)
     return validate(raw, path, source=str(path))
 

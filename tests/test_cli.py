@@ -109,6 +109,47 @@ def test_built_in_scenarios_are_listed_and_run_by_name(tmp_path, capsys):
     assert (out / "parts.csv").is_file()
 
 
+def test_built_in_files_are_listed_by_what_they_are_for(capsys):
+    from cell import catalog
+
+    assert main(["scenarios"]) == 0
+    listed = capsys.readouterr().out
+    headings = [line for line in listed.splitlines() if not line.startswith(" ")]
+    assert [h.split()[0] for h in headings] == ["scenario", "sweep", "dynamics"]
+    section = {h.split()[0]: [] for h in headings}
+    current = None
+    for line in listed.splitlines():
+        if line.startswith(" "):
+            section[current].append(line.split()[0])
+        else:
+            current = line.split()[0]
+    assert set(sum(section.values(), [])) == set(catalog.names())
+    assert "table_7_1" in section["sweep"] and "microbot_dynamics" in section["dynamics"]
+    # every file listed as a kind loads as that kind
+    from cell.dynamics_file import load_dynamics
+    from cell.scenario import load_scenario
+    from cell.sweep.spec import load_sweep
+
+    for name in section["scenario"]:
+        load_scenario(name)
+    for name in section["sweep"]:
+        load_sweep(name)
+    for name in section["dynamics"]:
+        load_dynamics(catalog.path(name))
+
+
+@pytest.mark.parametrize("command,name,found", [
+    (["run"], "table_7_1", "sweep"), (["run"], "microbot_dynamics", "dynamics"),
+    (["sweep"], "baseline", "scenario"), (["sweep"], "microbot_dynamics", "dynamics"),
+    (["compare", "baseline"], "whatif", "sweep")])
+def test_a_file_of_the_wrong_kind_is_named_for_what_it_is(tmp_path, capsys, command, name, found):
+    code = main([*command, name, "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code != 0 and len(err) == 1
+    assert f"{name}.yaml" in err[0] and f"this is a {found} file" in err[0]
+    assert not (tmp_path / "out").exists()
+
+
 def test_schema_describes_every_section(capsys):
     import json
 

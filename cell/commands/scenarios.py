@@ -19,7 +19,12 @@ def main(args: argparse.Namespace) -> int:
 
     names = catalog.names()
     width = max(len(n) for n in names)
-    for name in names:
-        where = f"  ({catalog.path(name)})" if args.path else ""
-        print(f"{name:<{width}}  {catalog.describe(name)}{where}")
+    by_kind = {k: [n for n in names if catalog.kind(catalog.read(n)) == k] for k in catalog.USE}
+    for k, members in by_kind.items():
+        if not members:
+            continue
+        print(f"{k} files ({catalog.USE[k].replace(' it ', ' them ')}):")
+        for name in members:
+            where = f"  ({catalog.path(name)})" if args.path else ""
+            print(f"  {name:<{width}}  {catalog.describe(name)}{where}")
     return 0

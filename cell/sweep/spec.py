@@ -223,6 +223,7 @@ def load_sweep(path: str | Path) -> Sweep:
 
     path = catalog.resolve(path)
     raw = load_mapping(path, "sweep")
+    catalog.refuse_other_kind(raw, path, "sweep")
     for key in raw:
         if key not in SWEEP_KEYS:
             raise ScenarioError(path, str(key), raw[key],
