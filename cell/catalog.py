@@ -58,6 +58,16 @@ def refuse_other_kind(raw: object, path: Path | str, wanted: str) -> None:
                             f"file: {USE[found]}")
 
 
+def shown(source: str | Path) -> str:
+    """How to name a file in a command line: a built-in one by its name, any other as given."""
+    p = Path(source)
+    try:
+        inside = p.resolve().parent == BUILT_IN and p.suffix == ".yaml"
+    except OSError:
+        inside = False
+    return p.stem if inside and Path(source).is_absolute() else str(source)
+
+
 def names() -> list[str]:
     """Every built-in file's name, without ``.yaml``."""
     return sorted(p.stem for p in BUILT_IN.glob("*.yaml"))

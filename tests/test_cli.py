@@ -157,3 +157,12 @@ def test_schema_describes_every_section(capsys):
     schema = json.loads(capsys.readouterr().out)
     assert {"cell", "path", "part", "robot", "belts", "arrivals", "controller", "run",
             "mintime"} <= set(schema["properties"])
+
+
+def test_a_built_in_file_is_named_in_reports_as_a_user_would_type_it(tmp_path):
+    from cell import catalog
+
+    assert catalog.shown(catalog.resolve("whatif")) == "whatif"
+    assert catalog.shown("scenarios/whatif.yaml") == "scenarios/whatif.yaml"
+    own = tmp_path / "whatif.yaml"
+    assert catalog.shown(own) == str(own)

@@ -66,9 +66,10 @@ def _sweep(args: argparse.Namespace) -> int:
           f"{reps} replications ({outcome.tasks_run} tasks run, "
           f"{outcome.tasks_reused} reused)")
     if target is not None:
+        from cell import catalog
         from cell.reporting.experiment import write_report
 
-        command = f"cell sweep {shlex.quote(sweep.source)} --report ..."
+        command = f"cell sweep {shlex.quote(catalog.shown(sweep.source))} --report ..."
         written = list(write_report(outcome.replications, sweep, target, command))
         folders = sorted({str(Path(p).parent) for p in written})
         print(f"wrote {', '.join(folders)}: " + ", ".join(Path(p).name for p in written))
