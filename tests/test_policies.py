@@ -190,11 +190,22 @@ def test_a_plug_in_policy_runs_through_a_sweep(plug_in, tmp_path, capsys):
     sweep = tmp_path / "sweep.yaml"
     sweep.write_text(f"base: {catalog.path('baseline')}\nset: {{run.parts: 60}}\n"
                      f"policies: [{plug_in}, non-adaptive]\nreplications: 3\nseed: 7\n")
-    assert main(["sweep", str(sweep), "--out", str(tmp_path / "out"), "--workers", "1"]) == 0
+    report = tmp_path / "report"
+    assert main(["sweep", str(sweep), "--out", str(tmp_path / "out"), "--workers", "1",
+                 "--report", str(report)]) == 0
     rows = pd.read_csv(tmp_path / "out" / "replications.csv")
     assert sorted(set(rows["policy"])) == sorted([plug_in, "non-adaptive"])
     by = rows.groupby("policy")["parts_missed"].apply(list)
     assert by[plug_in] == by["non-adaptive"]
+    # the report treats the plug-in as any policy: summarised, and paired with the other
+    summary = pd.read_csv(report / "summary.csv")
+    assert set(summary["policy"]) == {plug_in, "non-adaptive"}
+    missed = summary[summary["measure"] == "parts_missed"].set_index("policy")["mean"]
+    assert missed[plug_in] == missed["non-adaptive"] == pytest.approx(np.mean(by[plug_in]), rel=1e-9)
+    differences = pd.read_csv(report / "differences.csv")
+    paired = differences[differences["measure"] == "parts_missed"]
+    assert len(paired) == 1 and paired["mean"].iloc[0] == 0
+    assert plug_in in (report / "report.md").read_text()
 
 
 def test_an_unknown_policy_lists_the_known_ones(thesis_cell):
