@@ -18,6 +18,7 @@ import functools
 import hashlib
 import json
 import math
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -68,15 +69,27 @@ def planner_bounds(s: Scenario) -> Any:
     from cell.mintime.regimes import PlannerBounds
 
     mt = s.mintime
-    model = None
-    if mt.dynamics_file is not None:
-        path = s.base_dir / mt.dynamics_file
-        if not path.is_file():
-            raise ScenarioError(s.source, "mintime.dynamics_file", mt.dynamics_file,
-                                f"no such file (looked for {path})")
-        model = load_dynamics(path)
+    path = dynamics_path(s)
+    model = load_dynamics(path) if path is not None else None
     return PlannerBounds(mt.grid_points, mt.rate_fraction, mt.qddot_max_rad_s2,
                          mt.acceleration_bounds, model)
+
+
+def dynamics_path(s: Scenario) -> Path | None:
+    """The scenario's dynamics file: beside the scenario, else a built-in one of that name
+    (so a copy of ``baseline.yaml`` anywhere still finds ``microbot_dynamics.yaml``)."""
+    from cell import catalog
+
+    name = s.mintime.dynamics_file
+    if name is None:
+        return None
+    beside = s.base_dir / name
+    if beside.is_file():
+        return beside
+    built_in = catalog.path(name)
+    if Path(name).name == name and built_in.is_file():
+        return built_in
+    raise ScenarioError(s.source, "mintime.dynamics_file", name, f"no such file (looked for {beside})")
 
 
 # --------------------------------------------------------------------------- the path
@@ -194,8 +207,8 @@ def _timing_key(s: Scenario) -> dict[str, Any] | None:
     try:
         key: dict[str, Any] = {name: getattr(s, name).model_dump() for name in TIMING_SECTIONS}
         if s.robot.timing == "minimum-time" and s.mintime.dynamics_file is not None:
-            path = s.base_dir / s.mintime.dynamics_file
-            key["dynamics_file_sha256"] = hashlib.sha256(path.read_bytes()).hexdigest()
+            path = dynamics_path(s)
+            key["dynamics_file_sha256"] = hashlib.sha256(path.read_bytes() if path else b"").hexdigest()
         json.dumps(key)
     except (OSError, TypeError, ValueError):
         return None
@@ -373,7 +386,12 @@ def make_policy(s: Scenario, k: CellConstants) -> Policy:
 
 
 def assemble(s: Scenario) -> AssembledCell:
-    """Every check and every solved value the simulation needs, errors first."""
+    """Every check and every solved value the simulation needs, errors first (a dynamics file
+    is read and checked even when the timing does not use it)."""
+    if s.robot.timing != "minimum-time" and (unused := dynamics_path(s)) is not None:
+        from cell.dynamics_file import load_dynamics
+
+        load_dynamics(unused)
     timing = robot_timing(s)
     k = constants(s, timing)
     return AssembledCell(s, timing, k, make_policy(s, k))

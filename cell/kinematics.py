@@ -106,8 +106,9 @@ def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *,
     """Joint angles (..., 5) for target frames T5 (..., 4, 4), in closed form
     (docs/sources.md: eq. 3.26-3.31 as scanned are garbled).
 
-    The elbow-down branch (θ3 ≤ 0) of Table 3.1's ranges is taken; θ1 is the
-    solution inside the base's range.  A pose out of reach (|C3| > 1) or with a
+    The elbow-down branch (θ3 ≤ 0) of Table 3.1's ranges is taken; of θ1's two
+    solutions (arm towards or away from the wrist) the one that keeps every joint
+    inside its range.  A pose out of reach (|C3| > 1) or with a
     joint outside its range raises :class:`UnreachableError` naming the pose
     (``label(i)`` if given) and the joint.  Nothing is clamped.
     """
@@ -117,28 +118,36 @@ def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *,
     n, o, a, p = t[:, :3, 0], t[:, :3, 1], t[:, :3, 2], t[:, :3, 3]
     lim = arm.limits_rad
 
-    th1 = np.arctan2(p[:, 1], p[:, 0])
-    # The wrist may sit behind the base axis (θ2 > 90°): then the other atan2 branch.
-    th1 = np.where((th1 > lim[0, 1] + 1e-12) | (th1 < lim[0, 0] - 1e-12),
-                   np.arctan2(-p[:, 1], -p[:, 0]), th1)
-    c1, s1 = np.cos(th1), np.sin(th1)
-    th234 = np.arctan2(-(c1 * a[:, 0] + s1 * a[:, 1]), a[:, 2])
-    th5 = np.arctan2(c1 * n[:, 1] - s1 * n[:, 0], c1 * o[:, 1] - s1 * o[:, 0])
+    def solve(th1: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                                  NDArray[np.float64], NDArray[np.bool_]]:
+        c1, s1 = np.cos(th1), np.sin(th1)
+        th234 = np.arctan2(-(c1 * a[:, 0] + s1 * a[:, 1]), a[:, 2])
+        th5 = np.arctan2(c1 * n[:, 1] - s1 * n[:, 0], c1 * o[:, 1] - s1 * o[:, 0])
+        r = c1 * p[:, 0] + s1 * p[:, 1]
+        z = p[:, 2]
+        c3 = (r**2 + z**2 - arm.l2**2 - arm.l3**2) / (2 * arm.l2 * arm.l3)
+        reach_bad = np.abs(c3) > 1.0 + 1e-12
+        c3 = np.clip(c3, -1.0, 1.0)
+        s3 = -np.sqrt(1.0 - c3**2)
+        th3 = np.arctan2(s3, c3)
+        k1 = arm.l2 + arm.l3 * c3
+        th2 = np.arctan2(k1 * z - arm.l3 * s3 * r, k1 * r + arm.l3 * s3 * z)
+        th4 = th234 - th2 - th3
+        q = np.stack([th1, th2, th3, th4, th5], axis=-1)
+        q[:, 3] = _wrap_from(q[:, 3], lim[3, 0] - LIMIT_TOL_RAD)
+        q[:, 4] = _wrap_from(q[:, 4], lim[4, 0] - LIMIT_TOL_RAD)
+        outside = (q < lim[:, 0] - LIMIT_TOL_RAD) | (q > lim[:, 1] + LIMIT_TOL_RAD)
+        return q, r, reach_bad, outside
 
-    r = c1 * p[:, 0] + s1 * p[:, 1]
+    # θ1 points the arm at the wrist, or away from it when the wrist sits behind the base
+    # axis (θ2 > 90°): of the two, the one that keeps every joint inside its range.
+    q, r, reach_bad, outside = solve(np.arctan2(p[:, 1], p[:, 0]))
+    if outside.any():
+        q_b, r_b, _, outside_b = solve(np.arctan2(-p[:, 1], -p[:, 0]))
+        better: NDArray[np.bool_] = np.asarray(outside.any(axis=1) & ~outside_b.any(axis=1))
+        q, r, outside = (np.where(better[:, None], q_b, q), np.where(better, r_b, r),
+                         np.where(better[:, None], outside_b, outside))
     z = p[:, 2]
-    c3 = (r**2 + z**2 - arm.l2**2 - arm.l3**2) / (2 * arm.l2 * arm.l3)
-    reach_bad = np.abs(c3) > 1.0 + 1e-12
-    c3 = np.clip(c3, -1.0, 1.0)
-    s3 = -np.sqrt(1.0 - c3**2)
-    th3 = np.arctan2(s3, c3)
-    k1 = arm.l2 + arm.l3 * c3
-    th2 = np.arctan2(k1 * z - arm.l3 * s3 * r, k1 * r + arm.l3 * s3 * z)
-    th4 = th234 - th2 - th3
-
-    q = np.stack([th1, th2, th3, th4, th5], axis=-1)
-    q[:, 3] = _wrap_from(q[:, 3], lim[3, 0] - LIMIT_TOL_RAD)
-    q[:, 4] = _wrap_from(q[:, 4], lim[4, 0] - LIMIT_TOL_RAD)
 
     def name(i: int) -> str:
         if label is not None:
@@ -152,8 +161,6 @@ def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *,
             f"{name(i)} is out of reach: the wrist would be {dist:.4f} in from the shoulder, "
             f"the arm reaches {abs(arm.l2 - arm.l3):.4f} to {arm.l2 + arm.l3:.4f} in", i, None)
     if check_limits:
-        tol = LIMIT_TOL_RAD
-        outside = (q < lim[:, 0] - tol) | (q > lim[:, 1] + tol)
         if outside.any():
             i, j = (int(v) for v in np.argwhere(outside)[0])
             lo, hi = np.degrees(lim[j])

@@ -146,6 +146,12 @@ def _cross_checks(s: Scenario, file: object) -> None:
         if (g - h.g0_in) ** 2 / 2 > h.l2_in ** 2:
             raise ScenarioError(file, key, g, "finger opening beyond what the hand linkage "
                                 "allows (eq. 6.2: (G - G0)^2 / 2 must not exceed L2^2)")
+    if s.part.size_in > s.cell.belt_width_in:
+        changed = ("part.size_in", s.part.size_in) if s.part.size_in != _DEFAULTS.part.size_in \
+            else ("cell.belt_width_in", s.cell.belt_width_in)
+        raise ScenarioError(file, *changed, f"a {s.part.size_in:g} in part does not fit on a "
+                            f"{s.cell.belt_width_in:g} in wide belt (part.size_in must not exceed "
+                            "cell.belt_width_in)")
     p, m = s.path, s.path.moves
     for (start, end), (key, value), moves in (
             (("bot_in", "f_in"), ("lo_from_bot_in", p.lo_from_bot_in), m.R1),

@@ -55,7 +55,7 @@ class LayoutSettings(Section):
     robot_yaw_deg: float = _num(-45.0, ge=-360.0, le=360.0)
     """Robot frame = global rotated about z by this (eq. 6.1)."""
     belt_width_in: float = _num(8.0, gt=0.0, le=MAX_LENGTH_IN)
-    """Both conveyors (§4.1); used for drawings only."""
+    """Both conveyors (§4.1); a part must fit on them; otherwise used for drawings only."""
 
 
 # --------------------------------------------------------------------------- path

@@ -92,6 +92,32 @@ def test_cli_bad_dynamics_file_is_one_line_and_no_output(tmp_path, capsys):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_dynamics_file_is_checked_even_when_the_timing_does_not_use_it(tmp_path, capsys):
+    out = tmp_path / "run"
+    code = main(["run", BASE, "--set", "robot.timing=constant-rate", "--set",
+                 "mintime.dynamics_file=missing.yaml", "--set", "run.parts=5", "--out", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "\n" not in err and "mintime.dynamics_file" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_copy_of_the_baseline_elsewhere_finds_the_built_in_dynamics(tmp_path):
+    import json
+
+    from cell import catalog
+
+    copy = tmp_path / "mine.yaml"
+    copy.write_bytes(catalog.path("baseline").read_bytes())
+    for scenario, out in ((BASE, tmp_path / "theirs"), (copy, tmp_path / "mine")):
+        assert main(["mintime", str(scenario), "--out", str(out)]) == 0
+    ours = json.loads((tmp_path / "mine" / "summary.json").read_text())
+    theirs = json.loads((tmp_path / "theirs" / "summary.json").read_text())
+    assert ours["regimes"] == theirs["regimes"]
+    # a file of that name beside the scenario is preferred to the built-in one
+    (tmp_path / "microbot_dynamics.yaml").write_text("name: broken\n")
+    assert main(["mintime", str(copy), "--out", str(tmp_path / "beside")]) != 0
+
+
 def test_no_bounds_at_all_is_refused(tmp_path, capsys):
     code = main(["mintime", KIN, "--set", "mintime.acceleration_bounds=false",
                  "--out", str(tmp_path / "x")])

@@ -97,6 +97,8 @@ BAD = [
     ({"path": {"lo_from_bot_in": 9.0}}, "path.lo_from_bot_in", "one move"),
     ({"robot": {"hand": {"open_in": 5.0}}}, "robot.hand.open_in", "linkage"),
     ({"path": "x"}, "path", "mapping"),
+    ({"cell": {"belt_width_in": 1.5}}, "cell.belt_width_in", "does not fit"),
+    ({"part": {"size_in": 3.0}, "cell": {"belt_width_in": 2.5}}, "part.size_in", "does not fit"),
 ]
 
 
