@@ -349,26 +349,12 @@ def test_an_old_set_moved_aside_by_a_killed_run_comes_back(tmp_path):
 # --- killed at every step -------------------------------------------------------------------
 
 CHILD = textwrap.dedent("""
-    import os, signal, sys
+    import sys
     import cell.output as out
+    from tests.killing import die_at_step
 
     target, k, fallback, names = sys.argv[1], int(sys.argv[2]), sys.argv[3] == "1", sys.argv[4:]
-    calls = 0
-
-    def trap(function):
-        def trapped(*args, **kwargs):
-            global calls
-            calls += 1
-            if calls == k:
-                os.kill(os.getpid(), signal.SIGKILL)
-            return function(*args, **kwargs)
-        return trapped
-
-    if fallback:
-        out._exchange = lambda a, b: False
-    out._exchange, out._open = trap(out._exchange), trap(out._open)
-    for name in ("rename", "replace", "unlink", "rmdir", "mkdir", "fsync"):
-        setattr(os, name, trap(getattr(os, name)))
+    die_at_step(k, fallback)
     if names == ["--single"]:
         out.write_text("new\\n", target)
     else:

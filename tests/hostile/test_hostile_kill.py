@@ -12,7 +12,6 @@ import contextlib
 import io
 import os
 import shutil
-import signal
 from pathlib import Path
 
 import pytest
@@ -20,6 +19,7 @@ import pytest
 import cell.output as output
 from cell.output import OutputDir
 
+from ..killing import die_at_step
 from .harness import COUNT
 
 NAMES = ["parts.csv", "summary.csv", "belts.csv"]
@@ -31,21 +31,7 @@ def _run_killed_at(k: int, job, fallback: bool) -> int:
     pid = os.fork()
     if pid == 0:  # pragma: no cover - the child never returns
         try:
-            calls = [0]
-
-            def trap(function):
-                def trapped(*args, **kwargs):
-                    calls[0] += 1
-                    if calls[0] == k:
-                        os.kill(os.getpid(), signal.SIGKILL)
-                    return function(*args, **kwargs)
-                return trapped
-
-            if fallback:
-                output._exchange = lambda a, b: False
-            output._exchange, output._open = trap(output._exchange), trap(output._open)
-            for name in ("rename", "replace", "unlink", "rmdir", "mkdir", "fsync", "link"):
-                setattr(os, name, trap(getattr(os, name)))
+            die_at_step(k, fallback)
             devnull = os.open(os.devnull, os.O_WRONLY)
             os.dup2(devnull, 1)
             os.dup2(devnull, 2)
