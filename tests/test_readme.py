@@ -221,3 +221,24 @@ def test_links_point_at_files_that_exist():
     for link in re.findall(r"\]\(([^)#]+)(?:#[^)]*)?\)", README):
         if not link.startswith("http"):
             assert (ROOT / link).exists(), link
+
+
+def test_the_docs_minimum_time_figures_are_the_committed_report():
+    """docs/model.md's table and docs/assumptions.md's R IV times are reports/mintime's."""
+    cycles = json.loads((REPORTS / "mintime" / "cycles.json").read_text())["models"]
+    model = (ROOT / "docs" / "model.md").read_text(encoding="utf-8")
+    rows = {"constant rates (the thesis)": "constant-rate",
+            "planner, velocity and assumed acceleration bounds": "minimum-time (kinematic)",
+            "planner, velocity bounds and the estimated dynamic model": "minimum-time (dynamic)"}
+    for label, key in rows.items():
+        found = re.search(rf"\| {re.escape(label)} \| ([\d.]+) \| ([\d.]+) \| ([\d.]+) \|", model)
+        assert found, label
+        c = cycles[key]
+        assert found.groups() == (f"{c['R2_s']:.4f}", f"{c['R4_s']:.4f}",
+                                  f"{c['cycle_thesis_logic_s']:.4f}"), label
+    assumptions = (ROOT / "docs" / "assumptions.md").read_text(encoding="utf-8")
+    found = re.search(r"R IV's fastest\s+time is ([\d.]+) s against ([\d.]+) s at constant rates; "
+                      r"with the acceleration bounds instead,\s+([\d.]+) s", assumptions)
+    assert found
+    assert found.groups() == tuple(f"{cycles[k]['R4_s']:.4f}" for k in (
+        "minimum-time (dynamic)", "constant-rate", "minimum-time (kinematic)"))
