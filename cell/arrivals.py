@@ -20,7 +20,7 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from cell.cache import file_key, memo, store, stored
+from cell.cache import Remembered, file_key, memo
 from cell.errors import ScenarioError
 
 #: The feeder's child stream of the root SeedSequence (other streams take other keys).
@@ -164,36 +164,29 @@ def _facts_key(arrivals: ArrivalSpec) -> dict[str, Any]:
             "mean_s": arrivals.mean_s, "cv": arrivals.cv}
 
 
-def _memo_key(arrivals: ArrivalSpec) -> tuple[Any, ...]:
-    return (arrivals.distribution, tuple(sorted(arrivals.params.items())), arrivals.mean_s,
-            arrivals.cv)
+def _facts_from_plain(plain: Any) -> tuple[dict[str, float], float, float]:
+    return ({str(k): float(v) for k, v in plain["params"].items()}, float(plain["mean"]),
+            float(plain["low"]))
 
 
-_FACTS: dict[tuple[Any, ...], tuple[dict[str, float], float, float]] = {}
+def _facts_to_plain(facts: tuple[dict[str, float], float, float]) -> dict[str, Any]:
+    params, mean, low = facts
+    return {"params": params, "mean": mean, "low": low}
+
+
+#: (scipy parameters, mean, lower end of the support) of arrivals that passed
+#: :func:`check_arrivals`, here or in an earlier process; and the families scipy has.
+_FACTS: Remembered[tuple[dict[str, float], float, float]] = Remembered(
+    "arrivals", _facts_to_plain, _facts_from_plain)
+_FAMILIES: Remembered[bool] = Remembered("family")
 
 
 def _known_facts(arrivals: ArrivalSpec) -> tuple[dict[str, float], float, float] | None:
-    """(scipy parameters, mean, lower end of the support) of arrivals that passed
-    :func:`check_arrivals` here or in an earlier process (the disk cache); None if unknown."""
-    key = _memo_key(arrivals)
-    found = _FACTS.get(key)
-    if found is not None:
-        return found
-    plain = stored("arrivals", _facts_key(arrivals))
-    try:
-        params = {str(k): float(v) for k, v in plain["params"].items()}
-        facts = (params, float(plain["mean"]), float(plain["low"]))
-    except (TypeError, KeyError, AttributeError, ValueError):
-        return None
-    _FACTS[key] = facts
-    return facts
+    return _FACTS.get(_facts_key(arrivals))
 
 
 def _remember(arrivals: ArrivalSpec, params: dict[str, float], mean: float, low: float) -> None:
-    key = _memo_key(arrivals)
-    if key not in _FACTS:
-        _FACTS[key] = (dict(params), mean, low)
-        store("arrivals", _facts_key(arrivals), {"params": params, "mean": mean, "low": low})
+    _FACTS.put(_facts_key(arrivals), (dict(params), mean, low))
 
 
 def _frozen(arrivals: ArrivalSpec) -> Any:
@@ -261,14 +254,14 @@ def check_arrivals(arrivals: ArrivalSpec, base_dir: Path, file: object) -> None:
     if arrivals.trace_csv is None and _known_facts(arrivals) is not None:
         return
     family = {"distribution": arrivals.distribution}
-    if stored("family", family) is not True:
+    if _FAMILIES.get(family) is not True:
         import scipy.stats
 
         dist = getattr(scipy.stats, arrivals.distribution, None)
         if not isinstance(dist, scipy.stats.rv_continuous):
             raise ScenarioError(file, "arrivals.distribution", arrivals.distribution,
                                 "not a continuous distribution in scipy.stats")
-        store("family", family, True)
+        _FAMILIES.put(family, True)
     if arrivals.trace_csv is not None:
         path = base_dir / arrivals.trace_csv
         if not path.is_file():

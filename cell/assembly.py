@@ -14,7 +14,6 @@ before neither solves the path nor imports what solving needs (scipy's splines).
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import json
 import math
@@ -25,7 +24,7 @@ import numpy as np
 
 from cell import registry
 from cell.arrivals import mean_interarrival
-from cell.cache import memo, store, stored
+from cell.cache import Remembered, memo
 from cell.errors import CellError, InfeasibleError, NoMotionError, ScenarioError, UnreachableError
 from cell.kinematics import JOINT_NAMES, Arm, Hand, Placement
 from cell.motors import Motors, max_rates
@@ -171,11 +170,11 @@ def _check_motor_rates(s: Scenario) -> None:
 def robot_timing(s: Scenario) -> RobotTiming:
     """The robot's regime segments (§6.1), floored by the planner under minimum-time timing."""
     key = _timing_key(s)
-    timing = _known_timing(key) if key is not None else None
+    timing = _TIMINGS.get(key) if key is not None else None
     if timing is None:
         timing = _solved_timing(s)
         if key is not None:
-            _remember_timing(key, timing)
+            _TIMINGS.put(key, timing)
     return _checked(s, timing)
 
 
@@ -215,34 +214,8 @@ def _timing_key(s: Scenario) -> dict[str, Any] | None:
     return key
 
 
-@functools.lru_cache(maxsize=16)
-def _timing_by_text(text: str) -> RobotTiming | None:
-    try:
-        return timing_from_plain(stored("timing", json.loads(text)))
-    except (TypeError, KeyError, AttributeError, ValueError):
-        return None
-
-
-def _known_timing(key: dict[str, Any]) -> RobotTiming | None:
-    """A timing solved before for these values, in this process or an earlier one."""
-    text = json.dumps(key, sort_keys=True)
-    timing = _SOLVED.get(text)
-    return timing if timing is not None else _timing_by_text(text)
-
-
-def _remember_timing(key: dict[str, Any], timing: RobotTiming) -> None:
-    text = json.dumps(key, sort_keys=True)
-    if text in _SOLVED:
-        return
-    _SOLVED[text] = timing
-    try:
-        store("timing", key, timing_to_plain(timing))
-    except TypeError:
-        pass
-
-
-#: Timings solved in this process, by their key's text.
-_SOLVED: dict[str, RobotTiming] = {}
+#: Timings solved before, in this process or an earlier one, by the values they depend on.
+_TIMINGS: Remembered[RobotTiming] = Remembered("timing", timing_to_plain, timing_from_plain)
 
 
 #: The thesis's cell, against which a changed key is blamed.

@@ -35,6 +35,16 @@ P = ParamSpec("P")
 R = TypeVar("R")
 
 
+#: Every memo and every remembered kind of value in this process (for :func:`forget`).
+_IN_PROCESS: list[Memo[Any, Any] | Remembered[Any]] = []
+
+
+def forget() -> None:
+    """Forget every value remembered in this process; the disk cache stays as it is."""
+    for kept in _IN_PROCESS:
+        kept.clear()
+
+
 class Memo(Generic[P, R]):
     """``fn`` memoised on ``key(*args, **kwargs)``; the ``maxsize`` most recent are kept."""
 
@@ -42,6 +52,7 @@ class Memo(Generic[P, R]):
         self.fn, self.key, self.maxsize = fn, key, maxsize
         self._store: OrderedDict[Hashable, R] = OrderedDict()
         functools.update_wrapper(self, fn)
+        _IN_PROCESS.append(self)
 
     def __call__(self, *args: P.args, **kwargs: P.kwargs) -> R:
         k = self.key(*args, **kwargs)
@@ -72,6 +83,61 @@ def memo(key: Callable[..., Hashable] | None = None, maxsize: int = 32
         return Memo(fn, key or by_args, maxsize)
 
     return wrap
+
+
+class Remembered(Generic[R]):
+    """Values of one ``kind`` solved once for good: kept in this process, and on disk for the
+    next one (:func:`stored`, :func:`store`).  ``key`` is plain JSON data, the values the
+    result depends on; ``to_plain`` and ``from_plain`` turn a value into JSON data and back
+    (a stored value that cannot be read back is a miss)."""
+
+    def __init__(self, kind: str, to_plain: Callable[[R], Any] = lambda v: v,
+                 from_plain: Callable[[Any], R] = lambda v: v):
+        self.kind, self.to_plain, self.from_plain = kind, to_plain, from_plain
+        self._here: dict[str, R] = {}
+        _IN_PROCESS.append(self)
+
+    def get(self, key: Any) -> R | None:
+        """The value remembered for ``key``, here or on disk; None if there is none."""
+        text = _text(key)
+        if text is None:
+            return None
+        found = self._here.get(text)
+        if found is not None:
+            return found
+        plain = stored(self.kind, key)
+        if plain is None:
+            return None
+        try:
+            found = self.from_plain(plain)
+        except (TypeError, KeyError, AttributeError, ValueError):
+            return None
+        self._here[text] = found
+        return found
+
+    def put(self, key: Any, value: R) -> None:
+        """Remember ``value`` for ``key``, here and on disk (a value the disk cannot take
+        is kept here only)."""
+        text = _text(key)
+        if text is None or text in self._here:
+            return
+        self._here[text] = value
+        try:
+            plain = self.to_plain(value)
+        except TypeError:
+            return
+        store(self.kind, key, plain)
+
+    def clear(self) -> None:
+        self._here.clear()
+
+
+def _text(key: Any) -> str | None:
+    """A key as text (None for one that is not plain JSON data: then nothing is kept)."""
+    try:
+        return json.dumps(key, sort_keys=True, allow_nan=True)
+    except (TypeError, ValueError):
+        return None
 
 
 def file_key(path: str | Path) -> tuple[str, int, int]:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from cell import arrivals, assembly, cache
+from cell import assembly, cache
 from cell.scenario import load_scenario
 from cell.simulation import simulate
 
@@ -27,9 +27,7 @@ def own_cache(tmp_path, monkeypatch):
 
 
 def _forget() -> None:
-    assembly._SOLVED.clear()  # noqa: SLF001 - the point is to read from disk
-    assembly._timing_by_text.cache_clear()  # noqa: SLF001
-    arrivals._FACTS.clear()  # noqa: SLF001
+    cache.forget()  # the point is to read from disk
 
 
 VALUE = {"x": [0.1, 1 / 3, -0.0, 5e-324, 1.7976931348623157e308, math.inf], "n": 3, "s": "ok"}
@@ -91,6 +89,23 @@ def test_an_unwritable_cache_is_silent(tmp_path, monkeypatch):
 def _segments(t):
     return {name: [getattr(t, name).time(v) for v in (0.5, 1.0, 2.0, 3.0, 7.5, 40.0)]
             for name in ("r1_pre", "r1_post", "r2", "r3_pre", "r3_post", "r4")}
+
+
+def test_a_remembered_value_outlives_the_process_but_not_a_failed_read_back(own_cache):
+    kept = cache.Remembered("square", to_plain=lambda v: {"v": v}, from_plain=lambda p: p["v"])
+    assert kept.get({"x": 3}) is None
+    kept.put({"x": 3}, 9.0)
+    assert kept.get({"x": 3}) == 9.0
+    cache.forget()                      # a new process: only the disk remembers
+    assert kept.get({"x": 3}) == 9.0
+    other = cache.Remembered("square", from_plain=lambda p: p["missing"])
+    assert other.get({"x": 3}) is None  # stored, but not readable as this kind: a miss
+    kept.put({"x": object()}, 1.0)      # a key that is not plain data is not kept
+    assert kept.get({"x": object()}) is None
+    kept.put({"y": 1}, {"not": {1, 2}})  # a value the disk cannot take stays in this process
+    assert kept.get({"y": 1}) == {"not": {1, 2}}
+    cache.forget()
+    assert kept.get({"y": 1}) is None
 
 
 @pytest.mark.parametrize("timing", ["constant-rate", "minimum-time"])
