@@ -16,11 +16,16 @@ already there:
   otherwise it waits for the next ``put``.
 
 Same-instant hand-offs are served in the order they were made.
+
+Hand-written for speed (every part passes through four of these): an event is
+scheduled by pushing it onto SimPy's event queue exactly as
+``Environment.schedule`` does, one Python call less per event.
 """
 
 from __future__ import annotations
 
 from collections import deque
+from heapq import heappush
 from typing import Any
 
 import simpy
@@ -40,13 +45,15 @@ def _taken(env: simpy.Environment, item: Any) -> Event:
 class Mailbox:
     """Unbounded FIFO: ``put(item)`` now, ``put_after(item, delay)``, ``yield box.get()``."""
 
-    __slots__ = ("env", "items", "_getter")
+    __slots__ = ("env", "items", "_getter", "_queue", "_eid")
 
     def __init__(self, env: simpy.Environment):
         self.env = env
         self.items: deque[Any] = deque()
         """Items put but not yet taken."""
         self._getter: Event | None = None
+        # what Environment.schedule pushes onto: the queue and its event counter
+        self._queue, self._eid = env._queue, env._eid
 
     def put(self, item: Any) -> None:
         getter = self._getter
@@ -54,7 +61,7 @@ class Mailbox:
             self._getter = None
             getter._ok = True
             getter._value = item
-            self.env.schedule(getter)
+            heappush(self._queue, (self.env._now, NORMAL, next(self._eid), getter))
         else:
             self.items.append(item)
 
@@ -70,12 +77,13 @@ class Mailbox:
         self._getter = None
         getter._ok = True
         getter._value = item
-        self.env.schedule(getter, NORMAL, delay)
+        heappush(self._queue, (self.env._now + delay, NORMAL, next(self._eid), getter))
         return getter
 
     def get(self) -> Event:
-        if self.items:
-            return _taken(self.env, self.items.popleft())
+        items = self.items
+        if items:
+            return _taken(self.env, items.popleft())
         if self._getter is not None:
             raise RuntimeError("a Mailbox serves one waiting process at a time")
         event = self._getter = Event(self.env)

@@ -169,23 +169,23 @@ class RunLog:
     def flag(self, part: PartRecord, limits: int) -> None:
         self.flags[part.part] = self.flags.get(part.part, 0) | limits
 
-    def missed(self, part: PartRecord) -> None:
-        self._done(part)
-
-    def delivered_part(self, part: PartRecord) -> None:
-        self._done(part)
-
     def _done(self, part: PartRecord) -> None:
-        if part.part != self.next:
-            self.waiting[part.part] = part
+        """A part is done: handed on now if every part before it is, else kept till then."""
+        i = part.part
+        if i != self.next:
+            self.waiting[i] = part
             return
         emit = self._emit
         emit(part)
-        self.next += 1
+        i += 1
         waiting = self.waiting
-        while waiting and self.next in waiting:
-            emit(waiting.pop(self.next))
-            self.next += 1
+        while waiting and i in waiting:
+            emit(waiting.pop(i))
+            i += 1
+        self.next = i
+
+    missed = delivered_part = _done
+    """A part fell off at F / was set down."""
 
     def _emitter(self) -> Callable[[PartRecord], None]:
         """Completes a part's record and hands it on (the log's hot path, locals bound)."""

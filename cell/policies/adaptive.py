@@ -46,6 +46,8 @@ from cell.records import (
     RunSummary,
 )
 
+_new_tuple = tuple.__new__
+
 
 def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
                   gap_in: float | None, lag: float | None = None) -> Plan:
@@ -124,7 +126,9 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
         elif u > k.output_max:
             u = k.output_max
             flags |= OUTPUT_CEILING
-    return Plan(r1a, r1b, r2, r3a, r3b, r4, v, w, v_next, u, r1a + r1b + r2, cycle, flags)
+    # Plan(...) without its Python-level __new__ (once a part): every field, in order
+    return _new_tuple(Plan, (r1a, r1b, r2, r3a, r3b, r4, v, w, v_next, u, r1a + r1b + r2, cycle,
+                             flags, True))
 
 
 class Adaptive(Policy):
