@@ -67,7 +67,9 @@ class Belt:
 
     def time_at(self, x: float) -> float:
         """First instant at which the belt's travel reaches x (speeds are > 0)."""
-        k = max(bisect_right(self._x, x) - 1, 0)
+        k = bisect_right(self._x, x) - 1
+        if k < 0:
+            k = 0
         return self._t[k] + (x - self._x[k]) / self._v[k]
 
     def plan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:

@@ -108,7 +108,8 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
                         w = k.input_min
                         flags |= INPUT_FLOOR
     # 6.3: decay toward nominal after the cycle; departure: never below what R II absorbs.
-    v_next = 0.5 * (w + k.v_nom) if w > k.v_nom else max(w, k.input_absorb)
+    v_next = 0.5 * (w + k.v_nom) if w > k.v_nom else \
+        (k.input_absorb if k.input_absorb > w else w)  # max(w, absorb)
     if v_next > t.input_track_max_in_s:
         v_next = t.input_track_max_in_s
         flags |= INPUT_TRACKING
@@ -143,12 +144,13 @@ class Adaptive(Policy):
             raise ScenarioError(file, "controller.ideal_cycle_s", ideal,
                                 "the adaptive policy runs at the nominal cycle; "
                                 "set controller.nominal_cycle_s instead")
+        self._lag = k.timing.r1_pre.time
+        """B → LO tracking the input belt at a speed (R I's part before lift-off)."""
 
     def plan(self, view: CellView) -> Plan:
-        k = self.k
         v = view.input_speed()
-        lag = k.timing.r1_pre.time(v)
-        return adaptive_plan(k, v, view.next_part(lag, v), view.output_gap(), lag)
+        lag = self._lag(v)
+        return adaptive_plan(self.k, v, view.next_part(lag, v), view.output_gap(), lag)
 
     def accounting(self) -> MotionTimeAccounting:
         return AdaptiveAccounting(self)
