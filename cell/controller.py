@@ -16,7 +16,7 @@ import simpy
 from cell.conveyors import EPS_S, InputConveyor, OutputConveyor
 from cell.policies.base import CellConstants, Policy
 from cell.records import LET_GO, PartRecord
-from cell.robot import Order, Robot
+from cell.robot import Robot
 
 
 class RunLog(Protocol):
@@ -28,35 +28,42 @@ class RunLog(Protocol):
 
 
 class View:
-    """What a policy may read of the cell when a part is at B (:class:`cell.policies.CellView`)."""
+    """What a policy may read of the cell when a part is at B (:class:`cell.policies.CellView`).
+
+    The controller sets ``part`` and ``now`` before it asks the policy.
+    """
 
     def __init__(self, env: simpy.Environment, k: CellConstants, fed_s: list[float],
                  n_parts: int, conveyor: InputConveyor, output: OutputConveyor):
         self.env, self.k, self.fed_s, self.n = env, k, fed_s, n_parts
         self.conveyor, self.output = conveyor, output
         self._input_speed, self._output_travel = conveyor.belt.speed, output.belt.travel
+        self._input_travel, self._x_fed = conveyor.belt.travel, conveyor.x_fed
+        self._length = k.input_length
         self.part = 0
         """Index of the part at B."""
+        self.now = 0.0
+        """The instant it reached B (the simulation's clock)."""
 
     def input_speed(self) -> float:
-        return self._input_speed(self.env.now + EPS_S)
+        return self._input_speed(self.now + EPS_S)
 
     def output_gap(self) -> float | None:
         """How far the last part set down has travelled (:meth:`OutputConveyor.gap_now`)."""
         last = self.output.last_td_x
-        return None if last is None else self._output_travel(self.env.now) - last
+        return None if last is None else self._output_travel(self.now) - last
 
     def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
         """(a, b) of the first part after this one that can still be caught."""
-        now = self.env.now
-        conv, length = self.conveyor, self.k.input_length
-        x_now = conv.belt.travel(now)
-        x_fed_of = conv.x_fed
+        now, fed_s, length = self.now, self.fed_s, self._length
+        x_now = None
         for j in range(self.part + 1, self.n):
-            f = self.fed_s[j]
+            f = fed_s[j]
             if f > now + lag:
                 return (f - now, length)
-            x_fed = x_fed_of.get(j)
+            if x_now is None:
+                x_now = self._input_travel(now)
+            x_fed = self._x_fed.get(j)
             if x_fed is None:  # dropped between now and LO (or held back): not on the belt yet
                 x_fed = x_now + v * (max(f, now) - now)
             d = x_fed + length - (x_now + v * lag)
@@ -77,21 +84,24 @@ class Controller:
         self.process = env.process(self.run())
 
     def run(self):  # noqa: ANN201 (SimPy generator)
+        """Once per part: locals bound, the clock read as ``env._now`` (what ``env.now``
+        returns, without the property call)."""
         env, robot, view, plan_for = self.env, self.robot, self.view, self.policy.plan
         replan_in, replan_out, u_nom = self.conveyor.replan, self.output.replan, self.k.u_nom
-        get, log, order = self.conveyor.at_bot.get, self.log, robot.order
+        get, flag, missed, order = self.conveyor.at_bot.get, self.log.flag, self.log.missed, \
+            robot.order
         t = self.k.timing
         l1, l2, l3, l4 = t.r1_length_in, t.r2.length_in, t.r3_length_in, t.r4.length_in
         residual = self.residual_s
         while True:
             part: Any = yield get()
-            now = env.now
+            now = env._now
             if not robot.free_at_s <= now + EPS_S:  # the robot is not back: the part rides on
                 part.missed = True
-                log.flag(part, LET_GO)
-                log.missed(part)
+                flag(part, LET_GO)
+                missed(part)
                 continue
-            view.part = part.part - 1
+            view.part, view.now = part.part - 1, now
             (r1_pre, r1_post, r2, r3_pre, r3_post, r4, input_speed, input_after_lo, input_next,
              output_to_g, to_g, cycle, limits, steers_belts) = plan_for(view)
             if steers_belts:
@@ -105,9 +115,9 @@ class Controller:
             part.v_r1_in_s, part.v_r2_in_s = l1 / r1, l2 / r2
             part.v_r3_in_s, part.v_r4_in_s = l3 / r3, l4 / r4
             if limits:
-                log.flag(part, limits)
+                flag(part, limits)
             # step 6.2: motion time to TD plus the previous cycle's residual
             part.thesis_interval_s = to_g + r3_pre + residual
             self.residual_s = residual = r3_post + r4
             # B → TD summed as LO + (LO → TD), the order the robot's legs are timed in
-            order(Order(part, r1_pre, r1_pre + (to_g - r1_pre + r3_pre), cycle))
+            order(part, r1_pre, r1_pre + (to_g - r1_pre + r3_pre), cycle)

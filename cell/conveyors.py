@@ -38,6 +38,8 @@ class Belt:
     writer) and dropped, so a long run keeps a few entries, not its history.
     """
 
+    __slots__ = ("_t", "_x", "_v", "on_change", "max_speed_in_s", "min_speed_in_s")
+
     def __init__(self, speed_in_s: float,
                  on_change: Callable[[float, float], Any] | None = None):
         self._t: list[float] = [0.0]
@@ -65,7 +67,9 @@ class Belt:
 
     def time_at(self, x: float) -> float:
         """First instant at which the belt's travel reaches x (speeds are > 0)."""
-        k = max(bisect_right(self._x, x) - 1, 0)
+        k = bisect_right(self._x, x) - 1
+        if k < 0:
+            k = 0
         return self._t[k] + (x - self._x[k]) / self._v[k]
 
     def plan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
@@ -75,40 +79,57 @@ class Belt:
         A new plan supersedes whatever was planned after t1 (the controller
         replans every cycle); a change within EPS_S of the last one replaces it.
         Changes before ``t1`` whose successors have started are settled.
+        (Called twice a part: its lists are bound to locals and settling is inlined.)
         """
         if not v1 > 0 or (t2 is not None and not v2 > 0):
             raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}")
         ts, xs, vs = self._t, self._x, self._v
+        t0 = ts[-1]
+        if t0 < t1 and t2 is not None and t1 < t2:
+            # the controller's every replan: both changes after the last one, which alone
+            # is kept (the general case below, unrolled)
+            n = len(ts) - 1
+            if n > 0:
+                self._settle(n)
+            x0, v0 = xs[-1], vs[-1]
+            x1 = x0 + v0 * (t1 - t0)
+            self._t, self._x, self._v = [t0, t1, t2], [x0, x1, x1 + v1 * (t2 - t1)], [v0, v1, v2]
+            return
         k = bisect_right(ts, t1 + EPS_S)
         if k < len(ts):
             del ts[k:], xs[k:], vs[k:]
         n = bisect_right(ts, t1) - 1
         if n > 0:  # settle the changes whose successors have started
-            self._emit(n)
+            self._settle(n)
             del ts[:n], xs[:n], vs[:n]
         # run at v1 from t1 on (at or before the last change: that change's speed is v1)
-        if t1 <= ts[-1]:
+        t0 = ts[-1]
+        if t1 <= t0:
             vs[-1] = v1
         else:
-            xs.append(xs[-1] + vs[-1] * (t1 - ts[-1]))
+            xs.append(xs[-1] + vs[-1] * (t1 - t0))
             ts.append(t1)
             vs.append(v1)
+            t0 = t1
         if t2 is not None:
-            if t2 <= ts[-1]:
+            if t2 <= t0:
                 vs[-1] = v2
             else:
-                xs.append(xs[-1] + vs[-1] * (t2 - ts[-1]))
+                xs.append(xs[-1] + vs[-1] * (t2 - t0))
                 ts.append(t2)
                 vs.append(v2)
 
-    def _emit(self, n: int) -> None:
+    def _settle(self, n: int) -> None:
+        """The first ``n`` changes are final: note their speeds and tell ``on_change``."""
         vs = self._v
+        hi, lo = self.max_speed_in_s, self.min_speed_in_s
         for i in range(n):
             v = vs[i]
-            if v > self.max_speed_in_s:
-                self.max_speed_in_s = v
-            if v < self.min_speed_in_s:
-                self.min_speed_in_s = v
+            if v > hi:
+                hi = v
+            if v < lo:
+                lo = v
+        self.max_speed_in_s, self.min_speed_in_s = hi, lo
         told = self.on_change
         if told is not None:
             ts = self._t
@@ -117,7 +138,7 @@ class Belt:
 
     def close(self) -> None:
         """Hand every change still held (planned ones included) to ``on_change``."""
-        self._emit(len(self._t))
+        self._settle(len(self._t))
         del self._t[:], self._x[:], self._v[:]
 
 
@@ -161,7 +182,7 @@ class InputConveyor:
     def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
         """New speed plan from the controller (see :meth:`Belt.plan`), made as a part
         reaches B: before the next part is timed."""
-        if self.env.now < self.due_s:
+        if self.env._now < self.due_s:
             raise RuntimeError("the input belt was replanned while a part was on its way to B")
         self.belt.plan(t1, v1, t2, v2)
         feeder = self.feeder
@@ -174,7 +195,7 @@ class InputConveyor:
         while True:
             part = yield get()
             i = part.part - 1
-            now = env.now
+            now = env._now  # env.now without the property call (also below)
             delay = time_at(x_fed[i] + length) - now
             if delay < 0.0:
                 delay = 0.0
@@ -206,6 +227,8 @@ class OutputConveyor:
         """Belt travel at the last touch-down (None before the first)."""
         self.last_td_s: float | None = None
         """Instant of the last touch-down (None before the first)."""
+        self.replan = self.belt.plan
+        """New speed plan from the controller (:meth:`Belt.plan`)."""
         self.process = env.process(self.run())
 
     def gap_now(self) -> float | None:
@@ -214,14 +237,11 @@ class OutputConveyor:
             return None
         return self.belt.travel(self.env.now) - self.last_td_x
 
-    def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
-        self.belt.plan(t1, v1, t2, v2)
-
     def run(self):  # noqa: ANN201 (SimPy generator)
         env, get, travel, delivered = self.env, self.placed.get, self.belt.travel, self.delivered
         while True:
             part = yield get()
-            td = part.touchdown_s = env.now
+            td = part.touchdown_s = env._now
             x = travel(td)
             last_x, last_td = self.last_td_x, self.last_td_s
             if last_x is not None and last_td is not None:

@@ -18,6 +18,7 @@ import simpy
 from numpy.typing import NDArray
 
 from cell.conveyors import EPS_S
+from cell.mailbox import Timer
 from cell.records import HELD_AT_FEEDER, PartRecord
 
 #: Belt travel this close to clear counts as clear (the rounding of travel and its inverse).
@@ -56,15 +57,18 @@ class Feeder:
         self.process = env.process(self.run())
 
     def run(self):  # noqa: ANN201 (SimPy generator)
+        """Once per part: locals bound, the clock read as ``env._now`` (what ``env.now``
+        returns, without the property call)."""
         env, drop, fed, t = self.env, self.conveyor.drop, self.fed_s, self.interarrival_s
         timeout, travel, flag = env.timeout, self.conveyor.belt.travel, self.flag
+        after = Timer(env).after  # env.timeout's schedule, without a new event a part
         size = self.part_size_in
         clear_at = -float("inf")
         for i in range(self.n_parts):
             f = fed[i]
-            delay = f - env.now
-            yield timeout(delay if delay > 0.0 else 0.0)  # after a hold it may be due already
-            x = travel(env.now)
+            delay = f - env._now
+            yield after(delay if delay > 0.0 else 0.0)  # after a hold it may be due already
+            x = travel(env._now)
             if x < clear_at - CLEAR_TOL_IN:
                 belt = self.conveyor.belt
                 self.holding = True

@@ -13,7 +13,7 @@ regime's time for a velocity is one numpy sum.
 
 from __future__ import annotations
 
-import bisect
+from bisect import bisect_left, bisect_right
 from dataclasses import dataclass
 
 import numpy as np
@@ -115,7 +115,7 @@ class Segment:
     def time(self, velocity: float) -> float:
         """Σ max(ℓ/v, t_min): the moves' time at tip (or belt) velocity v > 0."""
         u = 1.0 / velocity
-        j = bisect.bisect_right(self._ub, u)
+        j = bisect_right(self._ub, u)
         return self._tfix[j] + self._lfree[j] * u
 
     def velocity(self, time_s: float) -> float:
@@ -123,7 +123,7 @@ class Segment:
         if time_s < self.floor_s * (1 - 1e-12):
             raise InfeasibleError(f"{time_s:.4f} s is below the motors' minimum "
                                   f"of {self.floor_s:.4f} s")
-        j = bisect.bisect_left(self._tbreak, time_s)
+        j = bisect_left(self._tbreak, time_s)
         if self._lfree[j] <= 0:
             return float("inf")
         return self._lfree[j] / (time_s - self._tfix[j])

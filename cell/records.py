@@ -38,13 +38,15 @@ LIMIT_BIT = {name: 1 << i for i, name in enumerate(LIMITS)}
 
 def limit_names(flags: int) -> str:
     """The names of the limits in a flag word, space-separated, in :data:`LIMITS` order."""
-    names = _NAMES.get(flags)
+    names = LIMIT_NAMES.get(flags)
     if names is None:
-        names = _NAMES[flags] = " ".join(name for i, name in enumerate(LIMITS) if flags >> i & 1)
+        names = LIMIT_NAMES[flags] = " ".join(name for i, name in enumerate(LIMITS)
+                                              if flags >> i & 1)
     return names
 
 
-_NAMES: dict[int, str] = {}
+LIMIT_NAMES: dict[int, str] = {}
+""":func:`limit_names`' answers so far, by flag word."""
 
 
 @dataclass(slots=True)

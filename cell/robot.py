@@ -19,7 +19,7 @@ and the move times are only floored by the motors (§4.3 c).
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import simpy
@@ -139,21 +139,13 @@ def timing_from_plain(data: dict[str, Any]) -> RobotTiming:
 
 
 # --------------------------------------------------------------------------- process
-class Order(NamedTuple):
-    """One transfer cycle as the controller sends it (step 6.1), times from now (s)."""
-
-    part: Any
-    """The part's record; the robot writes its lift-off and touch-down instants."""
-    to_lo_s: float
-    """B → LO (R I up to lift-off)."""
-    to_td_s: float
-    """B → TD (R I, R II and R III up to touch-down)."""
-    cycle_s: float
-    """B → B: the whole cycle; the robot is free again this long after starting."""
-
-
 class Robot:
-    """The arm as a SimPy process: told an :class:`Order`, runs it, hands the part over.
+    """The arm as a SimPy process: told an order, runs it, hands the part over.
+
+    An order is one transfer cycle as the controller sends it (step 6.1): the
+    part's record (the robot writes its lift-off and touch-down instants), and
+    B → LO and B → TD in seconds from now; the robot is free again the cycle's
+    B → B later.
 
     The robot owns its state: ``free_at_s``, when it will be back at B, is set the
     moment it is told an order.  One event per order besides the order itself: a
@@ -167,7 +159,7 @@ class Robot:
     def __init__(self, env: simpy.Environment, output: Mailbox):
         self.env = env
         self.orders: Mailbox = Mailbox(env)
-        """Cycles to run, from the controller."""
+        """Cycles to run, from the controller: (part, B → LO, B → TD) tuples."""
         self.output = output
         """Where parts are set down (the output conveyor's mailbox)."""
         self.free_at_s = 0.0
@@ -177,14 +169,15 @@ class Robot:
     def is_free(self, now: float) -> bool:
         return self.free_at_s <= now + EPS_S
 
-    def order(self, order: Order) -> None:
-        """Start a cycle now (the robot must be free)."""
-        self.free_at_s = self.env.now + order.cycle_s
-        self.orders.put(order)
+    def order(self, part: Any, to_lo_s: float, to_td_s: float, cycle_s: float) -> None:
+        """Start a cycle now (the robot must be free): lift-off ``to_lo_s``, touch-down
+        ``to_td_s`` and back at B ``cycle_s`` from now."""
+        self.free_at_s = self.env._now + cycle_s
+        self.orders.put((part, to_lo_s, to_td_s))
 
     def run(self):  # noqa: ANN201 (SimPy generator)
         env, set_down, get = self.env, self.output.put_after, self.orders.get
         while True:
-            part, to_lo_s, to_td_s, _ = yield get()
-            part.pick_s = env.now + to_lo_s
+            part, to_lo_s, to_td_s = yield get()
+            part.pick_s = env._now + to_lo_s
             set_down(part, to_td_s)  # touch-down: B + (B → TD), as a timeout would fall

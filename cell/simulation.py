@@ -41,6 +41,7 @@ from cell.feeder import Feeder
 from cell.policies.base import Accounting
 from cell.records import (
     LIMIT_BIT,
+    LIMIT_NAMES,
     PART_COLUMNS,
     SPACING_OFF,
     BeltChange,
@@ -169,23 +170,23 @@ class RunLog:
     def flag(self, part: PartRecord, limits: int) -> None:
         self.flags[part.part] = self.flags.get(part.part, 0) | limits
 
-    def missed(self, part: PartRecord) -> None:
-        self._done(part)
-
-    def delivered_part(self, part: PartRecord) -> None:
-        self._done(part)
-
     def _done(self, part: PartRecord) -> None:
-        if part.part != self.next:
-            self.waiting[part.part] = part
+        """A part is done: handed on now if every part before it is, else kept till then."""
+        i = part.part
+        if i != self.next:
+            self.waiting[i] = part
             return
         emit = self._emit
         emit(part)
-        self.next += 1
+        i += 1
         waiting = self.waiting
-        while waiting and self.next in waiting:
-            emit(waiting.pop(self.next))
-            self.next += 1
+        while waiting and i in waiting:
+            emit(waiting.pop(i))
+            i += 1
+        self.next = i
+
+    missed = delivered_part = _done
+    """A part fell off at F / was set down."""
 
     def _emitter(self) -> Callable[[PartRecord], None]:
         """Completes a part's record and hands it on (the log's hot path, locals bound)."""
@@ -194,17 +195,19 @@ class RunLog:
         note = self.per_part.extend
         sinks = tuple(self.sinks)
         keep = self.rows.append if self.rows is not None else None
+        names_of = LIMIT_NAMES.get  # limit_names' cache, read first
 
         def emit(p: PartRecord) -> None:
-            t_next = t[p.part]
+            i = p.part
+            t_next = t[i]
             d = p.delivery_interval_s
             p.ip_wallclock = ip = t_next / d
             acct_part(p, t_next)
-            flags = flags_of(p.part, 0)
+            flags = flags_of(i, 0)
             sp = p.spacing_in
             if sp == sp and abs(sp - spacing_in) > tol:
                 flags |= SPACING_OFF
-            p.limits = limit_names(flags) if flags else ""
+            p.limits = (names_of(flags) or limit_names(flags)) if flags else ""
             note((p.touchdown_s, p.picked, p.r4_s, p.output_speed_in_s, ip, d, sp, flags,
                   p.feed_delay_s))
             if keep is not None:

@@ -7,7 +7,7 @@ import simpy
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from cell.mailbox import Mailbox
+from cell.mailbox import Mailbox, Timer
 
 
 def _deliveries(box_factory, puts: list[tuple[float, int]], pause: float) -> list[tuple[float, int]]:
@@ -108,3 +108,47 @@ def test_one_waiting_process_at_a_time():
     box.get()
     with pytest.raises(RuntimeError):
         box.get()
+
+
+def test_a_box_reuses_its_events_and_still_delivers_every_item_once():
+    env = simpy.Environment()
+    box = Mailbox(env)
+    got = []
+
+    def consumer():  # noqa: ANN202
+        while True:
+            got.append(((yield box.get()), env.now))
+
+    def producer():  # noqa: ANN202
+        for i in range(5):
+            yield env.timeout(1.0)
+            box.put(i)
+            if i % 2:
+                box.put(-i)                # a second one queued behind it
+
+    env.process(consumer())
+    env.process(producer())
+    env.run()
+    assert got == [(0, 1.0), (1, 2.0), (-1, 2.0), (2, 3.0), (3, 4.0), (-3, 4.0), (4, 5.0)]
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.sampled_from([0.0, 0.5, 1.0, 2.5]), min_size=1, max_size=12))
+def test_a_timer_wakes_its_process_as_a_timeout_would(delays):
+    """Two processes waiting on the same delays, one on a Timer and one on env.timeout,
+    wake in the same order as two on env.timeout."""
+    def wakes(use_timer: bool) -> list[tuple[float, str]]:
+        env = simpy.Environment()
+        log: list[tuple[float, str]] = []
+
+        def waiter(name: str, wait):  # noqa: ANN001, ANN202
+            for d in delays:
+                yield wait(d)
+                log.append((env.now, name))
+
+        env.process(waiter("a", Timer(env).after if use_timer else env.timeout))
+        env.process(waiter("b", env.timeout))
+        env.run()
+        return log
+
+    assert wakes(True) == wakes(False)

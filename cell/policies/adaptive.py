@@ -46,6 +46,8 @@ from cell.records import (
     RunSummary,
 )
 
+_new_tuple = tuple.__new__
+
 
 def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
                   gap_in: float | None, lag: float | None = None) -> Plan:
@@ -106,7 +108,8 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
                         w = k.input_min
                         flags |= INPUT_FLOOR
     # 6.3: decay toward nominal after the cycle; departure: never below what R II absorbs.
-    v_next = 0.5 * (w + k.v_nom) if w > k.v_nom else max(w, k.input_absorb)
+    v_next = 0.5 * (w + k.v_nom) if w > k.v_nom else \
+        (k.input_absorb if k.input_absorb > w else w)  # max(w, absorb)
     if v_next > t.input_track_max_in_s:
         v_next = t.input_track_max_in_s
         flags |= INPUT_TRACKING
@@ -124,7 +127,9 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
         elif u > k.output_max:
             u = k.output_max
             flags |= OUTPUT_CEILING
-    return Plan(r1a, r1b, r2, r3a, r3b, r4, v, w, v_next, u, r1a + r1b + r2, cycle, flags)
+    # Plan(...) without its Python-level __new__ (once a part): every field, in order
+    return _new_tuple(Plan, (r1a, r1b, r2, r3a, r3b, r4, v, w, v_next, u, r1a + r1b + r2, cycle,
+                             flags, True))
 
 
 class Adaptive(Policy):
@@ -139,12 +144,13 @@ class Adaptive(Policy):
             raise ScenarioError(file, "controller.ideal_cycle_s", ideal,
                                 "the adaptive policy runs at the nominal cycle; "
                                 "set controller.nominal_cycle_s instead")
+        self._lag = k.timing.r1_pre.time
+        """B → LO tracking the input belt at a speed (R I's part before lift-off)."""
 
     def plan(self, view: CellView) -> Plan:
-        k = self.k
         v = view.input_speed()
-        lag = k.timing.r1_pre.time(v)
-        return adaptive_plan(k, v, view.next_part(lag, v), view.output_gap(), lag)
+        lag = self._lag(v)
+        return adaptive_plan(self.k, v, view.next_part(lag, v), view.output_gap(), lag)
 
     def accounting(self) -> MotionTimeAccounting:
         return AdaptiveAccounting(self)

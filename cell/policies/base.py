@@ -184,12 +184,13 @@ class MotionTimeAccounting(Accounting):
     lost when it is lost on the wall clock."""
 
     def part(self, rec: PartRecord, next_interarrival_s: float) -> None:
-        d = rec.thesis_interval_s if rec.picked else math.nan
-        rec.missed_thesis = not rec.picked
+        picked = rec.picked
+        d = rec.thesis_interval_s if picked else math.nan
+        rec.missed_thesis = not picked
         rec.thesis_interval_s = d
         rec.ip_thesis = next_interarrival_s / d
         self.interval.append(d)
-        self.lost.append(not rec.picked)
+        self.lost.append(not picked)
 
     def finish(self, s: RunSummary, start: int, picked_r4_s: np.ndarray,
                t_next: np.ndarray) -> None:

@@ -74,17 +74,18 @@ class ReconstructedAccounting(Accounting):
         super().__init__(policy)
         self.cycle_s = policy.ideal_cycle_s
         """The robot's fixed cycle C."""
+        self._lost_below = self.cycle_s - accounting.THESIS_SLACK_S
+        """C − s: a part that comes sooner than this after the last is lost."""
 
     def part(self, rec: PartRecord, next_interarrival_s: float) -> None:
-        c = self.cycle_s
         t = rec.interarrival_s
-        lost = t < c - accounting.THESIS_SLACK_S
-        d = t + c if lost else t
+        lost = t < self._lost_below
+        d = t + self.cycle_s if lost else t
         rec.missed_thesis = lost
         rec.thesis_interval_s = d
-        rec.ip_thesis = next_interarrival_s / (2.0 * d)
+        rec.ip_thesis = ip = next_interarrival_s / (2.0 * d)
         self.interval.append(d)
-        self.ip.append(rec.ip_thesis)
+        self.ip.append(ip)
         self.lost.append(lost)
 
     def finish(self, s: RunSummary, start: int, picked_r4_s: np.ndarray,
