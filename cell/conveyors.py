@@ -55,6 +55,12 @@ class Belt:
         self.min_speed_in_s = speed_in_s
         """The slowest of them."""
 
+    @property
+    def held(self) -> int:
+        """Speed segments held in memory: the one in force and those planned ahead
+        (what is behind is told to ``on_change`` and dropped, so memory stays flat)."""
+        return len(self._t)
+
     def speed(self, t: float) -> float:
         """The speed at instant t (:func:`speed_at`)."""
         k = bisect_right(self._t, t) - 1
