@@ -24,7 +24,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import simpy
 
-from cell.conveyors import EPS_S
 from cell.mailbox import Mailbox
 from cell.motors import Segment
 
@@ -165,9 +164,6 @@ class Robot:
         self.free_at_s = 0.0
         """When the robot is (or will be) back at B, ready for a part."""
         self.process = env.process(self.run())
-
-    def is_free(self, now: float) -> bool:
-        return self.free_at_s <= now + EPS_S
 
     def order(self, part: Any, to_lo_s: float, to_td_s: float, cycle_s: float) -> None:
         """Start a cycle now (the robot must be free): lift-off ``to_lo_s``, touch-down
