@@ -49,7 +49,7 @@ class View:
         return self._input_speed(self.now + EPS_S)
 
     def output_gap(self) -> float | None:
-        """How far the last part set down has travelled (:meth:`OutputConveyor.gap_now`)."""
+        """How far the last part set down has travelled since (None if none yet)."""
         last = self.output.last_td_x
         return None if last is None else self._output_travel(self.now) - last
 

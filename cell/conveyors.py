@@ -237,12 +237,6 @@ class OutputConveyor:
         """New speed plan from the controller (:meth:`Belt.plan`)."""
         self.process = env.process(self.run())
 
-    def gap_now(self) -> float | None:
-        """How far the last part set down has travelled since (None if none yet)."""
-        if self.last_td_x is None:
-            return None
-        return self.belt.travel(self.env.now) - self.last_td_x
-
     def run(self):  # noqa: ANN201 (SimPy generator)
         env, get, travel, delivered = self.env, self.placed.get, self.belt.travel, self.delivered
         while True:
