@@ -79,8 +79,6 @@ class Controller:
                  conveyor: InputConveyor, output: OutputConveyor, robot: Robot, log: RunLog):
         self.env, self.k, self.policy, self.view = env, k, policy, view
         self.conveyor, self.output, self.robot, self.log = conveyor, output, robot, log
-        self.residual_s = k.r3_post_nom + k.r4_nom
-        """The previous cycle's TD → K and R IV (step 5.0, 6.2); nominal before the first."""
         self.process = env.process(self.run())
 
     def run(self):  # noqa: ANN201 (SimPy generator)
@@ -92,7 +90,8 @@ class Controller:
             robot.order
         t = self.k.timing
         l1, l2, l3, l4 = t.r1_length_in, t.r2.length_in, t.r3_length_in, t.r4.length_in
-        residual = self.residual_s
+        # the previous cycle's TD → K and R IV (step 5.0, 6.2); nominal before the first
+        residual = self.k.r3_post_nom + self.k.r4_nom
         while True:
             part: Any = yield get()
             now = env._now
@@ -118,6 +117,6 @@ class Controller:
                 flag(part, limits)
             # step 6.2: motion time to TD plus the previous cycle's residual
             part.thesis_interval_s = to_g + r3_pre + residual
-            self.residual_s = residual = r3_post + r4
+            residual = r3_post + r4
             # B → TD summed as LO + (LO → TD), the order the robot's legs are timed in
             order(part, r1_pre, r1_pre + (to_g - r1_pre + r3_pre), cycle)
