@@ -33,10 +33,9 @@ class View:
     The controller sets ``part`` and ``now`` before it asks the policy.
     """
 
-    def __init__(self, env: simpy.Environment, k: CellConstants, fed_s: list[float],
-                 n_parts: int, conveyor: InputConveyor, output: OutputConveyor):
-        self.env, self.k, self.fed_s, self.n = env, k, fed_s, n_parts
-        self.conveyor, self.output = conveyor, output
+    def __init__(self, k: CellConstants, fed_s: list[float], n_parts: int,
+                 conveyor: InputConveyor, output: OutputConveyor):
+        self.k, self.fed_s, self.n, self.output = k, fed_s, n_parts, output
         self._input_speed, self._output_travel = conveyor.belt.speed, output.belt.travel
         self._input_travel, self._x_fed = conveyor.belt.travel, conveyor.x_fed
         self._length = k.input_length

@@ -275,7 +275,7 @@ def simulate(scenario: Scenario | AssembledCell,
     robot = Robot(env, output.placed)
     feeder = Feeder(env, t_all, conveyor, n, k.part_size, log.flag, t_list)
     conveyor.feeder = feeder
-    view = View(env, k, feeder.fed_s, n, conveyor, output)
+    view = View(k, feeder.fed_s, n, conveyor, output)
     Controller(env, k, policy, view, conveyor, output, robot, log)
     env.run()
     conveyor.belt.close()
