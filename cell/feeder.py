@@ -15,7 +15,6 @@ from typing import Any, Protocol
 
 import numpy as np
 import simpy
-from numpy.typing import NDArray
 
 from cell.conveyors import EPS_S
 from cell.mailbox import Timer
@@ -37,14 +36,11 @@ class Feeder:
     """Drops part i on the input conveyor T_i after part i − 1, when the belt is clear
     (SimPy process)."""
 
-    def __init__(self, env: simpy.Environment, interarrival_s: NDArray[np.float64],
-                 conveyor: Loadable, n_parts: int, part_size_in: float,
-                 flag: Any = None, interarrival_list: list[float] | None = None):
+    def __init__(self, env: simpy.Environment, interarrival_s: list[float],
+                 conveyor: Loadable, n_parts: int, part_size_in: float, flag: Any = None):
         self.env = env
-        self.interarrival_s = interarrival_s.tolist() if interarrival_list is None \
-            else interarrival_list
-        """All the run's draws; the one after the last part is the controller's look-ahead
-        (``interarrival_list``: the same as a list, if the caller has it already)."""
+        self.interarrival_s = interarrival_s
+        """All the run's draws; the one after the last part is the controller's look-ahead."""
         self.fed_s: list[float] = np.cumsum(interarrival_s).tolist()
         """When each part comes (is due to be dropped): the upstream process's schedule."""
         self.n_parts = n_parts

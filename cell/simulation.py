@@ -273,7 +273,7 @@ def simulate(scenario: Scenario | AssembledCell,
     conveyor = InputConveyor(env, k.v_nom, k.input_length, belts.told(0))
     output = OutputConveyor(env, k.u_nom, log.delivered_part, belts.told(1))
     robot = Robot(env, output.placed)
-    feeder = Feeder(env, t_all, conveyor, n, k.part_size, log.flag, t_list)
+    feeder = Feeder(env, t_list, conveyor, n, k.part_size, log.flag)
     conveyor.feeder = feeder
     view = View(k, feeder.fed_s, n, conveyor, output)
     Controller(env, k, policy, view, conveyor, output, robot, log)
