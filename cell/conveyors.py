@@ -62,7 +62,7 @@ class Belt:
         return len(self._t)
 
     def speed(self, t: float) -> float:
-        """The speed at instant t (:func:`speed_at`)."""
+        """The speed at instant t (:func:`speed_at`, hand-written for speed: no ``max`` call)."""
         k = bisect_right(self._t, t) - 1
         return self._v[k if k > 0 else 0]
 
@@ -74,7 +74,7 @@ class Belt:
     def time_at(self, x: float) -> float:
         """First instant at which the belt's travel reaches x (speeds are > 0)."""
         k = bisect_right(self._x, x) - 1
-        if k < 0:
+        if k < 0:  # max(k, 0) without the builtin call (once a part)
             k = 0
         return self._t[k] + (x - self._x[k]) / self._v[k]
 
@@ -85,7 +85,7 @@ class Belt:
         A new plan supersedes whatever was planned after t1 (the controller
         replans every cycle); a change within EPS_S of the last one replaces it.
         Changes before ``t1`` whose successors have started are settled.
-        (Called twice a part: its lists are bound to locals and settling is inlined.)
+        (Called twice a part: the controller's case is unrolled first, for speed.)
         """
         if not v1 > 0 or (t2 is not None and not v2 > 0):
             raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}")
@@ -203,7 +203,7 @@ class InputConveyor:
             i = part.part - 1
             now = env._now  # env.now without the property call (also below)
             delay = time_at(x_fed[i] + length) - now
-            if delay < 0.0:
+            if delay < 0.0:  # max(delay, 0) without the builtin call
                 delay = 0.0
             # the instant the part reaches B, as the event queue will have it
             part.at_bot_s = self.due_s = now + delay

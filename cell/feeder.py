@@ -63,7 +63,7 @@ class Feeder:
         for i in range(self.n_parts):
             f = fed[i]
             delay = f - env._now
-            yield after(delay if delay > 0.0 else 0.0)  # after a hold it may be due already
+            yield after(delay if delay > 0.0 else 0.0)  # max(delay, 0): after a hold it may be due
             x = travel(env._now)
             if x < clear_at - CLEAR_TOL_IN:
                 belt = self.conveyor.belt
