@@ -23,8 +23,9 @@ scheduled by pushing it onto SimPy's event queue exactly as
 its events rather than making one per hand-off.  :class:`Timer` does the same for
 a process's timeouts.  This reaches into SimPy 4.1's internals (the environment's
 ``_queue``, ``_eid`` and ``_now``; an event's ``callbacks``, ``_ok`` and ``_value``),
-so ``pyproject.toml`` pins ``simpy<4.2``; ``tests/test_mailbox.py`` checks the order of
-deliveries against ``simpy.Store`` and ``env.timeout`` as the reference.
+as do the cell's processes, which read the clock as ``env._now`` (``env.now`` without
+its property call), so ``pyproject.toml`` pins ``simpy<4.2``; ``tests/test_mailbox.py``
+checks the order of deliveries against ``simpy.Store`` and ``env.timeout`` as the reference.
 """
 
 from __future__ import annotations
