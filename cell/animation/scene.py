@@ -71,12 +71,11 @@ class AnimationInput:
 
 def belt_history(result: Any, belt: str) -> Floats:
     """(m, 2) rows (from_s, speed_in_s) of one belt's speed changes, as the run recorded
-    them (``SimResult.belt_changes``, the rows of ``belts.csv``), in time order."""
-    rows = [(c.from_s, c.speed_in_s) for c in result.belt_changes if c.belt == belt]
-    return np.array(sorted(rows), dtype=float).reshape(-1, 2)
+    them (``SimResult.belts``, the rows of ``belts.csv``), in time order."""
+    return np.array(result.belts[belt], dtype=float).reshape(-1, 2)
 
 
-def frames_input(result: Any, table: StepTable, scenario: Scenario) -> AnimationInput:
+def frames_input(result: Any, scenario: Scenario) -> AnimationInput:
     """The run's part records and belt changes as plain arrays.
 
     ``start_s`` is ``at_bot_s`` for a picked part (the robot starts its cycle the
@@ -89,7 +88,6 @@ def frames_input(result: Any, table: StepTable, scenario: Scenario) -> Animation
     d = result.parts
     picked = d["picked"].to_numpy(dtype=bool)
     at_bot = d["at_bot_s"].to_numpy(dtype=float)
-    del table
     return AnimationInput(
         policy=str(result.summary.policy),
         part=d["part"].to_numpy(dtype=np.int64),
