@@ -89,9 +89,10 @@ def a_matrix(theta: ArrayLike, d: float, a: float, alpha: float) -> Frame:
 def forward(q: ArrayLike, arm: Arm = Arm()) -> Frame:
     """T5 = A1 A2 A3 A4 A5 (eq. 3.13-3.15) for configurations ``q`` of shape (..., 5)."""
     q = np.asarray(q, dtype=float)
+    link_a = arm.link_a
     t = a_matrix(q[..., 0], 0.0, 0.0, DH_ALPHA[0])
     for i in range(1, 5):
-        t = t @ a_matrix(q[..., i], 0.0, arm.link_a[i], DH_ALPHA[i])
+        t = t @ a_matrix(q[..., i], 0.0, link_a[i], DH_ALPHA[i])
     return t
 
 
