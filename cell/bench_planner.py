@@ -38,18 +38,9 @@ def converged_time(times: list[float]) -> float:
 
 
 def benchmarks(repeat: int = 5) -> dict[str, float]:
-    from scipy.interpolate import CubicSpline
-
     from cell.assembly import geometry_of, motors_of, planner_bounds, step_table
     from cell.dynamics import chain
-    from cell.mintime.planner import (
-        PathRows,
-        acceleration_rows,
-        path_grid,
-        plan,
-        torque_rows,
-        velocity_rows,
-    )
+    from cell.mintime.planner import PathRows, path_grid, plan, torque_rows, velocity_rows
     from cell.mintime.reference import toppra_profile
     from cell.mintime.regimes import FREE_REGIMES, plan_regimes, regime_path, regime_rows
     from cell.scenario import load_scenario
@@ -63,15 +54,7 @@ def benchmarks(repeat: int = 5) -> dict[str, float]:
             for rp in paths}
 
     def ours(n: int) -> list[float]:
-        s = path_grid(n)
-        out = []
-        for rp in paths:
-            sp = CubicSpline(rp.s_way, rp.q_way)
-            dq, ddq = sp(s, 1), sp(s, 2)
-            rows = PathRows.join(velocity_rows(s, dq, vmax[rp.regime]),
-                                 acceleration_rows(s, dq, ddq, amax))
-            out.append(plan(rows).time_s)
-        return out
+        return [plan(regime_rows(rp, motors, bounds, geometry, n)[2]).time_s for rp in paths]
 
     def theirs(n: int) -> list[float]:
         s = path_grid(n)
@@ -97,7 +80,7 @@ def benchmarks(repeat: int = 5) -> dict[str, float]:
     s = path_grid(460)
 
     def ours_tau() -> float:
-        sp = CubicSpline(r4.s_way, r4.q_way)
+        sp = r4.spline()
         q, dq, ddq = sp(s), sp(s, 1), sp(s, 2)
         return plan(PathRows.join(velocity_rows(s, dq, vmax["R4"]),
                                   torque_rows(s, q, dq, ddq, ch.rnea, tau))).time_s

@@ -188,7 +188,5 @@ def free_speed(model: DynamicsModel, no_load_rad_s: ArrayLike) -> Array:
     spare = 1.0 - k * w0 / tau_s
     if np.any(spare <= 0):
         j = int(np.flatnonzero(spare <= 0)[0])
-        err = InfeasibleError(f"drive {j + 1}: friction at the no-load rate exceeds the stall torque")
-        err.joint = j  # type: ignore[attr-defined]
-        raise err
+        raise InfeasibleError(f"drive {j + 1}: friction at the no-load rate exceeds the stall torque")
     return w0 / spare

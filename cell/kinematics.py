@@ -89,9 +89,10 @@ def a_matrix(theta: ArrayLike, d: float, a: float, alpha: float) -> Frame:
 def forward(q: ArrayLike, arm: Arm = Arm()) -> Frame:
     """T5 = A1 A2 A3 A4 A5 (eq. 3.13-3.15) for configurations ``q`` of shape (..., 5)."""
     q = np.asarray(q, dtype=float)
+    link_a = arm.link_a
     t = a_matrix(q[..., 0], 0.0, 0.0, DH_ALPHA[0])
     for i in range(1, 5):
-        t = t @ a_matrix(q[..., i], 0.0, arm.link_a[i], DH_ALPHA[i])
+        t = t @ a_matrix(q[..., i], 0.0, link_a[i], DH_ALPHA[i])
     return t
 
 
@@ -101,8 +102,7 @@ def _wrap_from(angle: NDArray[np.float64], lo: float) -> NDArray[np.float64]:
 
 
 def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *,
-                       label: Callable[[int], str] | None = None,
-                       check_limits: bool = True) -> NDArray[np.float64]:
+                       label: Callable[[int], str] | None = None) -> NDArray[np.float64]:
     """Joint angles (..., 5) for target frames T5 (..., 4, 4), in closed form
     (docs/sources.md: eq. 3.26-3.31 as scanned are garbled).
 
@@ -116,6 +116,7 @@ def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *,
     shape = t.shape[:-2]
     t = t.reshape(-1, 4, 4)
     n, o, a, p = t[:, :3, 0], t[:, :3, 1], t[:, :3, 2], t[:, :3, 3]
+    z = p[:, 2]
     lim = arm.limits_rad
 
     def solve(th1: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64],
@@ -124,7 +125,6 @@ def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *,
         th234 = np.arctan2(-(c1 * a[:, 0] + s1 * a[:, 1]), a[:, 2])
         th5 = np.arctan2(c1 * n[:, 1] - s1 * n[:, 0], c1 * o[:, 1] - s1 * o[:, 0])
         r = c1 * p[:, 0] + s1 * p[:, 1]
-        z = p[:, 2]
         c3 = (r**2 + z**2 - arm.l2**2 - arm.l3**2) / (2 * arm.l2 * arm.l3)
         reach_bad = np.abs(c3) > 1.0 + 1e-12
         c3 = np.clip(c3, -1.0, 1.0)
@@ -139,28 +139,26 @@ def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *,
         outside = (q < lim[:, 0] - LIMIT_TOL_RAD) | (q > lim[:, 1] + LIMIT_TOL_RAD)
         return q, r, reach_bad, outside
 
-    # θ1 points the arm at the wrist, or away from it when the wrist sits behind the base
-    # axis (θ2 > 90°): of the two, the one that keeps every joint inside its range.
-    q, r, reach_bad, outside = solve(np.arctan2(p[:, 1], p[:, 0]))
-    if outside.any():
-        q_b, r_b, _, outside_b = solve(np.arctan2(-p[:, 1], -p[:, 0]))
-        better: NDArray[np.bool_] = np.asarray(outside.any(axis=1) & ~outside_b.any(axis=1))
-        q, r, outside = (np.where(better[:, None], q_b, q), np.where(better, r_b, r),
-                         np.where(better[:, None], outside_b, outside))
-    z = p[:, 2]
-
     def name(i: int) -> str:
         if label is not None:
             return label(i)
         return "pose at p = (" + ", ".join(f"{v:.4f}" for v in p[i]) + ") in the robot frame"
 
+    # θ1 points the arm at the wrist, or away from it when the wrist sits behind the base
+    # axis (θ2 > 90°): of the two, the one that keeps every joint inside its range.
+    # Reach does not depend on the branch (|r| is the same), so it is checked first.
+    q, r, reach_bad, outside = solve(np.arctan2(p[:, 1], p[:, 0]))
     if reach_bad.any():
         i = int(np.flatnonzero(reach_bad)[0])
         dist = float(np.hypot(r[i], z[i]))
         raise UnreachableError(
             f"{name(i)} is out of reach: the wrist would be {dist:.4f} in from the shoulder, "
             f"the arm reaches {abs(arm.l2 - arm.l3):.4f} to {arm.l2 + arm.l3:.4f} in", i, None)
-    if check_limits:
+    if outside.any():
+        q_b, _, _, outside_b = solve(np.arctan2(-p[:, 1], -p[:, 0]))
+        better: NDArray[np.bool_] = np.asarray(outside.any(axis=1) & ~outside_b.any(axis=1))
+        q = np.where(better[:, None], q_b, q)
+        outside = np.where(better[:, None], outside_b, outside)
         if outside.any():
             i, j = (int(v) for v in np.argwhere(outside)[0])
             lo, hi = np.degrees(lim[j])

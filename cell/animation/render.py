@@ -40,7 +40,7 @@ from cell.animation.scene import (
     parts_at,
     robot_state,
 )
-from cell.figures.layout import BELT_COLOUR
+from cell.figures.layout import BELT_COLOUR, named_points, regime_points
 from cell.figures.style import LIMIT_COLOUR, POLICY_COLOURS, REGIME_COLOURS, REGIME_LABELS, style
 
 PART_COLOUR = "#d9a441"
@@ -139,13 +139,10 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene) -> Panel
     close.add_patch(Rectangle((scene.td_xy[0] - w / 2, w / 2), w, CLOSE_Y[1] + 1 - w / 2,
                               color=BELT_COLOUR, zorder=0))
     for reg in (1, 2, 3, 4):
-        idx = np.flatnonzero(p.regime == reg)
-        idx = np.concatenate([[idx[0] - 1], idx]) if idx[0] > 0 else idx
+        idx = regime_points(p, reg)
         close.plot(p.xyz_in[idx, 0], p.xyz_in[idx, 1], color=REGIME_COLOURS[reg], lw=0.9,
                    alpha=0.5, zorder=1)
-    named = {"B": b, "F": f, "G": np.asarray(s.path.g_in[:2]), "K": np.asarray(s.path.eot_in[:2]),
-             "LO": p.xyz_in[p.lo, :2], "TD": scene.td_xy}
-    for name, (x, y) in named.items():
+    for name, (x, y, _) in named_points(s, scene.table).items():
         close.plot(x, y, "+", color="0.25", ms=5, mew=0.9, zorder=2)
         close.annotate(name, (x, y), xytext=(3, -9), textcoords="offset points", fontsize=7,
                        color="0.25", zorder=2)

@@ -28,7 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 from cell.conveyors import speed_at
 from cell.kinematics import Arm, forward, hand_frame
 from cell.scenario import Scenario
-from cell.steptable import SEGMENTS, StepTable
+from cell.steptable import StepTable
 
 Floats = NDArray[np.float64]
 
@@ -71,12 +71,11 @@ class AnimationInput:
 
 def belt_history(result: Any, belt: str) -> Floats:
     """(m, 2) rows (from_s, speed_in_s) of one belt's speed changes, as the run recorded
-    them (``SimResult.belt_changes``, the rows of ``belts.csv``), in time order."""
-    rows = [(c.from_s, c.speed_in_s) for c in result.belt_changes if c.belt == belt]
-    return np.array(sorted(rows), dtype=float).reshape(-1, 2)
+    them (``SimResult.belts``, the rows of ``belts.csv``), in time order."""
+    return np.array(result.belts[belt], dtype=float).reshape(-1, 2)
 
 
-def frames_input(result: Any, table: StepTable, scenario: Scenario) -> AnimationInput:
+def frames_input(result: Any, scenario: Scenario) -> AnimationInput:
     """The run's part records and belt changes as plain arrays.
 
     ``start_s`` is ``at_bot_s`` for a picked part (the robot starts its cycle the
@@ -89,7 +88,6 @@ def frames_input(result: Any, table: StepTable, scenario: Scenario) -> Animation
     d = result.parts
     picked = d["picked"].to_numpy(dtype=bool)
     at_bot = d["at_bot_s"].to_numpy(dtype=float)
-    del table
     return AnimationInput(
         policy=str(result.summary.policy),
         part=d["part"].to_numpy(dtype=np.int64),
@@ -166,26 +164,14 @@ class Scene:
         return self.table.path.xyz_in[self.table.path.td, :2]
 
 
-def segments(start_s: float, pick_s: float, touchdown_s: float,
-             regime_s: ArrayLike) -> dict[str, float]:
-    """A cycle's six stretches (:data:`~cell.steptable.SEGMENTS`) from its records:
-    R I and R III split at LO and TD (§4.2)."""
-    r1, r2, r3, r4 = (float(v) for v in np.asarray(regime_s, dtype=float))
-    r1_pre = pick_s - start_s
-    r3_pre = touchdown_s - start_s - r1 - r2
-    seg = {"r1_pre": r1_pre, "r1_post": r1 - r1_pre, "r2": r2, "r3_pre": r3_pre,
-           "r3_post": r3 - r3_pre, "r4": r4}
-    return {k: seg[k] for k in SEGMENTS}
-
-
 def build_scene(data: AnimationInput, table: StepTable, scenario: Scenario) -> Scene:
     """Time every robot cycle move by move (``timeline``, §6.1) and find each lost part's fall."""
-    from cell.figures.motion import timeline
+    from cell.figures.motion import record_segments, timeline
 
     cycles = np.flatnonzero(data.picked)
     t_s = np.empty((len(cycles), table.path.n_points))
     for row, i in enumerate(cycles):
-        seg = segments(data.start_s[i], data.pick_s[i], data.touchdown_s[i], data.regime_s[i])
+        seg = record_segments(data.start_s[i], data.pick_s[i], data.touchdown_s[i], data.regime_s[i])
         t_s[row] = data.start_s[i] + timeline(table, seg).t_s
     to_f = data.input_length_in + float(scenario.path.f_in[0] - scenario.path.bot_in[0])
     fall = np.where(data.picked, np.nan,

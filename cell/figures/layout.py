@@ -10,6 +10,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle, FancyArrow, Rectangle
 from matplotlib.transforms import Bbox
 from mpl_toolkits.mplot3d import proj3d  # type: ignore[import-untyped]
+from numpy.typing import NDArray
 
 from cell.assembly import geometry_of
 from cell.figures.style import (
@@ -22,17 +23,25 @@ from cell.figures.style import (
     save,
 )
 from cell.kinematics import hand_length
+from cell.path import TransferPath
 from cell.scenario import Scenario
 from cell.steptable import StepTable
 
 BELT_COLOUR = "#c8c8c8"
 
 
-def _named_points(s: Scenario, table: StepTable) -> dict[str, np.ndarray]:
+def named_points(s: Scenario, table: StepTable) -> dict[str, np.ndarray]:
+    """B, F, G, K (the scenario's) and LO, TD (the path's), global frame (in)."""
     p = table.path
     return {"B": np.asarray(s.path.bot_in), "F": np.asarray(s.path.f_in),
             "G": np.asarray(s.path.g_in), "K": np.asarray(s.path.eot_in),
             "LO": p.xyz_in[p.lo], "TD": p.xyz_in[p.td]}
+
+
+def regime_points(p: TransferPath, regime: int) -> NDArray[np.intp]:
+    """Indices of a regime's points, with the point it starts from: its curve to draw."""
+    idx = np.flatnonzero(p.regime == regime)
+    return np.concatenate([[idx[0] - 1], idx]) if idx[0] > 0 else idx
 
 
 def _belt_extent(s: Scenario) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -61,13 +70,12 @@ def fig08_working_environment(s: Scenario, table: StepTable, out: Path) -> Path:
             va="center")
     p = table.path
     for reg in (1, 2, 3, 4):
-        idx = np.flatnonzero(p.regime == reg)
-        idx = np.concatenate([[idx[0] - 1], idx]) if idx[0] > 0 else idx
+        idx = regime_points(p, reg)
         ax.plot(p.xyz_in[idx, 0], p.xyz_in[idx, 1], color=REGIME_COLOURS[reg], lw=2.4,
                 label=f"{REGIME_LABELS[reg]} path", zorder=4)
     offsets = {"B": (-0.6, 0.9), "F": (0.4, 0.9), "G": (0.7, -0.3), "K": (0.7, 0.2),
                "LO": (-0.6, -1.3), "TD": (0.8, -0.3)}
-    for name, pt in _named_points(s, table).items():
+    for name, pt in named_points(s, table).items():
         ax.plot(pt[0], pt[1], "o", color="black", ms=5, zorder=5)
         dx, dy = offsets[name]
         ax.text(pt[0] + dx, pt[1] + dy, f"{name} ({pt[0]:g}, {pt[1]:g})", fontsize=9,
@@ -101,13 +109,12 @@ def fig09_figure(s: Scenario, table: StepTable) -> Figure:
     curves = ax.plot([bx, bx], [by, by], [bz, top[2]], color="0.25", lw=4)
     p = table.path
     for reg in (1, 2, 3, 4):
-        idx = np.flatnonzero(p.regime == reg)
-        idx = np.concatenate([[idx[0] - 1], idx]) if idx[0] > 0 else idx
+        idx = regime_points(p, reg)
         xyz = p.xyz_in[idx]
         curves += ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], color=REGIME_COLOURS[reg], lw=2.6,
                           label=f"{REGIME_LABELS[reg]} ({idx.size - 1} moves, "
                                 f"{table.regime_length(reg):.3f} in)")
-    named = _named_points(s, table)
+    named = named_points(s, table)
     for pt in named.values():
         ax.scatter(*pt, color="black", s=14, depthshade=False)
     ax.set_xlabel("x (in)")

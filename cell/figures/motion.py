@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from cell.assembly import motors_of
 from cell.figures.style import LIMIT_COLOUR, REGIME_LABELS, mark_events, new_figure, save, shade_regimes
@@ -47,6 +47,18 @@ class Timeline:
         g = self.segment_s
         return {1: g["r1_pre"] + g["r1_post"], 2: g["r2"], 3: g["r3_pre"] + g["r3_post"],
                 4: g["r4"]}
+
+
+def record_segments(start_s: float, pick_s: float, touchdown_s: float,
+                    regime_s: ArrayLike) -> dict[str, float]:
+    """A simulated cycle's six stretches (:data:`~cell.steptable.SEGMENTS`) from its
+    records: each regime's time, R I and R III split at LO and TD (§4.2)."""
+    r1, r2, r3, r4 = (float(v) for v in np.asarray(regime_s, dtype=float))
+    r1_pre = pick_s - start_s
+    r3_pre = touchdown_s - start_s - r1 - r2
+    seg = {"r1_pre": r1_pre, "r1_post": r1 - r1_pre, "r2": r2, "r3_pre": r3_pre,
+           "r3_post": r3 - r3_pre, "r4": r4}
+    return {k: seg[k] for k in SEGMENTS}
 
 
 def joint_travel_min_times(table: StepTable) -> NDArray[np.float64]:

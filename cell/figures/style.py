@@ -123,9 +123,7 @@ def freeze_layout(fig: Figure) -> None:
 def display_paths(artist: Artist) -> list[MplPath]:
     """An artist's outline in display pixels: a line's, a step curve's, a collection's lines.
     A 3-D line gives its projection as last drawn."""
-    if isinstance(artist, Line2D):
-        return [artist.get_transform().transform_path(artist.get_path())]
-    if isinstance(artist, Patch):
+    if isinstance(artist, (Line2D, Patch)):
         return [artist.get_transform().transform_path(artist.get_path())]
     if isinstance(artist, Collection):
         tr = artist.get_transform()

@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from cell.assembly import nominal_cycle
 from cell.conveyors import speed_at
-from cell.figures.motion import Timeline, joint_travel_min_times, timeline
+from cell.figures.motion import Timeline, joint_travel_min_times, record_segments, timeline
 from cell.figures.runs import Run, Runs
 from cell.figures.style import (
     POLICY_COLOURS,
@@ -39,7 +39,7 @@ from cell.figures.style import (
     shade_regimes,
 )
 from cell.scenario import Scenario
-from cell.steptable import SEGMENTS, StepTable
+from cell.steptable import StepTable
 
 #: Offsets (points) tried, in order, for a label next to what it names.
 OFFSETS = [(0, 9), (0, -9), (0, 16), (0, -16), (0, 24), (0, -24), (0, 34), (0, -34), (0, 48),
@@ -49,14 +49,9 @@ SHIFTS = (0, -40, 40, -80, 80)
 
 
 def part_segments(row: pd.Series) -> dict[str, float]:
-    """A simulated part's six segment times from its record: each regime's time, split
-    at lift-off (``pick_s``) in R I and at touch-down in R III."""
-    start = float(row["at_bot_s"])
-    r1_pre = float(row["pick_s"]) - start
-    r3_pre = float(row["touchdown_s"]) - start - float(row["r1_s"]) - float(row["r2_s"])
-    seg = {"r1_pre": r1_pre, "r1_post": float(row["r1_s"]) - r1_pre, "r2": float(row["r2_s"]),
-           "r3_pre": r3_pre, "r3_post": float(row["r3_s"]) - r3_pre, "r4": float(row["r4_s"])}
-    return {k: seg[k] for k in SEGMENTS}
+    """A simulated part's six segment times from its record (:func:`record_segments`)."""
+    return record_segments(float(row["at_bot_s"]), float(row["pick_s"]),
+                           float(row["touchdown_s"]), [row[f"r{r}_s"] for r in (1, 2, 3, 4)])
 
 
 def belt_speed_at(history: list[tuple[float, float]], when: float) -> float:

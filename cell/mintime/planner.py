@@ -302,11 +302,6 @@ class Profile:
     switching_s: list[float]
     """Where the control switches between the phases (interval boundaries)."""
 
-    def times(self) -> Array:
-        """(N,) time at each grid point."""
-        dt = 2.0 * np.diff(self.s) / (self.sdot[:-1] + self.sdot[1:])
-        return np.concatenate([[0.0], np.cumsum(dt)])
-
 
 def _where(s: Array, i: int) -> str:
     return f"s = {s[i]:.4f}"
