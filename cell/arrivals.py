@@ -263,10 +263,7 @@ def check_arrivals(arrivals: ArrivalSpec, base_dir: Path, file: object) -> None:
                                 "not a continuous distribution in scipy.stats")
         _FAMILIES.put(family, True)
     if arrivals.trace_csv is not None:
-        path = base_dir / arrivals.trace_csv
-        if not path.is_file():
-            raise ScenarioError(file, "arrivals.trace_csv", str(path), "no such file")
-        read_trace(path, file)
+        read_trace(base_dir / arrivals.trace_csv, file)
         return
     if (arrivals.mean_s is None) != (arrivals.cv is None):
         key = "arrivals.cv" if arrivals.cv is None else "arrivals.mean_s"
