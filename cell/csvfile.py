@@ -14,7 +14,7 @@ from collections.abc import Sequence
 from operator import attrgetter
 from typing import Any, TextIO
 
-FLOAT_FORMAT = "%.10g"
+from cell.output import FLOAT_FORMAT
 
 
 def cell_text(value: Any, float_format: str = FLOAT_FORMAT) -> str:
