@@ -9,6 +9,10 @@ it needs.  Nothing below this layer imports it.
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from cell.scenario import Scenario
 
 
 def scenario_arguments(p: argparse.ArgumentParser) -> None:
@@ -16,6 +20,14 @@ def scenario_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("scenario", help="a scenario file, or the name of a built-in one "
                                     "(`cell scenarios` lists them), e.g. baseline")
     set_argument(p)
+
+
+def scenario_of(args: argparse.Namespace) -> Scenario:
+    """The scenario of SCENARIO (``args.scenario``) with its ``--set`` overrides."""
+    from cell.overrides import parse_sets
+    from cell.scenario import load_scenario
+
+    return load_scenario(args.scenario, parse_sets(args.sets))
 
 
 def set_argument(p: argparse.ArgumentParser) -> None:
