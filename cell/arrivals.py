@@ -307,7 +307,7 @@ def read_trace(path: Path, file: object = None) -> NDArray[np.float64]:
     return times
 
 
-@memo(key=lambda path: file_key(path))
+@memo(key=file_key)
 def _parse_trace(path: Path) -> Any:
     """The trace's times, or why they cannot be used (a message)."""
     import pandas as pd
