@@ -263,10 +263,7 @@ def check_arrivals(arrivals: ArrivalSpec, base_dir: Path, file: object) -> None:
                                 "not a continuous distribution in scipy.stats")
         _FAMILIES.put(family, True)
     if arrivals.trace_csv is not None:
-        path = base_dir / arrivals.trace_csv
-        if not path.is_file():
-            raise ScenarioError(file, "arrivals.trace_csv", str(path), "no such file")
-        read_trace(path, file)
+        read_trace(base_dir / arrivals.trace_csv, file)
         return
     if (arrivals.mean_s is None) != (arrivals.cv is None):
         key = "arrivals.cv" if arrivals.cv is None else "arrivals.mean_s"
@@ -310,7 +307,7 @@ def read_trace(path: Path, file: object = None) -> NDArray[np.float64]:
     return times
 
 
-@memo(key=lambda path: file_key(path))
+@memo(key=file_key)
 def _parse_trace(path: Path) -> Any:
     """The trace's times, or why they cannot be used (a message)."""
     import pandas as pd

@@ -15,7 +15,6 @@ before neither solves the path nor imports what solving needs (scipy's splines).
 from __future__ import annotations
 
 import hashlib
-import json
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -202,15 +201,15 @@ TIMING_SECTIONS = ("cell", "path", "part", "robot", "mintime")
 
 
 def _timing_key(s: Scenario) -> dict[str, Any] | None:
-    """The plain values the robot's timing depends on (None: not to be cached)."""
-    try:
-        key: dict[str, Any] = {name: getattr(s, name).model_dump() for name in TIMING_SECTIONS}
-        if s.robot.timing == "minimum-time" and s.mintime.dynamics_file is not None:
+    """The plain values the robot's timing depends on (None: not to be cached; a key that is
+    not JSON data is not cached either, :class:`~cell.cache.Remembered` sees to that)."""
+    key: dict[str, Any] = {name: getattr(s, name).model_dump() for name in TIMING_SECTIONS}
+    if s.robot.timing == "minimum-time" and s.mintime.dynamics_file is not None:
+        try:
             path = dynamics_path(s)
             key["dynamics_file_sha256"] = hashlib.sha256(path.read_bytes() if path else b"").hexdigest()
-        json.dumps(key)
-    except (OSError, TypeError, ValueError):
-        return None
+        except (OSError, ValueError):  # no such file: solving it says so, with its key
+            return None
     return key
 
 

@@ -75,18 +75,22 @@ def names() -> list[str]:
 
 def read(name: str) -> object:
     """A built-in file's top-level document (None if it is not YAML)."""
+    return _parsed(path(name).read_text(encoding="utf-8"))
+
+
+def _parsed(text: str) -> object:
     import yaml
 
     try:
-        return yaml.safe_load(path(name).read_text(encoding="utf-8"))
+        return yaml.safe_load(text)
     except yaml.YAMLError:  # pragma: no cover - the files are the project's own
         return None
 
 
 def describe(name: str) -> str:
     """A built-in file's ``description``, or its first comment line."""
-    doc = read(name)
     text = path(name).read_text(encoding="utf-8")
+    doc = _parsed(text)
     if isinstance(doc, dict) and doc.get("description"):
         return str(doc["description"])
     first = next((line for line in text.splitlines() if line.startswith("#")), "# ")

@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import csv
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from operator import attrgetter
 from typing import Any, TextIO
 
-FLOAT_FORMAT = "%.10g"
+from cell.output import FLOAT_FORMAT
 
 
 def cell_text(value: Any, float_format: str = FLOAT_FORMAT) -> str:
@@ -36,7 +36,6 @@ class RowWriter:
         self._w.writerow(self.columns)
         self._values: Any = attrgetter(*self.columns) if len(self.columns) > 1 else \
             (lambda obj: tuple(getattr(obj, c) for c in self.columns))
-        self.rows = 0
 
     def record(self, obj: Any) -> None:
         f = self.float_format
@@ -47,8 +46,3 @@ class RowWriter:
                           else str(v) if type(v) is bool or type(v) is int
                           else cell_text(v, f)
                           for v in self._values(obj)])
-        self.rows += 1
-
-    def rows_of(self, objs: Iterable[Any]) -> None:
-        for obj in objs:
-            self.record(obj)

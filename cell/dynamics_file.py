@@ -64,7 +64,7 @@ def load_dynamics(path: str | Path) -> DynamicsModel:
     return _load(path)
 
 
-@memo(key=lambda path: file_key(path))
+@memo(key=file_key)
 def _load(path: Path) -> DynamicsModel:
     from cell import catalog
     from cell.yamlio import load_mapping

@@ -36,6 +36,7 @@ from yaml.resolver import BaseResolver
 from yaml.scanner import Scanner
 
 from cell.errors import ScenarioError
+from cell.errors import one_line as _oneline
 
 MAX_BYTES = 1 << 20  #: largest file read (bytes); scenario and sweep files are a few kilobytes
 MAX_DEPTH = 32  #: deepest nesting of lists and mappings
@@ -129,12 +130,6 @@ if yaml.__with_libyaml__:
             _Composer.__init__(self)
 
     _Loader = _CLoader
-
-
-def _oneline(text: str, limit: int = 200) -> str:
-    """``text`` without line breaks, cut to ``limit`` characters."""
-    text = " ".join(text.splitlines())
-    return text if len(text) <= limit else text[:limit - 1] + "…"
 
 
 def _dotted(path: Iterable[str | int | None], limit: int = 80) -> str:

@@ -9,6 +9,10 @@ it needs.  Nothing below this layer imports it.
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from cell.scenario import Scenario
 
 
 def scenario_arguments(p: argparse.ArgumentParser) -> None:
@@ -18,7 +22,29 @@ def scenario_arguments(p: argparse.ArgumentParser) -> None:
     set_argument(p)
 
 
+def scenario_of(args: argparse.Namespace) -> Scenario:
+    """The scenario of SCENARIO (``args.scenario``) with its ``--set`` overrides."""
+    from cell.overrides import parse_sets
+    from cell.scenario import load_scenario
+
+    return load_scenario(args.scenario, parse_sets(args.sets))
+
+
 def set_argument(p: argparse.ArgumentParser) -> None:
     p.add_argument("--set", dest="sets", action="append", metavar="KEY=VALUE",
                    help="override a scenario value, e.g. --set run.parts=100 or "
                         "--set arrivals.params.scale=6.0 (repeatable)")
+
+
+def workers_argument(p: argparse.ArgumentParser) -> None:
+    """``--workers N``, as the commands that run a sweep take it."""
+    p.add_argument("--workers", type=int, default=None,
+                   help="local worker processes (default: number of cores)")
+
+
+def check_workers(workers: int | None) -> None:
+    """Refuse ``--workers`` below 1 before any work."""
+    from cell.errors import CellError
+
+    if workers is not None and workers < 1:
+        raise CellError(f"--workers {workers}: must be at least 1")

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import argparse
 
-from cell.commands import scenario_arguments
+from cell.commands import scenario_arguments, scenario_of
 
 HELP = "watch the cell run: a GIF or MP4 of the cell from above"
 DESCRIPTION = ("Animate a run seen from above: belts, parts at their true positions, the arm, "
@@ -65,10 +65,7 @@ def main(args: argparse.Namespace) -> int:
 
     check_output(args.out)  # before anything is simulated
     check_file(args.out)
-    from cell.overrides import parse_sets
-    from cell.scenario import load_scenario
-
-    scenario = load_scenario(args.scenario, parse_sets(args.sets))
+    scenario = scenario_of(args)
     from cell.arrivals import mean_interarrival
 
     check_options(args, max(scenario.controller.nominal_cycle_s or 0.0,

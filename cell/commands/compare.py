@@ -13,7 +13,7 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING
 
-from cell.commands import set_argument
+from cell.commands import check_workers, set_argument, workers_argument
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -34,8 +34,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help=f"replications of each (default {DEFAULT_REPLICATIONS})")
     p.add_argument("--seed", type=int, default=None,
                    help="root seed of the replications' streams (default: A's run.seed)")
-    p.add_argument("--workers", type=int, default=None,
-                   help="local worker processes (default: number of cores)")
+    workers_argument(p)
     p.add_argument("--out", default=None, metavar="DIR",
                    help="write report.md, summary.csv, differences.csv, figures and "
                         "replications.csv into DIR")
@@ -65,8 +64,7 @@ def main(args: argparse.Namespace) -> int:
                         "(a confidence interval needs two)")
     if args.seed is not None and not 0 <= args.seed < 2**63:
         raise CellError(f"--seed {args.seed}: must be a whole number from 0 to 2**63 - 1")
-    if args.workers is not None and args.workers < 1:
-        raise CellError(f"--workers {args.workers}: must be at least 1")
+    check_workers(args.workers)
     seed = a.run.seed if args.seed is None else args.seed
     sweep = comparison(a, b, (_label(args.a), _label(args.b)), args.replications, seed)
     target = None

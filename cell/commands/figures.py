@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import argparse
 
-from cell.commands import set_argument
+from cell.commands import scenario_of, set_argument
 
 HELP = "regenerate the thesis's figures as PNG"
 DESCRIPTION = "Write figNN_<slug>.png for the thesis's Fig. 8-30 into --out."
@@ -24,12 +24,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     from cell.figures import FILES, make_figures
     from cell.output import OutputDir
-    from cell.overrides import parse_sets
-    from cell.scenario import load_scenario
 
     names = [f"{stem}.png" for stem in FILES.values()]
     OutputDir.check(args.out, names)  # before any work
-    scenario = load_scenario(args.scenario, parse_sets(getattr(args, "sets", None)))
+    scenario = scenario_of(args)
     with OutputDir(args.out, names) as out:
         drawn = make_figures(scenario, out.stage, progress=lambda p: print(f"drew {p.name}"))
     print(f"wrote {len(drawn)} figures into {out.target}")

@@ -13,7 +13,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from cell.commands import scenario_arguments
+from cell.commands import scenario_arguments, scenario_of
 
 HELP = "minimum-time motion along the path (Shin & McKay)"
 DESCRIPTION = ("Phase-plane minimum-time parameterisation of R II and R IV; writes "
@@ -61,11 +61,10 @@ def main(args: argparse.Namespace) -> int:
     from cell.errors import CellError, InfeasibleError, NoMotionError, ScenarioError
     from cell.mintime.regimes import plan_regimes, summary
     from cell.output import OutputDir
-    from cell.overrides import parse_sets
-    from cell.scenario import MAX_TIME_S, load_scenario
+    from cell.scenario import MAX_TIME_S
 
     check_out(args.out)  # before any work
-    scenario = load_scenario(args.scenario, parse_sets(args.sets))
+    scenario = scenario_of(args)
     step_table(scenario)  # reach and motor checks, naming their keys
     bounds = planner_bounds(scenario)
     rates = "robot.motors.max_rate_no_load_rad_s"

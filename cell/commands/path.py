@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from cell.commands import scenario_arguments
+from cell.commands import scenario_arguments, scenario_of
 
 HELP = "write the joint-step table of the transfer path (CSV)"
 DESCRIPTION = ("Solve the transfer path once (thesis §4.2, eq. 6.7) and write one row per path "
@@ -19,11 +19,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     from cell.assembly import step_table
     from cell.output import check_file, write_csv
-    from cell.overrides import parse_sets
-    from cell.scenario import load_scenario
 
     check_file(args.out)  # before any work
-    scenario = load_scenario(args.scenario, parse_sets(args.sets))
+    scenario = scenario_of(args)
     table = step_table(scenario)
     write_csv(table.to_frame(), args.out)
     n = table.path.n_points

@@ -12,7 +12,7 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
-from cell.commands import scenario_arguments
+from cell.commands import scenario_arguments, scenario_of
 
 HELP = "simulate one scenario; write parts.csv, summary.csv and belts.csv"
 DESCRIPTION = "Run the cell in simulated time under the scenario's policy."
@@ -35,15 +35,13 @@ def main(args: argparse.Namespace) -> int:
     from cell.assembly import assemble
     from cell.csvfile import RowWriter
     from cell.output import OutputDir
-    from cell.overrides import parse_sets
     from cell.progress import Progress
     from cell.records import BELT_COLUMNS, PART_COLUMNS, SUMMARY_COLUMNS
     from cell.reporting.runs import format_summary, run_heading, thesis_figures, warnings
-    from cell.scenario import load_scenario
     from cell.simulation import simulate
 
     OutputDir.check(args.out, RUN_FILES)  # before any work
-    scenario = load_scenario(args.scenario, parse_sets(args.sets))
+    scenario = scenario_of(args)
     cell = assemble(scenario)  # every error is raised before anything is written
     print(run_heading(cell))
     for line in warnings(cell.k):

@@ -9,6 +9,8 @@ import threading
 from pathlib import Path
 from typing import Any
 
+from cell.commands import check_workers, workers_argument
+
 HELP = "replicated sweep over scenario keys, with its report"
 DESCRIPTION = ("Run a grid of scenarios with replications (common random numbers); write "
                "replications.csv and, with --report, the experiment's report: summary.csv, "
@@ -19,8 +21,7 @@ DESCRIPTION = ("Run a grid of scenarios with replications (common random numbers
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("sweep", help="sweep YAML file, or a built-in one by name (table_7_1)")
     p.add_argument("--out", required=True, help="directory for results")
-    p.add_argument("--workers", type=int, default=None,
-                   help="local worker processes (default: number of cores)")
+    workers_argument(p)
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="run on a dask.distributed cluster at ADDRESS")
     p.add_argument("--resume", action="store_true", help="run only what is missing in --out")
@@ -45,14 +46,12 @@ def main(args: argparse.Namespace) -> int:
 
 
 def _sweep(args: argparse.Namespace) -> int:
-    from cell.errors import CellError
     from cell.sweep import load_sweep, run_sweep, simulate_summary
     from cell.sweep.runner import check_out
 
     check_out(args.out)  # before the sweep file's points are built and checked
     sweep = load_sweep(args.sweep)
-    if args.workers is not None and args.workers < 1:
-        raise CellError(f"--workers {args.workers}: must be at least 1")
+    check_workers(args.workers)
     target = None
     if args.report:
         from cell.reporting.experiment import plan_report

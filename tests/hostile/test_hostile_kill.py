@@ -20,7 +20,7 @@ import cell.output as output
 from cell.output import OutputDir
 
 from ..killing import die_at_step
-from .harness import COUNT
+from .harness import COUNT, tree
 
 NAMES = ["parts.csv", "summary.csv", "belts.csv"]
 
@@ -42,33 +42,27 @@ def _run_killed_at(k: int, job, fallback: bool) -> int:
     return status
 
 
-def _files(path: Path) -> dict[str, bytes] | None:
-    if not path.exists():
-        return None
-    return {str(p.relative_to(path)): p.read_bytes() for p in sorted(path.rglob("*")) if p.is_file()}
-
-
 def _every_kill(tmp_path: Path, target: Path, write_old, job, names, fallback: bool) -> set[str]:
     """Kill ``job`` at step 1, 2, ... until it finishes: each time ``target`` holds the old set or
     the new one whole (absent too, with the fallback, until the next run puts the old one back)."""
     write_old()
-    old = _files(target)
+    old = tree(target)
     job()
-    new = _files(target)
+    new = tree(target)
     assert old != new and old is not None and new is not None
     seen = set()
     for k in range(1, 200):
         write_old()
         status = _run_killed_at(k, job, fallback)
-        state = {_key(old): "old", _key(new): "new"}.get(_key(_files(target)), "mixed")
-        seen.add(state if _files(target) is not None else "absent")
-        assert state in ("old", "new") or fallback and _files(target) is None, \
-            f"killed at step {k}: {target} holds {sorted(_files(target) or [])}"
+        state = {_key(old): "old", _key(new): "new"}.get(_key(tree(target)), "mixed")
+        seen.add(state if tree(target) is not None else "absent")
+        assert state in ("old", "new") or fallback and tree(target) is None, \
+            f"killed at step {k}: {target} holds {sorted(tree(target) or [])}"
         OutputDir(target, names).discard()  # what the next run does first: clean up, put back
-        assert _key(_files(target)) in (_key(old), _key(new))
+        assert _key(tree(target)) in (_key(old), _key(new))
         assert sorted(p.name for p in target.parent.iterdir() if p.name.startswith("." + target.name)) == []
         if os.WIFEXITED(status):
-            assert _files(target) == new
+            assert tree(target) == new
             break
     else:
         pytest.fail("the command never finished")
