@@ -117,7 +117,7 @@ def markdown(summary: pd.DataFrame, differences: pd.DataFrame, replications: pd.
     """The whole ``report.md``."""
     parts = _parts(sweep)
     cols = display_columns(summary, sweep)
-    policies = list(dict.fromkeys(p.policy for p in sweep.points))
+    policies = sweep.policies
     level = f"{sweep.confidence * 100:g} %"
     lines = [f"# {sweep.name}" + (f": {sweep.description}" if sweep.description else ""), ""]
     lines += [" ".join([

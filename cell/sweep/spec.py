@@ -149,6 +149,11 @@ class Sweep:
         return np.random.SeedSequence(self.seed, spawn_key=(replication,))
 
     @property
+    def policies(self) -> list[str]:
+        """The sweep's policies, in the order its points list them."""
+        return list(dict.fromkeys(p.policy for p in self.points))
+
+    @property
     def confidence(self) -> float:
         """The confidence level of every interval of the sweep's report."""
         return self.precision.confidence if self.precision else 0.95
@@ -199,7 +204,7 @@ class Sweep:
                 if j is not None and j != i:
                     out.append(Pair(i, j, b.label(self.points[j].policy)))
             return out
-        order = list(dict.fromkeys(p.policy for p in self.points))
+        order = self.policies
         for i, p in enumerate(self.points):
             mine = dict(p.values)
             for j, q in enumerate(self.points):
