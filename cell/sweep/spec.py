@@ -199,8 +199,8 @@ class Sweep:
         out: list[Pair] = []
         if self.baseline is not None:
             b = self.baseline
-            for i in range(len(self.points)):
-                j = self.baseline_of(i)
+            for i, p in enumerate(self.points):
+                j = baseline_point(self.points, b, p)
                 if j is not None and j != i:
                     out.append(Pair(i, j, b.label(self.points[j].policy)))
             return out
@@ -212,12 +212,6 @@ class Sweep:
                         mine[k] == v for k, v in q.values if k in mine):
                     out.append(Pair(i, j, q.policy))
         return out
-
-    def baseline_of(self, i: int) -> int | None:
-        """The baseline point of point ``i`` (None without a baseline, or if there is none)."""
-        if self.baseline is None:
-            return None
-        return baseline_point(self.points, self.baseline, self.points[i])
 
 
 def load_sweep(path: str | Path) -> Sweep:
