@@ -25,6 +25,8 @@ from cell.reporting.headlines import (
     headline,
     number,
     plus_minus,
+    table_head,
+    table_row,
 )
 from cell.sweep import Sweep, grid_columns
 from cell.sweep.columns import NAME_SUFFIX
@@ -183,7 +185,7 @@ def _precision(replications: pd.DataFrame, summary: pd.DataFrame, sweep: Sweep,
             "half-width / |mean|", ""]
     lines = ["## Precision", "", f"Asked: the {q.confidence * 100:g} % half-width of "
              f"`{q.measure}` at most {q.precision * 100:g} % of |mean| at every point.", "",
-             "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+             *table_head(head)]
     short = 0
     for i, row in enumerate(rows):
         values = runs_of(replications, sweep, i)[q.measure].to_numpy(dtype=float)
@@ -191,9 +193,8 @@ def _precision(replications: pd.DataFrame, summary: pd.DataFrame, sweep: Sweep,
         done = len(values) >= q.min_n and rhw <= q.precision
         short += not done
         verdict = "reached" if done else f"not reached: stopped at max = {q.max_n}"
-        lines.append("| " + " | ".join([*(show(row[c]) for c in cols), str(row["policy"]),
-                                         str(int(row["n"])), f"{rhw * 100:.2f} %", verdict])
-                     + " |")
+        lines.append(table_row([*(show(row[c]) for c in cols), str(row["policy"]),
+                                str(int(row["n"])), f"{rhw * 100:.2f} %", verdict]))
     lines += ["", f"{len(rows) - short} of {len(rows)} points reached the precision"
               + (f"; {short} stopped at the maximum of {q.max_n} replications." if short
                  else "."), ""]
@@ -206,9 +207,9 @@ def _table(rows: pd.DataFrame, cols: Sequence[str], policies: Sequence[str],
     for r in rows.to_dict("records"):
         grid.setdefault(tuple(show(r[c]) for c in cols), {})[str(r["policy"])] = cell(r, whole)
     head = [c.removesuffix(NAME_SUFFIX) for c in cols] + list(policies)
-    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    out = table_head(head)
     for keys, cells in grid.items():
-        out.append("| " + " | ".join([*keys, *(cells.get(p, "") for p in policies)]) + " |")
+        out.append(table_row([*keys, *(cells.get(p, "") for p in policies)]))
     return out
 
 

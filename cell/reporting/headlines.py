@@ -1,4 +1,5 @@
-"""The headline measures of an experiment's report, and how to say a difference in words.
+"""The headline measures of an experiment's report, how to say a difference in words,
+and the number and markdown-table formatting the reports share.
 
 A report summarises every numeric column of the runs' summaries (new columns of
 :class:`cell.records.RunSummary` flow through untouched); these few get a table,
@@ -10,6 +11,7 @@ measure: more parts delivered, fewer lost, a shorter cycle, an IP nearer 1
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 
@@ -95,3 +97,13 @@ def better(h: Headline, a: float, b: float) -> int:
         da, db = abs(a - 1.0), abs(b - 1.0)
         return 0 if da == db else (1 if da < db else -1)
     return (1 if a > b else -1) * (1 if h.better == "higher" else -1)
+
+
+def table_row(cells: Iterable[str]) -> str:
+    """A markdown table row: ``| a | b |``."""
+    return "| " + " | ".join(cells) + " |"
+
+
+def table_head(head: Sequence[str]) -> list[str]:
+    """A markdown table's header row and its rule."""
+    return [table_row(head), "|" + "---|" * len(head)]
