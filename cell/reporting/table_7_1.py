@@ -36,6 +36,7 @@ from cell import thesis as published
 from cell.analysis.stats import summarise
 from cell.errors import CellError
 from cell.output import write_csv, write_text
+from cell.reporting.experiment_data import runs_of
 from cell.reporting.headlines import table_head, table_row
 from cell.reporting.table_7_1_reading import (
     ACCOUNTINGS,
@@ -118,8 +119,7 @@ def table_7_1(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
                    key=lambda i: (POLICIES.index(sweep.points[i].policy), i))
     for i in order:
         p = sweep.points[i]
-        runs = replications[(replications["policy"] == p.policy)
-                            & (replications["point"] == p.index)]
+        runs = runs_of(replications, sweep, i)
         cycle = ideal_cycle(p)
         for accounting in ACCOUNTINGS:
             for measure in MEASURES:
