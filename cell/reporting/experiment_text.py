@@ -22,6 +22,7 @@ from cell.reporting.headlines import (
     HUGE,
     Headline,
     decimals,
+    half_width,
     headline,
     number,
     plus_minus,
@@ -72,7 +73,7 @@ def cell(s: Mapping[Any, Any], whole: bool = False) -> str:
         return "—"
     if n == 1:
         return f"{number(mean)} (one run)"
-    half = (float(s["ci_high"]) - float(s["ci_low"])) / 2
+    half = half_width(s)
     if float(s["sd"]) == 0.0:
         return f"{number(mean)} (no variation)"
     lo, hi = float(s["run_p2_5"]), float(s["run_p97_5"])
@@ -107,7 +108,7 @@ def sentence(h: Headline, d: Mapping[Any, Any], a: str, b: str, parts: int | Non
         return h.sentence.format(a=a, x=number(abs(mean)), dir=direction, b=b) + per + \
             f" in every one of {n} replications (no variation between replications)."
     lo, hi = float(d["ci_low"]), float(d["ci_high"])
-    text = h.sentence.format(a=a, x=plus_minus(abs(mean), (hi - lo) / 2), dir=direction, b=b)
+    text = h.sentence.format(a=a, x=plus_minus(abs(mean), half_width(d)), dir=direction, b=b)
     text += f"{per} ({level} CI, paired over {n} replications)"
     if lo <= 0.0 <= hi:
         text += "; the interval includes zero: no difference shown"
@@ -279,7 +280,7 @@ def _signed(row: Mapping[Any, Any]) -> str:
     mean, sd = float(row["mean"]), float(row["sd"])
     if not sd > 0:
         return f"{mean:+.6g}"
-    half = (float(row["ci_high"]) - float(row["ci_low"])) / 2
+    half = half_width(row)
     return f"{mean:+.3g}" if abs(mean) >= HUGE else f"{mean:+.{decimals(half)}f}"
 
 
@@ -290,7 +291,7 @@ def _scatter(h: Headline, summary: pd.DataFrame, cols: Sequence[str]) -> list[st
     rows = summary[(summary["measure"] == h.column) & (summary["n"] >= 2)]
     for r in rows.to_dict("records"):
         mean, lo, hi = (float(r[k]) for k in ("mean", "run_p2_5", "run_p97_5"))
-        half = (float(r["ci_high"]) - float(r["ci_low"])) / 2
+        half = half_width(r)
         if not half > abs(mean) / 2:
             continue
         at = where(r, cols)
@@ -316,8 +317,7 @@ def _trend(h: Headline, summary: pd.DataFrame, sweep: Sweep, cols: Sequence[str]
         if len(group) < 2 or values.isna().any():
             continue
         first, last = group.iloc[0], group.iloc[-1]
-        d = decimals(max((float(first["ci_high"]) - float(first["ci_low"])) / 2,
-                         (float(last["ci_high"]) - float(last["ci_low"])) / 2))
+        d = decimals(max(half_width(first), half_width(last)))
         out.append(f"{str(policy).capitalize()} goes from {float(first['mean']):.{d}f} at "
                    f"{col} = {show(first[col])} to {float(last['mean']):.{d}f} at "
                    f"{show(last[col])}.")

@@ -11,8 +11,12 @@ measure: more parts delivered, fewer lost, a shorter cycle, an IP nearer 1
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 @dataclass(frozen=True)
@@ -78,6 +82,11 @@ def number(value: float, places: int | None = None) -> str:
     if places is None or abs(value) >= HUGE:
         return f"{value:.6g}" if places is None else f"{value:.3g}"
     return f"{value:.{places}f}"
+
+
+def half_width(row: Mapping[Any, Any] | pd.Series) -> float:
+    """Half the width of a summary or difference row's confidence interval."""
+    return (float(row["ci_high"]) - float(row["ci_low"])) / 2
 
 
 def plus_minus(mean: float, half: float, signed: bool = False) -> str:

@@ -37,7 +37,7 @@ from cell.analysis.stats import summarise
 from cell.errors import CellError
 from cell.output import write_csv, write_text
 from cell.reporting.experiment_data import runs_of
-from cell.reporting.headlines import table_head, table_row
+from cell.reporting.headlines import half_width, table_head, table_row
 from cell.reporting.table_7_1_reading import (
     ACCOUNTINGS,
     LABELS,
@@ -139,7 +139,7 @@ def _fmt(value: float, measure: str, decimals: int | None = None) -> str:
 
 
 def _ours(row: Mapping[str, Any], measure: str) -> str:
-    half = (row["ci_high"] - row["ci_low"]) / 2
+    half = half_width(row)
     lo_hi = (f"{_fmt(row['run_p2_5'], measure, 0 if measure == 'parts_missed' else None)}–"
              f"{_fmt(row['run_p97_5'], measure, 0 if measure == 'parts_missed' else None)}")
     mark = ""
