@@ -163,13 +163,10 @@ class Sweep:
         """Replications every point gets before any precision is judged."""
         return self.precision.min_n if self.precision else self.replications
 
-    def tasks(self, ranges: dict[int, tuple[int, int]] | None = None) -> list[Task]:
-        """The tasks covering replications ``first .. last-1`` of each point (by default
-        the first round), cut into batches, in point order."""
-        return list(self.iter_tasks(ranges))
-
     def iter_tasks(self, ranges: dict[int, tuple[int, int]] | None = None) -> Iterator[Task]:
-        """:meth:`tasks`, one at a time (a sweep of many replications holds no list of them)."""
+        """The tasks covering replications ``first .. last-1`` of each point (by default
+        the first round), cut into batches, in point order; one at a time, so a sweep of
+        many replications holds no list of them."""
         if ranges is None:
             ranges = {p: (0, self.first_round) for p in range(len(self.points))}
         for p, (start, last) in sorted(ranges.items()):
