@@ -23,7 +23,6 @@ from cell.reporting.headlines import (
     Headline,
     decimals,
     half_width,
-    headline,
     number,
     plus_minus,
     table_head,
@@ -324,4 +323,4 @@ def _trend(h: Headline, summary: pd.DataFrame, sweep: Sweep, cols: Sequence[str]
     return out
 
 
-__all__ = ["display_columns", "headline", "markdown", "reading", "sentence"]
+__all__ = ["display_columns", "markdown", "reading", "sentence"]

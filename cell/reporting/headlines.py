@@ -54,14 +54,6 @@ HEADLINES: tuple[Headline, ...] = (
              "{a} leaves {x} {dir} spacings outside 45 ± 0.25 in than {b}",
              ("more", "fewer"), "lower", per_run=True, unit="spacings"),
 )
-BY_COLUMN = {h.column: h for h in HEADLINES}
-
-
-def headline(column: str) -> Headline:
-    """The measure's headline, or a plain one for any other column."""
-    return BY_COLUMN.get(column) or Headline(
-        column, column, "{a} has a " + column + " {x} {dir} than {b}", ("higher", "lower"),
-        "higher")
 
 
 def decimals(half: float) -> int:
