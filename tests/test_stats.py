@@ -295,3 +295,14 @@ def test_mser_short_and_bad_series():
         mser5([1.0, np.nan] * 10)
     with pytest.raises(ValueError):
         mser([1.0] * 10, batch=0)
+
+
+def test_mser_needs_no_scipy():
+    """`run.warmup_parts: auto` calls MSER on every run: it must not load scipy."""
+    import subprocess
+    import sys
+
+    code = ("import sys\nfrom cell.analysis.stats import mser5\nmser5([1.0] * 50)\n"
+            "print('scipy' in sys.modules)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"

@@ -2,8 +2,10 @@
 differences, a replications-to-precision stopping rule and MSER warm-up detection.
 
 Pure functions over numpy arrays; the distributions and intervals come from
-``scipy.stats``.  NaNs are dropped before any computation (pairwise for paired
-data), so a failed replication recorded as NaN does not poison a summary.
+``scipy.stats``, imported only where an interval is computed, so a run whose
+warm-up is found by MSER (``run.warmup_parts: auto``) starts without scipy.
+NaNs are dropped before any computation (pairwise for paired data), so a
+failed replication recorded as NaN does not poison a summary.
 """
 
 from __future__ import annotations
@@ -14,7 +16,6 @@ from typing import TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import stats
 
 K = TypeVar("K", bound=Hashable)
 
@@ -71,6 +72,8 @@ def summarise(x: ArrayLike, confidence: float = 0.95) -> dict[str, float]:
     if sd == 0.0:  # no variation
         lo = hi = mean
     else:
+        from scipy import stats
+
         lo, hi = (float(v) for v in stats.t.interval(confidence, df=n - 1, loc=mean,
                                                        scale=sd / math.sqrt(n)))
     return {"n": n, "mean": mean, "sd": sd, "ci_low": lo, "ci_high": hi,
@@ -101,6 +104,8 @@ def paired_difference(a: ArrayLike, b: ArrayLike, confidence: float = 0.95) -> d
     sd = float(np.std(d, ddof=1))
     if sd == 0.0:  # no variation
         return {"n": n, "mean": mean, "sd": sd, "ci_low": mean, "ci_high": mean, "p_value": nan}
+    from scipy import stats
+
     res = stats.ttest_rel(x, y)
     ci = res.confidence_interval(confidence)
     return {"n": n, "mean": mean, "sd": sd, "ci_low": float(ci.low), "ci_high": float(ci.high),

@@ -10,12 +10,13 @@ against replication r (common random numbers).
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 
 import numpy as np
 import pandas as pd
 
 from cell.analysis.stats import PAIRED_KEYS, SUMMARY_KEYS, paired_difference, summarise
-from cell.sweep import Sweep, grid_columns
+from cell.sweep import Column, Sweep, grid_columns
 
 #: Columns of replications.csv that are not measures.
 NOT_MEASURES = {"policy", "point", "seed", "replication"}
@@ -36,12 +37,10 @@ def runs_of(replications: pd.DataFrame, sweep: Sweep, i: int) -> pd.DataFrame:
     return rows.sort_values("replication")
 
 
-def grid_values(replications: pd.DataFrame, sweep: Sweep, i: int) -> dict[str, object]:
-    """Point ``i``'s value in each grid column, as ``replications.csv`` holds it."""
-    rows = runs_of(replications, sweep, i)
-    first = rows.iloc[0] if len(rows) else None
-    return {c.name: (None if first is None else _plain(first[c.name]))
-            for c in grid_columns(sweep)}
+def grid_values(runs: pd.DataFrame, columns: Sequence[Column]) -> dict[str, object]:
+    """A point's value in each grid column, as its ``runs`` (:func:`runs_of`) hold it."""
+    first = runs.iloc[0] if len(runs) else None
+    return {c.name: (None if first is None else _plain(first[c.name])) for c in columns}
 
 
 def _plain(value: object) -> object:
@@ -62,15 +61,17 @@ def _exact(stats: dict[str, float], x: np.ndarray) -> dict[str, float]:
 
 def summary_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     """``summary.csv``: every point, policy and measure with its statistics."""
-    cols = [c.name for c in grid_columns(sweep)]
+    columns, names = grid_columns(sweep), measures(replications, sweep)
     rows = []
     for i, p in enumerate(sweep.points):
-        runs, keys = runs_of(replications, sweep, i), grid_values(replications, sweep, i)
-        for m in measures(replications, sweep):
+        runs = runs_of(replications, sweep, i)
+        keys = grid_values(runs, columns)
+        for m in names:
             x = runs[m].to_numpy(dtype=float)
             s = _exact(summarise(x, sweep.confidence), x)
             rows.append({**keys, "policy": p.policy, "measure": m, **s})
-    return pd.DataFrame(rows, columns=[*cols, "policy", "measure", *SUMMARY_KEYS])
+    return pd.DataFrame(rows, columns=[*(c.name for c in columns), "policy", "measure",
+                                       *SUMMARY_KEYS])
 
 
 def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
@@ -79,17 +80,17 @@ def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     The grid columns hold the compared point's values, or its partner's for a key
     only the partner varies.
     """
-    columns = grid_columns(sweep)
+    columns, names = grid_columns(sweep), measures(replications, sweep)
     rows = []
     for pair in sweep.pairs():
         a, b = sweep.points[pair.point], sweep.points[pair.versus]
-        mine, theirs = grid_values(replications, sweep, pair.point), \
-            grid_values(replications, sweep, pair.versus)
+        runs_a, runs_b = runs_of(replications, sweep, pair.point), \
+            runs_of(replications, sweep, pair.versus)
+        mine, theirs = grid_values(runs_a, columns), grid_values(runs_b, columns)
         keys = {c.name: theirs[c.name] if c.key in dict(b.values) and c.key not in dict(a.values)
                 else mine[c.name] for c in columns}
-        both = runs_of(replications, sweep, pair.point).merge(
-            runs_of(replications, sweep, pair.versus), on="replication", suffixes=("", "@b"))
-        for m in measures(replications, sweep):
+        both = runs_a.merge(runs_b, on="replication", suffixes=("", "@b"))
+        for m in names:
             with warnings.catch_warnings():  # nearly equal pairs: scipy warns, the sd says it
                 warnings.filterwarnings("ignore", "Precision loss", RuntimeWarning)
                 x, y = both[m].to_numpy(dtype=float), both[m + "@b"].to_numpy(dtype=float)

@@ -48,7 +48,7 @@ def figures(summary: pd.DataFrame, replications: pd.DataFrame, sweep: Sweep) -> 
                                     for r in summary[cols[1:]].itertuples(index=False)))
     if len(panels) > MAX_PANELS:
         return {}
-    policies = list(dict.fromkeys(p.policy for p in sweep.points))
+    policies = sweep.policies
     colours = {p: COLOURS.get(p) or OTHERS[i % len(OTHERS)] for i, p in enumerate(policies)}
     out = {}
     for h in HEADLINES:
@@ -98,7 +98,7 @@ def _figure(h: Headline, rows: pd.DataFrame, sweep: Sweep, cols: Sequence[str],
 def _panel(ax: Axes, h: Headline, rows: pd.DataFrame, sweep: Sweep, cols: Sequence[str],
            colours: dict[str, str]) -> None:
     ax.set_ylabel(h.title)
-    policies = list(dict.fromkeys(p.policy for p in sweep.points))
+    policies = sweep.policies
     if not cols:  # only the policies vary: a point per policy
         for i, policy in enumerate(policies):
             r = rows[rows["policy"] == policy]

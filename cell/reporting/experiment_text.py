@@ -22,9 +22,11 @@ from cell.reporting.headlines import (
     HUGE,
     Headline,
     decimals,
-    headline,
+    half_width,
     number,
     plus_minus,
+    table_head,
+    table_row,
 )
 from cell.sweep import Sweep, grid_columns
 from cell.sweep.columns import NAME_SUFFIX
@@ -70,7 +72,7 @@ def cell(s: Mapping[Any, Any], whole: bool = False) -> str:
         return "—"
     if n == 1:
         return f"{number(mean)} (one run)"
-    half = (float(s["ci_high"]) - float(s["ci_low"])) / 2
+    half = half_width(s)
     if float(s["sd"]) == 0.0:
         return f"{number(mean)} (no variation)"
     lo, hi = float(s["run_p2_5"]), float(s["run_p97_5"])
@@ -105,7 +107,7 @@ def sentence(h: Headline, d: Mapping[Any, Any], a: str, b: str, parts: int | Non
         return h.sentence.format(a=a, x=number(abs(mean)), dir=direction, b=b) + per + \
             f" in every one of {n} replications (no variation between replications)."
     lo, hi = float(d["ci_low"]), float(d["ci_high"])
-    text = h.sentence.format(a=a, x=plus_minus(abs(mean), (hi - lo) / 2), dir=direction, b=b)
+    text = h.sentence.format(a=a, x=plus_minus(abs(mean), half_width(d)), dir=direction, b=b)
     text += f"{per} ({level} CI, paired over {n} replications)"
     if lo <= 0.0 <= hi:
         text += "; the interval includes zero: no difference shown"
@@ -117,7 +119,7 @@ def markdown(summary: pd.DataFrame, differences: pd.DataFrame, replications: pd.
     """The whole ``report.md``."""
     parts = _parts(sweep)
     cols = display_columns(summary, sweep)
-    policies = list(dict.fromkeys(p.policy for p in sweep.points))
+    policies = sweep.policies
     level = f"{sweep.confidence * 100:g} %"
     lines = [f"# {sweep.name}" + (f": {sweep.description}" if sweep.description else ""), ""]
     lines += [" ".join([
@@ -183,7 +185,7 @@ def _precision(replications: pd.DataFrame, summary: pd.DataFrame, sweep: Sweep,
             "half-width / |mean|", ""]
     lines = ["## Precision", "", f"Asked: the {q.confidence * 100:g} % half-width of "
              f"`{q.measure}` at most {q.precision * 100:g} % of |mean| at every point.", "",
-             "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+             *table_head(head)]
     short = 0
     for i, row in enumerate(rows):
         values = runs_of(replications, sweep, i)[q.measure].to_numpy(dtype=float)
@@ -191,9 +193,8 @@ def _precision(replications: pd.DataFrame, summary: pd.DataFrame, sweep: Sweep,
         done = len(values) >= q.min_n and rhw <= q.precision
         short += not done
         verdict = "reached" if done else f"not reached: stopped at max = {q.max_n}"
-        lines.append("| " + " | ".join([*(show(row[c]) for c in cols), str(row["policy"]),
-                                         str(int(row["n"])), f"{rhw * 100:.2f} %", verdict])
-                     + " |")
+        lines.append(table_row([*(show(row[c]) for c in cols), str(row["policy"]),
+                                str(int(row["n"])), f"{rhw * 100:.2f} %", verdict]))
     lines += ["", f"{len(rows) - short} of {len(rows)} points reached the precision"
               + (f"; {short} stopped at the maximum of {q.max_n} replications." if short
                  else "."), ""]
@@ -206,9 +207,9 @@ def _table(rows: pd.DataFrame, cols: Sequence[str], policies: Sequence[str],
     for r in rows.to_dict("records"):
         grid.setdefault(tuple(show(r[c]) for c in cols), {})[str(r["policy"])] = cell(r, whole)
     head = [c.removesuffix(NAME_SUFFIX) for c in cols] + list(policies)
-    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    out = table_head(head)
     for keys, cells in grid.items():
-        out.append("| " + " | ".join([*keys, *(cells.get(p, "") for p in policies)]) + " |")
+        out.append(table_row([*keys, *(cells.get(p, "") for p in policies)]))
     return out
 
 
@@ -278,7 +279,7 @@ def _signed(row: Mapping[Any, Any]) -> str:
     mean, sd = float(row["mean"]), float(row["sd"])
     if not sd > 0:
         return f"{mean:+.6g}"
-    half = (float(row["ci_high"]) - float(row["ci_low"])) / 2
+    half = half_width(row)
     return f"{mean:+.3g}" if abs(mean) >= HUGE else f"{mean:+.{decimals(half)}f}"
 
 
@@ -289,7 +290,7 @@ def _scatter(h: Headline, summary: pd.DataFrame, cols: Sequence[str]) -> list[st
     rows = summary[(summary["measure"] == h.column) & (summary["n"] >= 2)]
     for r in rows.to_dict("records"):
         mean, lo, hi = (float(r[k]) for k in ("mean", "run_p2_5", "run_p97_5"))
-        half = (float(r["ci_high"]) - float(r["ci_low"])) / 2
+        half = half_width(r)
         if not half > abs(mean) / 2:
             continue
         at = where(r, cols)
@@ -315,12 +316,11 @@ def _trend(h: Headline, summary: pd.DataFrame, sweep: Sweep, cols: Sequence[str]
         if len(group) < 2 or values.isna().any():
             continue
         first, last = group.iloc[0], group.iloc[-1]
-        d = decimals(max((float(first["ci_high"]) - float(first["ci_low"])) / 2,
-                         (float(last["ci_high"]) - float(last["ci_low"])) / 2))
+        d = decimals(max(half_width(first), half_width(last)))
         out.append(f"{str(policy).capitalize()} goes from {float(first['mean']):.{d}f} at "
                    f"{col} = {show(first[col])} to {float(last['mean']):.{d}f} at "
                    f"{show(last[col])}.")
     return out
 
 
-__all__ = ["display_columns", "headline", "markdown", "reading", "sentence"]
+__all__ = ["display_columns", "markdown", "reading", "sentence"]

@@ -1,4 +1,5 @@
-"""The headline measures of an experiment's report, and how to say a difference in words.
+"""The headline measures of an experiment's report, how to say a difference in words,
+and the number and markdown-table formatting the reports share.
 
 A report summarises every numeric column of the runs' summaries (new columns of
 :class:`cell.records.RunSummary` flow through untouched); these few get a table,
@@ -10,7 +11,12 @@ measure: more parts delivered, fewer lost, a shorter cycle, an IP nearer 1
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 @dataclass(frozen=True)
@@ -48,14 +54,6 @@ HEADLINES: tuple[Headline, ...] = (
              "{a} leaves {x} {dir} spacings outside 45 ± 0.25 in than {b}",
              ("more", "fewer"), "lower", per_run=True, unit="spacings"),
 )
-BY_COLUMN = {h.column: h for h in HEADLINES}
-
-
-def headline(column: str) -> Headline:
-    """The measure's headline, or a plain one for any other column."""
-    return BY_COLUMN.get(column) or Headline(
-        column, column, "{a} has a " + column + " {x} {dir} than {b}", ("higher", "lower"),
-        "higher")
 
 
 def decimals(half: float) -> int:
@@ -78,6 +76,11 @@ def number(value: float, places: int | None = None) -> str:
     return f"{value:.{places}f}"
 
 
+def half_width(row: Mapping[Any, Any] | pd.Series) -> float:
+    """Half the width of a summary or difference row's confidence interval."""
+    return (float(row["ci_high"]) - float(row["ci_low"])) / 2
+
+
 def plus_minus(mean: float, half: float, signed: bool = False) -> str:
     """``mean ± half`` to the half-width's two significant figures (exponent form if huge)."""
     sign = "+" if signed else ""
@@ -95,3 +98,13 @@ def better(h: Headline, a: float, b: float) -> int:
         da, db = abs(a - 1.0), abs(b - 1.0)
         return 0 if da == db else (1 if da < db else -1)
     return (1 if a > b else -1) * (1 if h.better == "higher" else -1)
+
+
+def table_row(cells: Iterable[str]) -> str:
+    """A markdown table row: ``| a | b |``."""
+    return "| " + " | ".join(cells) + " |"
+
+
+def table_head(head: Sequence[str]) -> list[str]:
+    """A markdown table's header row and its rule."""
+    return [table_row(head), "|" + "---|" * len(head)]

@@ -36,6 +36,8 @@ from cell import thesis as published
 from cell.analysis.stats import summarise
 from cell.errors import CellError
 from cell.output import write_csv, write_text
+from cell.reporting.experiment_data import runs_of
+from cell.reporting.headlines import half_width, table_head, table_row
 from cell.reporting.table_7_1_reading import (
     ACCOUNTINGS,
     LABELS,
@@ -117,8 +119,7 @@ def table_7_1(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
                    key=lambda i: (POLICIES.index(sweep.points[i].policy), i))
     for i in order:
         p = sweep.points[i]
-        runs = replications[(replications["policy"] == p.policy)
-                            & (replications["point"] == p.index)]
+        runs = runs_of(replications, sweep, i)
         cycle = ideal_cycle(p)
         for accounting in ACCOUNTINGS:
             for measure in MEASURES:
@@ -138,7 +139,7 @@ def _fmt(value: float, measure: str, decimals: int | None = None) -> str:
 
 
 def _ours(row: Mapping[str, Any], measure: str) -> str:
-    half = (row["ci_high"] - row["ci_low"]) / 2
+    half = half_width(row)
     lo_hi = (f"{_fmt(row['run_p2_5'], measure, 0 if measure == 'parts_missed' else None)}–"
              f"{_fmt(row['run_p97_5'], measure, 0 if measure == 'parts_missed' else None)}")
     mark = ""
@@ -153,7 +154,7 @@ def _layout(table: pd.DataFrame, policy: str, accounting: str, with_thesis: bool
     head = ["ideal cycle (s)"]
     for m in MEASURES:
         head += [f"{LABELS[m]}: thesis", "ours"] if with_thesis else [LABELS[m]]
-    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    lines = table_head(head)
     for cycle, group in sub.groupby("ideal_cycle_s", sort=False):
         by: dict[str, Mapping[str, Any]] = {str(r["measure"]): {str(k): v for k, v in r.items()}
                                             for r in group.to_dict("records")}
@@ -162,7 +163,7 @@ def _layout(table: pd.DataFrame, policy: str, accounting: str, with_thesis: bool
             if with_thesis:
                 cells.append(_fmt(by[m]["thesis"], m, 4 if m != "parts_missed" else 0))
             cells.append(_ours(by[m], m))
-        lines.append("| " + " | ".join(cells) + " |")
+        lines.append(table_row(cells))
     return lines
 
 
@@ -217,14 +218,14 @@ def _one_run_table(table: pd.DataFrame, policy: str) -> list[str]:
     """The published run's figures, then ours in both accountings."""
     lines = [f"## {policy.capitalize()} (thesis §7.2: {published.PUBLISHED[policy].summary})", ""]
     head = ["accounting"] + [LABELS[m] for m in MEASURES]
-    lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    lines += table_head(head)
     cycle = float(table.loc[table["policy"] == policy, "ideal_cycle_s"].iloc[0])
     published_cells = [_fmt(thesis_value(policy, cycle, "thesis", m), m,
                             0 if m == "parts_missed" else 4) for m in MEASURES]
-    lines.append("| thesis (published) | " + " | ".join(published_cells) + " |")
+    lines.append(table_row(["thesis (published)", *published_cells]))
     for accounting in ACCOUNTINGS:
         cells = [_ours(row_of(table, policy, cycle, accounting, m), m) for m in MEASURES]
-        lines.append(f"| ours, {accounting} | " + " | ".join(cells) + " |")
+        lines.append(table_row([f"ours, {accounting}", *cells]))
     return lines + [""]
 
 

@@ -171,7 +171,7 @@ def read_replications(raw: Mapping[str, Any], file: object) -> tuple[int, Precis
 def read_baseline(raw: Any, sweep: Sweep, file: object) -> Baseline:
     """``baseline``: the policy and/or values of varied keys of the point to compare with,
     checked against the grid; every point must have a baseline point."""
-    policies = list(dict.fromkeys(p.policy for p in sweep.points))
+    policies = sweep.policies
     if not isinstance(raw, Mapping) or not raw:
         raise ScenarioError(file, "baseline", raw, "must name a point of the grid, e.g. "
                             "{policy: non-adaptive, controller.ideal_cycle_s: 22.5872}")

@@ -74,17 +74,8 @@ def simulate_summary(scenario: Scenario, seed: np.random.SeedSequence) -> Mappin
 
 def run_task(replicate: Replicate, scenario: Scenario,
              seeds: Sequence[np.random.SeedSequence]) -> list[dict[str, Any]]:
-    """Run one batch (in a worker): each stream's summary as a plain dict.
-
-    Each replication gets a fresh copy of its stream, so a replication that
-    spawns from it cannot change what the next point or policy sees.
-    """
-    return [{k: _plain(v) for k, v in replicate(scenario, _fresh(s)).items()} for s in seeds]
-
-
-def _fresh(seed: np.random.SeedSequence) -> np.random.SeedSequence:
-    return np.random.SeedSequence(seed.entropy, spawn_key=seed.spawn_key,
-                                  pool_size=seed.pool_size)
+    """Run one batch (in a worker): each stream's summary as a plain dict."""
+    return [{k: _plain(v) for k, v in replicate(scenario, s).items()} for s in seeds]
 
 
 def _plain(value: Any) -> Any:
@@ -181,6 +172,8 @@ def _run_tasks(sweep: Sweep, todo: Iterable[Task], replicate: Replicate,
                done: Callable[[Task, list[dict[str, Any]]], None]) -> None:
     """Run ``todo``, at most ``window`` tasks in flight; ``done`` as each one finishes."""
     def args(task: Task) -> tuple[Any, ...]:
+        # Streams made afresh for each task: a replication that spawns from its stream
+        # (mutating it) cannot change what another point or policy sees.
         seeds = [sweep.stream(r) for r in range(task.first, task.last)]
         return (replicate, sweep.points[task.point].scenario, seeds)
 

@@ -149,6 +149,11 @@ class Sweep:
         return np.random.SeedSequence(self.seed, spawn_key=(replication,))
 
     @property
+    def policies(self) -> list[str]:
+        """The sweep's policies, in the order its points list them."""
+        return list(dict.fromkeys(p.policy for p in self.points))
+
+    @property
     def confidence(self) -> float:
         """The confidence level of every interval of the sweep's report."""
         return self.precision.confidence if self.precision else 0.95
@@ -158,13 +163,10 @@ class Sweep:
         """Replications every point gets before any precision is judged."""
         return self.precision.min_n if self.precision else self.replications
 
-    def tasks(self, ranges: dict[int, tuple[int, int]] | None = None) -> list[Task]:
-        """The tasks covering replications ``first .. last-1`` of each point (by default
-        the first round), cut into batches, in point order."""
-        return list(self.iter_tasks(ranges))
-
     def iter_tasks(self, ranges: dict[int, tuple[int, int]] | None = None) -> Iterator[Task]:
-        """:meth:`tasks`, one at a time (a sweep of many replications holds no list of them)."""
+        """The tasks covering replications ``first .. last-1`` of each point (by default
+        the first round), cut into batches, in point order; one at a time, so a sweep of
+        many replications holds no list of them."""
         if ranges is None:
             ranges = {p: (0, self.first_round) for p in range(len(self.points))}
         for p, (start, last) in sorted(ranges.items()):
@@ -194,12 +196,12 @@ class Sweep:
         out: list[Pair] = []
         if self.baseline is not None:
             b = self.baseline
-            for i in range(len(self.points)):
-                j = self.baseline_of(i)
+            for i, p in enumerate(self.points):
+                j = baseline_point(self.points, b, p)
                 if j is not None and j != i:
                     out.append(Pair(i, j, b.label(self.points[j].policy)))
             return out
-        order = list(dict.fromkeys(p.policy for p in self.points))
+        order = self.policies
         for i, p in enumerate(self.points):
             mine = dict(p.values)
             for j, q in enumerate(self.points):
@@ -207,12 +209,6 @@ class Sweep:
                         mine[k] == v for k, v in q.values if k in mine):
                     out.append(Pair(i, j, q.policy))
         return out
-
-    def baseline_of(self, i: int) -> int | None:
-        """The baseline point of point ``i`` (None without a baseline, or if there is none)."""
-        if self.baseline is None:
-            return None
-        return baseline_point(self.points, self.baseline, self.points[i])
 
 
 def load_sweep(path: str | Path) -> Sweep:
