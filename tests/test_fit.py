@@ -253,3 +253,99 @@ def test_bad_destinations_and_options(trace: Path):
 def test_p_value_is_finite(thesis_fit):
     _, fits = thesis_fit
     assert all(0.0 <= f.p_value <= 1.0 and math.isfinite(f.aic) for f in fits)
+
+
+# --------------------------------------------------------------------------- arrival times (--times)
+def _write(path: Path, column: str, values) -> Path:
+    path.write_text(f"{column}\n" + "".join(f"{v}\n" for v in values))
+    return path
+
+
+def _arrival_times(n: int = 60, seed: int = 11) -> list[str]:
+    """Arrival times as a clock would log them: from 0, rounded to the millisecond."""
+    return [f"{t:.3f}" for t in np.concatenate([[0.0], np.cumsum(thesis_draws(n, seed=seed))])]
+
+
+def test_arrival_times_are_refused_without_times(tmp_path: Path):
+    path = _write(tmp_path / "times.csv", "arrival_s", _arrival_times())
+    out = tmp_path / "arrivals.yaml"
+    with pytest.raises(ScenarioError) as err:
+        cmd_fit(parse(str(path), "--column", "arrival_s", "--out", str(out)))
+    e = err.value
+    assert e.file == str(path) and e.key == "arrival_s"
+    assert e.value.startswith("61 values rising from 0.000 to ")  # not 'row 1 = 0: must be > 0'
+    assert "--times" in e.why and "\n" not in str(e)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["times.csv"]
+
+
+def test_times_fits_the_differenced_column(tmp_path: Path, capsys):
+    times = _write(tmp_path / "times.csv", "arrival_s", _arrival_times())
+    gaps = np.diff(np.array(_arrival_times(), dtype=float))
+    diffed = _write(tmp_path / "gaps.csv", "arrival_s", [repr(float(g)) for g in gaps])
+    by_times, by_gaps = tmp_path / "a_times.yaml", tmp_path / "a_gaps.yaml"
+    assert cmd_fit(parse(str(times), "--column", "arrival_s", "--times", "--out", str(by_times))) == 0
+    assert cmd_fit(parse(str(diffed), "--column", "arrival_s", "--out", str(by_gaps))) == 0
+    text = by_times.read_text()
+    assert yaml.safe_load(text) == yaml.safe_load(by_gaps.read_text())
+    assert "(60 gaps between 61 arrival times)" in text.splitlines()[0]
+    assert "(60 values)" in by_gaps.read_text().splitlines()[0]
+    capsys.readouterr()
+
+
+def test_sorted_gaps_need_gaps_and_then_fit_as_unsorted(tmp_path: Path, capsys):
+    x = thesis_draws(60, seed=5)
+    ordinary = _write(tmp_path / "gaps.csv", "interarrival_s", [repr(float(v)) for v in x])
+    in_order = _write(tmp_path / "sorted.csv", "interarrival_s", [repr(float(v)) for v in np.sort(x)])
+    with pytest.raises(ScenarioError) as err:
+        cmd_fit(parse(str(in_order)))
+    assert "--gaps" in err.value.why
+    capsys.readouterr()
+    assert cmd_fit(parse(str(ordinary))) == 0
+    plain = yaml.safe_load(capsys.readouterr().out)
+    assert cmd_fit(parse(str(ordinary), "--gaps")) == 0
+    assert yaml.safe_load(capsys.readouterr().out) == plain
+    assert cmd_fit(parse(str(in_order), "--gaps")) == 0
+    sorted_fit = yaml.safe_load(capsys.readouterr().out)["arrivals"]
+    assert sorted_fit["distribution"] == plain["arrivals"]["distribution"]
+    assert sorted_fit["params"] == pytest.approx(plain["arrivals"]["params"], rel=1e-6)
+
+
+def test_times_and_gaps_exclude_each_other():
+    with pytest.raises(SystemExit):
+        parse("t.csv", "--times", "--gaps")
+
+
+def _times(values: list[str]) -> str:
+    return "arrival_s\n" + "\n".join(values + _arrival_times(30)[1:]) + "\n"
+
+
+BAD_TIMES = [
+    ("goes back", _times(["0", "21.5", "20.0"]), "arrival_s[row 3]", "20.0", "not after 21.5 in row 2"),
+    ("repeated", _times(["0", "21.5", "21.5"]), "arrival_s[row 3]", "21.5", "must increase"),
+    ("not a number", _times(["0", "abc"]), "arrival_s[row 2]", "abc", "not a number"),
+    ("infinite", _times(["0", "inf"]), "arrival_s[row 2]", "inf", "must be finite"),
+    ("too few", "arrival_s\n" + "\n".join(_arrival_times(19)) + "\n", "arrival_s", "20 arrival times",
+     "at least 21 arrival times"),
+    ("evenly spaced", "arrival_s\n" + "\n".join(str(22 * i) for i in range(30)) + "\n", "arrival_s",
+     "all 29 gaps = 22", "without variation"),
+]
+
+
+@pytest.mark.parametrize("label, text, key, value, why", BAD_TIMES, ids=[b[0] for b in BAD_TIMES])
+def test_bad_arrival_times_are_refused(tmp_path: Path, label, text, key, value, why):
+    path = tmp_path / "bad.csv"
+    path.write_text(text)
+    with pytest.raises(ScenarioError) as err:
+        cmd_fit(parse(str(path), "--column", "arrival_s", "--times", "--out", str(tmp_path / "a.yaml")))
+    e = err.value
+    assert (e.file, e.key, e.value) == (str(path), key, value)
+    assert why in e.why
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.csv"]
+
+
+def test_short_increasing_column_is_too_few_not_times(tmp_path: Path):
+    """Below MIN_VALUES the order says little; the count is the problem."""
+    path = _write(tmp_path / "short.csv", "interarrival_s", [f"{20 + i}" for i in range(10)])
+    with pytest.raises(ScenarioError) as err:
+        cmd_fit(parse(str(path)))
+    assert err.value.value == "10 values" and "at least 20 values" in err.value.why

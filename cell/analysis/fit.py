@@ -1,10 +1,11 @@
 """Input modelling: fit inter-arrival distributions to a trace (``cell fit``).
 
-``cell fit TRACE.csv [--column interarrival_s] [--out SCENARIO.yaml] [--figure F.png]``
+``cell fit TRACE.csv [--column interarrival_s] [--times] [--out SCENARIO.yaml] [--figure F.png]``
 fits candidate ``scipy.stats`` families by maximum likelihood, ranks them (by AIC,
 or by the Kolmogorov-Smirnov distance), prints the table, and writes the best
 fit that allows no negative times as the ``arrivals:`` block of a scenario file,
-with a histogram of the data under the fitted densities.
+with a histogram of the data under the fitted densities.  With ``--times`` the
+column holds arrival times, and the gaps between them are fitted.
 """
 
 from __future__ import annotations
@@ -265,16 +266,61 @@ def draw(values: ArrayLike, fits: Sequence[Fit], out_png: str | Path, *, best: F
 
 
 # --------------------------------------------------------------------------- command line
-def read_column(path: str | Path, column: str = "interarrival_s") -> NDArray[np.float64]:
-    """A CSV column of at least :data:`MIN_VALUES` finite numbers > 0 (not all equal).
+def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool = False,
+                sorted_ok: bool = False) -> NDArray[np.float64]:
+    """The inter-arrival gaps in a CSV column: at least :data:`MIN_VALUES`, finite, > 0, not all equal.
 
-    Any problem raises :class:`~cell.errors.ScenarioError` naming the file, the
-    key (``(file)``, ``--column`` or ``COLUMN[row N]``, data rows counted from 1)
-    and the value as written.
+    With ``times`` the column holds arrival times (finite, strictly increasing) and
+    their differences are returned.  Without it, a column of :data:`MIN_VALUES` or
+    more values that never decreases is refused as arrival times (n iid gaps come
+    in increasing order with probability 1/n!, < 1e-18 at n = 20), unless
+    ``sorted_ok`` says they are gaps in sorted order.  Any problem raises
+    :class:`~cell.errors.ScenarioError` naming the file, the key (``(file)``,
+    ``--column``, ``COLUMN`` or ``COLUMN[row N]``, data rows counted from 1) and
+    the value as written.
     """
     import pandas as pd
 
     p = Path(path)
+    written = _read_cells(p, column)
+    cells = written.astype(str).str.strip()
+    values = pd.to_numeric(cells, errors="coerce").to_numpy(dtype=float)
+    finite = np.isfinite(values)
+    if not (times or sorted_ok) and values.size >= MIN_VALUES and finite.all() \
+            and np.all(np.diff(values) >= 0.0) and np.ptp(values) > 0.0:
+        seen = f"{values.size} values rising from {cells.iloc[0]} to {cells.iloc[-1]}"
+        raise ScenarioError(p, column, seen,
+                            "the column never decreases, so it looks like arrival times, not gaps: "
+                            "use --times to fit their differences (or --gaps if these are sorted gaps)")
+    bad = np.flatnonzero(~finite if times else ~finite | ~(values > 0.0))
+    if bad.size:
+        i = int(bad[0])
+        why = ("missing value" if cells.iloc[i] == "" else
+               "not a number" if math.isnan(values[i]) and cells.iloc[i].lower() != "nan" else
+               "arrival times must be finite" if times else "inter-arrival times must be finite and > 0")
+        raise ScenarioError(p, f"{column}[row {i + 1}]", written.iloc[i], why)
+    noun = "values"
+    if times:
+        back = np.flatnonzero(~(np.diff(values) > 0.0))
+        if back.size:
+            i = int(back[0]) + 1
+            raise ScenarioError(p, f"{column}[row {i + 1}]", written.iloc[i],
+                                f"arrival times must increase: not after {cells.iloc[i - 1]} in row {i}")
+        values, noun = np.diff(values), "gaps"
+    if values.size < MIN_VALUES:
+        shown = f"{cells.size} arrival times" if times else f"{values.size} values"
+        need = f"{MIN_VALUES + 1} arrival times" if times else f"{MIN_VALUES} values"
+        raise ScenarioError(p, column, shown, f"needs at least {need} to fit a distribution")
+    if np.ptp(values) == 0.0:
+        raise ScenarioError(p, column, f"all {values.size} {noun} = {values[0]:g}",
+                            f"{noun} without variation cannot be fitted")
+    return values
+
+
+def _read_cells(p: Path, column: str) -> Any:
+    """The cells of ``column`` in the CSV file ``p``, as written (a pandas Series of str)."""
+    import pandas as pd
+
     if not p.is_file():
         raise ScenarioError(p, "(file)", str(p), "no such file")
     try:
@@ -300,19 +346,4 @@ def read_column(path: str | Path, column: str = "interarrival_s") -> NDArray[np.
         names = ", ".join(map(str, frame.columns))
         hint = " (is it separated by ';'? use commas)" if any(";" in str(c) for c in frame.columns) else ""
         raise ScenarioError(p, "--column", column, f"no such column; the columns are: {names}{hint}")
-    cells = frame[column].astype(str).str.strip()
-    values = pd.to_numeric(cells, errors="coerce").to_numpy(dtype=float)
-    bad = np.flatnonzero(~np.isfinite(values) | ~(values > 0.0))
-    if bad.size:
-        i = int(bad[0])
-        why = ("missing value" if cells.iloc[i] == "" else
-               "not a number" if math.isnan(values[i]) and cells.iloc[i].lower() != "nan" else
-               "inter-arrival times must be finite and > 0")
-        raise ScenarioError(p, f"{column}[row {i + 1}]", frame[column].iloc[i], why)
-    if values.size < MIN_VALUES:
-        raise ScenarioError(p, column, f"{values.size} values",
-                            f"needs at least {MIN_VALUES} values to fit a distribution")
-    if np.ptp(values) == 0.0:
-        raise ScenarioError(p, column, f"all {values.size} values = {values[0]:g}",
-                            "values without variation cannot be fitted")
-    return values
+    return frame[column]

@@ -1,9 +1,10 @@
-"""``cell fit TRACE.csv [--column interarrival_s] [--out SCENARIO.yaml]``: input modelling.
+"""``cell fit TRACE.csv [--column interarrival_s] [--times] [--out SCENARIO.yaml]``: input modelling.
 
 Fits candidate scipy.stats distributions to observed inter-arrival times by
 maximum likelihood (:mod:`cell.analysis.fit`), prints them ranked, and writes
 the ``arrivals:`` block of the best one that never gives a negative time,
-with a histogram of the data and the fitted densities.
+with a histogram of the data and the fitted densities.  ``--times`` reads the
+column as arrival times and fits the gaps between them.
 """
 
 from __future__ import annotations
@@ -22,6 +23,11 @@ DESCRIPTION = __doc__.splitlines()[2] if __doc__ else ""
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("trace", help="CSV file of observed inter-arrival times")
     parser.add_argument("--column", default="interarrival_s", help="column to fit (default: %(default)s)")
+    kind = parser.add_mutually_exclusive_group()
+    kind.add_argument("--times", action="store_true",
+                      help="the column holds arrival times (increasing): fit the gaps between them")
+    kind.add_argument("--gaps", action="store_true",
+                      help="the column holds gaps even though it never decreases (sorted gaps)")
     parser.add_argument("--out", default=None, metavar="SCENARIO.yaml",
                         help="write the arrivals: block here (default: print it)")
     parser.add_argument("--figure", default=None, metavar="FILE.png",
@@ -71,17 +77,20 @@ def main(args: argparse.Namespace) -> int:
         if not isinstance(getattr(stats, family, None), stats.rv_continuous):
             raise ScenarioError("--families", "--families", family,
                                 "not a continuous distribution in scipy.stats")
-    values = read_column(trace, args.column)
+    times = bool(getattr(args, "times", False))
+    values = read_column(trace, args.column, times=times, sorted_ok=bool(getattr(args, "gaps", False)))
+    count = f"{values.size} gaps between {values.size + 1} arrival times" if times else \
+        f"{values.size} values"
     try:
         fits = fit_trace(values, families, rank_by=getattr(args, "rank_by", "aic"))
     except ValueError as exc:
-        raise ScenarioError(trace, args.column, f"{values.size} values", str(exc)) from None
+        raise ScenarioError(trace, args.column, count, str(exc)) from None
     usable = [f for f in fits if f.nonnegative]
     if not usable:
         raise ScenarioError(trace, "--families", ",".join(families),
                             "no fitted family keeps inter-arrival times non-negative")
     chosen = usable[0]
-    block = arrivals_yaml(chosen, f"{trace}, column {args.column} ({values.size} values)")
+    block = arrivals_yaml(chosen, f"{trace}, column {args.column} ({count})")
     table = format_table(fits)
     if chosen is not fits[0]:
         table += f"\nChosen: {chosen.family}, the best fit that allows no negative times."
@@ -90,7 +99,8 @@ def main(args: argparse.Namespace) -> int:
     with ExitStack() as stack:  # both written in full, then renamed: the figure first, the YAML last
         out_tmp = stack.enter_context(atomic_path(out)) if out is not None else None
         if figure is not None:
-            draw(values, fits, stack.enter_context(atomic_path(figure)), best=chosen, xlabel=args.column)
+            draw(values, fits, stack.enter_context(atomic_path(figure)), best=chosen,
+                 xlabel=f"gaps between {args.column}" if times else args.column)
         if out_tmp is not None:
             out_tmp.write_text(block, encoding="utf-8")
     comment = "# " if out is None else ""  # printed table and block together are valid YAML
