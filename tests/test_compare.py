@@ -127,3 +127,58 @@ def test_compare_refuses_an_out_that_is_a_file_before_running(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1 and "taken" in err
     assert blocker.read_text() == "x"
+
+
+def compare_run(capsys, a: Path | str, b: Path | str, *more: str) -> tuple[str, list[str]]:
+    """``cell compare A B`` over 3 replications: its stdout and its stderr's warning lines."""
+    code = main(["compare", str(a), str(b), "--replications", "3", "--workers", "1", *more])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    return out, [line for line in err.splitlines() if "warning" in line]
+
+
+def verdict_rows(out: str) -> dict[str, str]:
+    return {line.split("  ")[1].strip(): line for line in out.splitlines()[1:]}
+
+
+def test_compare_warns_once_when_run_lengths_differ_and_leaves_counts_uncompared(
+        tmp_path, capsys):
+    a = scenario(tmp_path, "short", run__parts=30)
+    b = scenario(tmp_path, "long", run__parts=45, controller__policy="non-adaptive")
+    out, warned = compare_run(capsys, a, b)
+    assert len(warned) == 1, warned
+    assert "short runs 30 parts, long 45" in warned[0] and "not comparable" in warned[0]
+    assert "--set run.parts=45" in warned[0]
+    rows = verdict_rows(out)
+    for count in ("Parts delivered", "Parts lost (wall clock)", "Spacings outside 45 ± 0.25 in"):
+        assert "not compared" in rows[count] and "run.parts 30 against 45" in rows[count]
+        assert "better" not in rows[count]
+    for rate in ("Parts per hour (wall clock)", "IP (wall clock, eq. 5.1)"):
+        assert "not compared" not in rows[rate] and "±" in rows[rate]
+    assert "3 replications of 30 and 45 parts" in out.splitlines()[0]
+    # the suggested --set makes the windows equal: no warning, counts compared per run
+    out, warned = compare_run(capsys, a, b, "--set", "run.parts=45")
+    assert warned == []
+    assert "per 45-part run" in verdict_rows(out)["Parts delivered"]
+
+
+def test_compare_does_not_warn_when_windows_are_equal(tmp_path, capsys):
+    a = scenario(tmp_path, "one", run__parts=30, run__warmup_parts=5)
+    b = scenario(tmp_path, "other", run__parts=30, run__warmup_parts=5,
+                 controller__policy="non-adaptive")
+    out, warned = compare_run(capsys, a, b)
+    assert warned == []
+    assert "not compared" not in out
+    assert "per 30-part run" in verdict_rows(out)["Parts lost (wall clock)"]
+
+
+def test_compare_warns_when_warmups_differ(tmp_path, capsys):
+    a = scenario(tmp_path, "auto", run__parts=30, run__warmup_parts="auto")
+    b = scenario(tmp_path, "fixed", run__parts=30, run__warmup_parts=4)
+    out, warned = compare_run(capsys, a, b)
+    assert len(warned) == 1, warned
+    assert "auto has run.warmup_parts auto, fixed 4" in warned[0]
+    assert "--set run.warmup_parts=4" in warned[0] and "run.parts" not in warned[0]
+    assert "not compared" in verdict_rows(out)["Parts delivered"]
+    out, warned = compare_run(capsys, a, b, "--set", "run.warmup_parts=4")
+    assert warned == [] and "not compared" not in out

@@ -5,7 +5,9 @@ numbers: replication r of both draws the same parts, so their difference is
 taken replication by replication (a paired t interval).  Prints, per headline
 measure, which is better, by how much, and whether the interval excludes zero;
 ``--out DIR`` writes the report (as ``cell sweep --report``) and the
-replications, as a unit.
+replications, as a unit.  Counts (parts delivered, lost, ...) are per run, after
+the warm-up: if A and B differ in ``run.parts`` or ``run.warmup_parts`` a warning
+says so and the verdict leaves counts uncompared; rates still compare.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from cell.commands import check_workers, set_argument, workers_argument
 if TYPE_CHECKING:
     import pandas as pd
 
+    from cell.scenario import Scenario
     from cell.sweep import Sweep
 
 HELP = "compare two scenarios, paired over common random numbers"
@@ -47,7 +50,34 @@ def _label(arg: str) -> str:
     return Path(arg).stem if arg.endswith((".yaml", ".yml")) else Path(arg).name
 
 
+def _windows(a: Scenario, b: Scenario) -> list[tuple[str, object, object]]:
+    """The settings of the window counts are taken over on which A and B differ:
+    (key, A's value, B's value)."""
+    return [(key, getattr(a.run, key), getattr(b.run, key))
+            for key in ("parts", "warmup_parts") if getattr(a.run, key) != getattr(b.run, key)]
+
+
+def _suggest(va: object, vb: object) -> object:
+    """A value valid for both (``--set`` sets it for both): the larger
+    number, or the fixed warm-up when the other is ``auto``."""
+    return max(v for v in (va, vb) if isinstance(v, int))
+
+
+def window_warning(a: Scenario, b: Scenario, labels: tuple[str, str]) -> str | None:
+    """One line if A's and B's counts are over different windows, else None."""
+    differ = _windows(a, b)
+    if not differ:
+        return None
+    la, lb = labels
+    said = {"parts": "runs {} parts", "warmup_parts": "has run.warmup_parts {}"}
+    what = "; ".join(f"{la} {said[k].format(va)}, {lb} {vb}" for k, va, vb in differ)
+    sets = " ".join(f"--set run.{k}={_suggest(va, vb)}" for k, va, vb in differ)
+    return (f"{what}: counts (parts delivered, parts lost, spacings outside tolerance) are "
+            f"not comparable; compare the rates, or give both the same window ({sets})")
+
+
 def main(args: argparse.Namespace) -> int:
+    import sys
     import tempfile
     from pathlib import Path
 
@@ -75,6 +105,10 @@ def main(args: argparse.Namespace) -> int:
         names = (*REPORT_FILES, "replications.csv")
         OutputDir.check(args.out, names)  # before anything runs
         target = Target(Path(args.out), names, False)
+    pa, pb = sweep.points
+    warning = window_warning(a, b, (dict(pa.values)["scenario"], dict(pb.values)["scenario"]))
+    if warning:
+        print(f"cell: warning: {warning}", file=sys.stderr)
     with tempfile.TemporaryDirectory(prefix="cell-compare-") as work:
         outcome = run_sweep(sweep, work, workers=args.workers, replicate=simulate_summary)
         replications = outcome.replications
@@ -94,19 +128,28 @@ def main(args: argparse.Namespace) -> int:
 
 
 def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> str:
-    """A few lines: per headline measure, which is better and by how much (A - B)."""
+    """A few lines: per headline measure, which is better and by how much (A - B).  Counts
+    are not compared if A and B take them over different windows (run length, warm-up)."""
     from cell.reporting.headlines import HEADLINES, better, decimals, number
 
     (la, a), (lb, b) = ((dict(p.values)["scenario"], p) for p in sweep.points)
+    differ = _windows(a.scenario, b.scenario)
     parts = a.scenario.run.parts if a.scenario.run.parts == b.scenario.run.parts else None
     level = f"{sweep.confidence * 100:g} %"
+    length = (f" of {parts} parts" if parts else
+              f" of {a.scenario.run.parts} and {b.scenario.run.parts} parts")
     lines = [f"{la} ({a.policy}) against {lb} ({b.policy}): {sweep.replications} replications"
-             + (f" of {parts} parts" if parts else "") + f", seed {sweep.seed}, common random "
-             f"numbers; A - B with its paired {level} confidence interval"]
+             f"{length}, seed {sweep.seed}, common random numbers; A - B with its paired "
+             f"{level} confidence interval"]
+    apart = ", ".join(f"run.{k} {va} against {vb}" for k, va, vb in differ)
     width = max(len(h.title) for h in HEADLINES)
     for h in HEADLINES:
         d = differences[differences["measure"] == h.column]
         if d.empty:
+            continue
+        if h.per_run and differ:
+            lines.append(f"  {h.title:<{width}}  not compared: a count, over different windows "
+                         f"({apart}); compare the rates")
             continue
         row = d.iloc[0]
         means = summary[summary["measure"] == h.column].set_index("scenario")["mean"]
