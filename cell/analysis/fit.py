@@ -288,7 +288,7 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
     finite = np.isfinite(values)
     if not (times or sorted_ok) and values.size >= MIN_VALUES and finite.all() \
             and np.all(np.diff(values) >= 0.0) and np.ptp(values) > 0.0:
-        seen = f"{values.size} values rising from {values[0]:.6g} to {values[-1]:.6g}"
+        seen = f"{values.size} values rising from {cells.iloc[0]} to {cells.iloc[-1]}"
         raise ScenarioError(p, column, seen,
                             "the column never decreases, so it looks like arrival times, not gaps: "
                             "use --times to fit their differences (or --gaps if these are sorted gaps)")
