@@ -279,6 +279,21 @@ def test_kept_and_streamed_runs_give_the_same_rows():
     assert list(frame.columns) == PART_COLUMNS and len(frame) == 400
 
 
+def test_summary_counts_the_parts_that_name_each_limit():
+    from cell.records import LIMIT_COUNTS, LIMITS
+
+    s = default_scenario().with_overrides({"arrivals.distribution": "gamma", "arrivals.mean_s": 21.0,
+                                           "arrivals.cv": 1.0, "run.parts": 300})
+    r = simulate(s, seed=7)
+    named = [set(names.split()) for names in r.parts["limits"].fillna("")]
+    counts = {}
+    for name, counted in LIMIT_COUNTS.items():
+        assert name in LIMITS and counted.field in SUMMARY_COLUMNS
+        counts[counted.field] = sum(name in n for n in named)
+        assert r.summary[counted.field] == counts[counted.field], name
+    assert sum(v > 0 for v in counts.values()) >= 4   # the run hits several limits
+
+
 def _reference_non_adaptive(s, seed):
     """The non-adaptive cell as a plain loop, no SimPy: belts never change speed, so a part
     reaches B when the belt has carried it the belt's length, the robot takes it if it is

@@ -9,7 +9,7 @@ from typing import Any
 from cell import thesis as published
 from cell.assembly import AssembledCell
 from cell.policies.base import CellConstants
-from cell.records import RunSummary
+from cell.records import LIMIT_COUNTS, RunSummary
 from cell.scenario import Scenario, load_scenario
 
 #: Relative difference between the nominal cycle and the arrivals' mean worth a warning.
@@ -18,16 +18,6 @@ NOMINAL_MISMATCH = 0.01
 IP_LINE = ("IP (eq. 5.1) = the next part's inter-arrival time / the time between deliveries: "
            "1 means the cell keeps pace with its parts.  The thesis's accounting is how the "
            "thesis counted (docs/accounting.md); the wall clock is what a stopwatch shows.")
-
-#: Summary fields of the limits, as printed.
-LIMIT_FIELDS = (("limit_r4_peak", "R IV at the base's peak rate"),
-                ("limit_r2_peak", "R II at the motors' peak"),
-                ("limit_input_floor", "input belt at its floor (part let go)"),
-                ("limit_input_ceiling", "input belt at its ceiling (robot waited)"),
-                ("limit_input_tracking", "input belt held to the robot's tracking limit"),
-                ("limit_output_floor", "output belt at its floor"),
-                ("limit_output_ceiling", "output belt at its ceiling"),
-                ("parts_held", "held at the feeder (belt not clear)"))
 
 
 def run_heading(cell: AssembledCell) -> str:
@@ -118,7 +108,8 @@ def format_summary(r: RunSummary, thesis: dict[str, str] | None = None) -> str:
         add("IP, next arrivals counted from each pick-up", r.ip_thesis_memoryless, field="ip_thesis")
     add("spacing min / max, in", f"{r.spacing_min_in:.3f} / {r.spacing_max_in:.3f}", "{}")
     add("spacings outside 45 ± 0.25 in", r.spacing_outside_tol, "{:d}")
-    hit = [f"{label} {getattr(r, field)}" for field, label in LIMIT_FIELDS if getattr(r, field)]
+    hit = [f"{label} {getattr(r, field)}" for field, label in LIMIT_COUNTS.values()
+           if getattr(r, field)]
     add("limits hit (parts)", "; ".join(hit) if hit else "none", "{}")
     if r.warmup_parts:
         add("warm-up left out, parts", r.warmup_parts, "{:d}")
