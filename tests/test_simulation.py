@@ -134,6 +134,19 @@ def test_the_thesis_figures_are_printed_beside_the_thesis_run_only(tmp_path, cap
     assert "(thesis:" not in capsys.readouterr().out
 
 
+def test_the_thesis_figures_of_each_table_7_1_row_are_that_row():
+    from cell.reporting.runs import thesis_figures
+    from cell.thesis import TABLE_7_1
+
+    base = load_scenario("baseline", {"controller.policy": "non-adaptive"})
+    for cycle, (actual, missed, per_hr, vavg, ip) in TABLE_7_1.items():
+        shown = thesis_figures(base.with_overrides({"controller.ideal_cycle_s": cycle}))
+        assert shown == {"parts_missed_thesis": f"{missed}", "actual_cycle_thesis_s": f"{actual:.4f}",
+                         "parts_per_hr_thesis": f"{per_hr:.4f}", "vavg_r4_in_s": f"{vavg:.4f}",
+                         "ip_thesis": f"{ip:.4f}"}
+    assert thesis_figures(base.with_overrides({"controller.ideal_cycle_s": 21.25})) is None
+
+
 def test_other_seed_other_parts(tmp_path):
     s = default_scenario().with_overrides({"run.parts": 30})
     a = simulate(s, seed=1).parts["interarrival_s"]

@@ -19,6 +19,12 @@ IP_LINE = ("IP (eq. 5.1) = the next part's inter-arrival time / the time between
            "1 means the cell keeps pace with its parts.  The thesis's accounting is how the "
            "thesis counted (docs/accounting.md); the wall clock is what a stopwatch shows.")
 
+#: Table 7.1's measures (cell.thesis), as printed beside the summary fields, by field.
+TABLE_7_1_SHOWN = {"parts_missed_thesis": ("parts_missed", "{:.0f}"),
+                   "actual_cycle_thesis_s": ("actual_cycle_s", "{:.4f}"),
+                   "parts_per_hr_thesis": ("parts_per_hr", "{:.4f}"),
+                   "vavg_r4_in_s": ("vavg_r4_in_s", "{:.4f}"), "ip_thesis": ("ip", "{:.4f}")}
+
 
 def run_heading(cell: AssembledCell) -> str:
     """What runs, and at which ideal cycle, said before the run starts."""
@@ -64,13 +70,14 @@ def thesis_figures(s: Scenario) -> dict[str, str] | None:
                 "ip_thesis": f"{published.ADAPTIVE_IP}",
                 "cycle_vs_nominal_pct": f"within {published.ADAPTIVE_CYCLE_PCT} %"}
     ideal = c.ideal_cycle_s if c.ideal_cycle_s is not None else base.controller.nominal_cycle_s
-    row = published.TABLE_7_1.get(round(float(ideal or math.nan), 4))
-    if row is None or c.policy != "non-adaptive":
+    if c.policy != "non-adaptive":
         return None
-    actual, missed, per_hr, vavg, ip = row
-    return {"parts_missed_thesis": f"{missed:.0f}", "actual_cycle_thesis_s": f"{actual:.4f}",
-            "parts_per_hr_thesis": f"{per_hr:.4f}", "vavg_r4_in_s": f"{vavg:.4f}",
-            "ip_thesis": f"{ip:.4f}"}
+    table = published.PUBLISHED[c.policy]
+    values = {field: table.value(float(ideal or math.nan), measure)
+              for field, (measure, _) in TABLE_7_1_SHOWN.items()}
+    if any(v is None for v in values.values()):
+        return None
+    return {field: fmt.format(values[field]) for field, (_, fmt) in TABLE_7_1_SHOWN.items()}
 
 
 def _comparable(s: Scenario) -> dict[str, Any]:
