@@ -13,7 +13,6 @@ from cell.accounting import (
     thesis_adaptive,
     thesis_non_adaptive,
     thesis_non_adaptive_held,
-    wallclock,
 )
 
 #: docs/accounting.md's figures for the reconstruction held at the thesis's own miss counts:
@@ -75,16 +74,6 @@ def test_calibrated_slack_reproduces_the_parts_missed_column(draws, row):
     counts = thesis_non_adaptive(draws, ideal).missed
     # the thesis's single run lies within about one run's spread of the mean
     assert abs(counts.mean() - missed) < 1.5 * counts.std() + 1
-
-
-def test_wallclock_intervals_skip_lost_parts():
-    td = np.array([10.0, 32.0, np.nan, 80.0])
-    t_next = np.array([22.0, 24.0, 23.0, 25.0])
-    r = wallclock(t_next, td)
-    assert np.isnan(r.interval_s[[0, 2]]).all()
-    assert r.interval_s[[1, 3]].tolist() == [22.0, 48.0]
-    assert r.ip[1] == pytest.approx(24.0 / 22.0)
-    assert r.actual_cycle_s == pytest.approx((80.0 - 10.0) / 2)
 
 
 def test_thesis_adaptive_is_next_arrival_over_motion_time():
