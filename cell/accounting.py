@@ -2,7 +2,8 @@
 
 * Wall-clock: a delivery interval is the time between consecutive set-downs
   (TD) on the output belt; IP (eq. 5.1) = the next part's inter-arrival time
-  over that interval; the actual cycle is the mean interval.
+  over that interval; the actual cycle is the mean interval (counted as the run
+  goes, by :mod:`cell.simulation`).
 * The thesis's: for the adaptive robot, step 6.2's "time between part
   deliveries" (motion time to TD plus the previous cycle's residual, idle waits
   left out); for the non-adaptive table, docs/accounting.md's reconstruction of how Table
@@ -36,25 +37,6 @@ class Accounts(NamedTuple):
 def parts_per_hr(actual_cycle_s: ArrayLike) -> NDArray[np.float64]:
     """Table 7.1's parts/hr = 3600 / actual cycle."""
     return 3600.0 / np.asarray(actual_cycle_s, dtype=float)
-
-
-def wallclock(next_interarrival_s: ArrayLike, touchdown_s: ArrayLike) -> Accounts:
-    """Delivery intervals between consecutive set-downs and IP = T_{i+1} / interval.
-
-    ``touchdown_s`` is NaN for parts not delivered; the first delivery has no
-    interval.  Actual cycle = (last TD - first TD) / (deliveries - 1).
-    """
-    tn = np.asarray(next_interarrival_s, dtype=float)
-    td = np.asarray(touchdown_s, dtype=float)
-    interval = np.full(td.shape, np.nan)
-    done = np.flatnonzero(np.isfinite(td))
-    if done.size:
-        interval[done[1:]] = np.diff(td[done])
-    ip = tn / interval
-    n = done.size
-    actual = float((td[done[-1]] - td[done[0]]) / (n - 1)) if n > 1 else float("nan")
-    mean_ip = float(np.nanmean(ip)) if np.isfinite(ip).any() else float("nan")
-    return Accounts(interval, ip, actual, mean_ip)
 
 
 def thesis_adaptive(next_interarrival_s: ArrayLike, time_between_deliveries_s: ArrayLike

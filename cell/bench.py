@@ -24,7 +24,6 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -33,19 +32,11 @@ import simpy
 from cell import catalog
 from cell.scenario import Scenario, default_scenario, load_scenario
 from cell.simulation import simulate
+from cell.stopwatch import best_seconds
 
 #: Targets (the bench prints whether each is met; nothing fails on them).
 TARGETS = {"flat": 0.9, "ceiling_ratio": 0.5, "cold_run_s": 0.7, "sweep_table_7_1_s": 5.0,
            "peak_mb_1m_parts": 500.0}
-
-
-def _best_seconds(fn: Callable[[], Any], repeats: int) -> float:
-    best = float("inf")
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
 
 
 def _streamed(scenario: Scenario) -> Any:
@@ -55,7 +46,7 @@ def _streamed(scenario: Scenario) -> Any:
 def parts_per_second(scenario: Scenario, repeats: int = 5) -> float:
     """Best-of-``repeats`` simulated parts per second (after one warm-up run)."""
     _streamed(scenario.with_overrides({"run.parts": 50}))  # solves and caches the path
-    return scenario.run.parts / _best_seconds(lambda: _streamed(scenario), repeats)
+    return scenario.run.parts / best_seconds(lambda: _streamed(scenario), repeats)
 
 
 def events_per_part(scenario: Scenario) -> float:
@@ -88,7 +79,7 @@ def simpy_timeouts_per_second(n: int = 200_000, repeats: int = 3) -> float:
         env.process(loop(env))
         env.run()
 
-    return n / _best_seconds(once, repeats)
+    return n / best_seconds(once, repeats)
 
 
 def _cell(*args: str) -> float:

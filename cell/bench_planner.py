@@ -15,21 +15,11 @@ its default grid against the converged time, from the planner on 460·2^k points
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable
-
 import numpy as np
 
+from cell.stopwatch import best_seconds
+
 RICHARDSON = tuple(460 * 2 ** k for k in range(5))
-
-
-def _best_ms(fn: Callable[[], object], repeat: int) -> float:
-    best = np.inf
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return 1e3 * best
 
 
 def converged_time(times: list[float]) -> float:
@@ -64,8 +54,8 @@ def benchmarks(repeat: int = 5) -> dict[str, float]:
     out: dict[str, float] = {}
     for n in (460, 2000):
         a, b = ours(n), theirs(n)
-        out[f"mintime_ms_{n}"] = _best_ms(lambda: ours(n), repeat)       # noqa: B023
-        out[f"toppra_ms_{n}"] = _best_ms(lambda: theirs(n), repeat)      # noqa: B023
+        out[f"mintime_ms_{n}"] = 1e3 * best_seconds(lambda: ours(n), repeat)       # noqa: B023
+        out[f"toppra_ms_{n}"] = 1e3 * best_seconds(lambda: theirs(n), repeat)      # noqa: B023
         out[f"mintime_vs_toppra_time_rel_{n}"] = float(max(abs(x - y) / y for x, y in zip(a, b)))
 
     # Torque (baseline dynamic model) on R IV at 460 points: toppra calls the same inverse
@@ -90,8 +80,8 @@ def benchmarks(repeat: int = 5) -> dict[str, float]:
                               inv_dyn=lambda q, qd, qdd: ch.rnea(q, qd, qdd, friction=False),
                               tau_max=tau)[1]
 
-    out["mintime_torque_ms_460"] = _best_ms(ours_tau, 3)
-    out["toppra_torque_ms_460"] = _best_ms(theirs_tau, 1)
+    out["mintime_torque_ms_460"] = 1e3 * best_seconds(ours_tau, 3)
+    out["toppra_torque_ms_460"] = 1e3 * best_seconds(theirs_tau, 1)
 
     r4_times = [plan_regimes(base_geometry, base_motors, base_bounds, n)["R4"].profile.time_s
                 for n in RICHARDSON]

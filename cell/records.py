@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
-from typing import Any
+from typing import Any, NamedTuple
 
 NAN = math.nan
 
@@ -34,6 +34,31 @@ LIMITS = (
 LIMIT_BIT = {name: 1 << i for i, name in enumerate(LIMITS)}
 (INPUT_FLOOR, INPUT_CEILING, INPUT_TRACKING, OUTPUT_FLOOR, OUTPUT_CEILING, R2_PEAK, R4_PEAK,
  LET_GO, SPACING_OFF, HELD_AT_FEEDER) = (1 << i for i in range(len(LIMITS)))
+
+
+class LimitCount(NamedTuple):
+    """How summary.csv counts the parts that hit a limit."""
+
+    field: str
+    """The :class:`RunSummary` field (the column) holding the count."""
+    label: str
+    """What the count is, as ``cell run`` prints it."""
+
+
+#: The limits counted in summary.csv, by name, in the order ``cell run`` lists them as
+#: "limits hit" (``let_go`` and ``spacing_off`` are reported as the parts lost and the
+#: spacings outside the tolerance):
+LIMIT_COUNTS: dict[str, LimitCount] = {
+    "r4_peak": LimitCount("limit_r4_peak", "R IV at the base's peak rate"),
+    "r2_peak": LimitCount("limit_r2_peak", "R II at the motors' peak"),
+    "input_floor": LimitCount("limit_input_floor", "input belt at its floor (part let go)"),
+    "input_ceiling": LimitCount("limit_input_ceiling", "input belt at its ceiling (robot waited)"),
+    "input_tracking": LimitCount("limit_input_tracking",
+                                 "input belt held to the robot's tracking limit"),
+    "output_floor": LimitCount("limit_output_floor", "output belt at its floor"),
+    "output_ceiling": LimitCount("limit_output_ceiling", "output belt at its ceiling"),
+    "held_at_feeder": LimitCount("parts_held", "held at the feeder (belt not clear)"),
+}
 
 
 def limit_names(flags: int) -> str:

@@ -42,6 +42,7 @@ from cell.feeder import Feeder
 from cell.policies.base import Accounting
 from cell.records import (
     LIMIT_BIT,
+    LIMIT_COUNTS,
     LIMIT_NAMES,
     PART_COLUMNS,
     SPACING_OFF,
@@ -321,10 +322,6 @@ def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, 
         spacing_min_in=float(sp.min()) if sp.size else math.nan,
         spacing_max_in=float(sp.max()) if sp.size else math.nan,
         spacing_outside_tol=count("spacing_off"),
-        limit_input_floor=count("input_floor"), limit_input_ceiling=count("input_ceiling"),
-        limit_input_tracking=count("input_tracking"), limit_output_floor=count("output_floor"),
-        limit_output_ceiling=count("output_ceiling"), limit_r2_peak=count("r2_peak"),
-        limit_r4_peak=count("r4_peak"), parts_held=int(held.sum()),
         feed_delay_max_s=float(delay[held].max()) if held.any() else 0.0,
         output_speed_min_in_s=float(vout.min()) if vout.size else math.nan,
         output_speed_max_in_s=float(vout.max()) if vout.size else math.nan,
@@ -332,6 +329,8 @@ def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, 
         nominal_from=k.nominal_from, mean_interarrival_s=k.mean_interarrival_s,
         fastest_cycle_s=k.fastest_cycle_s, utilisation=k.utilisation, warmup_parts=w,
         sim_end_s=end_s)
+    for name, counted in LIMIT_COUNTS.items():
+        setattr(r, counted.field, count(name))
     acct.finish(r, w, log.column("r4", w)[picked], t[1:])
     r.parts_per_hr_wallclock = float(accounting.parts_per_hr(r.actual_cycle_wallclock_s))
     r.parts_per_hr_thesis = float(accounting.parts_per_hr(r.actual_cycle_thesis_s))

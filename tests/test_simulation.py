@@ -134,6 +134,19 @@ def test_the_thesis_figures_are_printed_beside_the_thesis_run_only(tmp_path, cap
     assert "(thesis:" not in capsys.readouterr().out
 
 
+def test_the_thesis_figures_of_each_table_7_1_row_are_that_row():
+    from cell.reporting.runs import thesis_figures
+    from cell.thesis import TABLE_7_1
+
+    base = load_scenario("baseline", {"controller.policy": "non-adaptive"})
+    for cycle, (actual, missed, per_hr, vavg, ip) in TABLE_7_1.items():
+        shown = thesis_figures(base.with_overrides({"controller.ideal_cycle_s": cycle}))
+        assert shown == {"parts_missed_thesis": f"{missed}", "actual_cycle_thesis_s": f"{actual:.4f}",
+                         "parts_per_hr_thesis": f"{per_hr:.4f}", "vavg_r4_in_s": f"{vavg:.4f}",
+                         "ip_thesis": f"{ip:.4f}"}
+    assert thesis_figures(base.with_overrides({"controller.ideal_cycle_s": 21.25})) is None
+
+
 def test_other_seed_other_parts(tmp_path):
     s = default_scenario().with_overrides({"run.parts": 30})
     a = simulate(s, seed=1).parts["interarrival_s"]
@@ -277,6 +290,21 @@ def test_kept_and_streamed_runs_give_the_same_rows():
         _bits(getattr(streamed.summary, c) for c in SUMMARY_COLUMNS)
     frame = kept.parts
     assert list(frame.columns) == PART_COLUMNS and len(frame) == 400
+
+
+def test_summary_counts_the_parts_that_name_each_limit():
+    from cell.records import LIMIT_COUNTS, LIMITS
+
+    s = default_scenario().with_overrides({"arrivals.distribution": "gamma", "arrivals.mean_s": 21.0,
+                                           "arrivals.cv": 1.0, "run.parts": 300})
+    r = simulate(s, seed=7)
+    named = [set(names.split()) for names in r.parts["limits"].fillna("")]
+    counts = {}
+    for name, counted in LIMIT_COUNTS.items():
+        assert name in LIMITS and counted.field in SUMMARY_COLUMNS
+        counts[counted.field] = sum(name in n for n in named)
+        assert r.summary[counted.field] == counts[counted.field], name
+    assert sum(v > 0 for v in counts.values()) >= 4   # the run hits several limits
 
 
 def _reference_non_adaptive(s, seed):

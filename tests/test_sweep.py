@@ -270,6 +270,32 @@ def test_real_simulation_same_numbers_locally_and_on_dask(sweeps, tmp_path):
     assert one == (tmp_path / "dask" / "replications.csv").read_bytes()
 
 
+def assembling_each_time(scenario, seed) -> dict:
+    """The default replication as it was: the cell assembled for every run."""
+    from cell.simulation import simulate
+
+    return simulate(scenario, seed=seed, keep_parts=False, keep_belts=False).summary.as_dict()
+
+
+def test_real_simulation_assembles_a_cell_once_a_point_and_gives_the_same_bytes(
+        sweeps, tmp_path, monkeypatch):
+    import cell.assembly
+
+    sweep = load_sweep(sweeps.write(tmp_path, replications=3, batch=2))  # 2 tasks a point
+    run_sweep(sweep, tmp_path / "each", workers=1, replicate=assembling_each_time,
+              progress=False)
+    built, assemble = [], cell.assembly.assemble
+    monkeypatch.setattr(cell.assembly, "assemble", lambda s: built.append(s) or assemble(s))
+    run_sweep(sweep, tmp_path / "w1", workers=1, progress=False)
+    monkeypatch.undo()
+    assert len(built) == 3 and all(b is p.scenario for b, p in zip(built, sweep.points))
+    run_sweep(sweep, tmp_path / "w2", workers=2, progress=False)
+    each = (tmp_path / "each" / "replications.csv").read_bytes()
+    assert each.count(b"\n") == 1 + 9
+    assert each == (tmp_path / "w1" / "replications.csv").read_bytes()
+    assert each == (tmp_path / "w2" / "replications.csv").read_bytes()
+
+
 def test_real_simulation_both_policies_see_the_same_parts(sweeps, tmp_path):
     pytest.importorskip("cell.simulation")
     sweep = load_sweep(sweeps.write(tmp_path, replications=2, set={"run.parts": 30}))

@@ -9,7 +9,7 @@ from typing import Any
 from cell import thesis as published
 from cell.assembly import AssembledCell
 from cell.policies.base import CellConstants
-from cell.records import RunSummary
+from cell.records import LIMIT_COUNTS, RunSummary
 from cell.scenario import Scenario, load_scenario
 
 #: Relative difference between the nominal cycle and the arrivals' mean worth a warning.
@@ -19,15 +19,11 @@ IP_LINE = ("IP (eq. 5.1) = the next part's inter-arrival time / the time between
            "1 means the cell keeps pace with its parts.  The thesis's accounting is how the "
            "thesis counted (docs/accounting.md); the wall clock is what a stopwatch shows.")
 
-#: Summary fields of the limits, as printed.
-LIMIT_FIELDS = (("limit_r4_peak", "R IV at the base's peak rate"),
-                ("limit_r2_peak", "R II at the motors' peak"),
-                ("limit_input_floor", "input belt at its floor (part let go)"),
-                ("limit_input_ceiling", "input belt at its ceiling (robot waited)"),
-                ("limit_input_tracking", "input belt held to the robot's tracking limit"),
-                ("limit_output_floor", "output belt at its floor"),
-                ("limit_output_ceiling", "output belt at its ceiling"),
-                ("parts_held", "held at the feeder (belt not clear)"))
+#: Table 7.1's measures (cell.thesis), as printed beside the summary fields, by field.
+TABLE_7_1_SHOWN = {"parts_missed_thesis": ("parts_missed", "{:.0f}"),
+                   "actual_cycle_thesis_s": ("actual_cycle_s", "{:.4f}"),
+                   "parts_per_hr_thesis": ("parts_per_hr", "{:.4f}"),
+                   "vavg_r4_in_s": ("vavg_r4_in_s", "{:.4f}"), "ip_thesis": ("ip", "{:.4f}")}
 
 
 def run_heading(cell: AssembledCell) -> str:
@@ -74,13 +70,14 @@ def thesis_figures(s: Scenario) -> dict[str, str] | None:
                 "ip_thesis": f"{published.ADAPTIVE_IP}",
                 "cycle_vs_nominal_pct": f"within {published.ADAPTIVE_CYCLE_PCT} %"}
     ideal = c.ideal_cycle_s if c.ideal_cycle_s is not None else base.controller.nominal_cycle_s
-    row = published.TABLE_7_1.get(round(float(ideal or math.nan), 4))
-    if row is None or c.policy != "non-adaptive":
+    if c.policy != "non-adaptive":
         return None
-    actual, missed, per_hr, vavg, ip = row
-    return {"parts_missed_thesis": f"{missed:.0f}", "actual_cycle_thesis_s": f"{actual:.4f}",
-            "parts_per_hr_thesis": f"{per_hr:.4f}", "vavg_r4_in_s": f"{vavg:.4f}",
-            "ip_thesis": f"{ip:.4f}"}
+    table = published.PUBLISHED[c.policy]
+    values = {field: table.value(float(ideal or math.nan), measure)
+              for field, (measure, _) in TABLE_7_1_SHOWN.items()}
+    if any(v is None for v in values.values()):
+        return None
+    return {field: fmt.format(values[field]) for field, (_, fmt) in TABLE_7_1_SHOWN.items()}
 
 
 def _comparable(s: Scenario) -> dict[str, Any]:
@@ -118,7 +115,8 @@ def format_summary(r: RunSummary, thesis: dict[str, str] | None = None) -> str:
         add("IP, next arrivals counted from each pick-up", r.ip_thesis_memoryless, field="ip_thesis")
     add("spacing min / max, in", f"{r.spacing_min_in:.3f} / {r.spacing_max_in:.3f}", "{}")
     add("spacings outside 45 ± 0.25 in", r.spacing_outside_tol, "{:d}")
-    hit = [f"{label} {getattr(r, field)}" for field, label in LIMIT_FIELDS if getattr(r, field)]
+    hit = [f"{label} {getattr(r, field)}" for field, label in LIMIT_COUNTS.values()
+           if getattr(r, field)]
     add("limits hit (parts)", "; ".join(hit) if hit else "none", "{}")
     if r.warmup_parts:
         add("warm-up left out, parts", r.warmup_parts, "{:d}")

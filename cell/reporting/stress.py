@@ -28,12 +28,15 @@ import pandas as pd
 
 from cell.analysis.stats import paired_difference, summarise
 from cell.output import OutputDir
+from cell.records import LIMIT_COUNTS
 
 KEYS = ("arrivals.distribution", "arrivals.cv", "arrivals.mean_s")
 FILES = ("stress.csv", "stress.png", "README.md")
 POLICIES = ("non-adaptive", "adaptive")
-LIMITS = ("limit_input_floor", "limit_r4_peak", "limit_r2_peak", "limit_input_ceiling",
-          "limit_output_floor", "parts_held")
+#: The limits counted in stress.csv (their summary columns, cell.records.LIMIT_COUNTS).
+LIMITS = tuple(LIMIT_COUNTS[name].field for name in ("input_floor", "r4_peak", "r2_peak",
+                                                      "input_ceiling", "output_floor",
+                                                      "held_at_feeder"))
 #: The property tests allow the adaptive robot this many fewer parts (of 500) than the
 #: fixed-cycle one on the same draws (tests/test_any_arrivals.py scales it to its runs).
 MARGIN_PARTS = 3

@@ -52,6 +52,8 @@ from cell.sweep.spec import Sweep, Task
 if TYPE_CHECKING:  # pandas is imported when first needed: local workers start without it
     import pandas as pd
 
+    from cell.assembly import AssembledCell
+
 #: A replication: (scenario, stream) -> the run's summary row.
 Replicate = Callable[[Scenario, np.random.SeedSequence], Mapping[str, Any]]
 
@@ -65,11 +67,21 @@ TASK_DIR = "tasks"
 CLUSTER_WINDOW = 1024
 
 
+#: The scenario this process last ran replications of, and its cell.
+_last: tuple[Scenario, AssembledCell] | None = None
+
+
 def simulate_summary(scenario: Scenario, seed: np.random.SeedSequence) -> Mapping[str, Any]:
-    """The default replication: one run of the cell, its summary row."""
+    """The default replication: one run of the cell, its summary row (the cell assembled
+    once for the replications of one scenario object that follow each other: a task's)."""
+    from cell.assembly import assemble
     from cell.simulation import simulate
 
-    return simulate(scenario, seed=seed, keep_parts=False, keep_belts=False).summary.as_dict()
+    global _last
+    last = _last
+    if last is None or last[0] is not scenario:
+        last = _last = (scenario, assemble(scenario))
+    return simulate(last[1], seed=seed, keep_parts=False, keep_belts=False).summary.as_dict()
 
 
 def run_task(replicate: Replicate, scenario: Scenario,
