@@ -93,3 +93,21 @@ def test_counting_arrivals_from_each_pickup_gives_the_thesis_adaptive_figures():
     assert r.mean_ip == pytest.approx(1.0214, abs=3e-3)                      # §7.2
     assert 100 * (22.5872 - r.actual_cycle_s) / 22.5872 == pytest.approx(2.1, abs=0.15)
     assert thesis_adaptive_memoryless([22.5872], 22.5872, shortest).mean_ip == 1.0
+
+
+@pytest.mark.parametrize("ideal", [22.5872, 21.0])
+def test_a_non_adaptive_run_keeps_the_reconstructed_books(ideal):
+    """The run's part-by-part bookkeeping (policies/fixed.py) gives what the vectorised
+    reconstruction gives on the same draws (cell.accounting.thesis_non_adaptive)."""
+    from cell.arrivals import interarrival_times
+    from cell.scenario import load_scenario
+    from cell.simulation import simulate
+
+    s = load_scenario("non_adaptive").with_overrides(
+        {"run.parts": 300, "run.seed": 11, "controller.ideal_cycle_s": ideal})
+    summary = simulate(s, keep_parts=False).summary
+    t = interarrival_times(s.arrivals, s.run.parts + 1, s.run.seed, s.base_dir)
+    books = thesis_non_adaptive(t, ideal)
+    assert summary.parts_missed_thesis == int(books.missed) > 0
+    assert summary.actual_cycle_thesis_s == pytest.approx(float(books.actual_cycle_s), rel=1e-12)
+    assert summary.ip_thesis == pytest.approx(float(books.mean_ip), rel=1e-12)

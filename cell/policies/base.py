@@ -161,7 +161,6 @@ class Accounting:
     def __init__(self, policy: Policy):
         self.policy = policy
         self.interval = array("d")
-        self.ip = array("d")
         self.lost = array("b")
 
     def part(self, rec: PartRecord, next_interarrival_s: float) -> None:

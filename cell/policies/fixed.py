@@ -8,6 +8,7 @@ while the robot is busy rides on and falls off at F; a late part is waited for.
 from __future__ import annotations
 
 import math
+from array import array
 from typing import Any
 
 import numpy as np
@@ -66,7 +67,11 @@ class FixedCycle(Policy):
 class ReconstructedAccounting(Accounting):
     """How the thesis computed Table 7.1 (reconstructed, docs/accounting.md): part i is
     lost when T_i < C − s whatever the robot is doing; its interval is D_i = T_i, or
-    T_i + C when lost; IP = T(i+1) / (2 D_i); actual cycle = Σ D / parts delivered."""
+    T_i + C when lost; IP = T(i+1) / (2 D_i); actual cycle = Σ D / parts delivered.
+
+    The rule of :func:`cell.accounting.thesis_non_adaptive`, applied one part at a time
+    as parts complete (so each record carries its columns); tests/test_accounting.py
+    checks a run's summary against that function on the run's own draws."""
 
     policy: FixedCycle
 
@@ -76,6 +81,7 @@ class ReconstructedAccounting(Accounting):
         """The robot's fixed cycle C."""
         self._lost_below = self.cycle_s - accounting.THESIS_SLACK_S
         """C − s: a part that comes sooner than this after the last is lost."""
+        self.ip = array("d")
 
     def part(self, rec: PartRecord, next_interarrival_s: float) -> None:
         t = rec.interarrival_s
