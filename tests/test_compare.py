@@ -182,3 +182,16 @@ def test_compare_warns_when_warmups_differ(tmp_path, capsys):
     assert "not compared" in verdict_rows(out)["Parts delivered"]
     out, warned = compare_run(capsys, a, b, "--set", "run.warmup_parts=4")
     assert warned == [] and "not compared" not in out
+
+
+def test_compare_report_carries_the_window_caveat(tmp_path, capsys):
+    """``--out``'s report.md says what the warning said, before its tables; not otherwise."""
+    a = scenario(tmp_path, "short", run__parts=30)
+    b = scenario(tmp_path, "long", run__parts=45, controller__policy="non-adaptive")
+    _, warned = compare_run(capsys, a, b, "--out", str(tmp_path / "differ"))
+    report = (tmp_path / "differ" / "report.md").read_text()
+    said = warned[0].split("warning: ", 1)[1]
+    assert f"**Caveat:** {said}." in report
+    assert report.index("**Caveat:**") < report.index("## ")
+    compare_run(capsys, a, b, "--out", str(tmp_path / "same"), "--set", "run.parts=45")
+    assert "Caveat" not in (tmp_path / "same" / "report.md").read_text()

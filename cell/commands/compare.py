@@ -121,7 +121,7 @@ def main(args: argparse.Namespace) -> int:
 
         command = (f"cell compare {args.a} {args.b} --replications {args.replications} "
                    f"--seed {seed}")
-        write_report(replications, sweep, target, command)
+        write_report(replications, sweep, target, command, warning)
         print(f"wrote {args.out}/: report.md, summary.csv, differences.csv, figures, "
               "replications.csv")
     return 0

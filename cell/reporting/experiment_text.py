@@ -115,8 +115,10 @@ def sentence(h: Headline, d: Mapping[Any, Any], a: str, b: str, parts: int | Non
 
 
 def markdown(summary: pd.DataFrame, differences: pd.DataFrame, replications: pd.DataFrame,
-             sweep: Sweep, command: str, figures: Sequence[str]) -> str:
-    """The whole ``report.md``."""
+             sweep: Sweep, command: str, figures: Sequence[str],
+             caveat: str | None = None) -> str:
+    """The whole ``report.md``; ``caveat``, if given, is said first (e.g. that counts
+    come from different windows)."""
     parts = _parts(sweep)
     cols = display_columns(summary, sweep)
     policies = sweep.policies
@@ -131,6 +133,8 @@ def markdown(summary: pd.DataFrame, differences: pd.DataFrame, replications: pd.
         "Differences are paired, replication by replication.",
         "Every numeric summary column: `summary.csv`; every paired difference: "
         "`differences.csv`."]), ""]
+    if caveat:
+        lines += [f"**Caveat:** {caveat}.", ""]
     lines += _variation(summary, sweep)
     lines += _precision(replications, summary, sweep, cols)
     present = [h for h in HEADLINES if h.column in set(summary["measure"])]
