@@ -10,6 +10,8 @@ merged in by ``cell bench``):
   doing ``yield env.timeout(1)`` in a loop (events per second) for scale: the
   *ceiling ratio* is parts/s over (bare events/s ÷ events per part), the share of
   SimPy's own speed that the model's Python leaves;
+* the hand-off floor: the five processes passing parts along through the cell's
+  own hand-offs with no model work (microseconds a part), what the model adds to;
 * whole processes: ``cell run baseline`` from a cold start (median of several,
   the disk cache warm as after any first run), ``cell sweep`` of Table 7.1 on two
   workers (700,000 parts), and the peak memory of ``cell run`` of 1,000,000 parts.
@@ -30,6 +32,7 @@ from typing import Any
 import simpy
 
 from cell import catalog
+from cell.mailbox import Mailbox, Timer
 from cell.scenario import Scenario, default_scenario, load_scenario
 from cell.simulation import simulate
 from cell.stopwatch import best_seconds
@@ -82,6 +85,42 @@ def simpy_timeouts_per_second(n: int = 200_000, repeats: int = 3) -> float:
     return n / best_seconds(once, repeats)
 
 
+def handoff_seconds_per_part(n: int = 200_000, repeats: int = 3) -> float:
+    """The cell's five processes handing each part along with the cell's own hand-offs
+    (:class:`~cell.mailbox.Timer`, :class:`~cell.mailbox.Mailbox`: drop, arrival at B,
+    order, set-down) and no model work: seconds a part, the floor under the model.
+
+    With a ceiling ratio r and e events a part, the model's own work may take at most
+    e / (r · bare events/s) minus this a part."""
+    def once() -> None:
+        env = simpy.Environment()
+        loaded, at_bot, orders, placed = (Mailbox(env) for _ in range(4))
+
+        def feeder():  # noqa: ANN202
+            after = Timer(env).after
+            for i in range(n):
+                yield after(22.0)
+                loaded.put(i)
+
+        def relay(box: Mailbox, hand_on: Any, delay: float, wait: bool):  # noqa: ANN202
+            get = box.get
+            while True:
+                part = yield get()
+                if hand_on is not None:
+                    handed = hand_on(part, delay) if delay else hand_on(part)
+                    if wait:
+                        yield handed
+
+        env.process(feeder())
+        env.process(relay(loaded, at_bot.put_after, 5.0, True))   # input conveyor
+        env.process(relay(at_bot, orders.put, 0.0, False))        # controller
+        env.process(relay(orders, placed.put_after, 10.0, False))  # robot
+        env.process(relay(placed, None, 0.0, False))              # output conveyor
+        env.run()
+
+    return best_seconds(once, repeats) / n
+
+
 def _cell(*args: str) -> float:
     """Seconds a whole ``cell`` process takes (output discarded)."""
     t0 = time.perf_counter()
@@ -126,7 +165,8 @@ def benchmarks(scenario_file: str | Path = "scenarios/baseline.yaml", *,
     ``processes=False`` leaves out the whole-process ones."""
     path = Path(scenario_file)
     base = load_scenario(path) if path.is_file() else default_scenario()
-    out: dict[str, Any] = {"simpy_timeouts_per_s": simpy_timeouts_per_second()}
+    out: dict[str, Any] = {"simpy_timeouts_per_s": simpy_timeouts_per_second(),
+                           "handoff_us_per_part": 1e6 * handoff_seconds_per_part()}
     for policy, name in (("adaptive", "adaptive"), ("non-adaptive", "non_adaptive")):
         s = base.with_overrides({"controller.policy": policy})
         out[f"parts_per_s_{name}_5k"] = parts_per_second(s.with_overrides({"run.parts": 5_000}))
