@@ -235,6 +235,35 @@ def test_drawn_parts_sit_where_the_belts_travel_puts_them(scenes: list[Scene], s
     assert drawn_in > 40 and drawn_out > 40
 
 
+def test_a_lone_part_at_the_strips_end_shows_nothing_past_it(scenes: list[Scene],
+                                                              scenario: Scenario) -> None:
+    """A square drawn alone across the output strip's end is cut at the strip's edge, as
+    when it shares the strip with others (matplotlib's one-path shortcut is not taken)."""
+    from matplotlib.colors import to_rgba
+
+    from cell.animation.render import PART_COLOUR, build_figure
+
+    fig, panels = build_figure(scenes, dpi=100.0)
+    strip = panels[0].parts_out
+    ax = strip.axes
+    end = ax.get_xlim()[1]
+    size = scenario.part.size_in
+
+    def pixels_past_the_end(squares: list[float]) -> np.ndarray:
+        strip.set_verts([[(x - size / 2, -size / 2), (x + size / 2, -size / 2),
+                          (x + size / 2, size / 2), (x - size / 2, size / 2)] for x in squares])
+        strip.set_facecolor([to_rgba(PART_COLOUR)] * len(squares))
+        fig.canvas.draw()
+        rgba = np.asarray(fig.canvas.buffer_rgba())
+        box = ax.bbox
+        rows = slice(rgba.shape[0] - int(box.y1), rgba.shape[0] - int(box.y0))
+        return rgba[rows, int(np.ceil(box.x1)):int(np.ceil(box.x1)) + 3].copy()
+
+    empty = pixels_past_the_end([])
+    np.testing.assert_array_equal(pixels_past_the_end([end, end - 3 * size]), empty)
+    np.testing.assert_array_equal(pixels_past_the_end([end]), empty)
+
+
 def test_the_demo_shows_a_part_the_fixed_cycle_loses_and_the_adaptive_saves() -> None:
     from cell.animation import DEMO_FIRST, DEMO_PARTS
     from cell.scenario import load_scenario
