@@ -29,6 +29,8 @@ from matplotlib.patches import Circle, Rectangle
 from matplotlib.text import Text
 
 from cell.animation.scene import (
+    CLOSE_X,
+    CLOSE_Y,
     FALLING,
     INPUT,
     OUTPUT,
@@ -47,11 +49,6 @@ PART_COLOUR = "#d9a441"
 PART_EDGE = "#5c4510"
 LOST_COLOUR = LIMIT_COLOUR
 IDLE_COLOUR = "0.45"
-#: The close-up's extent (in): the robot, both tracking windows and some belt either side.
-CLOSE_X = (-36.0, 10.0)
-CLOSE_Y = (-9.0, 37.0)
-#: How many part spacings of output belt the strip shows past TD.
-OUTPUT_SPACINGS = 2.4
 #: Figure height and one column's width (in); the layout below is in inches too.
 HEIGHT_IN, COLUMN_IN = 7.0, 5.5
 CLOSE_IN, STRIP_IN, GAP_IN = 4.55, 0.55, 0.36
@@ -186,7 +183,7 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene) -> Panel
     parts_in = _parts_collection(0.4, 2)
     strip_in.add_collection(parts_in)
     # the output belt unrolled along its y
-    y_end = scene.td_xy[1] + OUTPUT_SPACINGS * s.belts.spacing_in
+    y_end = scene.output_end_y
     _strip(strip_out, w / 2, y_end, w, strip_w, {"TD": scene.td_xy[1], "K": s.path.eot_in[1]},
            "output belt, unrolled (y) →", y_end, "right")
     parts_out = _parts_collection(0.4, 2)
