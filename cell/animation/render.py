@@ -345,5 +345,6 @@ def render(scenes: list[Scene], times: Floats, out: Path, *, fps: int, dpi: floa
                 if gif:  # ffmpeg's writer redraws the whole figure itself
                     canvas.restore_region(background)
                     for a in moving:
-                        fig.draw_artist(a)
+                        if a.get_visible():  # most parts' labels are hidden in any frame
+                            fig.draw_artist(a)
                 writer.grab_frame()
