@@ -29,6 +29,8 @@ from matplotlib.patches import Circle, Rectangle
 from matplotlib.text import Text
 
 from cell.animation.scene import (
+    CLOSE_X,
+    CLOSE_Y,
     FALLING,
     INPUT,
     OUTPUT,
@@ -47,11 +49,6 @@ PART_COLOUR = "#d9a441"
 PART_EDGE = "#5c4510"
 LOST_COLOUR = LIMIT_COLOUR
 IDLE_COLOUR = "0.45"
-#: The close-up's extent (in): the robot, both tracking windows and some belt either side.
-CLOSE_X = (-36.0, 10.0)
-CLOSE_Y = (-9.0, 37.0)
-#: How many part spacings of output belt the strip shows past TD.
-OUTPUT_SPACINGS = 2.4
 #: Figure height and one column's width (in); the layout below is in inches too.
 HEIGHT_IN, COLUMN_IN = 7.0, 5.5
 CLOSE_IN, STRIP_IN, GAP_IN = 4.55, 0.55, 0.36
@@ -119,6 +116,14 @@ def _strip(ax: Axes, x0: float, x1: float, w: float, width_in: float,
         ax.spines[side].set_visible(False)
 
 
+def _parts_collection(linewidth: float, zorder: float) -> PolyCollection:
+    """Squares for parts, drawn alike however many there are: the line width is given per
+    square (twice the same) so that matplotlib never takes its one-path shortcut, which lets
+    a lone square show a pixel past the axes' edge."""
+    return PolyCollection([], edgecolors=PART_EDGE, linewidths=[linewidth, linewidth],
+                          zorder=zorder)
+
+
 def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene) -> Panel:
     s, p = scene.scenario, scene.table.path
     w = s.cell.belt_width_in
@@ -158,7 +163,7 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene) -> Panel
     arm = [close.plot([], [], "-", lw=5.5, solid_capstyle="round", zorder=6)[0],
            close.plot([], [], "o-", lw=3.5, ms=4.5, solid_capstyle="round", zorder=6)[0],
            close.plot([], [], "-", lw=2.2, color="0.1", solid_capstyle="butt", zorder=7)[0]]
-    parts = PolyCollection([], edgecolors=PART_EDGE, linewidths=0.6, zorder=4)
+    parts = _parts_collection(0.6, 4)
     close.add_collection(parts)
     labels = [close.text(0, 0, str(n), fontsize=6, ha="center", va="center", zorder=4.5,
                          clip_on=True) for n in scene.data.part]
@@ -175,13 +180,13 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene) -> Panel
            "input belt, drop point → F (falls off at F)", (drop + b[0]) / 2, "center")
     strip_in.add_patch(Rectangle((CLOSE_X[0], -w / 2), f[0] - CLOSE_X[0], w, fill=False, ec="0.45",
                                  lw=0.6, ls=":", zorder=1))
-    parts_in = PolyCollection([], edgecolors=PART_EDGE, linewidths=0.4, zorder=2)
+    parts_in = _parts_collection(0.4, 2)
     strip_in.add_collection(parts_in)
     # the output belt unrolled along its y
-    y_end = scene.td_xy[1] + OUTPUT_SPACINGS * s.belts.spacing_in
+    y_end = scene.output_end_y
     _strip(strip_out, w / 2, y_end, w, strip_w, {"TD": scene.td_xy[1], "K": s.path.eot_in[1]},
            "output belt, unrolled (y) →", y_end, "right")
-    parts_out = PolyCollection([], edgecolors=PART_EDGE, linewidths=0.4, zorder=2)
+    parts_out = _parts_collection(0.4, 2)
     strip_out.add_collection(parts_out)
     gaps = [strip_out.text(0, 0, "", fontsize=6.5, ha="center", va="center", color="0.1",
                            clip_on=True, zorder=3) for _ in range(4)]
@@ -340,5 +345,6 @@ def render(scenes: list[Scene], times: Floats, out: Path, *, fps: int, dpi: floa
                 if gif:  # ffmpeg's writer redraws the whole figure itself
                     canvas.restore_region(background)
                     for a in moving:
-                        fig.draw_artist(a)
+                        if a.get_visible():  # most parts' labels are hidden in any frame
+                            fig.draw_artist(a)
                 writer.grab_frame()

@@ -10,7 +10,8 @@ works on the plain arrays of :class:`AnimationInput`:
   drops it, and moves by the belt's travel; one not caught rides on and falls off
   the belt's end at F (§6.3);
 * from LO to TD it is in the hand, at the tool-centre point Z T5 E (eq. 6.6);
-* from TD on it moves with the output belt's travel;
+* from TD on it moves with the output belt's travel, until it is out of view past
+  the drawn output belt's end (:data:`OUTPUT_SPACINGS`, :data:`CLOSE_Y`);
 * the arm follows the path's joint angles (eq. 6.7), each cycle's moves timed
   as :func:`cell.figures.motion.timeline` spreads the part's regime times (§6.1),
   and waits at B between cycles.
@@ -38,6 +39,11 @@ FALL_S = 6.0
 FALL_TURN_RAD = 0.4
 #: Seconds shown after the last part of the window is set down (or has fallen).
 TAIL_S = 2.0
+#: The close-up's extent (in): the robot, both tracking windows and some belt either side.
+CLOSE_X = (-36.0, 10.0)
+CLOSE_Y = (-9.0, 37.0)
+#: How many part spacings of output belt the strip shows past TD.
+OUTPUT_SPACINGS = 2.4
 
 
 @dataclass(frozen=True)
@@ -150,6 +156,13 @@ class Scene:
     """(c, N) instant the robot reaches each path point in each cycle."""
     fall_s: Floats
     """(n,) instant a part not caught reaches the belt's end at F (NaN if picked)."""
+    arrival_travel_in: Floats
+    """(n,) the input belt's travel X at each part's drop."""
+    touchdown_travel_in: Floats
+    """(n,) the output belt's travel at each part's TD (NaN if not picked)."""
+    off_output_s: Floats
+    """(n,) instant a part set down is out of view, a part's size past the output belt's
+    drawn end (:func:`output_gone_y`); it leaves the scene then (NaN if not picked)."""
 
     @property
     def b_xy(self) -> Floats:
@@ -163,9 +176,25 @@ class Scene:
     def td_xy(self) -> Floats:
         return self.table.path.xyz_in[self.table.path.td, :2]
 
+    @property
+    def output_end_y(self) -> float:
+        return output_end_y(self.scenario, self.table)
+
+
+def output_end_y(scenario: Scenario, table: StepTable) -> float:
+    """Where the output belt's strip ends (y, in): :data:`OUTPUT_SPACINGS` spacings past TD."""
+    return float(table.path.xyz_in[table.path.td, 1] + OUTPUT_SPACINGS * scenario.belts.spacing_in)
+
+
+def output_gone_y(scenario: Scenario, table: StepTable) -> float:
+    """A part's centre past this y (in) is drawn nowhere: a part's size past the farther
+    of the output strip's end and the close-up's top."""
+    return max(output_end_y(scenario, table), CLOSE_Y[1]) + scenario.part.size_in
+
 
 def build_scene(data: AnimationInput, table: StepTable, scenario: Scenario) -> Scene:
-    """Time every robot cycle move by move (``timeline``, §6.1) and find each lost part's fall."""
+    """Time every robot cycle move by move (``timeline``, §6.1), find each lost part's fall
+    and when each part set down has left the drawn output belt."""
     from cell.figures.motion import record_segments, timeline
 
     cycles = np.flatnonzero(data.picked)
@@ -174,9 +203,12 @@ def build_scene(data: AnimationInput, table: StepTable, scenario: Scenario) -> S
         seg = record_segments(data.start_s[i], data.pick_s[i], data.touchdown_s[i], data.regime_s[i])
         t_s[row] = data.start_s[i] + timeline(table, seg).t_s
     to_f = data.input_length_in + float(scenario.path.f_in[0] - scenario.path.bot_in[0])
-    fall = np.where(data.picked, np.nan,
-                    time_at(data.input_belt, travel(data.input_belt, data.arrival_s) + to_f))
-    return Scene(data, table, scenario, cycles.astype(np.int64), t_s, fall)
+    x_drop = travel(data.input_belt, data.arrival_s)
+    fall = np.where(data.picked, np.nan, time_at(data.input_belt, x_drop + to_f))
+    y_td = np.where(data.picked, travel(data.output_belt, data.touchdown_s), np.nan)
+    to_gone = output_gone_y(scenario, table) - float(table.path.xyz_in[table.path.td, 1])
+    off = np.where(data.picked, time_at(data.output_belt, y_td + to_gone), np.nan)
+    return Scene(data, table, scenario, cycles.astype(np.int64), t_s, fall, x_drop, y_td, off)
 
 
 # --------------------------------------------------------------------------- the robot
@@ -290,9 +322,8 @@ def parts_at(scene: Scene, t: float) -> PartsAt:
         on_input = dropped & (t < gone_by)
         falling = on_input & ~d.picked & (t >= scene.fall_s)
         held = d.picked & (d.pick_s <= t) & (t < d.touchdown_s)
-        out = d.picked & (t >= d.touchdown_s)
-    x_in = scene.b_xy[0] - d.input_length_in + (travel(d.input_belt, t)
-                                                 - travel(d.input_belt, d.arrival_s))
+        out = d.picked & (t >= d.touchdown_s) & (t < scene.off_output_s)
+    x_in = scene.b_xy[0] - d.input_length_in + (travel(d.input_belt, t) - scene.arrival_travel_in)
     xy[on_input] = np.column_stack([x_in, np.full(n, scene.b_xy[1])])[on_input]
     where[on_input] = INPUT
     where[falling] = FALLING
@@ -304,7 +335,7 @@ def parts_at(scene: Scene, t: float) -> PartsAt:
         xy[held] = arm_pose(scene.scenario, state.q_rad, state.opening_in).tcp[0, :2]
         angle[held] = state.phi_rad[0]
         where[held] = HAND
-    y_out = scene.td_xy[1] + travel(d.output_belt, t) - travel(d.output_belt, d.touchdown_s)
+    y_out = scene.td_xy[1] + travel(d.output_belt, t) - scene.touchdown_travel_in
     xy[out] = np.column_stack([np.full(n, scene.td_xy[0]), y_out])[out]
     angle[out] = scene.table.path.phi_rad[scene.table.path.td]
     where[out] = OUTPUT
