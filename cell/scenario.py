@@ -52,7 +52,7 @@ class Scenario(Section):
     """A whole scenario: the cell, the robot, the parts and how the run goes."""
 
     name: str = "baseline"
-    """A short name, printed in summaries."""
+    """A short name, printed in summaries; a file without one is named after the file."""
     description: str = ""
     """One line on what the scenario is for."""
     cell: LayoutSettings = LayoutSettings()
@@ -208,6 +208,8 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
     path = catalog.resolve(path)
     given = load_mapping(path, "scenario")
     catalog.refuse_other_kind(given, path, "scenario")
+    if "name" not in given:  # a file without a name goes by the file's
+        given = {**given, "name": path.stem}
     raw = merge(_DEFAULTS.to_dict(), given, (), is_section)
     raw = apply_overrides(raw, overrides or {}, path, is_section)
     return validate(raw, path, source=str(path))

@@ -184,3 +184,14 @@ def test_set_on_the_command_line_reaches_into_mappings(tmp_path):
     f.write_text("run:\n")                      # an empty section
     s = load_scenario(f, parse_sets(["arrivals.params.scale=6.0", "run.parts=10"]))
     assert s.arrivals.params["scale"] == 6.0 and s.run.parts == 10
+
+
+def test_a_file_without_a_name_goes_by_the_files_name(tmp_path):
+    unnamed = tmp_path / "faster_belt.yaml"
+    unnamed.write_text("belts: {input_nominal_in_s: 3.5}\n")
+    named = tmp_path / "other.yaml"
+    named.write_text("name: mine\n")
+    assert load_scenario(unnamed).name == "faster_belt"
+    assert load_scenario(named).name == "mine"
+    assert load_scenario(unnamed, {"name": "given"}).name == "given"
+    assert load_scenario("baseline").name == "baseline"
