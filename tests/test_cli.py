@@ -166,3 +166,19 @@ def test_a_built_in_file_is_named_in_reports_as_a_user_would_type_it(tmp_path):
     assert catalog.shown("scenarios/whatif.yaml") == "scenarios/whatif.yaml"
     own = tmp_path / "whatif.yaml"
     assert catalog.shown(own) == str(own)
+
+
+def test_cell_run_says_when_a_short_trace_is_replayed(tmp_path, capsys):
+    """A trace shorter than the run's T_1 .. T_{n+1} is replayed from its start, and
+    ``cell run`` says so, by how many times; a long enough trace is not mentioned."""
+    (tmp_path / "gaps.csv").write_text("interarrival_s\n" + "\n".join(["21.0", "24.5"] * 5))
+    scenario = tmp_path / "traced.yaml"
+    scenario.write_text("arrivals: {trace_csv: gaps.csv}\nrun: {parts: 25}\n")
+    assert main(["run", str(scenario), "--out", str(tmp_path / "a")]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("cell run: traced (adaptive), 25 parts")
+    assert "gaps.csv holds 10 inter-arrival times and the run needs 26" in out
+    parts = pd.read_csv(tmp_path / "a" / "parts.csv")
+    assert parts["interarrival_s"].tolist() == [21.0, 24.5] * 12 + [21.0]
+    assert main(["run", str(scenario), "--set", "run.parts=9", "--out", str(tmp_path / "b")]) == 0
+    assert "replayed" not in capsys.readouterr().out

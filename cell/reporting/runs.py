@@ -4,6 +4,7 @@ results beside the thesis's where the run is the thesis's own, and the limits hi
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Any
 
 from cell import thesis as published
@@ -32,10 +33,19 @@ def run_heading(cell: AssembledCell) -> str:
     source = {"scenario": "controller.nominal_cycle_s",
               "arrivals": "the arrivals' mean",
               "fastest": "the robot's fastest cycle: the arrivals come faster"}[k.nominal_from]
-    return (f"cell run: {s.name} ({cell.policy.name}), {s.run.parts} parts, seed {s.run.seed}\n"
-            f"nominal cycle {k.cycle_nom:.4f} s ({source}); mean inter-arrival "
-            f"{k.mean_interarrival_s:.4f} s; the robot's fastest cycle {k.fastest_cycle_s:.4f} s: "
-            f"utilisation {k.utilisation:.3f}")
+    heading = (f"cell run: {s.name} ({cell.policy.name}), {s.run.parts} parts, seed {s.run.seed}\n"
+               f"nominal cycle {k.cycle_nom:.4f} s ({source}); mean inter-arrival "
+               f"{k.mean_interarrival_s:.4f} s; the robot's fastest cycle {k.fastest_cycle_s:.4f} "
+               f"s: utilisation {k.utilisation:.3f}")
+    trace = s.arrivals.trace_csv
+    if trace is not None:
+        from cell.arrivals import read_trace
+
+        n = len(read_trace(Path(s.base_dir) / trace))
+        if n < s.run.parts + 1:  # the run needs T_1 .. T_{parts+1}
+            heading += (f"\narrivals: {trace} holds {n} inter-arrival times and the run needs "
+                        f"{s.run.parts + 1}: it is replayed from the start every {n} parts")
+    return heading
 
 
 def warnings(k: CellConstants) -> list[str]:
