@@ -9,6 +9,7 @@ thesis's eq. 6.9 through scipy.
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -191,6 +192,13 @@ def test_precision_report_says_per_point_whether_it_was_reached(sweeps, tmp_path
     assert "## Precision" in text
     assert "not reached: stopped at max = 200" in text
     assert "2 of 3 points reached the precision; 1 stopped at the maximum of 200" in text
+    # every row of every markdown table has as many cells as its header (a | in a cell,
+    # as in "half-width / |mean|", is escaped, not a cell boundary)
+    for table in re.findall(r"(?:^\|.*\|\n)+", text, flags=re.M):
+        rows = table.splitlines()
+        widths = {len(re.split(r"(?<!\\)\|", row)) for row in rows}
+        assert len(widths) == 1, rows
+    assert "half-width / \\|mean\\|" in text
 
 
 def test_a_fixed_count_draws_the_same_streams_whatever_the_count(sweeps, tmp_path):

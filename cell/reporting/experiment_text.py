@@ -186,7 +186,7 @@ def _precision(replications: pd.DataFrame, summary: pd.DataFrame, sweep: Sweep,
         return []
     rows = summary[summary["measure"] == q.measure].to_dict("records")
     head = [*(c.removesuffix(NAME_SUFFIX) for c in cols), "policy", "replications",
-            "half-width / |mean|", ""]
+            "half-width / |mean|", "precision"]
     lines = ["## Precision", "", f"Asked: the {q.confidence * 100:g} % half-width of "
              f"`{q.measure}` at most {q.precision * 100:g} % of |mean| at every point.", "",
              *table_head(head)]

@@ -101,8 +101,9 @@ def better(h: Headline, a: float, b: float) -> int:
 
 
 def table_row(cells: Iterable[str]) -> str:
-    """A markdown table row: ``| a | b |``."""
-    return "| " + " | ".join(cells) + " |"
+    """A markdown table row: ``| a | b |``; a ``|`` within a cell is escaped (``\\|``),
+    so it does not split the cell."""
+    return "| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |"
 
 
 def table_head(head: Sequence[str]) -> list[str]:
