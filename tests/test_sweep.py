@@ -332,3 +332,28 @@ def test_a_grid_over_a_distribution_parameter(sweeps, tmp_path):
     sweep = load_sweep(path)
     assert [p.scenario.arrivals.params["loc"] for p in sweep.points] == [16.0, 17.6019]
     assert all(p.scenario.arrivals.params["scale"] == 5.4342 for p in sweep.points)
+
+
+def test_an_interrupted_sweep_says_how_to_go_on(tmp_path):
+    """Ctrl-C in the middle of ``cell sweep``: exit 130, one line naming what is kept and
+    --resume; the same command with --resume then reuses those tasks."""
+    import signal
+    import subprocess
+    import sys
+
+    command = [sys.executable, "-m", "cell", "sweep", str(catalog.path("table_7_1")),
+               "--out", str(tmp_path / "out"), "--workers", "1"]
+    proc = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            text=True)
+    assert proc.stderr is not None
+    for line in proc.stderr:  # progress lines come on stderr when it is not a terminal
+        if "replications (" in line:
+            proc.send_signal(signal.SIGINT)
+            break
+    err = proc.stderr.read()
+    assert proc.wait(timeout=120) == 130, err
+    hint = next(line for line in err.splitlines() if line.startswith("cell sweep: stopped"))
+    kept = int(hint.split("; ")[1].split()[0])
+    assert kept > 0 and "--resume" in hint
+    done = subprocess.run([*command, "--resume"], capture_output=True, text=True, check=True)
+    assert f"{kept} reused)" in done.stdout

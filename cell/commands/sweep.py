@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import shlex
 import signal
+import sys
 import threading
 from pathlib import Path
 from typing import Any
@@ -57,8 +58,16 @@ def _sweep(args: argparse.Namespace) -> int:
         from cell.reporting.experiment import plan_report
 
         target = plan_report(sweep, args.report)  # checked before anything runs
-    outcome = run_sweep(sweep, args.out, workers=args.workers, scheduler=args.scheduler,
-                        resume=args.resume, replicate=simulate_summary)
+    try:
+        outcome = run_sweep(sweep, args.out, workers=args.workers, scheduler=args.scheduler,
+                            resume=args.resume, replicate=simulate_summary)
+    except KeyboardInterrupt:
+        from cell.sweep.runner import TASK_DIR
+
+        kept = len(list((Path(args.out) / TASK_DIR).glob("task-*.csv")))
+        print(f"cell sweep: stopped; {kept} finished task{'s' if kept != 1 else ''} kept in "
+              f"{args.out}: the same command with --resume runs only the rest", file=sys.stderr)
+        raise
     counts = sorted(set(outcome.counts.values()))
     reps = (f"{counts[0]}" if len(counts) == 1 else f"{counts[0]}-{counts[-1]}")
     print(f"wrote {Path(args.out) / 'replications.csv'}: {len(sweep.points)} points x "
