@@ -27,7 +27,7 @@ from cell.errors import CellError, one_line, shown_path
 
 #: Subcommands in the order ``cell --help`` lists them; each is cell.commands.<name>.
 COMMANDS = ("run", "sweep", "compare", "fit", "figures", "animate", "path", "mintime",
-            "scenarios", "schema", "bench")
+            "scenarios", "schema", "docs", "bench")
 
 #: Errors of the operating system that a command's output can meet however well it checks.
 OUTPUT_ERRNOS = frozenset({errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOSPC, errno.EDQUOT,

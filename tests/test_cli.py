@@ -12,7 +12,7 @@ import pytest
 from cell.cli import build_parser, main
 
 SUBCOMMANDS = ["path", "run", "sweep", "compare", "figures", "mintime", "bench", "fit",
-               "animate", "scenarios", "schema"]
+               "animate", "scenarios", "schema", "docs"]
 
 
 def test_help_lists_the_subcommands():
@@ -182,3 +182,19 @@ def test_cell_run_says_when_a_short_trace_is_replayed(tmp_path, capsys):
     assert parts["interarrival_s"].tolist() == [21.0, 24.5] * 12 + [21.0]
     assert main(["run", str(scenario), "--set", "run.parts=9", "--out", str(tmp_path / "b")]) == 0
     assert "replayed" not in capsys.readouterr().out
+
+
+def test_cell_docs_reads_the_pages_its_output_refers_to(tmp_path, capsys):
+    """``cell docs`` lists every page of docs/; a page by name (or as the output writes it,
+    docs/accounting.md) is that file's text; an unknown page is one line, exit 2."""
+    docs = Path(__file__).resolve().parent.parent / "docs"
+    assert main(["docs"]) == 0
+    listed = capsys.readouterr().out
+    for page in docs.glob("*.md"):
+        assert page.stem in listed
+    for name in ("accounting", "docs/accounting.md"):
+        assert main(["docs", name]) == 0
+        assert capsys.readouterr().out == (docs / "accounting.md").read_text(encoding="utf-8")
+    assert main(["docs", "nope"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "'nope'" in err[0] and "accounting" in err[0]

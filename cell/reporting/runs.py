@@ -18,7 +18,8 @@ NOMINAL_MISMATCH = 0.01
 
 IP_LINE = ("IP (eq. 5.1) = the next part's inter-arrival time / the time between deliveries: "
            "1 means the cell keeps pace with its parts.  The thesis's accounting is how the "
-           "thesis counted (docs/accounting.md); the wall clock is what a stopwatch shows.")
+           "thesis counted (docs/accounting.md, or `cell docs accounting`); the wall clock is what "
+           "a stopwatch shows.")
 
 #: Table 7.1's measures (cell.thesis), as printed beside the summary fields, by field.
 TABLE_7_1_SHOWN = {"parts_missed_thesis": ("parts_missed", "{:.0f}"),
