@@ -3,8 +3,9 @@
 A cached function names its key explicitly: plain, hashable values (frozen
 dataclasses of the maths, numbers, tuples), or :func:`file_key` for something
 read from a file (its resolved path, size and modification time, so an edited
-file is read again).  Nothing is keyed on a whole scenario, so no cached value
-can silently carry another scenario's settings.
+file is read again).  Nothing is keyed on a whole scenario's value, so no cached
+value can silently carry another scenario's settings; a sweep's assembled cell is
+kept only for the same scenario object (:class:`Identity`).
 
 What is slow to solve and needed at every start (the robot's timing, the
 arrivals' distribution facts) is also kept on disk (:func:`stored`,
@@ -71,6 +72,23 @@ class Memo(Generic[P, R]):
 
     def __len__(self) -> int:
         return len(self._store)
+
+
+class Identity:
+    """A key that is one object, by identity (``memo(key=Identity)``): for a value made from
+    an object that is the same for a while (a sweep task's scenario).  The key holds its
+    object, so the object's id cannot be reused while the value is kept."""
+
+    __slots__ = ("obj",)
+
+    def __init__(self, obj: object):
+        self.obj = obj
+
+    def __hash__(self) -> int:
+        return id(self.obj)
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Identity) and other.obj is self.obj
 
 
 def memo(key: Callable[..., Hashable] | None = None, maxsize: int = 32

@@ -169,3 +169,22 @@ def test_a_warm_start_imports_nothing_heavy(tmp_path, own_cache):
     assert (tmp_path / "out" / "parts.csv").read_bytes() == \
         (tmp_path / "again" / "parts.csv").read_bytes()
     assert Path(own_cache).is_dir()
+
+
+def test_an_identity_key_keeps_a_value_for_the_same_object_only():
+    """memo(key=Identity): the same object is one entry; an equal but distinct object is
+    another (no value carries across objects); forget() clears it like any memo."""
+    from cell import cache
+
+    made = []
+
+    @cache.memo(key=cache.Identity, maxsize=1)
+    def build(obj):
+        made.append(obj)
+        return len(made)
+
+    a, b = [1, 2], [1, 2]  # equal, not hashable, distinct
+    assert build(a) == build(a) == 1
+    assert build(b) == 2 and made[1] is b
+    cache.forget()
+    assert build(b) == 3

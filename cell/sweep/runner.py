@@ -42,6 +42,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from cell.cache import Identity, memo
 from cell.errors import CellError
 from cell.output import FLOAT_FORMAT, atomic_path, write_csv, write_text
 from cell.progress import Progress
@@ -67,21 +68,21 @@ TASK_DIR = "tasks"
 CLUSTER_WINDOW = 1024
 
 
-#: The scenario this process last ran replications of, and its cell.
-_last: tuple[Scenario, AssembledCell] | None = None
+@memo(key=Identity, maxsize=1)
+def _assembled(scenario: Scenario) -> AssembledCell:
+    """The scenario's cell, assembled once for the replications of one scenario object
+    that follow each other (a task's; in one process, a point's)."""
+    from cell.assembly import assemble
+
+    return assemble(scenario)
 
 
 def simulate_summary(scenario: Scenario, seed: np.random.SeedSequence) -> Mapping[str, Any]:
-    """The default replication: one run of the cell, its summary row (the cell assembled
-    once for the replications of one scenario object that follow each other: a task's)."""
-    from cell.assembly import assemble
+    """The default replication: one run of the cell, its summary row."""
     from cell.simulation import simulate
 
-    global _last
-    last = _last
-    if last is None or last[0] is not scenario:
-        last = _last = (scenario, assemble(scenario))
-    return simulate(last[1], seed=seed, keep_parts=False, keep_belts=False).summary.as_dict()
+    return simulate(_assembled(scenario), seed=seed, keep_parts=False,
+                    keep_belts=False).summary.as_dict()
 
 
 def run_task(replicate: Replicate, scenario: Scenario,
