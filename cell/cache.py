@@ -27,6 +27,7 @@ import hashlib
 import json
 import os
 import tempfile
+import threading
 from collections import OrderedDict
 from collections.abc import Callable, Hashable
 from pathlib import Path
@@ -52,19 +53,22 @@ class Memo(Generic[P, R]):
     def __init__(self, fn: Callable[P, R], key: Callable[P, Hashable], maxsize: int):
         self.fn, self.key, self.maxsize = fn, key, maxsize
         self._store: OrderedDict[Hashable, R] = OrderedDict()
+        self._lock = threading.Lock()
         functools.update_wrapper(self, fn)
         _IN_PROCESS.append(self)
 
     def __call__(self, *args: P.args, **kwargs: P.kwargs) -> R:
         k = self.key(*args, **kwargs)
         store = self._store
-        if k in store:
-            store.move_to_end(k)
-            return store[k]
-        value = self.fn(*args, **kwargs)
-        store[k] = value
-        if len(store) > self.maxsize:
-            store.popitem(last=False)
+        with self._lock:  # a threaded dask worker runs replications side by side
+            if k in store:
+                store.move_to_end(k)
+                return store[k]
+        value = self.fn(*args, **kwargs)  # not under the lock: others' values go on
+        with self._lock:
+            store[k] = value
+            if len(store) > self.maxsize:
+                store.popitem(last=False)
         return value
 
     def clear(self) -> None:

@@ -188,3 +188,34 @@ def test_an_identity_key_keeps_a_value_for_the_same_object_only():
     assert build(b) == 2 and made[1] is b
     cache.forget()
     assert build(b) == 3
+
+
+def test_a_memo_shared_by_threads_never_loses_an_entry_under_a_caller():
+    """A dask worker's threads call the same memo side by side: one thread's eviction must
+    not pull an entry out from under another (without the lock this raises KeyError)."""
+    import threading
+
+    before = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)  # switch threads as often as possible
+    try:
+        @cache.memo(maxsize=1)
+        def same(x):
+            return x
+
+        errors = []
+
+        def hammer(k):
+            try:
+                for _ in range(20_000):
+                    assert same(k) == k
+            except Exception as exc:  # noqa: BLE001 (collected and reported below)
+                errors.append(repr(exc))
+
+        threads = [threading.Thread(target=hammer, args=(i % 3,)) for i in range(6)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+    finally:
+        sys.setswitchinterval(before)
+    assert errors == []
