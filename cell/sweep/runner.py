@@ -147,14 +147,19 @@ class Outcome:
         return pd.read_csv(self.path)
 
 
-def _open_executor(workers: int, scheduler: str | None) -> tuple[cf.Executor | None, Any]:
-    """The executor for the tasks (None: run in this process) and a client to close."""
+def _open_executor(workers: int, scheduler: str | None, say: bool = True
+                   ) -> tuple[cf.Executor | None, Any]:
+    """The executor for the tasks (None: run in this process) and a client to close;
+    ``say``: tell stderr while a scheduler is being reached."""
     if scheduler:
         try:
             import distributed
         except ImportError:
             raise CellError("--scheduler needs dask.distributed: "
                             "pip install 'cell[dist]'") from None
+        if say:
+            print(f"connecting to the dask scheduler at {scheduler} (giving up after "
+                  f"{CONNECT_TIMEOUT})", file=sys.stderr)
         try:
             client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT)
         except (OSError, TimeoutError, ValueError) as exc:
@@ -305,7 +310,7 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     if workers > WORKERS_PER_CORE * cores and not scheduler:
         raise CellError(f"--workers {workers}: at most {WORKERS_PER_CORE * cores} on this "
                         f"machine ({cores} cores)")
-    executor, client = _open_executor(workers, scheduler)
+    executor, client = _open_executor(workers, scheduler, progress)
     window = CLUSTER_WINDOW if scheduler else 2 * workers
     columns = grid_columns(sweep)
     task_dir = out / TASK_DIR
