@@ -3,7 +3,8 @@
 :mod:`cell.sweep.spec` reads and checks a sweep file (:mod:`cell.sweep.options`:
 replications to a precision, the baseline); :mod:`cell.sweep.runner` runs its
 tasks (locally or on a dask cluster, resumable) into ``replications.csv``, whose
-grid columns :mod:`cell.sweep.columns` lays out.
+grid columns :mod:`cell.sweep.columns` lays out, in the ``--out`` directory that
+:mod:`cell.sweep.outdir` checks and prepares.
 """
 
 from cell.sweep.columns import Column, grid_columns, point_values

@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import functools
-import json
 import os
 import signal
 import sys
@@ -44,10 +43,11 @@ import numpy as np
 
 from cell.cache import Identity, memo
 from cell.errors import CellError
-from cell.output import FLOAT_FORMAT, atomic_path, write_csv, write_text
+from cell.output import FLOAT_FORMAT, atomic_path, write_csv
 from cell.progress import Progress
 from cell.scenario import Scenario
 from cell.sweep.columns import Column, grid_columns, point_values
+from cell.sweep.outdir import TASK_DIR, check_out, prepare
 from cell.sweep.spec import Sweep, Task
 
 if TYPE_CHECKING:  # pandas is imported when first needed: local workers start without it
@@ -60,10 +60,8 @@ Replicate = Callable[[Scenario, np.random.SeedSequence], Mapping[str, Any]]
 
 #: Float digits in the per-task files: enough to round-trip exactly.
 TASK_FLOAT_FORMAT = "%.17g"
-MANIFEST = "sweep.json"
 #: How long to try reaching a dask scheduler.
 CONNECT_TIMEOUT = "20s"
-TASK_DIR = "tasks"
 #: Tasks in flight on a dask cluster at once (local workers: twice their number).
 CLUSTER_WINDOW = 1024
 
@@ -243,57 +241,6 @@ def _close(executor: cf.Executor | None, client: Any, wait: bool) -> None:
 WORKERS_PER_CORE = 4
 
 
-def check_out(out: str | Path) -> Path:
-    """Refuse, before any work, a sweep directory that cannot be used: an empty name, a
-    file, a directory under a file, or one holding a ``sweep.json`` that is not a sweep's."""
-    if str(out) == "":
-        raise CellError("--out '': an empty path; give a directory for the sweep's results")
-    path = Path(out)
-    for parent in (path, *path.parents):
-        if parent.exists() and not parent.is_dir():
-            raise CellError(f"--out {out}: {parent} is not a directory")
-    manifest = path / MANIFEST
-    if manifest.exists():
-        if not manifest.is_file() or not isinstance(_manifest(manifest), dict):
-            raise CellError(f"--out {out}: {manifest} is not a sweep's manifest; choose another "
-                            "--out")
-    return path
-
-
-def _manifest(path: Path) -> Any:
-    try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError, UnicodeDecodeError):
-        return None
-
-
-def _prepare(sweep: Sweep, out: Path, resume: bool) -> None:
-    """Check a resumed directory is this sweep's, or clear a fresh one; write the manifest.
-    Either way the temporary files of a killed run are removed."""
-    task_dir, manifest = out / TASK_DIR, out / MANIFEST
-    fingerprint = sweep.fingerprint()
-    for leftover in task_dir.glob(".task-*.tmp") if task_dir.is_dir() else ():
-        leftover.unlink(missing_ok=True)
-    if resume and manifest.is_file():
-        found = _manifest(manifest)
-        previous = found.get("fingerprint") if isinstance(found, dict) else None
-        if previous != fingerprint:
-            raise CellError(f"--resume: {out} holds the results of a different sweep "
-                            f"(or of {sweep.source} before it was edited); "
-                            "run without --resume or choose another --out")
-    else:
-        for stale in task_dir.glob("task-*.csv") if task_dir.is_dir() else ():
-            stale.unlink()
-        (out / "replications.csv").unlink(missing_ok=True)
-    doc: dict[str, Any] = {"sweep": sweep.source, "name": sweep.name, "fingerprint": fingerprint,
-                           "tasks": len(sweep.points) * -(-sweep.first_round // sweep.batch),
-                           "replications": sweep.replications, "seed": sweep.seed,
-                           "batch": sweep.batch}
-    if sweep.precision is not None:
-        doc["precision"] = sweep.precision.as_dict()
-    write_text(json.dumps(doc, indent=2) + "\n", manifest)
-
-
 def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
               scheduler: str | None = None, resume: bool = False,
               replicate: Replicate = simulate_summary, progress: bool = True) -> Outcome:
@@ -318,7 +265,7 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     values: dict[int, list[float]] = {p: [] for p in counts}
     run = reused = 0
     try:
-        _prepare(sweep, out, resume)
+        prepare(sweep, out, resume)
         bar = Progress(sweep.total_replications, sweep.name, "replications", file=sys.stderr,
                        enabled=progress)
 

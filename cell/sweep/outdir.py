@@ -1,0 +1,66 @@
+"""A sweep's ``--out`` directory: refused before any work if unusable, its manifest
+(``sweep.json``, the sweep's fingerprint for ``--resume``) and its ``tasks/`` folder."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from cell.errors import CellError
+from cell.output import write_text
+from cell.sweep.spec import Sweep
+
+MANIFEST = "sweep.json"
+TASK_DIR = "tasks"
+
+
+def check_out(out: str | Path) -> Path:
+    """Refuse, before any work, a sweep directory that cannot be used: an empty name, a
+    file, a directory under a file, or one holding a ``sweep.json`` that is not a sweep's."""
+    if str(out) == "":
+        raise CellError("--out '': an empty path; give a directory for the sweep's results")
+    path = Path(out)
+    for parent in (path, *path.parents):
+        if parent.exists() and not parent.is_dir():
+            raise CellError(f"--out {out}: {parent} is not a directory")
+    manifest = path / MANIFEST
+    if manifest.exists():
+        if not manifest.is_file() or not isinstance(_manifest(manifest), dict):
+            raise CellError(f"--out {out}: {manifest} is not a sweep's manifest; choose another "
+                            "--out")
+    return path
+
+
+def _manifest(path: Path) -> Any:
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError, UnicodeDecodeError):
+        return None
+
+
+def prepare(sweep: Sweep, out: Path, resume: bool) -> None:
+    """Check a resumed directory is this sweep's, or clear a fresh one; write the manifest.
+    Either way the temporary files of a killed run are removed."""
+    task_dir, manifest = out / TASK_DIR, out / MANIFEST
+    fingerprint = sweep.fingerprint()
+    for leftover in task_dir.glob(".task-*.tmp") if task_dir.is_dir() else ():
+        leftover.unlink(missing_ok=True)
+    if resume and manifest.is_file():
+        found = _manifest(manifest)
+        previous = found.get("fingerprint") if isinstance(found, dict) else None
+        if previous != fingerprint:
+            raise CellError(f"--resume: {out} holds the results of a different sweep "
+                            f"(or of {sweep.source} before it was edited); "
+                            "run without --resume or choose another --out")
+    else:
+        for stale in task_dir.glob("task-*.csv") if task_dir.is_dir() else ():
+            stale.unlink()
+        (out / "replications.csv").unlink(missing_ok=True)
+    doc: dict[str, Any] = {"sweep": sweep.source, "name": sweep.name, "fingerprint": fingerprint,
+                           "tasks": len(sweep.points) * -(-sweep.first_round // sweep.batch),
+                           "replications": sweep.replications, "seed": sweep.seed,
+                           "batch": sweep.batch}
+    if sweep.precision is not None:
+        doc["precision"] = sweep.precision.as_dict()
+    write_text(json.dumps(doc, indent=2) + "\n", manifest)
