@@ -313,11 +313,17 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     return Outcome(path, run, reused, counts)
 
 
+def _finished(sweep: Sweep, task_dir: Path, task: Task) -> pd.DataFrame:
+    """A finished task's rows, from its file (:func:`_read_task`); an error if it is gone."""
+    frame = _read_task(sweep, task_dir / task.filename, task)
+    if frame is None:
+        raise CellError(f"{task_dir / task.filename}: missing or damaged; rerun the sweep")
+    return frame
+
+
 def _measure(sweep: Sweep, task_dir: Path, task: Task, measure: str) -> list[float]:
     """A finished task's values of the precision's measure, from its file."""
-    frame = _read_task(sweep, task_dir / task.filename, task)
-    if frame is None:  # pragma: no cover - written just before
-        raise CellError(f"{task_dir / task.filename}: missing or damaged; rerun the sweep")
+    frame = _finished(sweep, task_dir, task)
     if measure not in frame.columns:
         raise CellError(f"{sweep.source}: replications.measure = {measure!r}: the replications "
                         "have no such column")
@@ -335,9 +341,7 @@ def _assemble(sweep: Sweep, task_dir: Path, tasks: Sequence[Task], target: Path)
     frames = []
     names: dict[str, None] = {}
     for task in tasks:
-        frame = _read_task(sweep, task_dir / task.filename, task)
-        if frame is None:
-            raise CellError(f"{task_dir / task.filename}: missing or damaged; rerun the sweep")
+        frame = _finished(sweep, task_dir, task)
         names.update(dict.fromkeys(frame.columns))
         frames.append(frame)
     with atomic_path(target) as tmp, open(tmp, "w", encoding="utf-8", newline="") as stream:
