@@ -190,7 +190,7 @@ def memoryless(replications: pd.DataFrame | None, ip_published: float,
             f"a late part's lateness is not carried to the parts behind it, the IP is "
             f"{ip.mean():.4f} (single runs {lo:.4f}–{hi:.4f}; the published {ip_published:.4f} "
             f"is {where}) and the motion cycle {pct.mean():+.1f} % against the requested "
-            f"(the thesis: within 2.1 %)"
+            f"(the thesis: within {published.ADAPTIVE_CYCLE_PCT} %)"
             + (": this reading reproduces the published IP, which suggests it is how the "
                "thesis counted." if where == "inside" else
                ": this reading does not reproduce the published IP either.")]
