@@ -175,13 +175,13 @@ def figure(t: pd.DataFrame) -> bytes:
                ("delivered_vs_fixed", "adaptive", "adaptive − fixed, parts delivered", "PuOr")]
     fig = Figure(figsize=(19, 3.6 * len(families) + 0.8), dpi=90, layout="constrained")
     axes = fig.subplots(len(families), len(columns), squeeze=False)
-    for measure, policy, title, cmap in columns:
+    for j, (measure, policy, title, cmap) in enumerate(columns):
         sub = t[t["policy"] == policy]
         both = t[measure] if measure != "delivered_vs_fixed" else sub[measure]  # one scale a measure
         vmax = float(np.nanmax(np.abs(both)))
         vmin = -vmax if measure == "delivered_vs_fixed" else float(np.nanmin(both))
         for i, family in enumerate(families):
-            ax = axes[i][columns.index((measure, policy, title, cmap))]
+            ax = axes[i][j]
             grid = sub[sub["family"] == family].pivot(index="cv", columns="load", values=measure)
             im = ax.imshow(grid.to_numpy(), origin="lower", aspect="auto", cmap=cmap,
                            vmin=vmin, vmax=vmax)
