@@ -42,7 +42,7 @@ from cell.animation.scene import (
     parts_at,
     robot_state,
 )
-from cell.figures.layout import BELT_COLOUR, named_points, regime_points
+from cell.figures.layout import BELT_COLOUR, named_points
 from cell.figures.style import LIMIT_COLOUR, POLICY_COLOURS, REGIME_COLOURS, REGIME_LABELS, style
 
 PART_COLOUR = "#d9a441"
@@ -142,7 +142,7 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene) -> Panel
     close.add_patch(Rectangle((scene.td_xy[0] - w / 2, w / 2), w, CLOSE_Y[1] + 1 - w / 2,
                               color=BELT_COLOUR, zorder=0))
     for reg in (1, 2, 3, 4):
-        idx = regime_points(p, reg)
+        idx = scene.table.regime_points(reg)
         close.plot(p.xyz_in[idx, 0], p.xyz_in[idx, 1], color=REGIME_COLOURS[reg], lw=0.9,
                    alpha=0.5, zorder=1)
     for name, (x, y, _) in named_points(s, scene.table).items():

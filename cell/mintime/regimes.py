@@ -65,8 +65,8 @@ class RegimePath:
 
 
 def regime_path(table: StepTable, regime: str, geometry: CellGeometry) -> RegimePath:
-    moves = np.flatnonzero(table.regime_rows(regime))
-    pts = np.arange(moves[0] - 1, moves[-1] + 1)
+    pts = table.regime_points(regime)
+    moves = pts[1:]
     q = table.path.q_rad[pts]
     load = float(table.path.load_oz[moves].max())
     tcp = float(np.asarray(hand_length(table.path.opening_in[moves[0]], geometry.hand)))
