@@ -40,8 +40,7 @@ def benchmarks(repeat: int = 5) -> dict[str, float]:
     geometry, motors, bounds = geometry_of(kin), motors_of(kin), planner_bounds(kin)
     paths = [regime_path(table, r, geometry) for r in FREE_REGIMES]
     amax = np.asarray(kin.mintime.qddot_max_rad_s2)
-    vmax = {rp.regime: regime_rows(rp, motors, bounds, geometry, 3)[3].qdot_max_rad_s
-            for rp in paths}
+    vmax = {rp.regime: regime_rows(rp, motors, bounds, geometry, 3)[3] for rp in paths}
 
     def ours(n: int) -> list[float]:
         return [plan(regime_rows(rp, motors, bounds, geometry, n)[2]).time_s for rp in paths]

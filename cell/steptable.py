@@ -60,6 +60,11 @@ class StepTable:
         mask[0] = False
         return mask
 
+    def regime_points(self, regime: int | str) -> NDArray[np.intp]:
+        """Indices of a regime's points, with the point it starts from."""
+        rows = np.flatnonzero(self.regime_rows(regime))
+        return np.arange(rows[0] - 1, rows[-1] + 1)
+
     def min_times(self, fraction: float = 1.0) -> NDArray[np.float64]:
         """(N,) each move at its slowest joint's rate × ``fraction`` (row 0: 0)."""
         return min_move_times(self.steps, self.path.load_oz, self.motors, fraction)
@@ -90,8 +95,8 @@ class StepTable:
         out = self.move_in.copy()
         for regime in (1, 3):
             rows = self.regime_rows(regime)
-            ends = np.flatnonzero(rows)
-            start, end = xyz[ends[0] - 1, :2], xyz[ends[-1], :2]
+            pts = self.regime_points(regime)
+            start, end = xyz[pts[0], :2], xyz[pts[-1], :2]
             direction = (end - start) / np.linalg.norm(end - start)
             out[rows] = np.abs(np.diff(xyz[:, :2], axis=0)[rows[1:]] @ direction)
         return out

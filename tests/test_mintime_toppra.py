@@ -146,7 +146,7 @@ def cell():
             out[name, r] = {"times": [run[r].profile.time_s for run in runs],
                             "grid": runs[0][r].profile.s,
                             "path": regime_path(step_table(sc), r, geometry),
-                            "vmax": runs[0][r].limits.qdot_max_rad_s, "bounds": bounds,
+                            "vmax": runs[0][r].qdot_max_rad_s, "bounds": bounds,
                             "geometry": geometry}
     return out
 

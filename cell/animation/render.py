@@ -42,7 +42,7 @@ from cell.animation.scene import (
     parts_at,
     robot_state,
 )
-from cell.figures.layout import BELT_COLOUR, named_points, regime_points
+from cell.figures.layout import BELT_COLOUR, named_points
 from cell.figures.style import LIMIT_COLOUR, POLICY_COLOURS, REGIME_COLOURS, REGIME_LABELS, style
 
 PART_COLOUR = "#d9a441"
@@ -83,8 +83,6 @@ class Panel:
     texts: dict[str, Text]
     gaps: list[Text]
     """Distances between neighbours on the output belt."""
-    output_end: float
-    """The output strip's far end (y, in): gaps are labelled only between parts before it."""
 
     def artists(self) -> list[Artist]:
         """Everything that moves, in drawing order."""
@@ -144,7 +142,7 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene) -> Panel
     close.add_patch(Rectangle((scene.td_xy[0] - w / 2, w / 2), w, CLOSE_Y[1] + 1 - w / 2,
                               color=BELT_COLOUR, zorder=0))
     for reg in (1, 2, 3, 4):
-        idx = regime_points(p, reg)
+        idx = scene.table.regime_points(reg)
         close.plot(p.xyz_in[idx, 0], p.xyz_in[idx, 1], color=REGIME_COLOURS[reg], lw=0.9,
                    alpha=0.5, zorder=1)
     for name, (x, y, _) in named_points(s, scene.table).items():
@@ -190,7 +188,7 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene) -> Panel
     strip_out.add_collection(parts_out)
     gaps = [strip_out.text(0, 0, "", fontsize=6.5, ha="center", va="center", color="0.1",
                            clip_on=True, zorder=3) for _ in range(4)]
-    return Panel(scene, parts, parts_in, parts_out, labels, arm, texts, gaps, y_end)
+    return Panel(scene, parts, parts_in, parts_out, labels, arm, texts, gaps)
 
 
 def _figure_in(columns: int) -> tuple[float, float]:
@@ -244,7 +242,7 @@ def draw_frame(panel: Panel, t: float) -> None:
     y_out = at.xy[on_out, 1]
     show(panel.parts_out, on_out,
          _square(np.column_stack([y_out, np.zeros_like(y_out)]), np.zeros(len(y_out)), size))
-    ys = np.sort(y_out[y_out + size / 2 <= panel.output_end])
+    ys = np.sort(y_out[y_out + size / 2 <= sc.output_end_y])  # gaps only on the strip
     for k, gap in enumerate(panel.gaps):
         gap.set_visible(k + 1 < len(ys))
         if k + 1 < len(ys):

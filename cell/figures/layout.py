@@ -10,7 +10,6 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle, FancyArrow, Rectangle
 from matplotlib.transforms import Bbox
 from mpl_toolkits.mplot3d import proj3d  # type: ignore[import-untyped]
-from numpy.typing import NDArray
 
 from cell.assembly import geometry_of
 from cell.figures.style import (
@@ -23,7 +22,6 @@ from cell.figures.style import (
     save,
 )
 from cell.kinematics import hand_length
-from cell.path import TransferPath
 from cell.scenario import Scenario
 from cell.steptable import StepTable
 
@@ -36,12 +34,6 @@ def named_points(s: Scenario, table: StepTable) -> dict[str, np.ndarray]:
     return {"B": np.asarray(s.path.bot_in), "F": np.asarray(s.path.f_in),
             "G": np.asarray(s.path.g_in), "K": np.asarray(s.path.eot_in),
             "LO": p.xyz_in[p.lo], "TD": p.xyz_in[p.td]}
-
-
-def regime_points(p: TransferPath, regime: int) -> NDArray[np.intp]:
-    """Indices of a regime's points, with the point it starts from: its curve to draw."""
-    idx = np.flatnonzero(p.regime == regime)
-    return np.concatenate([[idx[0] - 1], idx]) if idx[0] > 0 else idx
 
 
 def _belt_extent(s: Scenario) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -70,7 +62,7 @@ def fig08_working_environment(s: Scenario, table: StepTable, out: Path) -> Path:
             va="center")
     p = table.path
     for reg in (1, 2, 3, 4):
-        idx = regime_points(p, reg)
+        idx = table.regime_points(reg)
         ax.plot(p.xyz_in[idx, 0], p.xyz_in[idx, 1], color=REGIME_COLOURS[reg], lw=2.4,
                 label=f"{REGIME_LABELS[reg]} path", zorder=4)
     offsets = {"B": (-0.6, 0.9), "F": (0.4, 0.9), "G": (0.7, -0.3), "K": (0.7, 0.2),
@@ -109,7 +101,7 @@ def fig09_figure(s: Scenario, table: StepTable) -> Figure:
     curves = ax.plot([bx, bx], [by, by], [bz, top[2]], color="0.25", lw=4)
     p = table.path
     for reg in (1, 2, 3, 4):
-        idx = regime_points(p, reg)
+        idx = table.regime_points(reg)
         xyz = p.xyz_in[idx]
         curves += ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], color=REGIME_COLOURS[reg], lw=2.6,
                           label=f"{REGIME_LABELS[reg]} ({idx.size - 1} moves, "

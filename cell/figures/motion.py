@@ -23,7 +23,6 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cell.assembly import motors_of
 from cell.figures.style import LIMIT_COLOUR, REGIME_LABELS, mark_events, new_figure, save, shade_regimes
 from cell.kinematics import JOINT_NAMES
 from cell.motors import max_rates, min_move_times, move_times, velocity_for_time
@@ -176,7 +175,7 @@ def fig_joint_rate(table: StepTable, tl: Timeline, steps_tl: Timeline, s: Scenar
     shade_regimes(ax, tl.t_s, p.regime)
     with np.errstate(invalid="ignore", divide="ignore"):
         rate = np.where(steps_tl.dt_s[1:] > 0, table.steps[1:, joint] / steps_tl.dt_s[1:], 0.0)
-    peak = max_rates(p.load_oz[1:], motors_of(s), 1.0)[:, joint]
+    peak = max_rates(p.load_oz[1:], table.motors, 1.0)[:, joint]
     nominal = peak * s.robot.motors.nominal_fraction
     ax.stairs(peak, tl.t_s, baseline=None, color=LIMIT_COLOUR, lw=1.3,
               label="maximum rate (100 %, at the move's load)")

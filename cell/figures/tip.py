@@ -118,8 +118,8 @@ def fig22_figure(runs: Runs, table: StepTable, s: Scenario) -> Figure:
                             ls="--", label="input belt speed"))
     spans = {}
     for r in (1, 2, 3, 4):
-        rows = np.flatnonzero(table.regime_rows(r))
-        spans[r] = (float(t[rows[0] - 1]), float(t[rows[-1]]))
+        pts = table.regime_points(r)
+        spans[r] = (float(t[pts[0]]), float(t[pts[-1]]))
         curves.append(ax.hlines(float(row[f"v_r{r}_in_s"]), *spans[r], colors="0.45",
                                 linestyles=":", lw=1.3,
                                 label="regime's average tip velocity (velocity state vector)"

@@ -65,25 +65,18 @@ class RegimePath:
 
 
 def regime_path(table: StepTable, regime: str, geometry: CellGeometry) -> RegimePath:
-    moves = np.flatnonzero(table.regime_rows(regime))
-    pts = np.arange(moves[0] - 1, moves[-1] + 1)
+    pts = table.regime_points(regime)
+    moves = pts[1:]
     q = table.path.q_rad[pts]
     load = float(table.path.load_oz[moves].max())
     tcp = float(np.asarray(hand_length(table.path.opening_in[moves[0]], geometry.hand)))
     return RegimePath(regime, np.linspace(0.0, 1.0, len(pts)), q, load, tcp)
 
 
-@dataclass(frozen=True)
-class Limits:
-    qdot_max_rad_s: NDArray[np.float64]
-    qddot_max_rad_s2: NDArray[np.float64] | None
-    torque: bool
-
-
 def regime_rows(rp: RegimePath, motors: Motors, bounds: PlannerBounds, geometry: CellGeometry,
                 n_grid: int | None = None,
-                ) -> tuple[NDArray[np.float64], NDArray[np.float64], PathRows, Limits]:
-    """(grid s, q(s), the rows of every bound, the limits used) for one regime."""
+                ) -> tuple[NDArray[np.float64], NDArray[np.float64], PathRows, NDArray[np.float64]]:
+    """(grid s, q(s), the rows of every bound, the joint velocity bounds) for one regime."""
     n = n_grid or bounds.grid_points
     s = path_grid(n)
     sp = rp.spline()
@@ -104,7 +97,7 @@ def regime_rows(rp: RegimePath, motors: Motors, bounds: PlannerBounds, geometry:
     if amax is None and model is None:
         raise NoMotionError("no acceleration or torque bounds: the fastest motion would need "
                             "infinite acceleration")
-    return s, q, PathRows.join(*parts), Limits(vmax, amax, model is not None)
+    return s, q, PathRows.join(*parts), vmax
 
 
 @dataclass(frozen=True)
@@ -112,7 +105,8 @@ class RegimeResult:
     regime: str
     q: NDArray[np.float64]
     profile: Profile
-    limits: Limits
+    qdot_max_rad_s: NDArray[np.float64]
+    """The joint velocity bounds used (rad/s)."""
 
 
 def plan_regimes(geometry: CellGeometry, motors: Motors, bounds: PlannerBounds,
@@ -122,12 +116,12 @@ def plan_regimes(geometry: CellGeometry, motors: Motors, bounds: PlannerBounds,
     out = {}
     for r in FREE_REGIMES:
         rp = regime_path(table, r, geometry)
-        s, q, rows, limits = regime_rows(rp, motors, bounds, geometry, n_grid)
+        s, q, rows, vmax = regime_rows(rp, motors, bounds, geometry, n_grid)
         try:
             profile = plan(rows)
         except CellError as exc:
             raise NoMotionError(f"regime {r}: {exc}") from None
-        out[r] = RegimeResult(r, q, profile, limits)
+        out[r] = RegimeResult(r, q, profile, vmax)
     return out
 
 
@@ -146,10 +140,10 @@ def summary(results: dict[str, RegimeResult], bounds: PlannerBounds) -> dict[str
     ``limits.qdot_max_rad_s`` is the elementwise tightest over the regimes (R II
     carries the part, so its rates are lower); each regime also lists its own.
     """
-    v = np.min([res.limits.qdot_max_rad_s for res in results.values()], axis=0)
+    v = np.min([res.qdot_max_rad_s for res in results.values()], axis=0)
     return {
         "regimes": {r: {"time_s": res.profile.time_s, "switching_s": res.profile.switching_s,
-                        "qdot_max_rad_s": res.limits.qdot_max_rad_s.tolist(),
+                        "qdot_max_rad_s": res.qdot_max_rad_s.tolist(),
                         "grid_points": len(res.profile.s)}
                     for r, res in results.items()},
         "limits": {
