@@ -359,3 +359,28 @@ def test_fig09_no_name_is_drawn_over() -> None:
     names = {t.get_text() for t in ax.texts}
     assert {"B", "F", "G", "K", "LO", "TD"} <= names
     assert covered(fig, list(ax.lines)) == []
+
+
+@pytest.mark.parametrize("arrivals", [
+    "{distribution: gamma, mean_s: 20, cv: 0.5}",
+    "{distribution: weibull_min, mean_s: 20, cv: 0.5}",
+    "{trace_csv: gaps.csv}"])
+def test_figs_13_14_draw_the_arrivals_the_feeder_draws_from(tmp_path: Path, arrivals) -> None:
+    """Fig. 13-14 for arrivals given by mean and cv (or a trace): the drawn curve is the
+    distribution the run samples (its mean and cv as given), or none for a trace."""
+    from cell.figures.arrivals import distribution, draws, fig13_pdf, fig14_cdf
+
+    (tmp_path / "gaps.csv").write_text("interarrival_s\n" + "\n".join(["18.5", "24", "21"] * 20))
+    f = tmp_path / "s.yaml"
+    f.write_text(f"arrivals: {arrivals}\n")
+    s = load_scenario(f)
+    d = distribution(s)
+    if "trace" in arrivals:
+        assert d is None
+    else:
+        assert d.mean() == pytest.approx(20.0, rel=1e-9)
+        assert d.std() / d.mean() == pytest.approx(0.5, rel=1e-6)
+    x = draws(s, 400)
+    for fig in (fig13_pdf, fig14_cdf):
+        png = fig(s, x, tmp_path / f"{fig.__name__}.png")
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

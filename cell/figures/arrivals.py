@@ -3,18 +3,23 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import scipy.stats
 from numpy.typing import NDArray
 
+from cell.arrivals import parameters
 from cell.figures.style import new_figure, save
 from cell.scenario import Scenario
 
 
-def distribution(s: Scenario) -> scipy.stats.rv_continuous:
-    """The scenario's frozen inter-arrival distribution (eq. 6.9 by default)."""
-    return getattr(scipy.stats, s.arrivals.distribution)(**dict(s.arrivals.params))
+def distribution(s: Scenario) -> Any:
+    """The scenario's frozen inter-arrival distribution (eq. 6.9 by default; by ``params``
+    or by ``mean_s`` and ``cv``, as the feeder draws from it); None for a trace."""
+    if s.arrivals.trace_csv is not None:
+        return None
+    return getattr(scipy.stats, s.arrivals.distribution)(**parameters(s.arrivals))
 
 
 def draws(s: Scenario, n: int) -> NDArray[np.float64]:
@@ -27,15 +32,19 @@ def draws(s: Scenario, n: int) -> NDArray[np.float64]:
 
 def _params_note(s: Scenario, x: NDArray[np.float64]) -> str:
     d = distribution(s)
-    p = ", ".join(f"{k} = {v:.4f}" for k, v in s.arrivals.params.items())
-    return (f"{s.arrivals.distribution}({p}): mean {d.mean():.3f} s, sd {d.std():.3f} s; "
-            f"{x.size} draws: mean {x.mean():.3f} s, sd {x.std(ddof=1):.3f} s")
+    seen = f"{x.size} draws: mean {x.mean():.3f} s, sd {x.std(ddof=1):.3f} s"
+    if d is None:
+        return f"the trace {s.arrivals.trace_csv}, replayed in order; {seen}"
+    p = ", ".join(f"{k} = {v:.4f}" for k, v in parameters(s.arrivals).items())
+    return f"{s.arrivals.distribution}({p}): mean {d.mean():.3f} s, sd {d.std():.3f} s; {seen}"
 
 
 def _grid(s: Scenario, x: NDArray[np.float64]) -> NDArray[np.float64]:
     d = distribution(s)
-    lo = min(float(d.ppf(1e-4)), float(x.min()))
-    return np.linspace(lo - 0.5, max(float(d.ppf(1 - 1e-4)), float(x.max())) + 0.5, 600)
+    lo, hi = float(x.min()), float(x.max())
+    if d is not None:
+        lo, hi = min(float(d.ppf(1e-4)), lo), max(float(d.ppf(1 - 1e-4)), hi)
+    return np.linspace(lo - 0.5, hi + 0.5, 600)
 
 
 def fig13_pdf(s: Scenario, x: NDArray[np.float64], out: Path) -> Path:
@@ -44,13 +53,17 @@ def fig13_pdf(s: Scenario, x: NDArray[np.float64], out: Path) -> Path:
     t = _grid(s, x)
     heights, _, _ = ax.hist(x, bins=30, density=True, color="#9ecae1", edgecolor="white",
             label=f"the {x.size} inter-arrival times of the run (seed {s.run.seed})")
-    ax.plot(t, d.pdf(t), color="black", label="pdf (eq. 6.8)")
-    ax.axvline(d.mean(), color="#d62728", ls="--", lw=1.2, label=f"mean {d.mean():.4f} s")
-    ax.axvline(s.arrivals.params.get("loc", np.nan), color="0.4", ls=":", lw=1.2,
-               label=f"location {s.arrivals.params.get('loc', np.nan):g} s")
+    top = float(heights.max())
+    if d is not None:
+        ax.plot(t, d.pdf(t), color="black", label="pdf (eq. 6.8)")
+        ax.axvline(d.mean(), color="#d62728", ls="--", lw=1.2, label=f"mean {d.mean():.4f} s")
+        loc = parameters(s.arrivals).get("loc")
+        if loc is not None:
+            ax.axvline(loc, color="0.4", ls=":", lw=1.2, label=f"location {loc:g} s")
+        top = max(top, float(d.pdf(t).max()))
     ax.set_xlabel("inter-arrival time T (s)")
     ax.set_ylabel("probability density (1/s)")
-    ax.set_ylim(0, 1.45 * max(float(heights.max()), float(d.pdf(t).max())))
+    ax.set_ylim(0, 1.45 * top)
     ax.legend(loc="upper left")
     ax.set_title(_params_note(s, x), loc="left", fontsize=8.5)
     return save(fig, out)
@@ -63,17 +76,21 @@ def fig14_cdf(s: Scenario, x: NDArray[np.float64], out: Path) -> Path:
     xs = np.sort(x)
     ax.step(xs, np.arange(1, xs.size + 1) / xs.size, where="post", color="#6baed6", lw=2.2,
             label=f"empirical cdf of the run's {x.size} draws")
-    ax.plot(t, d.cdf(t), color="black", lw=1.3, label="cdf F(T)")
-    u = 0.5
-    tu = float(d.ppf(u))
-    ax.plot([t[0], tu, tu], [u, u, 0], color="#d62728", ls="--", lw=1.1,
-            label=f"inverse cdf (eq. 6.9): u = {u} → T = {tu:.4f} s")
-    ks = scipy.stats.kstest(x, d.cdf)
+    if d is not None:
+        ax.plot(t, d.cdf(t), color="black", lw=1.3, label="cdf F(T)")
+        u = 0.5
+        tu = float(d.ppf(u))
+        ax.plot([t[0], tu, tu], [u, u, 0], color="#d62728", ls="--", lw=1.1,
+                label=f"inverse cdf (eq. 6.9): u = {u} → T = {tu:.4f} s")
+        ks = scipy.stats.kstest(x, d.cdf)
+        title = (f"T = F⁻¹(u) with u ~ U(0, 1); Kolmogorov-Smirnov D = {ks.statistic:.3f}, "
+                 f"p = {ks.pvalue:.2f}")
+    else:
+        title = f"the trace {s.arrivals.trace_csv}, replayed in order: no distribution to draw"
     ax.set_xlabel("inter-arrival time T (s)")
     ax.set_ylabel("cumulative probability u")
     ax.set_ylim(0, 1.02)
     ax.set_xlim(t[0], t[-1])
     ax.legend(loc="lower right")
-    ax.set_title(f"T = F⁻¹(u) with u ~ U(0, 1); Kolmogorov-Smirnov D = {ks.statistic:.3f}, "
-                 f"p = {ks.pvalue:.2f}", loc="left", fontsize=9)
+    ax.set_title(title, loc="left", fontsize=9)
     return save(fig, out)
