@@ -121,10 +121,9 @@ def _blame(s: Scenario, geometry: CellGeometry) -> tuple[str, Any, str]:
     thesis's cell, the first whose thesis value alone makes every point reachable."""
     from cell.path import build_path
 
-    thesis = default_scenario()
-    changed = [k for k in GEOMETRY_KEYS if s.get(k) != thesis.get(k)]
+    changed = [k for k in GEOMETRY_KEYS if s.get(k) != _THESIS.get(k)]
     for key in changed:
-        trial = _with(s, key, thesis.get(key))
+        trial = _with(s, key, _THESIS.get(key))
         if trial is None:
             continue
         try:
