@@ -100,7 +100,7 @@ def step_table(s: Scenario) -> StepTable:
     try:
         return StepTable.solve(geometry, motors)
     except UnreachableError as exc:
-        key, value, hint = _blame(s, geometry)
+        key, value, hint = _blame(s)
         raise ScenarioError(s.source, key, value, f"{exc}{hint}") from None
 
 
@@ -116,15 +116,14 @@ GEOMETRY_KEYS = (
 )
 
 
-def _blame(s: Scenario, geometry: CellGeometry) -> tuple[str, Any, str]:
+def _blame(s: Scenario) -> tuple[str, Any, str]:
     """The key whose value makes the path unreachable: of the keys that differ from the
     thesis's cell, the first whose thesis value alone makes every point reachable."""
     from cell.path import build_path
 
-    thesis = default_scenario()
-    changed = [k for k in GEOMETRY_KEYS if s.get(k) != thesis.get(k)]
+    changed = [k for k in GEOMETRY_KEYS if s.get(k) != _THESIS.get(k)]
     for key in changed:
-        trial = _with(s, key, thesis.get(key))
+        trial = _with(s, key, _THESIS.get(key))
         if trial is None:
             continue
         try:

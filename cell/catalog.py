@@ -71,27 +71,3 @@ def shown(source: str | Path) -> str:
 def names() -> list[str]:
     """Every built-in file's name, without ``.yaml``."""
     return sorted(p.stem for p in BUILT_IN.glob("*.yaml"))
-
-
-def read(name: str) -> object:
-    """A built-in file's top-level document (None if it is not YAML)."""
-    return _parsed(path(name).read_text(encoding="utf-8"))
-
-
-def _parsed(text: str) -> object:
-    import yaml
-
-    try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError:  # pragma: no cover - the files are the project's own
-        return None
-
-
-def describe(name: str) -> str:
-    """A built-in file's ``description``, or its first comment line."""
-    text = path(name).read_text(encoding="utf-8")
-    doc = _parsed(text)
-    if isinstance(doc, dict) and doc.get("description"):
-        return str(doc["description"])
-    first = next((line for line in text.splitlines() if line.startswith("#")), "# ")
-    return first.lstrip("# ").strip()

@@ -40,8 +40,9 @@ def parse_sets(pairs: Sequence[str] | None) -> dict[str, Any]:
 
 def apply_overrides(raw: Mapping[str, Any], overrides: Mapping[str, Any], file: object,
                     is_section: IsSection = _never) -> dict[str, Any]:
-    """A copy of ``raw`` with each dotted key set (sections merged, values replaced)."""
-    out = copy.deepcopy(dict(raw))
+    """A copy of ``raw`` with each dotted key set (sections merged, values replaced); ``raw``
+    is left as it was: the mappings on a key's way are copied, the rest shared."""
+    out = dict(raw)
     for key, value in overrides.items():
         set_dotted(out, str(key), value, file, is_section)
     return out
@@ -61,6 +62,8 @@ def set_dotted(raw: dict[str, Any], key: str, value: Any, file: object,
             where = ".".join(parts[:i + 1])
             raise ScenarioError(file, key, value, f"{where} is {child!r}, not a section "
                                 "whose keys can be set")
+        else:
+            child = node[part] = dict(child)
         node = child
     leaf = parts[-1]
     old = node.get(leaf)

@@ -312,7 +312,8 @@ def load_mapping(path: str | Path, what: str = "scenario") -> dict[Any, Any]:
     """
     name = _oneline(str(path))
     try:
-        if not stat.S_ISREG(os.stat(path).st_mode) and not os.path.isdir(path):
+        mode = os.stat(path).st_mode
+        if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
             raise ScenarioError(name, "(file)", name, f"not a regular file: not a {what} file")
         with open(path, "rb") as stream:
             data = stream.read(MAX_BYTES + 1)

@@ -77,12 +77,12 @@ def main(args: argparse.Namespace) -> int:
         if not isinstance(getattr(stats, family, None), stats.rv_continuous):
             raise ScenarioError("--families", "--families", family,
                                 "not a continuous distribution in scipy.stats")
-    times = bool(getattr(args, "times", False))
-    values = read_column(trace, args.column, times=times, sorted_ok=bool(getattr(args, "gaps", False)))
+    times = args.times
+    values = read_column(trace, args.column, times=times, sorted_ok=args.gaps)
     count = f"{values.size} gaps between {values.size + 1} arrival times" if times else \
         f"{values.size} values"
     try:
-        fits = fit_trace(values, families, rank_by=getattr(args, "rank_by", "aic"))
+        fits = fit_trace(values, families, rank_by=args.rank_by)
     except ValueError as exc:
         raise ScenarioError(trace, args.column, count, str(exc)) from None
     usable = [f for f in fits if f.nonnegative]
