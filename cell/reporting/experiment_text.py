@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from cell.analysis.stats import relative_half_width
+from cell.analysis.stats import precision_reached, relative_half_width
 from cell.reporting.experiment_data import runs_of
 from cell.reporting.headlines import (
     HEADLINES,
@@ -194,7 +194,7 @@ def _precision(replications: pd.DataFrame, summary: pd.DataFrame, sweep: Sweep,
     for i, row in enumerate(rows):
         values = runs_of(replications, sweep, i)[q.measure].to_numpy(dtype=float)
         rhw = relative_half_width(values, q.confidence)
-        done = len(values) >= q.min_n and rhw <= q.precision
+        done = precision_reached({i: values}, q.precision, q.confidence, q.min_n)[i]
         short += not done
         verdict = "reached" if done else f"not reached: stopped at max = {q.max_n}"
         lines.append(table_row([*(show(row[c]) for c in cols), str(row["policy"]),
