@@ -48,7 +48,7 @@ def main(args: argparse.Namespace) -> int:
 
 def _sweep(args: argparse.Namespace) -> int:
     from cell.sweep import load_sweep, run_sweep, simulate_summary
-    from cell.sweep.runner import check_out
+    from cell.sweep.outdir import check_out
 
     check_out(args.out)  # before the sweep file's points are built and checked
     sweep = load_sweep(args.sweep)
@@ -62,9 +62,9 @@ def _sweep(args: argparse.Namespace) -> int:
         outcome = run_sweep(sweep, args.out, workers=args.workers, scheduler=args.scheduler,
                             resume=args.resume, replicate=simulate_summary)
     except KeyboardInterrupt:
-        from cell.sweep.runner import TASK_DIR
+        from cell.sweep.outdir import finished_tasks
 
-        kept = len(list((Path(args.out) / TASK_DIR).glob("task-*.csv")))
+        kept = len(finished_tasks(args.out))
         print(f"cell sweep: stopped; {kept} finished task{'s' if kept != 1 else ''} kept in "
               f"{args.out}: the same command with --resume runs only the rest", file=sys.stderr)
         raise

@@ -13,6 +13,8 @@ from cell.sweep.spec import Sweep
 
 MANIFEST = "sweep.json"
 TASK_DIR = "tasks"
+#: A finished task's file (:attr:`cell.sweep.spec.Task.filename`).
+TASK_FILES = "task-*.csv"
 
 
 def check_out(out: str | Path) -> Path:
@@ -30,6 +32,12 @@ def check_out(out: str | Path) -> Path:
             raise CellError(f"--out {out}: {manifest} is not a sweep's manifest; choose another "
                             "--out")
     return path
+
+
+def finished_tasks(out: str | Path) -> list[Path]:
+    """The task files a run into ``out`` has finished (what ``--resume`` reuses if intact)."""
+    task_dir = Path(out) / TASK_DIR
+    return sorted(task_dir.glob(TASK_FILES)) if task_dir.is_dir() else []
 
 
 def _manifest(path: Path) -> Any:
@@ -54,7 +62,7 @@ def prepare(sweep: Sweep, out: Path, resume: bool) -> None:
                             f"(or of {sweep.source} before it was edited); "
                             "run without --resume or choose another --out")
     else:
-        for stale in task_dir.glob("task-*.csv") if task_dir.is_dir() else ():
+        for stale in finished_tasks(out):
             stale.unlink()
         (out / "replications.csv").unlink(missing_ok=True)
     doc: dict[str, Any] = {"sweep": sweep.source, "name": sweep.name, "fingerprint": fingerprint,
