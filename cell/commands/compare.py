@@ -22,6 +22,7 @@ if TYPE_CHECKING:
 
     from cell.scenario import Scenario
     from cell.sweep import Sweep
+    from cell.sweep.spec import Point
 
 HELP = "compare two scenarios, paired over common random numbers"
 DESCRIPTION = ("Run scenarios A and B with the same replications (common random numbers) and "
@@ -63,12 +64,18 @@ def _suggest(va: object, vb: object) -> object:
     return max(v for v in (va, vb) if isinstance(v, int))
 
 
-def window_warning(a: Scenario, b: Scenario, labels: tuple[str, str]) -> str | None:
+def _sides(sweep: Sweep) -> tuple[tuple[str, Point], tuple[str, Point]]:
+    """(label, point) of A and of B."""
+    (la, a), (lb, b) = ((dict(p.values)["scenario"], p) for p in sweep.points)
+    return (la, a), (lb, b)
+
+
+def window_warning(sweep: Sweep) -> str | None:
     """One line if A's and B's counts are over different windows, else None."""
-    differ = _windows(a, b)
+    (la, a), (lb, b) = _sides(sweep)
+    differ = _windows(a.scenario, b.scenario)
     if not differ:
         return None
-    la, lb = labels
     said = {"parts": "runs {} parts", "warmup_parts": "has run.warmup_parts {}"}
     what = "; ".join(f"{la} {said[k].format(va)}, {lb} {vb}" for k, va, vb in differ)
     sets = " ".join(f"--set run.{k}={_suggest(va, vb)}" for k, va, vb in differ)
@@ -105,8 +112,7 @@ def main(args: argparse.Namespace) -> int:
         names = (*REPORT_FILES, "replications.csv")
         OutputDir.check(args.out, names)  # before anything runs
         target = Target(Path(args.out), names, False)
-    pa, pb = sweep.points
-    warning = window_warning(a, b, (dict(pa.values)["scenario"], dict(pb.values)["scenario"]))
+    warning = window_warning(sweep)
     if warning:
         print(f"cell: warning: {warning}", file=sys.stderr)
     with tempfile.TemporaryDirectory(prefix="cell-compare-") as work:
@@ -130,9 +136,9 @@ def main(args: argparse.Namespace) -> int:
 def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> str:
     """A few lines: per headline measure, which is better and by how much (A - B).  Counts
     are not compared if A and B take them over different windows (run length, warm-up)."""
-    from cell.reporting.headlines import HEADLINES, better, decimals, number
+    from cell.reporting.headlines import HEADLINES, better, half_width, number, plus_minus
 
-    (la, a), (lb, b) = ((dict(p.values)["scenario"], p) for p in sweep.points)
+    (la, a), (lb, b) = _sides(sweep)
     differ = _windows(a.scenario, b.scenario)
     parts = a.scenario.run.parts if a.scenario.run.parts == b.scenario.run.parts else None
     level = f"{sweep.confidence * 100:g} %"
@@ -161,16 +167,11 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> s
             what = ("equal in every replication" if mean == 0 else
                     f"{number(abs(mean))}{unit} {word}{per} in every replication")
             judged = bool(mean != 0)
-        elif not (lo <= 0.0 <= hi):
-            p = decimals((hi - lo) / 2)
-            what = (f"{abs(mean):.{p}f} ± {(hi - lo) / 2:.{p}f}{unit} {word}{per} "
-                    "(interval excludes 0)")
-            judged = True
         else:
-            p = decimals((hi - lo) / 2)
-            what = (f"{abs(mean):.{p}f} ± {(hi - lo) / 2:.{p}f}{unit} {word}{per} "
-                    "(interval includes 0: no difference shown)")
-            judged = False
+            judged = not (lo <= 0.0 <= hi)
+            what = (f"{plus_minus(abs(mean), half_width(row))}{unit} {word}{per} "
+                    + ("(interval excludes 0)" if judged else
+                       "(interval includes 0: no difference shown)"))
         side = better(h, float(means[la]), float(means[lb])) if judged else 0
         who = {1: f"{la} better", -1: f"{lb} better", 0: "neither"}[side]
         if h.better == "one" and side:
