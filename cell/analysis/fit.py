@@ -54,7 +54,8 @@ class Fit:
         return bool(self.frozen().support()[0] >= 0.0)
 
 
-def _dist(family: str) -> Any:
+def family_of(family: str) -> Any:
+    """The scipy.stats continuous distribution of that name (ValueError if there is none)."""
     dist = getattr(stats, family, None)
     if not isinstance(dist, stats.rv_continuous):
         raise ValueError(f"{family!r} is not a continuous distribution in scipy.stats")
@@ -135,7 +136,7 @@ def _fit_threshold(dist: Any, x: NDArray[np.float64]) -> list[float]:
 
 
 def _fit_one(family: str, x: NDArray[np.float64]) -> Fit:
-    dist = _dist(family)
+    dist = family_of(family)
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         warnings.simplefilter("ignore", RuntimeWarning)
         theta = _fit_threshold(dist, x) if family in THRESHOLD_FAMILIES else \
@@ -174,7 +175,7 @@ def fit_trace(values: ArrayLike, families: Sequence[str] = DEFAULT_FAMILIES,
     if x.size < 2 or not np.all(np.isfinite(x)) or np.ptp(x) == 0.0:
         raise ValueError("need at least two finite values that are not all equal")
     for family in families:
-        _dist(family)  # an unknown name is an error, not a failed fit
+        family_of(family)  # an unknown name is an error, not a failed fit
     fits = []
     for family in families:
         try:

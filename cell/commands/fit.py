@@ -55,12 +55,11 @@ def _destination(path: str | Path, option: str, taken: Sequence[Path]) -> Path:
 
 def main(args: argparse.Namespace) -> int:
     """Fit, print the table, write (or print) the arrivals block and the figure."""
-    from scipy import stats
-
     from cell.analysis.fit import (
         DEFAULT_FAMILIES,
         arrivals_yaml,
         draw,
+        family_of,
         fit_trace,
         format_table,
         read_column,
@@ -74,9 +73,11 @@ def main(args: argparse.Namespace) -> int:
     chosen_families = args.families if args.families is not None else ",".join(DEFAULT_FAMILIES)
     families = [f.strip() for f in str(chosen_families).split(",") if f.strip()]
     for family in families or [""]:
-        if not isinstance(getattr(stats, family, None), stats.rv_continuous):
+        try:
+            family_of(family)
+        except ValueError:
             raise ScenarioError("--families", "--families", family,
-                                "not a continuous distribution in scipy.stats")
+                                "not a continuous distribution in scipy.stats") from None
     times = args.times
     values = read_column(trace, args.column, times=times, sorted_ok=args.gaps)
     count = f"{values.size} gaps between {values.size + 1} arrival times" if times else \
