@@ -130,10 +130,10 @@ def _blame(s: Scenario) -> tuple[str, Any, str]:
             build_path(geometry_of(trial))
         except UnreachableError:
             continue
-        return key, _shown(s.get(key)), f" (with the thesis's {key} it is reachable)"
+        return key, s.get(key), f" (with the thesis's {key} it is reachable)"
     if changed:
         others = ", ".join(changed[1:])
-        return changed[0], _shown(s.get(changed[0])), \
+        return changed[0], s.get(changed[0]), \
             f" (together with {others})" if others else ""
     return "path", None, ""  # pragma: no cover - the thesis's own cell is reachable
 
@@ -143,10 +143,6 @@ def _with(s: Scenario, key: str, value: Any) -> Scenario | None:
         return s.with_overrides({key: value})
     except ScenarioError:
         return None
-
-
-def _shown(value: Any) -> Any:
-    return list(value) if isinstance(value, tuple) else value
 
 
 def _check_motor_rates(s: Scenario) -> None:
@@ -187,7 +183,7 @@ def _solved_timing(s: Scenario) -> RobotTiming:
         key = "robot.motors.max_rate_no_load_rad_s"
         if s.get(key) == _THESIS.get(key):
             key = "mintime.dynamics_file"
-        raise ScenarioError(s.source, key, _shown(s.get(key)),
+        raise ScenarioError(s.source, key, s.get(key),
                             f"{exc} of the dynamic model ({s.mintime.dynamics_file})") from None
     except NoMotionError as exc:
         raise CellError(f"{s.source}: robot.timing = 'minimum-time': {exc}") from None
@@ -206,7 +202,8 @@ def _timing_key(s: Scenario) -> dict[str, Any] | None:
     if s.robot.timing == "minimum-time" and s.mintime.dynamics_file is not None:
         try:
             path = dynamics_path(s)
-            key["dynamics_file_sha256"] = hashlib.sha256(path.read_bytes() if path else b"").hexdigest()
+            assert path is not None  # dynamics_file is set
+            key["dynamics_file_sha256"] = hashlib.sha256(path.read_bytes()).hexdigest()
         except (OSError, ValueError):  # no such file: solving it says so, with its key
             return None
     return key
@@ -234,7 +231,7 @@ def _checked(s: Scenario, t: RobotTiming) -> RobotTiming:
     key = next((k for k in SPEED_KEYS if s.get(k) != _THESIS.get(k)
                 and (k != "mintime.rate_fraction" or s.robot.timing == "minimum-time")),
                "robot.motors.max_rate_no_load_rad_s")
-    raise ScenarioError(s.source, key, _shown(s.get(key)),
+    raise ScenarioError(s.source, key, s.get(key),
                         f"the motors would take {longest:.4g} s over one regime; at most "
                         f"{MAX_TIME_S:g} s")
 
@@ -320,7 +317,7 @@ def _tracking_blame(s: Scenario, belt: str, speed: float) -> tuple[str, Any]:
         t = robot_timing(trial)
         most = t.input_track_max_in_s if belt == "input" else t.output_track_max_in_s
         if speed <= most:
-            return key, _shown(s.get(key))
+            return key, s.get(key)
     return f"belts.{belt}_nominal_in_s", speed
 
 

@@ -22,6 +22,8 @@ class ScenarioError(CellError, ValueError):
     """
 
     def __init__(self, file: object, key: str, value: object, why: str):
+        if isinstance(value, tuple):  # a setting held as a tuple was written as a YAML list
+            value = list(value)
         self.file, self.key, self.value, self.why = str(file), key, value, why
         super().__init__(f"{_line(self.file)}: {_line(key)} = {short(value)}: {_line(why, 300)}")
 

@@ -73,13 +73,13 @@ def main(args: argparse.Namespace) -> int:
     except NoMotionError as exc:
         raise CellError(f"{scenario.source}: mintime: {exc}") from None
     except InfeasibleError as exc:  # the drives cannot turn at the motors' rates (dynamics file)
-        raise ScenarioError(scenario.source, rates, list(scenario.get(rates)),
+        raise ScenarioError(scenario.source, rates, scenario.get(rates),
                             f"{exc} (drives of {scenario.mintime.dynamics_file})") from None
     slowest = max(results, key=lambda r: results[r].profile.time_s)
     if not results[slowest].profile.time_s <= MAX_TIME_S:  # the schema's bound on any time
         key = "mintime.rate_fraction" if scenario.mintime.rate_fraction < 1 else rates
         value = scenario.get(key)
-        raise ScenarioError(scenario.source, key, list(value) if isinstance(value, tuple) else value,
+        raise ScenarioError(scenario.source, key, value,
                             f"{slowest} would take {results[slowest].profile.time_s:.4g} s, more "
                             f"than {MAX_TIME_S:g} s")
     table = frame(results)
