@@ -192,7 +192,7 @@ def test_cell_docs_reads_the_pages_its_output_refers_to(tmp_path, capsys):
     listed = capsys.readouterr().out
     for page in docs.glob("*.md"):
         assert page.stem in listed
-    for name in ("accounting", "docs/accounting.md"):
+    for name in ("accounting", "docs/accounting.md", "Accounting.MD"):
         assert main(["docs", name]) == 0
         assert capsys.readouterr().out == (docs / "accounting.md").read_text(encoding="utf-8")
     assert main(["docs", "nope"]) == 2

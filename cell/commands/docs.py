@@ -49,8 +49,8 @@ def main(args: argparse.Namespace) -> int:
             print(f"  {name:<{width}}  {title(listed)}" + (f"  ({listed})" if args.path else ""))
         print("cell docs PAGE prints a page (Markdown); pipe it to a pager: cell docs model | less")
         return 0
-    name = Path(args.page).name.removesuffix(".md")
-    page = known.get(name)
+    name = Path(args.page).name.lower().removesuffix(".md")
+    page = {stem.lower(): path for stem, path in known.items()}.get(name)
     if page is None:
         raise CellError(f"no documentation page {args.page!r} (pages: {', '.join(known)})")
     if args.path:
