@@ -208,7 +208,7 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
     path = catalog.resolve(path)
     given = load_mapping(path, "scenario")
     catalog.refuse_other_kind(given, path, "scenario")
-    if "name" not in given:  # a file without a name goes by the file's
+    if given.get("name") in (None, ""):  # a file without a name goes by the file's
         given = {**given, "name": path.stem}
     raw = merge(_DEFAULTS.to_dict(), given, (), is_section)
     raw = apply_overrides(raw, overrides or {}, path, is_section)

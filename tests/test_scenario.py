@@ -195,3 +195,6 @@ def test_a_file_without_a_name_goes_by_the_files_name(tmp_path):
     assert load_scenario(named).name == "mine"
     assert load_scenario(unnamed, {"name": "given"}).name == "given"
     assert load_scenario("baseline").name == "baseline"
+    for blank in ("name: ''\n", "name:\n"):
+        named.write_text(blank)
+        assert load_scenario(named).name == "other"
