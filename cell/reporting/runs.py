@@ -44,8 +44,9 @@ def run_heading(cell: AssembledCell) -> str:
 
         n = len(read_trace(Path(s.base_dir) / trace))
         if n < s.run.parts + 1:  # the run needs T_1 .. T_{parts+1}
-            heading += (f"\narrivals: {trace} holds {n} inter-arrival times and the run needs "
-                        f"{s.run.parts + 1}: it is replayed from the start every {n} parts")
+            held = f"{n} inter-arrival times" if n > 1 else "one inter-arrival time"
+            heading += (f"\narrivals: {trace} holds {held} and the run needs {s.run.parts + 1}: "
+                        f"it is replayed from the start" + (f" every {n} parts" if n > 1 else ""))
     return heading
 
 
