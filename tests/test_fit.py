@@ -349,3 +349,23 @@ def test_short_increasing_column_is_too_few_not_times(tmp_path: Path):
     with pytest.raises(ScenarioError) as err:
         cmd_fit(parse(str(path)))
     assert err.value.value == "10 values" and "at least 20 values" in err.value.why
+
+
+def test_times_as_date_times_fit_as_their_seconds(tmp_path: Path, capsys):
+    """--times takes ISO 8601 date-times (a log's arrival stamps, any one time zone) as
+    their seconds: the same fit as the same instants written in seconds."""
+    seconds = np.array(_arrival_times(), dtype=float)
+    start = np.datetime64("2026-03-02T08:15:00", "ms")
+    stamps = [str(start + np.timedelta64(int(round(t * 1000)), "ms")).replace("T", " ")
+              for t in seconds]
+    dated = _write(tmp_path / "dated.csv", "arrival_s", stamps)
+    plain = _write(tmp_path / "plain.csv", "arrival_s", _arrival_times())
+    assert cmd_fit(parse(str(dated), "--column", "arrival_s", "--times")) == 0
+    by_dates = yaml.safe_load(capsys.readouterr().out)
+    assert cmd_fit(parse(str(plain), "--column", "arrival_s", "--times")) == 0
+    assert by_dates == yaml.safe_load(capsys.readouterr().out)
+    bad = _write(tmp_path / "bad.csv", "arrival_s", [*stamps[:30], "soon", *stamps[31:]])
+    with pytest.raises(ScenarioError) as err:
+        cmd_fit(parse(str(bad), "--column", "arrival_s", "--times"))
+    assert err.value.key == "arrival_s[row 31]" and err.value.value == "soon"
+    assert "date-time" in err.value.why

@@ -271,9 +271,10 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
                 sorted_ok: bool = False) -> NDArray[np.float64]:
     """The inter-arrival gaps in a CSV column: at least :data:`MIN_VALUES`, finite, > 0, not all equal.
 
-    With ``times`` the column holds arrival times (finite, strictly increasing) and
-    their differences are returned.  Without it, a column of :data:`MIN_VALUES` or
-    more values that never decreases is refused as arrival times (n iid gaps come
+    With ``times`` the column holds arrival times (finite, strictly increasing), as
+    numbers of seconds or as ISO 8601 date-times, and their differences (s) are
+    returned.  Without it, a column of :data:`MIN_VALUES` or more values that never
+    decreases is refused as arrival times (n iid gaps come
     in increasing order with probability 1/n!, < 1e-18 at n = 20), unless
     ``sorted_ok`` says they are gaps in sorted order.  Any problem raises
     :class:`~cell.errors.ScenarioError` naming the file, the key (``(file)``,
@@ -286,6 +287,12 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
     written = _read_cells(p, column)
     cells = written.astype(str).str.strip()
     values = pd.to_numeric(cells, errors="coerce").to_numpy(dtype=float)
+    dated = times and bool(np.isnan(values).all())
+    if dated:  # arrival times as date-times (ISO 8601, e.g. 2026-03-02 08:15:04.5): seconds
+        stamps = pd.to_datetime(cells, format="ISO8601", errors="coerce", utc=True)
+        dated = bool(stamps.notna().any())
+        if dated:
+            values = (stamps - stamps.min()).dt.total_seconds().to_numpy(dtype=float)
     finite = np.isfinite(values)
     if not (times or sorted_ok) and values.size >= MIN_VALUES and finite.all() \
             and np.all(np.diff(values) >= 0.0) and np.ptp(values) > 0.0:
@@ -297,6 +304,7 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
     if bad.size:
         i = int(bad[0])
         why = ("missing value" if cells.iloc[i] == "" else
+               "not a date-time (YYYY-MM-DD hh:mm:ss)" if dated else
                "not a number" if math.isnan(values[i]) and cells.iloc[i].lower() != "nan" else
                "arrival times must be finite" if times else "inter-arrival times must be finite and > 0")
         raise ScenarioError(p, f"{column}[row {i + 1}]", written.iloc[i], why)

@@ -25,7 +25,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--column", default="interarrival_s", help="column to fit (default: %(default)s)")
     kind = parser.add_mutually_exclusive_group()
     kind.add_argument("--times", action="store_true",
-                      help="the column holds arrival times (increasing): fit the gaps between them")
+                      help="the column holds arrival times (increasing seconds, or ISO date-times): "
+                           "fit the gaps between them")
     kind.add_argument("--gaps", action="store_true",
                       help="the column holds gaps even though it never decreases (sorted gaps)")
     parser.add_argument("--out", default=None, metavar="SCENARIO.yaml",
