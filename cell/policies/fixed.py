@@ -8,7 +8,6 @@ while the robot is busy rides on and falls off at F; a late part is waited for.
 from __future__ import annotations
 
 import math
-from array import array
 from typing import Any
 
 import numpy as np
@@ -81,7 +80,6 @@ class ReconstructedAccounting(Accounting):
         """The robot's fixed cycle C."""
         self._lost_below = self.cycle_s - accounting.THESIS_SLACK_S
         """C − s: a part that comes sooner than this after the last is lost."""
-        self.ip = array("d")
 
     def part(self, rec: PartRecord, next_interarrival_s: float) -> None:
         t = rec.interarrival_s
@@ -89,14 +87,14 @@ class ReconstructedAccounting(Accounting):
         d = t + self.cycle_s if lost else t
         rec.missed_thesis = lost
         rec.thesis_interval_s = d
-        rec.ip_thesis = ip = next_interarrival_s / (2.0 * d)
+        rec.ip_thesis = next_interarrival_s / (2.0 * d)
         self.interval.append(d)
-        self.ip.append(ip)
         self.lost.append(lost)
 
     def finish(self, s: RunSummary, start: int, picked_r4_s: np.ndarray,
                t_next: np.ndarray) -> None:
-        d, ip = np.frombuffer(self.interval)[start:], np.frombuffer(self.ip)[start:]
+        d = np.frombuffer(self.interval)[start:]
+        ip = t_next[start:] / (2.0 * d)  # each part's IP, as its record has it
         ideal = self.policy.ideal_cycle_s
         missed = self._lost_after(start)
         s.parts_missed_thesis = missed
