@@ -126,20 +126,19 @@ class BeltLog:
         if not self.keep and self.sink is None:
             return None
         mark, times, speeds, sink = self.belt.append, self.t.append, self.v.append, self.sink
-        name = _BELTS[belt]
+
+        def keep(t: float, v: float) -> None:
+            mark(belt)
+            times(t)
+            speeds(v)
         if sink is None:
-            def keep(t: float, v: float) -> None:
-                mark(belt)
-                times(t)
-                speeds(v)
             return keep
+        name = _BELTS[belt]
         if not self.keep:
             return lambda t, v: sink(BeltChange(name, t, v))
 
         def both(t: float, v: float) -> None:
-            mark(belt)
-            times(t)
-            speeds(v)
+            keep(t, v)
             sink(BeltChange(name, t, v))
         return both
 
