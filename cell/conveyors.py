@@ -229,8 +229,8 @@ class OutputConveyor:
         self.delivered = delivered
         self.last_td_x: float | None = None
         """Belt travel at the last touch-down (None before the first)."""
-        self.last_td_s: float | None = None
-        """Instant of the last touch-down (None before the first)."""
+        self.last_td_s = math.nan
+        """Instant of the last touch-down (read once ``last_td_x`` is set)."""
         self.replan = self.belt.plan
         """New speed plan from the controller (:meth:`Belt.plan`)."""
         self.process = env.process(self.run())
@@ -241,9 +241,9 @@ class OutputConveyor:
             part = yield get()
             td = part.touchdown_s = env._now
             x = travel(td)
-            last_x, last_td = self.last_td_x, self.last_td_s
-            if last_x is not None and last_td is not None:
+            last_x = self.last_td_x
+            if last_x is not None:
                 part.spacing_in = x - last_x
-                part.delivery_interval_s = td - last_td
+                part.delivery_interval_s = td - self.last_td_s
             self.last_td_x, self.last_td_s = x, td
             delivered(part)
