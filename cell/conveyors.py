@@ -108,22 +108,20 @@ class Belt:
         if n > 0:  # settle the changes whose successors have started
             self._settle(n)
             del ts[:n], xs[:n], vs[:n]
-        # run at v1 from t1 on (at or before the last change: that change's speed is v1)
-        t0 = ts[-1]
-        if t1 <= t0:
-            vs[-1] = v1
-        else:
-            xs.append(xs[-1] + vs[-1] * (t1 - t0))
-            ts.append(t1)
-            vs.append(v1)
-            t0 = t1
+        self._run_from(t1, v1)
         if t2 is not None:
-            if t2 <= t0:
-                vs[-1] = v2
-            else:
-                xs.append(xs[-1] + vs[-1] * (t2 - t0))
-                ts.append(t2)
-                vs.append(v2)
+            self._run_from(t2, v2)
+
+    def _run_from(self, t: float, v: float) -> None:
+        """Run at v from instant t on (at or before the last change: that change's speed is v)."""
+        ts, xs, vs = self._t, self._x, self._v
+        t0 = ts[-1]
+        if t <= t0:
+            vs[-1] = v
+        else:
+            xs.append(xs[-1] + vs[-1] * (t - t0))
+            ts.append(t)
+            vs.append(v)
 
     def _settle(self, n: int) -> None:
         """The first ``n`` changes are final: note their speeds and tell ``on_change``."""
@@ -231,8 +229,8 @@ class OutputConveyor:
         self.delivered = delivered
         self.last_td_x: float | None = None
         """Belt travel at the last touch-down (None before the first)."""
-        self.last_td_s: float | None = None
-        """Instant of the last touch-down (None before the first)."""
+        self.last_td_s = math.nan
+        """Instant of the last touch-down (read once ``last_td_x`` is set)."""
         self.replan = self.belt.plan
         """New speed plan from the controller (:meth:`Belt.plan`)."""
         self.process = env.process(self.run())
@@ -243,9 +241,9 @@ class OutputConveyor:
             part = yield get()
             td = part.touchdown_s = env._now
             x = travel(td)
-            last_x, last_td = self.last_td_x, self.last_td_s
-            if last_x is not None and last_td is not None:
+            last_x = self.last_td_x
+            if last_x is not None:
                 part.spacing_in = x - last_x
-                part.delivery_interval_s = td - last_td
+                part.delivery_interval_s = td - self.last_td_s
             self.last_td_x, self.last_td_s = x, td
             delivered(part)

@@ -60,8 +60,8 @@ BeltSink = Callable[[BeltChange], Any]
 _row = attrgetter(*PART_COLUMNS)
 _BELTS = ("input", "output")
 #: What the run's log keeps of each part for the summary (flags and picked as floats).
-PER_PART = ("touchdown", "picked", "r4", "output_speed", "ip_wallclock", "interval",
-            "spacing", "limits", "feed_delay")
+PER_PART = ("touchdown", "picked", "r4", "output_speed", "interval", "spacing", "limits",
+            "feed_delay")
 _PACK_PER_PART = struct.Struct(f"={len(PER_PART)}d").pack
 
 
@@ -126,20 +126,19 @@ class BeltLog:
         if not self.keep and self.sink is None:
             return None
         mark, times, speeds, sink = self.belt.append, self.t.append, self.v.append, self.sink
-        name = _BELTS[belt]
+
+        def keep(t: float, v: float) -> None:
+            mark(belt)
+            times(t)
+            speeds(v)
         if sink is None:
-            def keep(t: float, v: float) -> None:
-                mark(belt)
-                times(t)
-                speeds(v)
             return keep
+        name = _BELTS[belt]
         if not self.keep:
             return lambda t, v: sink(BeltChange(name, t, v))
 
         def both(t: float, v: float) -> None:
-            mark(belt)
-            times(t)
-            speeds(v)
+            keep(t, v)
             sink(BeltChange(name, t, v))
         return both
 
@@ -205,14 +204,14 @@ class RunLog:
             i = p.part
             t_next = t[i]
             d = p.delivery_interval_s
-            p.ip_wallclock = ip = t_next / d
+            p.ip_wallclock = t_next / d
             acct_part(p, t_next)
             flags = flags_of(i, 0)
             sp = p.spacing_in
             if sp == sp and abs(sp - spacing_in) > tol:
                 flags |= SPACING_OFF
             p.limits = (names_of(flags) or limit_names(flags)) if flags else ""
-            note(pack(p.touchdown_s, p.picked, p.r4_s, p.output_speed_in_s, ip, d, sp, flags,
+            note(pack(p.touchdown_s, p.picked, p.r4_s, p.output_speed_in_s, d, sp, flags,
                       p.feed_delay_s))
             if keep is not None:
                 keep(_row(p))
@@ -300,7 +299,7 @@ def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, 
     td = log.column("touchdown", w)
     picked = log.column("picked", w) != 0
     vout = log.column("output_speed", w)[picked]
-    ip_wall = log.column("ip_wallclock", w)
+    ip_wall = t[w + 1:] / log.column("interval", w)  # each part's IP, as its record has it
     sp = log.column("spacing", w)
     sp = sp[np.isfinite(sp)]
     limits = log.column("limits", w).astype(np.int_)
