@@ -22,6 +22,7 @@ from cell.assembly import (
 )
 from cell.mintime.regimes import plan_regimes, summary
 from cell.output import OutputDir
+from cell.reporting.headlines import table_head, table_row
 from cell.scenario import load_scenario
 
 SCENARIOS = {"kinematic": "mintime_kinematic.yaml", "dynamic": "baseline.yaml"}
@@ -98,12 +99,12 @@ def readme(c: dict) -> str:
         f"*Thesis logic*: only R IV shortened, R II at its nominal {c['R2_nominal_s']:.4f} s, which",
         "gives Table 7.1's 20.0907 s under constant rates. *Both fastest*: R II at its fastest too.",
         "",
-        "| timing model | R II (s) | R IV (s) | min cycle, thesis logic (s) | min cycle, both fastest (s) |",
-        "|---|---|---|---|---|",
+        *table_head(["timing model", "R II (s)", "R IV (s)", "min cycle, thesis logic (s)",
+                     "min cycle, both fastest (s)"]),
     ]
     for model, m in c["models"].items():
-        lines.append(f"| {model} | {m['R2_s']:.4f} | {m['R4_s']:.4f} | "
-                     f"{m['cycle_thesis_logic_s']:.4f} | {m['cycle_both_fastest_s']:.4f} |")
+        lines.append(table_row([model, *(f"{m[k]:.4f}" for k in (
+            "R2_s", "R4_s", "cycle_thesis_logic_s", "cycle_both_fastest_s"))]))
     lines += [
         "",
         "- *constant-rate*: each move at its slowest joint's peak step rate, instant speed",
