@@ -153,11 +153,12 @@ class RunLog:
     no per-part object outlives its part unless the run keeps the rows.
     """
 
-    def __init__(self, t: list[float], acct: Accounting, sinks: list[PartSink],
+    def __init__(self, t: list[float], acct: Accounting, sink: PartSink | None,
                  spacing_in: float, tol_in: float, rows: list[tuple[Any, ...]] | None = None):
         self.t = t
         """T_1 … T_{n+1}: the last is only part n's "next arrival"."""
-        self.acct, self.sinks = acct, sinks
+        self.acct, self.sink = acct, sink
+        """Told of every completed record, in part order (None: nobody asks)."""
         self.spacing_in, self.tol_in = spacing_in, tol_in
         self.rows = rows
         """The kept rows (parts.csv's columns), if the run keeps them."""
@@ -196,7 +197,7 @@ class RunLog:
         t, acct_part, flags_of = self.t, self.acct.part, self.flags.pop
         spacing_in, tol = self.spacing_in, self.tol_in + 1e-9
         note, pack = self.per_part.extend, _PACK_PER_PART
-        sinks = tuple(self.sinks)
+        sink = self.sink
         keep = self.rows.append if self.rows is not None else None
         names_of = LIMIT_NAMES.get  # limit_names' cache, read first
 
@@ -215,7 +216,7 @@ class RunLog:
                       p.feed_delay_s))
             if keep is not None:
                 keep(_row(p))
-            for sink in sinks:
+            if sink is not None:
                 sink(p)
         return emit
 
@@ -267,12 +268,11 @@ def simulate(scenario: Scenario | AssembledCell,
     t_list: list[float] = t_all.tolist()
 
     rows: list[tuple[Any, ...]] | None = [] if keep_parts else None
-    sinks: list[PartSink] = [on_part] if on_part is not None else []
     belts = BeltLog(keep_belts, on_belt)
 
     acct = policy.accounting()
     env = simpy.Environment()
-    log = RunLog(t_list, acct, sinks, k.spacing, k.tol, rows)
+    log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows)
     conveyor = InputConveyor(env, k.v_nom, k.input_length, belts.told(0))
     output = OutputConveyor(env, k.u_nom, log.delivered_part, belts.told(1))
     robot = Robot(env, output.placed)
