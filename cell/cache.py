@@ -72,7 +72,8 @@ class Memo(Generic[P, R]):
         return value
 
     def clear(self) -> None:
-        self._store.clear()
+        with self._lock:
+            self._store.clear()
 
     def __len__(self) -> int:
         return len(self._store)
