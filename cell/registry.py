@@ -55,6 +55,12 @@ def names() -> tuple[str, ...]:
     return tuple(dict.fromkeys([*BUILT_IN, *_registered, *_plugins()]))
 
 
+def known(name: str) -> bool:
+    """Whether a policy of that name exists (installed plug-ins looked up only if it is not
+    built in or registered: a scan of the installed packages, once a process)."""
+    return name in BUILT_IN or name in _registered or name in _plugins()
+
+
 def get(name: str) -> Any:
     """The policy class registered as ``name`` (KeyError if there is none)."""
     if name in _registered:

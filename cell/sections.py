@@ -236,7 +236,7 @@ class ControllerSettings(Section):
     @field_validator("policy")
     @classmethod
     def _known_policy(cls, value: str) -> str:
-        if value not in registry.names():
+        if not registry.known(value):
             raise ValueError("must be one of " + ", ".join(registry.names()))
         return value
 
