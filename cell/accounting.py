@@ -39,6 +39,11 @@ def parts_per_hr(actual_cycle_s: ArrayLike) -> NDArray[np.float64]:
     return 3600.0 / np.asarray(actual_cycle_s, dtype=float)
 
 
+def pct_off(actual_cycle_s: float, ideal_cycle_s: float) -> float:
+    """The actual cycle against the ideal one, % (§7.2's "within 2.1 %")."""
+    return 100.0 * (actual_cycle_s - ideal_cycle_s) / ideal_cycle_s
+
+
 def thesis_adaptive(next_interarrival_s: ArrayLike, time_between_deliveries_s: ArrayLike
                     ) -> Accounts:
     """Step 6.2 accounting: IP_i = T_{i+1} / D_i with D_i the robot's motion time

@@ -167,5 +167,5 @@ class AdaptiveAccounting(MotionTimeAccounting):
         memo = accounting.thesis_adaptive_memoryless(t_next[start:], k.cycle_nom,
                                                      k.shortest_cycle_s)
         s.ip_thesis_memoryless = float(memo.mean_ip)
-        s.cycle_vs_nominal_memoryless_pct = \
-            100.0 * (float(memo.actual_cycle_s) - k.cycle_nom) / k.cycle_nom
+        s.cycle_vs_nominal_memoryless_pct = accounting.pct_off(float(memo.actual_cycle_s),
+                                                               k.cycle_nom)

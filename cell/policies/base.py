@@ -193,12 +193,12 @@ class MotionTimeAccounting(Accounting):
 
     def finish(self, s: RunSummary, start: int, picked_r4_s: np.ndarray,
                t_next: np.ndarray) -> None:
-        k = self.policy.k
         thesis = accounting.thesis_adaptive(t_next[start:], np.frombuffer(self.interval)[start:])
         s.parts_missed_thesis = self._lost_after(start)
         s.actual_cycle_thesis_s = float(thesis.actual_cycle_s)
         s.ip_thesis = float(thesis.mean_ip)
-        s.cycle_vs_nominal_pct = 100.0 * (s.actual_cycle_thesis_s - k.cycle_nom) / k.cycle_nom
+        s.cycle_vs_nominal_pct = accounting.pct_off(s.actual_cycle_thesis_s,
+                                                    self.policy.ideal_cycle_s)
         s.r4_s = float(picked_r4_s.mean()) if picked_r4_s.size else math.nan
 
 

@@ -101,6 +101,6 @@ class ReconstructedAccounting(Accounting):
         s.actual_cycle_thesis_s = float(d.sum() / (len(d) - missed)) if len(d) > missed \
             else math.nan
         s.ip_thesis = float(ip.mean()) if len(ip) else math.nan
-        s.cycle_vs_nominal_pct = 100.0 * (s.actual_cycle_thesis_s - ideal) / ideal
+        s.cycle_vs_nominal_pct = accounting.pct_off(s.actual_cycle_thesis_s, ideal)
         s.r4_s = self.policy.cycle.r4
         s.thesis_slack_s = accounting.THESIS_SLACK_S
