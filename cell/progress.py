@@ -64,6 +64,13 @@ class Progress:
         """Whether progress goes out as plain lines (enabled, and not a terminal)."""
         return self.enabled and self.bar is None
 
+    def grow(self, n: int) -> None:
+        """``n`` more units of work than first said (a sweep's next round)."""
+        self.total += n
+        if self.bar is not None:
+            self.bar.total = self.total
+            self.bar.refresh()
+
     def update(self, n: int = 1) -> None:
         """``n`` more units done."""
         self.n += n

@@ -145,6 +145,19 @@ class Outcome:
         return pd.read_csv(self.path)
 
 
+def check_workers(workers: int | None, scheduler: str | None = None) -> int:
+    """The number of local workers (None: one a core); refused below 1, or above
+    :data:`WORKERS_PER_CORE` a core unless the tasks go to a dask cluster."""
+    cores = os.cpu_count() or 1
+    workers = cores if workers is None else workers
+    if workers < 1:
+        raise CellError(f"--workers {workers}: must be at least 1")
+    if workers > WORKERS_PER_CORE * cores and not scheduler:
+        raise CellError(f"--workers {workers}: at most {WORKERS_PER_CORE * cores} on this "
+                        f"machine ({cores} cores)")
+    return workers
+
+
 def _open_executor(workers: int, scheduler: str | None, say: bool = True
                    ) -> tuple[cf.Executor | None, Any]:
     """The executor for the tasks (None: run in this process) and a client to close;
@@ -250,13 +263,7 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     It must be a module-level function when tasks run in other processes.
     """
     out = check_out(out)
-    cores = os.cpu_count() or 1
-    workers = cores if workers is None else workers
-    if workers < 1:
-        raise CellError(f"--workers {workers}: must be at least 1")
-    if workers > WORKERS_PER_CORE * cores and not scheduler:
-        raise CellError(f"--workers {workers}: at most {WORKERS_PER_CORE * cores} on this "
-                        f"machine ({cores} cores)")
+    workers = check_workers(workers, scheduler)
     executor, client = _open_executor(workers, scheduler, progress)
     window = CLUSTER_WINDOW if scheduler else 2 * workers
     columns = grid_columns(sweep)
@@ -300,10 +307,7 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
                 reached = precision_reached(values, q.precision, q.confidence, q.min_n)
                 more = next_round(counts, reached, sweep.batch, q.max_n)
                 ranges = {p: (counts[p], counts[p] + k) for p, k in more.items() if k}
-                bar.total += sum(more.values())
-                if bar.bar is not None:  # the terminal's bar grows with the round
-                    bar.bar.total = bar.total
-                    bar.bar.refresh()
+                bar.grow(sum(more.values()))
     except BaseException:
         _close(executor, client, wait=False)
         raise
