@@ -42,9 +42,9 @@ def workers_argument(p: argparse.ArgumentParser) -> None:
                    help="local worker processes (default: number of cores)")
 
 
-def check_workers(workers: int | None) -> None:
-    """Refuse ``--workers`` below 1 before any work."""
-    from cell.errors import CellError
+def check_workers(workers: int | None, scheduler: str | None = None) -> None:
+    """Refuse a ``--workers`` the sweep would refuse, before any work
+    (:func:`cell.sweep.runner.check_workers`)."""
+    from cell.sweep.runner import check_workers as check
 
-    if workers is not None and workers < 1:
-        raise CellError(f"--workers {workers}: must be at least 1")
+    check(workers, scheduler)

@@ -51,8 +51,8 @@ def _sweep(args: argparse.Namespace) -> int:
     from cell.sweep.outdir import check_out
 
     check_out(args.out)  # before the sweep file's points are built and checked
+    check_workers(args.workers, args.scheduler)
     sweep = load_sweep(args.sweep)
-    check_workers(args.workers)
     target = None
     if args.report:
         from cell.reporting.experiment import plan_report
