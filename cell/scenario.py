@@ -211,8 +211,14 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
     if given.get("name") in (None, ""):  # a file without a name goes by the file's
         given = {**given, "name": path.stem}
     raw = merge(_DEFAULTS.to_dict(), given, (), is_section)
-    raw = apply_overrides(raw, overrides or {}, path, is_section)
-    return validate(raw, path, source=str(path))
+    try:
+        return validate(apply_overrides(raw, overrides or {}, path, is_section), path,
+                        source=str(path))
+    except ScenarioError as exc:  # a value from --set: the line says so
+        if not overrides or not any(exc.key == k or exc.key.startswith(k + ".")
+                                    or k.startswith(exc.key + ".") for k in overrides):
+            raise
+        raise ScenarioError(f"{path} (--set)", exc.key, exc.value, exc.why) from None
 
 
 def default_scenario() -> Scenario:

@@ -62,6 +62,23 @@ def test_overrides_are_validated():
         default_scenario().with_overrides({"run.parts": 0})
 
 
+def test_an_error_in_a_set_value_says_it_came_from_set(tmp_path):
+    """A bad --set value is not the file's fault: the line says where it came from."""
+    path = tmp_path / "mine.yaml"
+    path.write_text("run: {parts: 0}\n")
+    with pytest.raises(ScenarioError) as from_file:
+        load_scenario(path)
+    assert "(--set)" not in str(from_file.value)
+    for sets, key in [({"run.parts": 0}, "run.parts"), ({"run": {"parts": 0}}, "run.parts"),
+                      ({"arrivals.params.scale": -1.0}, "arrivals.params")]:
+        with pytest.raises(ScenarioError) as err:
+            load_scenario("baseline", sets)
+        assert err.value.key == key and "baseline.yaml (--set)" in str(err.value)
+    with pytest.raises(ScenarioError) as other:  # a --set that is fine; the file's value is not
+        load_scenario(path, {"run.seed": 3})
+    assert "(--set)" not in str(other.value)
+
+
 def test_known_key():
     assert known_key("controller.ideal_cycle_s")
     assert known_key("robot.motors.nominal_fraction")
