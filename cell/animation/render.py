@@ -36,11 +36,10 @@ from cell.animation.scene import (
     OUTPUT,
     Floats,
     Scene,
-    arm_pose,
     belt_speed,
     counts_at,
     parts_at,
-    robot_state,
+    robot_at,
 )
 from cell.figures.layout import BELT_COLOUR, named_points
 from cell.figures.style import LIMIT_COLOUR, POLICY_COLOURS, REGIME_COLOURS, REGIME_LABELS, style
@@ -217,7 +216,9 @@ def draw_frame(panel: Panel, t: float) -> None:
     sc = panel.scene
     d = sc.data
     size = sc.scenario.part.size_in
-    at = parts_at(sc, t)
+    robot = robot_at(sc, t)  # once a frame: the arm, and where a part in its hand is
+    state, pose = robot
+    at = parts_at(sc, t, robot)
     falling = at.where == FALLING
     face = np.tile(np.array(to_rgba(PART_COLOUR)), (len(d.part), 1))
     edge = np.tile(np.array(to_rgba(PART_EDGE)), (len(d.part), 1))
@@ -248,8 +249,6 @@ def draw_frame(panel: Panel, t: float) -> None:
         if k + 1 < len(ys):
             gap.set_position(((ys[k] + ys[k + 1]) / 2, sc.td_xy[0]))
             gap.set_text(f"{ys[k + 1] - ys[k]:.2f} in")
-    state = robot_state(sc, t)
-    pose = arm_pose(sc.scenario, state.q_rad, state.opening_in)
     j = pose.joints[0]
     reg = int(state.regime[0])
     colour = REGIME_COLOURS.get(reg, IDLE_COLOUR)

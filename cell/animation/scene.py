@@ -308,8 +308,18 @@ class PartsAt:
     """(n,) opacity: 1, fading to 0 over FALL_S once it has fallen."""
 
 
-def parts_at(scene: Scene, t: float) -> PartsAt:
-    """Every part's place at instant t (see the module's docstring)."""
+def robot_at(scene: Scene, t: float) -> tuple[RobotState, ArmPose]:
+    """The robot's joints and its arm's pose at one instant (leading dimension 1)."""
+    state = robot_state(scene, t)
+    return state, arm_pose(scene.scenario, state.q_rad, state.opening_in)
+
+
+def parts_at(scene: Scene, t: float, robot: tuple[RobotState, ArmPose] | None = None) -> PartsAt:
+    """Every part's place at instant t (see the module's docstring).
+
+    ``robot``: :func:`robot_at` of the same instant, if the caller has it already (a
+    part in the hand is where the tool centre is); else it is worked out when needed.
+    """
     d = scene.data
     n = len(d.part)
     xy = np.full((n, 2), np.nan)
@@ -331,8 +341,8 @@ def parts_at(scene: Scene, t: float) -> PartsAt:
     angle[falling] = FALL_TURN_RAD
     alpha[falling] = np.clip(1.0 - (t - scene.fall_s[falling]) / FALL_S, 0.0, 1.0)
     if held.any():
-        state = robot_state(scene, t)
-        xy[held] = arm_pose(scene.scenario, state.q_rad, state.opening_in).tcp[0, :2]
+        state, pose = robot if robot is not None else robot_at(scene, t)
+        xy[held] = pose.tcp[0, :2]
         angle[held] = state.phi_rad[0]
         where[held] = HAND
     y_out = scene.td_xy[1] + travel(d.output_belt, t) - scene.touchdown_travel_in

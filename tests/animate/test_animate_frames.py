@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cell.animation.scene import ABSENT, OUTPUT, Scene, parts_at
+from cell.animation.scene import ABSENT, HAND, OUTPUT, Scene, parts_at
 from cell.scenario import Scenario
 
 from .helpers import integrated, named_points, output_reach, sample_times, square_centres
@@ -120,3 +120,31 @@ def test_a_lone_part_at_the_strips_end_shows_nothing_past_it(scenes: list[Scene]
     empty = pixels_past_the_end([])
     np.testing.assert_array_equal(pixels_past_the_end([end, end - 3 * size]), empty)
     np.testing.assert_array_equal(pixels_past_the_end([end]), empty)
+
+
+def test_a_frame_looks_the_robot_up_once_and_draws_the_held_part_between_the_fingers(
+        scenes: list[Scene], monkeypatch: pytest.MonkeyPatch) -> None:
+    """While a part is in the hand, one frame asks for the joints once, and the part (its
+    number) is drawn midway between the finger tips drawn in the same frame."""
+    from cell.animation import render, scene
+    from cell.animation.render import build_figure, draw_frame
+
+    sc = scenes[0]
+    d = sc.data
+    i = int(np.flatnonzero(d.picked)[1])
+    t = float(d.pick_s[i] + d.touchdown_s[i]) / 2
+    assert parts_at(sc, t).where[i] == HAND
+    panel = build_figure(scenes, dpi=20.0)[1][0]
+    asked: list[object] = []
+    original = scene.robot_state
+
+    def counted(*args: object) -> object:
+        asked.append(args[1])
+        return original(*args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(scene, "robot_state", counted)
+    monkeypatch.setattr(render, "robot_state", counted, raising=False)
+    draw_frame(panel, t)
+    assert asked == [t]
+    fingers = np.column_stack(panel.arm[2].get_data())
+    assert panel.labels[i].get_position() == pytest.approx(fingers.mean(axis=0), abs=1e-9)
