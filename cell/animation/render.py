@@ -36,13 +36,13 @@ from cell.animation.scene import (
     OUTPUT,
     Floats,
     Scene,
-    belt_speed,
     counts_at,
     parts_at,
     robot_at,
 )
 from cell.figures.layout import BELT_COLOUR, named_points
 from cell.figures.style import LIMIT_COLOUR, POLICY_COLOURS, REGIME_COLOURS, REGIME_LABELS, style
+from cell.figures.tip import belt_speed_at
 
 PART_COLOUR = "#d9a441"
 PART_EDGE = "#5c4510"
@@ -264,7 +264,7 @@ def draw_frame(panel: Panel, t: float) -> None:
     texts["tally"].set_text(f"arrived {n.arrived:3d}   delivered {n.delivered:3d}")
     texts["lost"].set_text(f"lost {n.lost:3d} (fell off at F)")
     texts["lost"].set_color(LOST_COLOUR if n.lost else "black")
-    v_in, v_out = float(belt_speed(d.input_belt, t)), float(belt_speed(d.output_belt, t))
+    v_in, v_out = belt_speed_at(d.input_belt, t), belt_speed_at(d.output_belt, t)
     texts["belts"].set_text(f"input belt  {v_in:5.2f} in/s\noutput belt {v_out:5.2f} in/s")
     texts["robot"].set_text(f"robot: {REGIME_LABELS[reg]}, part {d.part[state.part[0]]}" if reg
                             else "robot: waiting at B")

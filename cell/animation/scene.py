@@ -26,7 +26,6 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cell.conveyors import speed_at
 from cell.kinematics import Arm, forward, hand_frame
 from cell.scenario import Scenario
 from cell.steptable import StepTable
@@ -134,12 +133,6 @@ def time_at(history: ArrayLike, x: ArrayLike) -> Floats:
     x = np.asarray(x, dtype=float)
     k = np.clip(np.searchsorted(knots, x, side="right") - 1, 0, len(start) - 1)
     return start[k] + (x - knots[k]) / h[k, 1]
-
-
-def belt_speed(history: ArrayLike, t: float) -> float:
-    """The belt's speed at t (a change at t already holds): the conveyors' own lookup."""
-    h = np.asarray(history, dtype=float).reshape(-1, 2)
-    return speed_at(h[:, 0].tolist(), h[:, 1].tolist(), float(t))
 
 
 # --------------------------------------------------------------------------- the scene
