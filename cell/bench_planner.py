@@ -15,9 +15,16 @@ its default grid against the converged time, from the planner on 460·2^k points
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from cell.stopwatch import best_seconds
+
+if TYPE_CHECKING:
+    from cell.mintime.regimes import PlannerBounds, RegimePath
+    from cell.motors import Motors
+    from cell.path import CellGeometry
 
 RICHARDSON = tuple(460 * 2 ** k for k in range(5))
 
@@ -27,12 +34,22 @@ def converged_time(times: list[float]) -> float:
     return times[-1] + (times[-1] - times[-2]) / 3.0
 
 
+def regime_time(rp: RegimePath, motors: Motors, bounds: PlannerBounds, geometry: CellGeometry,
+                n: int | None = None) -> float:
+    """One regime's minimum time (s) on n grid points (None: the bounds' own), planned alone:
+    what :func:`~cell.mintime.regimes.plan_regimes` gives for it, without the other regime."""
+    from cell.mintime.planner import plan
+    from cell.mintime.regimes import regime_rows
+
+    return plan(regime_rows(rp, motors, bounds, geometry, n)[2]).time_s
+
+
 def benchmarks(repeat: int = 5) -> dict[str, float]:
     from cell.assembly import geometry_of, motors_of, planner_bounds, step_table
     from cell.dynamics import chain
     from cell.mintime.planner import PathRows, path_grid, plan, torque_rows, velocity_rows
     from cell.mintime.reference import toppra_profile
-    from cell.mintime.regimes import FREE_REGIMES, plan_regimes, regime_path, regime_rows
+    from cell.mintime.regimes import FREE_REGIMES, regime_path, regime_rows
     from cell.scenario import load_scenario
 
     kin = load_scenario("mintime_kinematic")
@@ -43,7 +60,7 @@ def benchmarks(repeat: int = 5) -> dict[str, float]:
     vmax = {rp.regime: regime_rows(rp, motors, bounds, geometry, 3)[3] for rp in paths}
 
     def ours(n: int) -> list[float]:
-        return [plan(regime_rows(rp, motors, bounds, geometry, n)[2]).time_s for rp in paths]
+        return [regime_time(rp, motors, bounds, geometry, n) for rp in paths]
 
     def theirs(n: int) -> list[float]:
         s = path_grid(n)
@@ -82,9 +99,9 @@ def benchmarks(repeat: int = 5) -> dict[str, float]:
     out["mintime_torque_ms_460"] = 1e3 * best_seconds(ours_tau, 3)
     out["toppra_torque_ms_460"] = 1e3 * best_seconds(theirs_tau, 1)
 
-    r4_times = [plan_regimes(base_geometry, base_motors, base_bounds, n)["R4"].profile.time_s
-                for n in RICHARDSON]
-    default = plan_regimes(base_geometry, base_motors, base_bounds)["R4"].profile.time_s
+    base_r4 = regime_path(step_table(base), "R4", base_geometry)
+    r4_times = [regime_time(base_r4, base_motors, base_bounds, base_geometry, n) for n in RICHARDSON]
+    default = regime_time(base_r4, base_motors, base_bounds, base_geometry)
     t_inf = converged_time(r4_times)
     out["mintime_r4_dynamic_rel_err"] = abs(default - t_inf) / t_inf
     return {k: round(v, 3) if "ms" in k else v for k, v in out.items()}

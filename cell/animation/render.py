@@ -36,14 +36,13 @@ from cell.animation.scene import (
     OUTPUT,
     Floats,
     Scene,
-    arm_pose,
-    belt_speed,
     counts_at,
     parts_at,
-    robot_state,
+    robot_at,
 )
 from cell.figures.layout import BELT_COLOUR, named_points
 from cell.figures.style import LIMIT_COLOUR, POLICY_COLOURS, REGIME_COLOURS, REGIME_LABELS, style
+from cell.figures.tip import belt_speed_at
 
 PART_COLOUR = "#d9a441"
 PART_EDGE = "#5c4510"
@@ -217,7 +216,9 @@ def draw_frame(panel: Panel, t: float) -> None:
     sc = panel.scene
     d = sc.data
     size = sc.scenario.part.size_in
-    at = parts_at(sc, t)
+    robot = robot_at(sc, t)  # once a frame: the arm, and where a part in its hand is
+    state, pose = robot
+    at = parts_at(sc, t, robot)
     falling = at.where == FALLING
     face = np.tile(np.array(to_rgba(PART_COLOUR)), (len(d.part), 1))
     edge = np.tile(np.array(to_rgba(PART_EDGE)), (len(d.part), 1))
@@ -248,8 +249,6 @@ def draw_frame(panel: Panel, t: float) -> None:
         if k + 1 < len(ys):
             gap.set_position(((ys[k] + ys[k + 1]) / 2, sc.td_xy[0]))
             gap.set_text(f"{ys[k + 1] - ys[k]:.2f} in")
-    state = robot_state(sc, t)
-    pose = arm_pose(sc.scenario, state.q_rad, state.opening_in)
     j = pose.joints[0]
     reg = int(state.regime[0])
     colour = REGIME_COLOURS.get(reg, IDLE_COLOUR)
@@ -265,7 +264,7 @@ def draw_frame(panel: Panel, t: float) -> None:
     texts["tally"].set_text(f"arrived {n.arrived:3d}   delivered {n.delivered:3d}")
     texts["lost"].set_text(f"lost {n.lost:3d} (fell off at F)")
     texts["lost"].set_color(LOST_COLOUR if n.lost else "black")
-    v_in, v_out = float(belt_speed(d.input_belt, t)), float(belt_speed(d.output_belt, t))
+    v_in, v_out = belt_speed_at(d.input_belt, t), belt_speed_at(d.output_belt, t)
     texts["belts"].set_text(f"input belt  {v_in:5.2f} in/s\noutput belt {v_out:5.2f} in/s")
     texts["robot"].set_text(f"robot: {REGIME_LABELS[reg]}, part {d.part[state.part[0]]}" if reg
                             else "robot: waiting at B")

@@ -26,7 +26,6 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cell.conveyors import speed_at
 from cell.kinematics import Arm, forward, hand_frame
 from cell.scenario import Scenario
 from cell.steptable import StepTable
@@ -134,12 +133,6 @@ def time_at(history: ArrayLike, x: ArrayLike) -> Floats:
     x = np.asarray(x, dtype=float)
     k = np.clip(np.searchsorted(knots, x, side="right") - 1, 0, len(start) - 1)
     return start[k] + (x - knots[k]) / h[k, 1]
-
-
-def belt_speed(history: ArrayLike, t: float) -> float:
-    """The belt's speed at t (a change at t already holds): the conveyors' own lookup."""
-    h = np.asarray(history, dtype=float).reshape(-1, 2)
-    return speed_at(h[:, 0].tolist(), h[:, 1].tolist(), float(t))
 
 
 # --------------------------------------------------------------------------- the scene
@@ -308,8 +301,18 @@ class PartsAt:
     """(n,) opacity: 1, fading to 0 over FALL_S once it has fallen."""
 
 
-def parts_at(scene: Scene, t: float) -> PartsAt:
-    """Every part's place at instant t (see the module's docstring)."""
+def robot_at(scene: Scene, t: float) -> tuple[RobotState, ArmPose]:
+    """The robot's joints and its arm's pose at one instant (leading dimension 1)."""
+    state = robot_state(scene, t)
+    return state, arm_pose(scene.scenario, state.q_rad, state.opening_in)
+
+
+def parts_at(scene: Scene, t: float, robot: tuple[RobotState, ArmPose] | None = None) -> PartsAt:
+    """Every part's place at instant t (see the module's docstring).
+
+    ``robot``: :func:`robot_at` of the same instant, if the caller has it already (a
+    part in the hand is where the tool centre is); else it is worked out when needed.
+    """
     d = scene.data
     n = len(d.part)
     xy = np.full((n, 2), np.nan)
@@ -331,8 +334,8 @@ def parts_at(scene: Scene, t: float) -> PartsAt:
     angle[falling] = FALL_TURN_RAD
     alpha[falling] = np.clip(1.0 - (t - scene.fall_s[falling]) / FALL_S, 0.0, 1.0)
     if held.any():
-        state = robot_state(scene, t)
-        xy[held] = arm_pose(scene.scenario, state.q_rad, state.opening_in).tcp[0, :2]
+        state, pose = robot if robot is not None else robot_at(scene, t)
+        xy[held] = pose.tcp[0, :2]
         angle[held] = state.phi_rad[0]
         where[held] = HAND
     y_out = scene.td_xy[1] + travel(d.output_belt, t) - scene.touchdown_travel_in

@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 import scipy.stats
+from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
 from cell.arrivals import parameters
@@ -39,6 +40,23 @@ def _params_note(s: Scenario, x: NDArray[np.float64]) -> str:
     return f"{s.arrivals.distribution}({p}): mean {d.mean():.3f} s, sd {d.std():.3f} s; {seen}"
 
 
+#: Titles' names of the families most used for arrivals; any other goes by its scipy name.
+FAMILY_NAMES = {"weibull_min": "Weibull", "gamma": "Gamma", "lognorm": "Lognormal",
+                "expon": "Exponential", "norm": "Normal"}
+#: What Fig. 13 and 14 draw of a trace, which has no distribution: its data only.
+TRACE_CURVES = {"pdf": "Histogram", "cdf": "Empirical cdf"}
+
+
+def caption(s: Scenario, curve: str) -> str:
+    """Fig. 13's (``curve`` "pdf") or 14's ("cdf") caption, after what is drawn: the
+    family's curve (the thesis's "Weibull pdf of the Inter-arrival Times" for eq. 6.9), or a
+    trace's histogram or empirical cdf."""
+    if s.arrivals.trace_csv is not None:
+        return f"{TRACE_CURVES[curve]} of the Inter-arrival Times (trace)"
+    family = s.arrivals.distribution
+    return f"{FAMILY_NAMES.get(family, family)} {curve} of the Inter-arrival Times"
+
+
 def _grid(s: Scenario, x: NDArray[np.float64]) -> NDArray[np.float64]:
     d = distribution(s)
     lo, hi = float(x.min()), float(x.max())
@@ -47,8 +65,9 @@ def _grid(s: Scenario, x: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.linspace(lo - 0.5, hi + 0.5, 600)
 
 
-def fig13_pdf(s: Scenario, x: NDArray[np.float64], out: Path) -> Path:
-    fig, ax = new_figure(13, "Weibull pdf of the Inter-arrival Times")
+def fig13_figure(s: Scenario, x: NDArray[np.float64]) -> Figure:
+    """Fig. 13, the draws' histogram under the distribution's pdf (not saved)."""
+    fig, ax = new_figure(13, caption(s, "pdf"))
     d = distribution(s)
     t = _grid(s, x)
     heights, _, _ = ax.hist(x, bins=30, density=True, color="#9ecae1", edgecolor="white",
@@ -66,11 +85,16 @@ def fig13_pdf(s: Scenario, x: NDArray[np.float64], out: Path) -> Path:
     ax.set_ylim(0, 1.45 * top)
     ax.legend(loc="upper left")
     ax.set_title(_params_note(s, x), loc="left", fontsize=8.5)
-    return save(fig, out)
+    return fig
 
 
-def fig14_cdf(s: Scenario, x: NDArray[np.float64], out: Path) -> Path:
-    fig, ax = new_figure(14, "Weibull cdf of the Inter-arrival Times")
+def fig13_pdf(s: Scenario, x: NDArray[np.float64], out: Path) -> Path:
+    return save(fig13_figure(s, x), out)
+
+
+def fig14_figure(s: Scenario, x: NDArray[np.float64]) -> Figure:
+    """Fig. 14, the draws' empirical cdf under the distribution's cdf (not saved)."""
+    fig, ax = new_figure(14, caption(s, "cdf"))
     d = distribution(s)
     t = _grid(s, x)
     xs = np.sort(x)
@@ -93,4 +117,8 @@ def fig14_cdf(s: Scenario, x: NDArray[np.float64], out: Path) -> Path:
     ax.set_xlim(t[0], t[-1])
     ax.legend(loc="lower right")
     ax.set_title(title, loc="left", fontsize=9)
-    return save(fig, out)
+    return fig
+
+
+def fig14_cdf(s: Scenario, x: NDArray[np.float64], out: Path) -> Path:
+    return save(fig14_figure(s, x), out)

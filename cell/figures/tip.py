@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.artist import Artist
 from matplotlib.figure import Figure
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from cell.assembly import nominal_cycle
 from cell.conveyors import speed_at
@@ -54,9 +54,13 @@ def part_segments(row: pd.Series) -> dict[str, float]:
                            float(row["touchdown_s"]), [row[f"r{r}_s"] for r in (1, 2, 3, 4)])
 
 
-def belt_speed_at(history: list[tuple[float, float]], when: float) -> float:
-    """Speed of a belt at an instant, from its (instant, speed) changes."""
-    return speed_at([t for t, _ in history], [v for _, v in history], when + 1e-9)
+def belt_speed_at(history: ArrayLike, when: float) -> float:
+    """A belt's speed at an instant, from its rows (instant, speed) in time order: the
+    conveyors' own look-up (:func:`cell.conveyors.speed_at`), so a change at that very
+    instant already holds.  The run records the input belt's change at LO at the part's
+    ``pick_s`` exactly (both are B + the look-ahead lag), so LO needs no nudge."""
+    h = np.asarray(history, dtype=float).reshape(-1, 2)
+    return float(speed_at(h[:, 0].tolist(), h[:, 1].tolist(), float(when)))
 
 
 def pick_transfer(run: Run) -> int:
@@ -64,7 +68,7 @@ def pick_transfer(run: Run) -> int:
     LO (the next part is late, step 3.1), the one with the longest lag before it
     may, as in the thesis's example (§7.1)."""
     d = run.parts
-    hist = run.belts["input"]
+    hist = np.asarray(run.belts["input"], dtype=float)  # converted once, not per look-up
     best, lag = 0, -np.inf
     for i in np.flatnonzero(d["picked"].to_numpy(dtype=bool))[1:-1]:
         row = d.iloc[i]
