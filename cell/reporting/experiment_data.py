@@ -12,7 +12,6 @@ from __future__ import annotations
 import warnings
 from collections.abc import Sequence
 
-import numpy as np
 import pandas as pd
 
 from cell.analysis.stats import PAIRED_KEYS, SUMMARY_KEYS, paired_difference, summarise
@@ -47,18 +46,6 @@ def _plain(value: object) -> object:
     return value.item() if hasattr(value, "item") else value
 
 
-def _exact(stats: dict[str, float], x: np.ndarray) -> dict[str, float]:
-    """Values (or differences) all equal: no variation, exactly -- the sd the mean's
-    rounding leaves (1e-15 of it) is not a spread between replications."""
-    x = x[~np.isnan(x)]
-    if x.size >= 2 and np.all(x == x[0]) and stats["sd"] != 0.0:
-        stats = {**stats, "mean": float(x[0]), "sd": 0.0, "ci_low": float(x[0]),
-                 "ci_high": float(x[0])}
-        if "p_value" in stats:
-            stats["p_value"] = float("nan")
-    return stats
-
-
 def summary_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     """``summary.csv``: every point, policy and measure with its statistics."""
     columns, names = grid_columns(sweep), measures(replications, sweep)
@@ -68,7 +55,7 @@ def summary_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
         keys = grid_values(runs, columns)
         for m in names:
             x = runs[m].to_numpy(dtype=float)
-            s = _exact(summarise(x, sweep.confidence), x)
+            s = summarise(x, sweep.confidence)
             rows.append({**keys, "policy": p.policy, "measure": m, **s})
     return pd.DataFrame(rows, columns=[*(c.name for c in columns), "policy", "measure",
                                        *SUMMARY_KEYS])
@@ -94,7 +81,7 @@ def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
             with warnings.catch_warnings():  # nearly equal pairs: scipy warns, the sd says it
                 warnings.filterwarnings("ignore", "Precision loss", RuntimeWarning)
                 x, y = both[m].to_numpy(dtype=float), both[m + "@b"].to_numpy(dtype=float)
-                d = _exact(paired_difference(x, y, sweep.confidence), x - y)
+                d = paired_difference(x, y, sweep.confidence)
             rows.append({**keys, "policy": a.policy, "versus": pair.label, "measure": m, **d})
     return pd.DataFrame(rows, columns=[*[c.name for c in columns], "policy", "versus", "measure",
                                        *PAIRED_KEYS])
