@@ -120,14 +120,14 @@ def main(args: argparse.Namespace) -> int:
         replications = outcome.replications
     from cell.reporting.experiment import difference_table, summary_table
 
-    print(verdict(summary_table(replications, sweep), difference_table(replications, sweep),
-                  sweep))
+    tables = summary_table(replications, sweep), difference_table(replications, sweep)
+    print(verdict(*tables, sweep))
     if target is not None:
         from cell.reporting.experiment import write_report
 
         command = (f"cell compare {args.a} {args.b} --replications {args.replications} "
                    f"--seed {seed}")
-        write_report(replications, sweep, target, command, warning)
+        write_report(replications, sweep, target, command, warning, tables)
         print(f"wrote {args.out}/: report.md, summary.csv, differences.csv, figures, "
               "replications.csv")
     return 0

@@ -89,11 +89,13 @@ def _shared(path: Path, names: Sequence[str]) -> bool:
 
 
 def write_report(replications: pd.DataFrame, sweep: Sweep, target: Target,
-                 command: str, caveat: str | None = None) -> list[Path]:
+                 command: str, caveat: str | None = None,
+                 tables: tuple[pd.DataFrame, pd.DataFrame] | None = None) -> list[Path]:
     """Write the report (see the module's docstring); return the paths written.
-    A target that names ``replications.csv`` gets the replications too."""
-    summary = summary_table(replications, sweep)
-    differences = difference_table(replications, sweep)
+    A target that names ``replications.csv`` gets the replications too.  ``tables``:
+    the summary and difference tables if already made from these replications."""
+    summary, differences = tables or (summary_table(replications, sweep),
+                                      difference_table(replications, sweep))
     pngs = figures(summary, replications, sweep)
     text = markdown(summary, differences, replications, sweep, command, list(pngs), caveat)
     written = []
