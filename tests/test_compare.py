@@ -211,3 +211,9 @@ def test_compare_report_carries_the_window_caveat(tmp_path, capsys):
     assert report.index("**Caveat:**") < report.index("## ")
     compare_run(capsys, a, b, "--out", str(tmp_path / "same"), "--set", "run.parts=45")
     assert "Caveat" not in (tmp_path / "same" / "report.md").read_text()
+    # differences.csv: the counts only over the same window, the rates either way
+    differ, same = (set(pd.read_csv(tmp_path / d / "differences.csv")["measure"])
+                    for d in ("differ", "same"))
+    counts = {"parts_delivered", "parts_missed", "spacing_outside_tol"}
+    assert counts <= same and not counts & differ
+    assert "parts_per_hr_wallclock" in differ & same

@@ -16,6 +16,7 @@ import pandas as pd
 
 from cell.analysis.stats import PAIRED_KEYS, SUMMARY_KEYS, paired_difference, summarise
 from cell.sweep import Column, Sweep, grid_columns
+from cell.sweep.windows import count_measures, pair_apart
 
 #: Columns of replications.csv that are not measures.
 NOT_MEASURES = {"policy", "point", "seed", "replication"}
@@ -65,11 +66,14 @@ def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     """``differences.csv``: each pair of points, replication by replication, per measure.
 
     The grid columns hold the compared point's values, or its partner's for a key
-    only the partner varies.
+    only the partner varies.  A pair whose points count over different windows
+    (:mod:`cell.sweep.windows`) has no rows for the counts.
     """
     columns, names = grid_columns(sweep), measures(replications, sweep)
+    counts = set(count_measures())
     rows = []
     for pair in sweep.pairs():
+        compared = [m for m in names if m not in counts] if pair_apart(sweep, pair) else names
         a, b = sweep.points[pair.point], sweep.points[pair.versus]
         runs_a, runs_b = runs_of(replications, sweep, pair.point), \
             runs_of(replications, sweep, pair.versus)
@@ -77,7 +81,7 @@ def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
         keys = {c.name: theirs[c.name] if c.key in dict(b.values) and c.key not in dict(a.values)
                 else mine[c.name] for c in columns}
         both = runs_a.merge(runs_b, on="replication", suffixes=("", "@b"))
-        for m in names:
+        for m in compared:
             with warnings.catch_warnings():  # nearly equal pairs: scipy warns, the sd says it
                 warnings.filterwarnings("ignore", "Precision loss", RuntimeWarning)
                 x, y = both[m].to_numpy(dtype=float), both[m + "@b"].to_numpy(dtype=float)
