@@ -74,6 +74,22 @@ def test_compare_paired_interval_is_scipys(tmp_path, capsys):
     assert set(reps["seed"]) == {1984}  # A's run.seed
 
 
+def test_compare_out_makes_each_table_once(tmp_path, capsys, monkeypatch):
+    """The verdict and ``--out``'s files come from one summary and one difference table."""
+    import cell.reporting.experiment as experiment
+
+    made: list[str] = []
+    for name in ("summary_table", "difference_table"):
+        real = getattr(experiment, name)
+        monkeypatch.setattr(experiment, name,
+                            lambda *a, _real=real, _name=name: made.append(_name) or _real(*a))
+    a = scenario(tmp_path, "one", run__parts=20)
+    b = scenario(tmp_path, "two", run__parts=20, controller__policy="non-adaptive")
+    compare_run(capsys, a, b, "--out", str(tmp_path / "cmp"))
+    assert sorted(made) == ["difference_table", "summary_table"]
+    assert {"summary.csv", "differences.csv"} <= {p.name for p in (tmp_path / "cmp").iterdir()}
+
+
 def test_verdict_says_which_is_better_on_each_measure():
     from cell.commands.compare import verdict
     from cell.scenario import load_scenario
@@ -195,3 +211,9 @@ def test_compare_report_carries_the_window_caveat(tmp_path, capsys):
     assert report.index("**Caveat:**") < report.index("## ")
     compare_run(capsys, a, b, "--out", str(tmp_path / "same"), "--set", "run.parts=45")
     assert "Caveat" not in (tmp_path / "same" / "report.md").read_text()
+    # differences.csv: the counts only over the same window, the rates either way
+    differ, same = (set(pd.read_csv(tmp_path / d / "differences.csv")["measure"])
+                    for d in ("differ", "same"))
+    counts = {"parts_delivered", "parts_missed", "spacing_outside_tol"}
+    assert counts <= same and not counts & differ
+    assert "parts_per_hr_wallclock" in differ & same

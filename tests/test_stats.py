@@ -71,6 +71,36 @@ def test_summarise_edge_cases():
     assert tiny["ci_low"] == tiny["ci_high"] == tiny["mean"] and no_variation([0.0, 1e-300])
 
 
+#: Equal values whose numpy mean misses them by a rounding (so np.std is about 1e-16 of them).
+ROUNDED = [(0.1, 3), (1 / 3, 10), (22.5872, 200), (159.7, 200)]
+
+
+def with_nans(value: float, n: int) -> np.ndarray:
+    """``n`` copies of ``value`` with a NaN after every third."""
+    return np.array([v for _ in range(n) for v in ([value] + [np.nan] * (_ % 3 == 2))])
+
+
+@pytest.mark.parametrize(("value", "n"), ROUNDED)
+def test_summarise_all_equal_is_the_value_with_no_spread(value, n):
+    x = with_nans(value, n)
+    assert np.mean(x[~np.isnan(x)]) != value  # the trap: the plain mean is off
+    s = summarise(x)
+    assert s["n"] == n and s["mean"] == value and s["sd"] == 0.0
+    assert s["ci_low"] == s["ci_high"] == s["run_p2_5"] == s["run_p97_5"] == value
+    assert no_variation(x) and relative_half_width(x) == 0.0
+    assert precision_reached({"p": x}, 1e-300, min_n=n) == {"p": True}
+
+
+@pytest.mark.parametrize(("value", "n"), ROUNDED)
+def test_paired_all_equal_differences_are_exact_without_a_p_value(value, n):
+    a, b = np.full(n + 2, value), np.zeros(n + 2)  # a - b is exactly a
+    a[0] = b[1] = np.nan  # a NaN on either side drops the pair
+    assert np.mean(a[2:] - b[2:]) != value
+    p = paired_difference(a, b)
+    assert p["n"] == n and p["mean"] == value and p["sd"] == 0.0
+    assert p["ci_low"] == p["ci_high"] == value and math.isnan(p["p_value"])
+
+
 def test_summarise_rejects_bad_confidence():
     with pytest.raises(ValueError):
         summarise([1.0, 2.0], confidence=95)
@@ -90,7 +120,7 @@ def test_coverage_of_the_t_interval_is_nominal():
 
 @settings(max_examples=200, deadline=None)
 @given(st.lists(st.floats(min_value=-1e6, max_value=1e6, allow_nan=False), min_size=2, max_size=60)
-       .filter(lambda v: np.std(v, ddof=1) > 0))  # a spread that does not underflow
+       .filter(lambda v: len(set(v)) > 1 and np.std(v, ddof=1) > 0))  # a spread, not underflowing
 def test_summarise_properties(values):
     s = summarise(values)
     assert not no_variation(values)
@@ -138,7 +168,8 @@ def test_paired_identical_inputs_have_no_variation():
 @pytest.mark.filterwarnings("ignore:Precision loss:RuntimeWarning")  # scipy, on near-equal differences
 @settings(max_examples=100, deadline=None)
 @given(st.lists(st.tuples(st.floats(-1e6, 1e6), st.floats(-1e6, 1e6)), min_size=2, max_size=40)
-       .filter(lambda pairs: np.std([a - b for a, b in pairs], ddof=1) > 0))
+       .filter(lambda pairs: len({a - b for a, b in pairs}) > 1
+               and np.std([a - b for a, b in pairs], ddof=1) > 0))
 def test_paired_properties(pairs):
     a, b = (np.array(v) for v in zip(*pairs))
     p = paired_difference(a, b)

@@ -42,7 +42,16 @@ def no_variation(x: ArrayLike) -> bool:
     print a zero-width interval.  For paired data pass ``a - b``.
     """
     a = _clean(x)
-    return a.size >= 2 and float(np.std(a, ddof=1)) == 0.0
+    return a.size >= 2 and _mean_sd(a)[1] == 0.0
+
+
+def _mean_sd(a: NDArray[np.float64]) -> tuple[float, float]:
+    """Mean and sample standard deviation (ddof 1) of two or more values.  All equal:
+    the value itself and 0, exactly -- numpy's mean of equal values can be off by a
+    rounding, which would leave an sd of about 1e-16 of them, not a spread."""
+    if np.all(a == a[0]):
+        return float(a[0]), 0.0
+    return float(np.mean(a)), float(np.std(a, ddof=1))
 
 
 def summarise(x: ArrayLike, confidence: float = 0.95) -> dict[str, float]:
@@ -55,7 +64,8 @@ def summarise(x: ArrayLike, confidence: float = 0.95) -> dict[str, float]:
     interpolation), the range of a single replication, not of the mean.
 
     n = 0: everything NaN.  n = 1: sd and the interval NaN.  No variation: the
-    interval is [mean, mean]; see :func:`no_variation`.
+    interval is [mean, mean]; values all equal give that value and sd 0 exactly
+    (see :func:`no_variation`).
     """
     _check_confidence(confidence)
     a = _clean(x)
@@ -63,12 +73,11 @@ def summarise(x: ArrayLike, confidence: float = 0.95) -> dict[str, float]:
     nan = math.nan
     if n == 0:
         return dict.fromkeys(SUMMARY_KEYS, nan) | {"n": 0}
-    mean = float(np.mean(a))
     p_lo, p_hi = (float(v) for v in np.percentile(a, [2.5, 97.5]))
     if n == 1:
-        return {"n": 1, "mean": mean, "sd": nan, "ci_low": nan, "ci_high": nan,
+        return {"n": 1, "mean": float(a[0]), "sd": nan, "ci_low": nan, "ci_high": nan,
                 "run_p2_5": p_lo, "run_p97_5": p_hi}
-    sd = float(np.std(a, ddof=1))
+    mean, sd = _mean_sd(a)
     if sd == 0.0:  # no variation
         lo = hi = mean
     else:
@@ -86,8 +95,9 @@ def paired_difference(a: ArrayLike, b: ArrayLike, confidence: float = 0.95) -> d
     For runs under common random numbers (replication i of ``a`` and of ``b``
     share their random streams).  Keys: ``n, mean, sd, ci_low, ci_high, p_value``
     (``scipy.stats.ttest_rel``).  Pairs with a NaN on either side are dropped.
-    Identical inputs give a zero-width interval and a NaN p-value: check
-    ``no_variation(a - b)``.  n < 2: sd, interval and p-value NaN.
+    Differences all equal give that difference, sd 0 and interval [mean, mean]
+    exactly, and a NaN p-value: check ``no_variation(a - b)``.  n < 2: sd,
+    interval and p-value NaN.
     """
     _check_confidence(confidence)
     x, y = np.asarray(a, dtype=float).ravel(), np.asarray(b, dtype=float).ravel()
@@ -98,10 +108,10 @@ def paired_difference(a: ArrayLike, b: ArrayLike, confidence: float = 0.95) -> d
     d = x - y
     n = d.size
     nan = math.nan
-    mean = float(np.mean(d)) if n else nan
     if n < 2:
+        mean = float(d[0]) if n else nan
         return {"n": n, "mean": mean, "sd": nan, "ci_low": nan, "ci_high": nan, "p_value": nan}
-    sd = float(np.std(d, ddof=1))
+    mean, sd = _mean_sd(d)
     if sd == 0.0:  # no variation
         return {"n": n, "mean": mean, "sd": sd, "ci_low": mean, "ci_high": mean, "p_value": nan}
     from scipy import stats

@@ -7,7 +7,8 @@ measure, which is better, by how much, and whether the interval excludes zero;
 ``--out DIR`` writes the report (as ``cell sweep --report``) and the
 replications, as a unit.  Counts (parts delivered, lost, ...) are per run, after
 the warm-up: if A and B differ in ``run.parts`` or ``run.warmup_parts`` a warning
-says so and the verdict leaves counts uncompared; rates still compare.
+says so, the verdict leaves counts uncompared and ``differences.csv`` leaves them
+out (:mod:`cell.sweep.windows`); rates still compare.
 """
 
 from __future__ import annotations
@@ -20,7 +21,6 @@ from cell.commands import check_workers, set_argument, workers_argument
 if TYPE_CHECKING:
     import pandas as pd
 
-    from cell.scenario import Scenario
     from cell.sweep import Sweep
     from cell.sweep.spec import Point
 
@@ -51,13 +51,6 @@ def _label(arg: str) -> str:
     return Path(arg).stem if arg.endswith((".yaml", ".yml")) else Path(arg).name
 
 
-def _windows(a: Scenario, b: Scenario) -> list[tuple[str, object, object]]:
-    """The settings of the window counts are taken over on which A and B differ:
-    (key, A's value, B's value)."""
-    return [(key, getattr(a.run, key), getattr(b.run, key))
-            for key in ("parts", "warmup_parts") if getattr(a.run, key) != getattr(b.run, key)]
-
-
 def _suggest(va: object, vb: object) -> object:
     """A value valid for both (``--set`` sets it for both): the larger
     number, or the fixed warm-up when the other is ``auto``."""
@@ -72,8 +65,10 @@ def _sides(sweep: Sweep) -> tuple[tuple[str, Point], tuple[str, Point]]:
 
 def window_warning(sweep: Sweep) -> str | None:
     """One line if A's and B's counts are over different windows, else None."""
+    from cell.sweep.windows import windows_apart
+
     (la, a), (lb, b) = _sides(sweep)
-    differ = _windows(a.scenario, b.scenario)
+    differ = windows_apart(a.scenario, b.scenario)
     if not differ:
         return None
     said = {"parts": "runs {} parts", "warmup_parts": "has run.warmup_parts {}"}
@@ -116,18 +111,19 @@ def main(args: argparse.Namespace) -> int:
     if warning:
         print(f"cell: warning: {warning}", file=sys.stderr)
     with tempfile.TemporaryDirectory(prefix="cell-compare-") as work:
-        outcome = run_sweep(sweep, work, workers=args.workers, replicate=simulate_summary)
+        outcome = run_sweep(sweep, work, workers=args.workers, replicate=simulate_summary,
+                            warn=False)  # said above, in compare's words
         replications = outcome.replications
     from cell.reporting.experiment import difference_table, summary_table
 
-    print(verdict(summary_table(replications, sweep), difference_table(replications, sweep),
-                  sweep))
+    tables = summary_table(replications, sweep), difference_table(replications, sweep)
+    print(verdict(*tables, sweep))
     if target is not None:
         from cell.reporting.experiment import write_report
 
         command = (f"cell compare {args.a} {args.b} --replications {args.replications} "
                    f"--seed {seed}")
-        write_report(replications, sweep, target, command, warning)
+        write_report(replications, sweep, target, command, warning, tables)
         print(f"wrote {args.out}/: report.md, summary.csv, differences.csv, figures, "
               "replications.csv")
     return 0
@@ -137,9 +133,10 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> s
     """A few lines: per headline measure, which is better and by how much (A - B).  Counts
     are not compared if A and B take them over different windows (run length, warm-up)."""
     from cell.reporting.headlines import HEADLINES, better, half_width, number, plus_minus
+    from cell.sweep.windows import windows_apart
 
     (la, a), (lb, b) = _sides(sweep)
-    differ = _windows(a.scenario, b.scenario)
+    differ = windows_apart(a.scenario, b.scenario)
     parts = a.scenario.run.parts if a.scenario.run.parts == b.scenario.run.parts else None
     level = f"{sweep.confidence * 100:g} %"
     length = (f" of {parts} parts" if parts else
@@ -151,11 +148,11 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> s
     width = max(len(h.title) for h in HEADLINES)
     for h in HEADLINES:
         d = differences[differences["measure"] == h.column]
-        if d.empty:
-            continue
-        if h.per_run and differ:
+        if h.per_run and differ and h.column in set(summary["measure"]):
             lines.append(f"  {h.title:<{width}}  not compared: a count, over different windows "
                          f"({apart}); compare the rates")
+            continue
+        if d.empty:
             continue
         row = d.iloc[0]
         means = summary[summary["measure"] == h.column].set_index("scenario")["mean"]

@@ -44,6 +44,7 @@ from cell.reporting.experiment_plots import figures
 from cell.reporting.experiment_text import markdown
 from cell.reporting.table_7_1 import is_table_7_1, table_7_1_files, write_table_7_1
 from cell.sweep import Sweep
+from cell.sweep.windows import window_warning
 
 REPORT_FILES = ("report.md", "summary.csv", "differences.csv", "fig_*.png")
 TABLE_7_1_FILES = ("table_7_1.csv", "table_7_1.md")
@@ -89,11 +90,17 @@ def _shared(path: Path, names: Sequence[str]) -> bool:
 
 
 def write_report(replications: pd.DataFrame, sweep: Sweep, target: Target,
-                 command: str, caveat: str | None = None) -> list[Path]:
+                 command: str, caveat: str | None = None,
+                 tables: tuple[pd.DataFrame, pd.DataFrame] | None = None) -> list[Path]:
     """Write the report (see the module's docstring); return the paths written.
-    A target that names ``replications.csv`` gets the replications too."""
-    summary = summary_table(replications, sweep)
-    differences = difference_table(replications, sweep)
+    A target that names ``replications.csv`` gets the replications too.  ``tables``:
+    the summary and difference tables if already made from these replications.
+    ``caveat`` opens report.md; by default the sweep's window warning, if it has one
+    (:func:`cell.sweep.windows.window_warning`)."""
+    if caveat is None:
+        caveat = window_warning(sweep)
+    summary, differences = tables or (summary_table(replications, sweep),
+                                      difference_table(replications, sweep))
     pngs = figures(summary, replications, sweep)
     text = markdown(summary, differences, replications, sweep, command, list(pngs), caveat)
     written = []

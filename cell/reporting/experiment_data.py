@@ -12,11 +12,11 @@ from __future__ import annotations
 import warnings
 from collections.abc import Sequence
 
-import numpy as np
 import pandas as pd
 
 from cell.analysis.stats import PAIRED_KEYS, SUMMARY_KEYS, paired_difference, summarise
 from cell.sweep import Column, Sweep, grid_columns
+from cell.sweep.windows import count_measures, pair_apart
 
 #: Columns of replications.csv that are not measures.
 NOT_MEASURES = {"policy", "point", "seed", "replication"}
@@ -47,18 +47,6 @@ def _plain(value: object) -> object:
     return value.item() if hasattr(value, "item") else value
 
 
-def _exact(stats: dict[str, float], x: np.ndarray) -> dict[str, float]:
-    """Values (or differences) all equal: no variation, exactly -- the sd the mean's
-    rounding leaves (1e-15 of it) is not a spread between replications."""
-    x = x[~np.isnan(x)]
-    if x.size >= 2 and np.all(x == x[0]) and stats["sd"] != 0.0:
-        stats = {**stats, "mean": float(x[0]), "sd": 0.0, "ci_low": float(x[0]),
-                 "ci_high": float(x[0])}
-        if "p_value" in stats:
-            stats["p_value"] = float("nan")
-    return stats
-
-
 def summary_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     """``summary.csv``: every point, policy and measure with its statistics."""
     columns, names = grid_columns(sweep), measures(replications, sweep)
@@ -68,7 +56,7 @@ def summary_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
         keys = grid_values(runs, columns)
         for m in names:
             x = runs[m].to_numpy(dtype=float)
-            s = _exact(summarise(x, sweep.confidence), x)
+            s = summarise(x, sweep.confidence)
             rows.append({**keys, "policy": p.policy, "measure": m, **s})
     return pd.DataFrame(rows, columns=[*(c.name for c in columns), "policy", "measure",
                                        *SUMMARY_KEYS])
@@ -78,11 +66,14 @@ def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     """``differences.csv``: each pair of points, replication by replication, per measure.
 
     The grid columns hold the compared point's values, or its partner's for a key
-    only the partner varies.
+    only the partner varies.  A pair whose points count over different windows
+    (:mod:`cell.sweep.windows`) has no rows for the counts.
     """
     columns, names = grid_columns(sweep), measures(replications, sweep)
+    counts = set(count_measures())
     rows = []
     for pair in sweep.pairs():
+        compared = [m for m in names if m not in counts] if pair_apart(sweep, pair) else names
         a, b = sweep.points[pair.point], sweep.points[pair.versus]
         runs_a, runs_b = runs_of(replications, sweep, pair.point), \
             runs_of(replications, sweep, pair.versus)
@@ -90,11 +81,11 @@ def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
         keys = {c.name: theirs[c.name] if c.key in dict(b.values) and c.key not in dict(a.values)
                 else mine[c.name] for c in columns}
         both = runs_a.merge(runs_b, on="replication", suffixes=("", "@b"))
-        for m in names:
+        for m in compared:
             with warnings.catch_warnings():  # nearly equal pairs: scipy warns, the sd says it
                 warnings.filterwarnings("ignore", "Precision loss", RuntimeWarning)
                 x, y = both[m].to_numpy(dtype=float), both[m + "@b"].to_numpy(dtype=float)
-                d = _exact(paired_difference(x, y, sweep.confidence), x - y)
+                d = paired_difference(x, y, sweep.confidence)
             rows.append({**keys, "policy": a.policy, "versus": pair.label, "measure": m, **d})
     return pd.DataFrame(rows, columns=[*[c.name for c in columns], "policy", "versus", "measure",
                                        *PAIRED_KEYS])

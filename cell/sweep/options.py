@@ -8,7 +8,7 @@ sweep file, the key and the value.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Hashable, Mapping, Sequence
 from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING, Any
 
@@ -17,7 +17,7 @@ from cell.records import RunSummary
 from cell.scenario import known_key
 
 if TYPE_CHECKING:
-    from cell.sweep.spec import Sweep
+    from cell.sweep.spec import Point, Sweep
 
 #: Keys the sweep itself sets for every run; they cannot be varied in a grid.
 RESERVED = {"controller.policy": "list policies under 'policies'",
@@ -198,10 +198,7 @@ def read_baseline(raw: Any, sweep: Sweep, file: object) -> Baseline:
         by_name = {n: v for n, v in offered if n is not None}
         if isinstance(value, str) and value in by_name:
             value = by_name[value]
-        grid_values: list[Any] = []
-        for _, v in offered:
-            if v not in grid_values:
-                grid_values.append(v)
+        grid_values = distinct(v for _, v in offered)
         if value not in grid_values:
             raise ScenarioError(file, f"baseline.{key}", value, "not among the grid's values ("
                                 + ", ".join(show(v) for v in grid_values) + ")")
@@ -210,8 +207,9 @@ def read_baseline(raw: Any, sweep: Sweep, file: object) -> Baseline:
             names.append((key, name))
         values.append((key, value))
     baseline = Baseline(policy, tuple(values), tuple(names))
+    index = PointIndex(sweep.points)
     for p in sweep.points:
-        if baseline_point(sweep.points, baseline, p) is None:
+        if baseline_point(index, baseline, p) is None:
             target = policy or p.policy
             keys = [k for k, _ in next(q for q in sweep.points if q.policy == target).values
                     if k not in dict(p.values) and k not in dict(values)]
@@ -221,10 +219,71 @@ def read_baseline(raw: Any, sweep: Sweep, file: object) -> Baseline:
     return baseline
 
 
-def baseline_point(points: Sequence[Any], baseline: Baseline, p: Any) -> int | None:
-    """The index of ``p``'s baseline point among ``points``: the baseline's policy (or
-    ``p``'s) with the baseline's values, and ``p``'s for the keys it does not name."""
+def baseline_point(index: PointIndex, baseline: Baseline, p: Point) -> int | None:
+    """The index of ``p``'s baseline point among the indexed points: the baseline's policy
+    (or ``p``'s) with the baseline's values, and ``p``'s for the keys it does not name."""
     target = {**dict(p.values), **dict(baseline.values)}
-    policy = baseline.policy or p.policy
-    return next((j for j, q in enumerate(points) if q.policy == policy and q.agrees(target)),
-                None)
+    found = index.find(baseline.policy or p.policy, target)
+    return found[0] if found else None
+
+
+def frozen(value: Any) -> Hashable:
+    """A hashable stand-in for a grid value (YAML's lists and mappings too), equal to
+    another's whenever the values are equal."""
+    if isinstance(value, Mapping):
+        return ("mapping", frozenset((k, frozen(v)) for k, v in value.items()))
+    if isinstance(value, (list, tuple)):
+        return ("sequence", tuple(frozen(v) for v in value))
+    if isinstance(value, (set, frozenset)):
+        return ("set", frozenset(frozen(v) for v in value))
+    return value
+
+
+def distinct(values: Any) -> list[Any]:
+    """``values`` without repeats (by ``==``), in order of first appearance, in linear time."""
+    seen: dict[Hashable, list[Any]] = {}
+    out: list[Any] = []
+    for v in values:
+        alike = seen.setdefault(frozen(v), [])
+        if not any(u is v or u == v for u in alike):
+            alike.append(v)
+            out.append(v)
+    return out
+
+
+class PointIndex:
+    """A sweep's points by policy and values, so that finding the points that agree with
+    some values takes time in proportion to the answer, not to the number of points."""
+
+    def __init__(self, points: Sequence[Point]) -> None:
+        self.points = points
+        self._members: dict[tuple[str, tuple[str, ...]], list[int]] = {}
+        for j, q in enumerate(points):
+            self._members.setdefault((q.policy, tuple(k for k, _ in q.values)), []).append(j)
+        self._tables: dict[tuple[str, tuple[str, ...], tuple[str, ...]],
+                           dict[Hashable, list[int]]] = {}
+
+    def _table(self, group: tuple[str, tuple[str, ...]],
+               on: tuple[str, ...]) -> dict[Hashable, list[int]]:
+        """The group's points by their values of the keys ``on`` (built once)."""
+        table = self._tables.get((*group, on))
+        if table is None:
+            table = {}
+            for j in self._members[group]:
+                mine = dict(self.points[j].values)
+                table.setdefault(frozen([mine[k] for k in on]), []).append(j)
+            self._tables[(*group, on)] = table
+        return table
+
+    def find(self, policy: str, values: Mapping[str, Any], every: bool = True) -> list[int]:
+        """Indices, ascending, of ``policy``'s points whose values equal ``values``: on every
+        key the point varies (``every``; :meth:`Point.agrees`), or on the keys both have."""
+        found: list[int] = []
+        for group in self._members:
+            keys = group[1]
+            if group[0] != policy or every and not all(k in values for k in keys):
+                continue
+            on = tuple(k for k in keys if k in values)
+            found += [j for j in self._table(group, on).get(frozen([values[k] for k in on]), ())
+                      if all(values[k] == v for k, v in self.points[j].values if k in values)]
+        return sorted(found)

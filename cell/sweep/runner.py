@@ -49,6 +49,7 @@ from cell.scenario import Scenario
 from cell.sweep.columns import Column, grid_columns, point_values
 from cell.sweep.outdir import TASK_DIR, check_out, prepare
 from cell.sweep.spec import Sweep, Task
+from cell.sweep.windows import window_warning
 
 if TYPE_CHECKING:  # pandas is imported when first needed: local workers start without it
     import pandas as pd
@@ -256,14 +257,19 @@ WORKERS_PER_CORE = 4
 
 def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
               scheduler: str | None = None, resume: bool = False,
-              replicate: Replicate = simulate_summary, progress: bool = True) -> Outcome:
+              replicate: Replicate = simulate_summary, progress: bool = True,
+              warn: bool = True) -> Outcome:
     """Run (or finish, with ``resume``) a sweep into ``out``; write replications.csv.
 
     ``replicate`` is what one replication does; the default simulates the cell.
     It must be a module-level function when tasks run in other processes.
+    ``warn``: say first, on stderr, if compared points count over different windows
+    (:func:`cell.sweep.windows.window_warning`).
     """
     out = check_out(out)
     workers = check_workers(workers, scheduler)
+    if warn and (warning := window_warning(sweep)):
+        print(f"cell: warning: {warning}", file=sys.stderr)
     executor, client = _open_executor(workers, scheduler, progress)
     window = CLUSTER_WINDOW if scheduler else 2 * workers
     columns = grid_columns(sweep)

@@ -52,6 +52,7 @@ from cell.scenario import Scenario, known_key, load_scenario
 from cell.sweep.options import (
     RESERVED,
     Baseline,
+    PointIndex,
     Precision,
     baseline_point,
     grid,
@@ -194,20 +195,20 @@ class Sweep:
         without a baseline, every point against each point of a policy listed before
         its own that agrees with it on the keys both vary."""
         out: list[Pair] = []
+        index = PointIndex(self.points)
         if self.baseline is not None:
             b = self.baseline
             for i, p in enumerate(self.points):
-                j = baseline_point(self.points, b, p)
+                j = baseline_point(index, b, p)
                 if j is not None and j != i:
                     out.append(Pair(i, j, b.label(self.points[j].policy)))
             return out
         order = self.policies
         for i, p in enumerate(self.points):
             mine = dict(p.values)
-            for j, q in enumerate(self.points):
-                if order.index(q.policy) < order.index(p.policy) and all(
-                        mine[k] == v for k, v in q.values if k in mine):
-                    out.append(Pair(i, j, q.policy))
+            before = order[:order.index(p.policy)]
+            found = sorted(j for q in before for j in index.find(q, mine, every=False))
+            out += [Pair(i, j, self.points[j].policy) for j in found]
         return out
 
 
