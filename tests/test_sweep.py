@@ -14,6 +14,7 @@ import pytest
 from cell import catalog
 from cell.cli import main
 from cell.errors import CellError, ScenarioError
+from cell.scenario import load_scenario
 from cell.sweep import load_sweep, run_sweep
 
 TABLE_7_1_CYCLES = [22.5872, 22.0, 21.5, 21.0, 20.5, 20.0907]
@@ -93,6 +94,18 @@ def test_bad_sweep_file_one_line_exit_2_no_output(sweeps, tmp_path, capsys, fiel
     assert key in err and why in err
     assert "sweep.yaml" in err or "nowhere.yaml" in err
     assert not out.exists() and not report.exists()
+
+
+def test_base_by_a_built_in_name(sweeps, tmp_path):
+    """``base: baseline`` (or baseline.yaml) with no such file beside the sweep file is the
+    built-in scenario, as ``cell run baseline`` is; a file of that name beside it wins."""
+    for name in ("baseline", "baseline.yaml"):
+        sweep = load_sweep(sweeps.write(tmp_path, base=name))
+        assert sweep.points[0].scenario.arrivals == load_scenario("baseline").arrivals
+    (tmp_path / "baseline.yaml").write_text("name: mine\narrivals: {mean_s: 30, cv: 0.2, "
+                                            "distribution: gamma}\n")
+    sweep = load_sweep(sweeps.write(tmp_path, base="baseline.yaml"))
+    assert sweep.points[0].scenario.arrivals.mean_s == 30
 
 
 def test_bad_value_error_names_file_key_and_value(sweeps, tmp_path):

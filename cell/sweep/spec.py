@@ -227,10 +227,16 @@ def load_sweep(path: str | Path) -> Sweep:
                                 "unknown key (known: " + ", ".join(SWEEP_KEYS) + ")")
     if "base" not in raw or not isinstance(raw["base"], str):
         raise ScenarioError(path, "base", raw.get("base"),
-                            "name the base scenario file (relative to the sweep file)")
+                            "name the base scenario: a file (relative to the sweep file) or "
+                            "a built-in one (`cell scenarios`)")
     base_path = path.parent / raw["base"]
+    if not base_path.is_file() and catalog.path(raw["base"]).is_file() \
+            and Path(raw["base"]).name == raw["base"]:
+        base_path = catalog.path(raw["base"])  # a built-in scenario by name: baseline
     if not base_path.is_file():
-        raise ScenarioError(path, "base", raw["base"], f"no such scenario file ({base_path})")
+        raise ScenarioError(path, "base", raw["base"],
+                            f"no such scenario file ({base_path}) nor built-in scenario "
+                            "(`cell scenarios` lists them)")
     base = load_scenario(base_path)
 
     fixed = raw.get("set") or {}
