@@ -104,7 +104,7 @@ def test_base_by_a_built_in_name(sweeps, tmp_path):
         assert sweep.points[0].scenario.arrivals == load_scenario("baseline").arrivals
     (tmp_path / "baseline.yaml").write_text("name: mine\narrivals: {mean_s: 30, cv: 0.2, "
                                             "distribution: gamma}\n")
-    sweep = load_sweep(sweeps.write(tmp_path, base="baseline.yaml"))
+    sweep = load_sweep(sweeps.write(tmp_path, base="baseline.yaml", policies=["adaptive"]))
     assert sweep.points[0].scenario.arrivals.mean_s == 30
 
 
