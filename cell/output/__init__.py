@@ -2,9 +2,10 @@
 
 A set of files goes through :class:`OutputDir` (a stage beside the target directory that
 replaces it as a unit), a single file through :func:`atomic_path` (a temporary file renamed
-over it).  Both check up front that the output can be written and clean up after killed runs.
-Files and directories are fsync'ed before the rename that publishes them, the parent after
-it: after a power cut too, the old output or the new one is there, never empty files.
+over it), a few files in any directories together through :func:`atomic_paths`.  All check up
+front that the output can be written and clean up after killed runs.  Files and directories
+are fsync'ed before the rename that publishes them, the parent after it: after a power cut
+too, the old output or the new one is there, never empty files.
 """
 
 from __future__ import annotations
@@ -25,16 +26,15 @@ from typing import IO, TYPE_CHECKING, Any
 
 from cell.errors import CellError
 from cell.errors import shown_path as _show
+from cell.output.files import atomic_paths
 from cell.output.paths import (
     DIR_MODE,
     DISK_ERRORS,
-    FILE_MODE,
     absolute,
     alive,
     allowed,
     check_file,
     check_parent,
-    clean_stale_files,
     failing,
     foreign_entries,
     fsync,
@@ -52,7 +52,8 @@ FLOAT_FORMAT = "%.10g"
 
 _open: Any = open  # every file written goes through here (tests simulate a full disk with it)
 
-__all__ = ["FLOAT_FORMAT", "OutputDir", "atomic_path", "check_file", "write_csv", "write_text"]
+__all__ = ["FLOAT_FORMAT", "OutputDir", "atomic_path", "atomic_paths", "check_file", "write_csv",
+           "write_text"]
 
 _renameat2: Any = None
 if sys.platform.startswith("linux"):
@@ -238,30 +239,10 @@ def atomic_path(target: str | os.PathLike[str]) -> Iterator[Path]:
 
     ``target`` is checked first (:func:`check_file`); failing to write it, or a full disk while
     the caller writes, is a one-line :class:`CellError`; temporary files of killed runs are removed.
+    Several files that belong together: :func:`~cell.output.files.atomic_paths`.
     """
-    path, shown = check_file(target), _show(target)
-    made: list[Path] = []
-    tmp: Path | None = None
-    try:
-        with failing(shown):
-            make_parents(path, made)
-            clean_stale_files(path)
-            fd, name = tempfile.mkstemp(prefix=f".{path.name}.cell-{os.getpid()}-", suffix=".tmp",
-                                        dir=path.parent)
-            os.close(fd)
-        tmp = Path(name)
-        with failing(shown, DISK_ERRORS):
-            yield tmp
-        with failing(shown):
-            os.chmod(tmp, FILE_MODE)  # mkstemp makes 0600; outputs are for everyone to read
-            fsync(tmp)
-            os.replace(tmp, path)
-        with contextlib.suppress(OSError):
-            fsync(path.parent, directory=True)
-    finally:  # after success there is no tmp, and the directories made are not empty
-        if tmp is not None:
-            tmp.unlink(missing_ok=True)
-        remove_made(made)
+    with atomic_paths(target) as (tmp,):
+        yield tmp
 
 
 def write_text(text: str, target: str | os.PathLike[str]) -> None:
