@@ -2,12 +2,12 @@
 
 Each target gets a temporary file beside it (``.NAME.cell-PID-XXXXXXXX.tmp``); when the caller
 has written them all, they are synced and renamed over their targets in turn.  If a rename
-fails, or Ctrl-C comes, the targets already replaced get their old files back (kept as hard
-links ``.NAME.cell-PID-old-XXXXXXXX.tmp`` until the set is complete), or are removed if new:
-the old set or the new one is there, never half of each.  SIGINT, SIGTERM and SIGHUP wait
-while the renames run.  Only a kill -9 or a power cut between two renames can leave the new
-file of one target beside the old one of another; a later write of a target removes the
-leftovers of such a run.
+fails, the targets already replaced get their old files back (kept as hard links
+``.NAME.cell-PID-old-XXXXXXXX.tmp`` until the set is complete), or are removed if new: the
+old set or the new one is there, never half of each.  SIGINT, SIGTERM and SIGHUP (Ctrl-C,
+kill) wait until the renames are done (in the main thread).  Only a kill -9 or a power cut
+between two renames can leave the new file of one target beside the old one of another; a
+later write of a target removes the leftovers of such a run.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ import os
 import shutil
 import signal
 import tempfile
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -117,12 +118,18 @@ def _keep_old(tmp: Path, path: Path) -> Path | None:
 
 @contextlib.contextmanager
 def _held() -> Iterator[None]:
-    """SIGINT, SIGTERM and SIGHUP wait until the block is left (where signal masks exist)."""
-    if not hasattr(signal, "pthread_sigmask"):
+    """SIGINT, SIGTERM and SIGHUP that come during the block take effect when it is left.
+
+    Python runs signal handlers in the main thread only, so elsewhere nothing is held."""
+    if threading.current_thread() is not threading.main_thread():
         yield
         return
-    before = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+    caught: list[int] = []
+    previous = {number: signal.signal(number, lambda n, _: caught.append(n)) for number in _HELD}
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, before)
+        for number, handler in previous.items():
+            signal.signal(number, signal.SIG_DFL if handler is None else handler)
+        for number in dict.fromkeys(caught):
+            signal.raise_signal(number)
