@@ -108,12 +108,18 @@ def _memoryless(f: Sources, n: list[str]) -> Iterable[tuple[Any, ...]]:
             (n[1], -summary["cycle_vs_nominal_memoryless_pct"]), (n[2], ADAPTIVE_CYCLE_PCT)]
 
 
+def _lost_and_ip(f: Sources, count: str) -> tuple[np.ndarray, np.ndarray]:
+    """Fig. 25's run (non-adaptive, cycle 22.5872 s): parts lost and their IP, counted the
+    thesis's way (``"thesis"``) or on the wall clock (``"wallclock"``)."""
+    d = f.runs.non_adaptive[22.5872].parts
+    missed = "missed_thesis" if count == "thesis" else "missed"
+    return d[missed].to_numpy(dtype=bool), d[f"ip_{count}"].to_numpy(dtype=float)
+
+
 @claim("two bands, {}–{} for delivered parts (its doubled denominator) and {}–{} for the {} missed "
        "parts (triangles), mean {} against Table 7.1's {}")
 def _fig25_bands(f: Sources, n: list[str]) -> Iterable[tuple[Any, ...]]:
-    d = f.runs.non_adaptive[22.5872].parts
-    lost = d["missed_thesis"].to_numpy(dtype=bool)
-    ip = d["ip_thesis"].to_numpy(dtype=float)
+    lost, ip = _lost_and_ip(f, "thesis")
     assert ip[~lost].min() > ip[lost].max()          # two bands, apart
     return [(n[0], ip[~lost].min()), (n[1], ip[~lost].max()), (n[2], ip[lost].min()),
             (n[3], ip[lost].max()), (n[4], lost.sum()), (n[5], ip.mean()),
@@ -123,9 +129,7 @@ def _fig25_bands(f: Sources, n: list[str]) -> Iterable[tuple[Any, ...]]:
 @claim("a delivered part's IP averages {} when the part before it was delivered and {} when it was "
        "lost, and the {} lost parts (no delivery, no IP) are marked on the floor; mean {}")
 def _fig25_wall(f: Sources, n: list[str]) -> Iterable[tuple[Any, ...]]:
-    d = f.runs.non_adaptive[22.5872].parts
-    lost = d["missed"].to_numpy(dtype=bool)
-    ip = d["ip_wallclock"].to_numpy(dtype=float)
+    lost, ip = _lost_and_ip(f, "wallclock")
     after_loss = np.r_[False, lost[:-1]]
     shown = ~lost & np.isfinite(ip)
     assert np.all(np.isnan(ip[lost]))
