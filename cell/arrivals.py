@@ -12,7 +12,9 @@ the distribution when given.
 
 from __future__ import annotations
 
+import csv
 import math
+import re
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Protocol
@@ -309,22 +311,41 @@ def read_trace(path: Path, file: object = None) -> NDArray[np.float64]:
 
 @memo(key=file_key)
 def _parse_trace(path: Path) -> Any:
-    """The trace's times, or why they cannot be used (a message)."""
-    import pandas as pd
+    """The trace's times, or why they cannot be used (a message).
 
+    Read with the csv module (no pandas at a run's start), as pandas would read it:
+    blank lines skipped, a UTF-8 byte-order mark dropped, numbers as Python's float.
+    """
     try:
-        frame = pd.read_csv(path, dtype=str, keep_default_na=False, encoding="utf-8")
-    except Exception as exc:  # noqa: BLE001 - pandas and the decoder raise many kinds
+        with path.open(encoding="utf-8-sig", newline="") as stream:
+            rows = [row for row in csv.reader(stream, strict=True) if any(c.strip() for c in row)]
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
         return f"not a readable CSV: {' '.join(str(exc).split())[:120]}"
-    if "interarrival_s" not in frame.columns:
+    if not rows:
+        return "not a readable CSV: No columns to parse from file"
+    header, data = rows[0], rows[1:]
+    if "interarrival_s" not in header:
         return "needs a column named interarrival_s"
-    text = frame["interarrival_s"].str.strip()
-    times = pd.to_numeric(text, errors="coerce").to_numpy(dtype=float)
+    column = header.index("interarrival_s")
+    ragged = next((i for i, row in enumerate(data) if len(row) > len(header)), None)
+    if ragged is not None:
+        return (f"not a readable CSV: row {ragged + 1} has {len(data[ragged])} fields, "
+                f"the header {len(header)}")
+    text = [row[column].strip() if column < len(row) else "" for row in data]
+    times = np.array([_seconds(t) for t in text], dtype=float)
     bad = np.flatnonzero(~np.isfinite(times) | (times <= 0) | (times > MAX_INTERARRIVAL_S))
     if bad.size:
-        return (f"row {bad[0] + 1} has inter-arrival time {text.iloc[bad[0]][:40]!r}; times "
+        return (f"row {bad[0] + 1} has inter-arrival time {text[bad[0]][:40]!r}; times "
                 f"must be positive numbers of seconds, at most {MAX_INTERARRIVAL_S:g}")
     if times.size == 0:
         return "has no inter-arrival times"
     times.setflags(write=False)
     return times
+
+
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\Z")
+
+
+def _seconds(text: str) -> float:
+    """A decimal number as a float; NaN for anything else (words, ``1_000``, ``0x10``)."""
+    return float(text) if _NUMBER.match(text) else math.nan

@@ -19,13 +19,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from cell.errors import InfeasibleError
 from cell.kinematics import DH_ALPHA
+from cell.types import Array, Five
 
-Array = NDArray[np.float64]
-Five = tuple[float, float, float, float, float]
 Xyz = tuple[float, float, float]
 Points5 = tuple[Xyz, Xyz, Xyz, Xyz, Xyz]
 

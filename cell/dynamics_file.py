@@ -21,8 +21,8 @@ Mass = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=0.0, le=1e4)]
 Metres = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=-100.0, le=100.0)]
 Positive = Annotated[float, Field(strict=True, allow_inf_nan=False, gt=0.0, le=1e6)]
 NonNegative = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=0.0, le=1e6)]
-Five = tuple[Positive, Positive, Positive, Positive, Positive]
-Five0 = tuple[NonNegative, NonNegative, NonNegative, NonNegative, NonNegative]
+PositiveFive = tuple[Positive, Positive, Positive, Positive, Positive]
+NonNegativeFive = tuple[NonNegative, NonNegative, NonNegative, NonNegative, NonNegative]
 Xyz = tuple[Metres, Metres, Metres]
 Moments = tuple[NonNegative, NonNegative, NonNegative]
 
@@ -40,10 +40,10 @@ class LinksFile(Section):
 class DrivesFile(Section):
     """Stepper drives as seen at the joints."""
 
-    gear_ratio: Five = Drives.gear_ratio
-    rotor_inertia_kg_m2: Five0 = Drives.rotor_inertia_kg_m2
-    stall_torque_nm: Five = Drives.stall_torque_nm
-    viscous_nm_s_rad: Five0 = Drives.viscous_nm_s_rad
+    gear_ratio: PositiveFive = Drives.gear_ratio
+    rotor_inertia_kg_m2: NonNegativeFive = Drives.rotor_inertia_kg_m2
+    stall_torque_nm: PositiveFive = Drives.stall_torque_nm
+    viscous_nm_s_rad: NonNegativeFive = Drives.viscous_nm_s_rad
 
 
 class DynamicsFile(Section):

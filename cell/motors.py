@@ -20,8 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from cell.errors import InfeasibleError
-
-Five = tuple[float, float, float, float, float]
+from cell.types import Five
 
 
 @dataclass(frozen=True)

@@ -37,7 +37,7 @@ Coord = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=-MAX_LENGTH_
 Point = tuple[Coord, Coord, Coord]
 Positive = Annotated[float, Field(strict=True, allow_inf_nan=False, gt=0.0, le=1e9)]
 NonNegative = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=0.0, le=1e9)]
-Five = tuple[Positive, Positive, Positive, Positive, Positive]
+PositiveFive = tuple[Positive, Positive, Positive, Positive, Positive]
 #: A motor makes at least one step per radian, or it cannot follow any path.
 StepsPerRad = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=1.0, le=1e7)]
 Angle = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=-360.0, le=360.0)]
@@ -142,10 +142,10 @@ class MotorSettings(Section):
     steps_per_rad: tuple[StepsPerRad, StepsPerRad, StepsPerRad, StepsPerRad, StepsPerRad] = (
         1125.0, 1125.0, 672.0, 241.0, 241.0)
     """TeachMover half-steps per radian: base, shoulder, elbow, pitch, roll."""
-    max_rate_no_load_rad_s: Five = (0.4194527, 0.36, 0.82, 2.02, 2.02)
+    max_rate_no_load_rad_s: PositiveFive = (0.4194527, 0.36, 0.82, 2.02, 2.02)
     """TeachMover no-load speeds, except the base: CALIBRATED to 0.4194527 rad/s
     (TeachMover 0.42) so that R IV at the nominal 75 % takes the thesis's 9.9855 s."""
-    max_rate_full_load_rad_s: Five = (0.37, 0.15, 0.23, 1.31, 1.31)
+    max_rate_full_load_rad_s: PositiveFive = (0.37, 0.15, 0.23, 1.31, 1.31)
     """TeachMover speeds carrying the full load (1 lb)."""
     full_load_oz: float = _num(16.0, gt=0.0, le=1e6)
     """The load of those full-load figures."""
@@ -264,7 +264,7 @@ class MinTimeSettings(Section):
     acceleration_bounds: bool = Field(True, strict=True)
     """Apply ``qddot_max_rad_s2``; switch off when the dynamic model is to set the
     accelerations alone."""
-    qddot_max_rad_s2: Five = (2.0, 2.0, 4.0, 8.0, 8.0)
+    qddot_max_rad_s2: PositiveFive = (2.0, 2.0, 4.0, 8.0, 8.0)
     """Joint acceleration bounds; ASSUMED (a stepper indexer's ramp; the thesis has none)."""
     dynamics_file: str | None = None
     """YAML of the rigid-body model (relative to the scenario file); empty: no torque bounds."""

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Sequence
-from contextlib import ExitStack
 from pathlib import Path
 
 from cell.errors import ScenarioError
@@ -96,15 +95,16 @@ def main(args: argparse.Namespace) -> int:
     table = format_table(fits)
     if chosen is not fits[0]:
         table += f"\nChosen: {chosen.family}, the best fit that allows no negative times."
-    from cell.output import atomic_path
+    from cell.output import atomic_paths
 
-    with ExitStack() as stack:  # both written in full, then renamed: the figure first, the YAML last
-        out_tmp = stack.enter_context(atomic_path(out)) if out is not None else None
+    targets = [t for t in (figure, out) if t is not None]
+    with atomic_paths(*targets) as tmps:  # both written in full, then put in place together
+        staged = dict(zip(targets, tmps))
         if figure is not None:
-            draw(values, fits, stack.enter_context(atomic_path(figure)), best=chosen,
+            draw(values, fits, staged[figure], best=chosen,
                  xlabel=f"gaps between {args.column}" if times else args.column)
-        if out_tmp is not None:
-            out_tmp.write_text(block, encoding="utf-8")
+        if out is not None:
+            staged[out].write_text(block, encoding="utf-8")
     comment = "# " if out is None else ""  # printed table and block together are valid YAML
     print("\n".join(comment + line for line in table.splitlines()))
     print(block.rstrip("\n") if out is None else f"wrote {out}")

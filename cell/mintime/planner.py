@@ -44,13 +44,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cell.errors import NoMotionError
+from cell.types import Array
 
 from .rows import PathRows, acceleration_rows, torque_rows, velocity_rows
 
 __all__ = ["NoMotionError", "PathRows", "Profile", "acceleration_rows", "path_grid", "plan",
            "torque_rows", "velocity_limit", "velocity_rows"]
 
-Array = NDArray[np.float64]
 
 #: |a| below this fraction of the row's largest |a| along the path counts as
 #: zero: the row then bounds ṡ only (a zero-inertia point).

@@ -2,9 +2,10 @@
 
 A set of files goes through :class:`OutputDir` (a stage beside the target directory that
 replaces it as a unit), a single file through :func:`atomic_path` (a temporary file renamed
-over it).  Both check up front that the output can be written and clean up after killed runs.
-Files and directories are fsync'ed before the rename that publishes them, the parent after
-it: after a power cut too, the old output or the new one is there, never empty files.
+over it), a few files in any directories together through :func:`atomic_paths`.  All check up
+front that the output can be written and clean up after killed runs.  Files and directories
+are fsync'ed before the rename that publishes them, the parent after it: after a power cut
+too, the old output or the new one is there, never empty files.
 """
 
 from __future__ import annotations
@@ -12,7 +13,6 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import errno
-import fnmatch
 import os
 import re
 import shutil
@@ -26,101 +26,34 @@ from typing import IO, TYPE_CHECKING, Any
 
 from cell.errors import CellError
 from cell.errors import shown_path as _show
+from cell.output.files import atomic_paths
+from cell.output.paths import (
+    DIR_MODE,
+    DISK_ERRORS,
+    absolute,
+    alive,
+    allowed,
+    check_file,
+    check_parent,
+    failing,
+    foreign_entries,
+    fsync,
+    make_parents,
+    reason,
+    remove_made,
+    sync_tree,
+)
 
 if TYPE_CHECKING:
     import pandas as pd
 
-_UMASK = os.umask(0o022)
-os.umask(_UMASK)
-#: The modes an ordinary new file and directory get (0644 and 0755 under the usual umask).
-_FILE_MODE, _DIR_MODE = 0o666 & ~_UMASK, 0o777 & ~_UMASK
-
 #: Digits kept in CSV floats: enough to round-trip, identical on every run.
 FLOAT_FORMAT = "%.10g"
 
-_JUNK = frozenset({".DS_Store", "Thumbs.db", "desktop.ini"})  # an OS's, never the user's data
-_DISK_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS, errno.EIO})
-
 _open: Any = open  # every file written goes through here (tests simulate a full disk with it)
 
-
-def _reason(exc: OSError) -> str:  # "permission denied", "no space left on device"...
-    return (exc.strerror or os.strerror(exc.errno or 0) or type(exc).__name__).lower()
-
-
-@contextlib.contextmanager
-def _failing(what: str, only: frozenset[int] | None = None) -> Iterator[None]:
-    """An OSError (with an errno in ``only``, if given) becomes a one-line CellError about ``what``."""
-    try:
-        yield
-    except OSError as exc:
-        if only is not None and exc.errno not in only:
-            raise
-        raise CellError(f"{what}: cannot write: {_reason(exc)}") from None
-
-
-def _alive(pid: int) -> bool:
-    """Whether process ``pid`` runs (on this host and in this PID namespace: others look dead)."""
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OverflowError):
-        return pid > 0
-    return True
-
-
-def _absolute(target: str | os.PathLike[str], what: str) -> Path:
-    if not os.fspath(target):
-        raise CellError(f"'': an empty path; name a {what}")
-    return Path(os.path.realpath(os.path.abspath(target)))
-
-
-_TEMP_EXTRA = 27  # what a temporary name adds: .NAME.cell-tmp-PID-XXXXXXXX, .NAME.cell-PID-XXXXXXXX.tmp
-
-
-def _check_parent(shown: str, path: Path) -> None:
-    """``path`` can be created: its nearest existing ancestor is a directory we may write in,
-    and no name on the way (nor the temporary name beside it) is too long for the file system."""
-    ancestor = path.parent
-    while not os.path.lexists(ancestor) and ancestor != ancestor.parent:
-        ancestor = ancestor.parent
-    if not ancestor.is_dir():
-        raise CellError(f"{shown}: not a directory ({_show(ancestor)} is a file)")
-    try:
-        name_max, path_max = os.pathconf(ancestor, "PC_NAME_MAX"), os.pathconf(ancestor, "PC_PATH_MAX")
-    except (OSError, ValueError, AttributeError):  # not every system tells
-        name_max, path_max = 255, 4096
-    names = [p.name for p in path.parents if ancestor in p.parents] + [path.name + "." * _TEMP_EXTRA]
-    if any(len(os.fsencode(n)) > name_max for n in names) or len(os.fsencode(str(path))) + 128 > path_max:
-        raise CellError(f"{shown}: file name too long (at most {name_max - _TEMP_EXTRA} bytes a name here)")
-    if hasattr(os, "statvfs") and os.statvfs(ancestor).f_flag & os.ST_RDONLY:
-        raise CellError(f"{shown}: cannot write in {_show(ancestor)}: read-only file system")
-    if not os.access(ancestor, os.W_OK | os.X_OK):
-        raise CellError(f"{shown}: cannot write in {_show(ancestor)}: permission denied")
-
-
-def _make_parents(path: Path, made: list[Path]) -> None:
-    """Create the missing directories above ``path``, outermost first, each added to ``made``."""
-    for parent in [p for p in path.parents if not os.path.lexists(p)][::-1]:
-        os.mkdir(parent)
-        made.append(parent)
-
-
-def _remove_made(made: list[Path]) -> None:
-    for directory in reversed(made):
-        with contextlib.suppress(OSError):
-            os.rmdir(directory)
-
-
-def _fsync(path: Path, directory: bool = False) -> None:
-    fd = os.open(path, os.O_RDONLY | (getattr(os, "O_DIRECTORY", 0) if directory else 0))
-    try:  # some file systems cannot sync a directory: nothing more to do there
-        with contextlib.suppress(*((OSError,) if directory else ())):
-            os.fsync(fd)
-    finally:
-        os.close(fd)
-
+__all__ = ["FLOAT_FORMAT", "OutputDir", "atomic_path", "atomic_paths", "check_file", "write_csv",
+           "write_text"]
 
 _renameat2: Any = None
 if sys.platform.startswith("linux"):
@@ -162,40 +95,40 @@ class OutputDir(contextlib.AbstractContextManager["OutputDir"]):
 
     def __init__(self, target: str | os.PathLike[str], names: Iterable[str], option: str = "--out"):
         self.target, self.names, self.option = _show(target), tuple(names), option
-        self.dir = _absolute(target, "directory")
+        self.dir = absolute(target, "directory")
         self._recover()
         self.check(target, self.names, option)
         self._made: list[Path] = []
         self._streams: list[IO[Any]] = []
         try:
-            _make_parents(self.dir, self._made)
+            make_parents(self.dir, self._made)
             self.stage = Path(tempfile.mkdtemp(prefix=f".{self.dir.name}.cell-tmp-{os.getpid()}-",
                                                dir=self.dir.parent))
         except OSError as exc:
-            _remove_made(self._made)
-            raise CellError(f"{self.target}: cannot write in {_show(self.dir.parent)}: {_reason(exc)}") \
+            remove_made(self._made)
+            raise CellError(f"{self.target}: cannot write in {_show(self.dir.parent)}: {reason(exc)}") \
                 from None
 
     @staticmethod
     def check(target: str | os.PathLike[str], names: Iterable[str], option: str = "--out") -> Path:
         """Refuse, changing nothing, a ``target`` this command could not write or must not replace."""
-        shown, path, names = _show(target), _absolute(target, "directory"), tuple(names)
+        shown, path, names = _show(target), absolute(target, "directory"), tuple(names)
         if path == Path.cwd() or path in Path.cwd().parents:
             raise CellError(f"{shown}: holds the current directory; choose another {option}")
         try:
             mode = os.stat(path).st_mode
         except OSError as exc:
-            _check_parent(shown, path)  # a file on the way, an unwritable parent?
+            check_parent(shown, path)  # a file on the way, an unwritable parent?
             if isinstance(exc, FileNotFoundError):
                 return path
-            raise CellError(f"{shown}: {_reason(exc)}") from None
+            raise CellError(f"{shown}: {reason(exc)}") from None
         if not stat.S_ISDIR(mode):
             raise CellError(f"{shown}: is a file, not a directory; choose another {option}")
-        foreign = _foreign(path, names)
+        foreign = foreign_entries(path, names)
         if foreign:
             raise CellError(f"{shown}: holds files cell did not write ({', '.join(foreign[:3])}"
                             f"{', …' if len(foreign) > 3 else ''}); choose another {option}")
-        _check_parent(shown, path)
+        check_parent(shown, path)
         if not os.access(path, os.W_OK | os.X_OK):
             raise CellError(f"{shown}: permission denied")
         return path
@@ -206,7 +139,7 @@ class OutputDir(contextlib.AbstractContextManager["OutputDir"]):
         with contextlib.suppress(OSError):
             for entry in os.scandir(self.dir.parent):
                 match = pattern.match(entry.name)
-                if not match or _alive(int(match.group(2))):
+                if not match or alive(int(match.group(2))):
                     continue
                 with contextlib.suppress(OSError):
                     if match.group(1) == "old" and not os.path.lexists(self.dir):
@@ -217,10 +150,10 @@ class OutputDir(contextlib.AbstractContextManager["OutputDir"]):
     def path(self, name: str) -> Path:
         """Where to write the file ``name`` (one of ``names``) in the stage."""
         parts = name.split("/")
-        if any(p in ("", ".", "..") for p in parts) or not _allowed(parts, self.names):
+        if any(p in ("", ".", "..") for p in parts) or not allowed(parts, self.names):
             raise ValueError(f"{name!r} is not among the files this OutputDir writes: {self.names}")
         if len(parts) > 1:
-            with _failing(f"{self.target}/{name}"):
+            with failing(f"{self.target}/{name}"):
                 (self.stage / name).parent.mkdir(parents=True, exist_ok=True)
         return self.stage / name
 
@@ -229,17 +162,17 @@ class OutputDir(contextlib.AbstractContextManager["OutputDir"]):
         if "r" in mode or "+" in mode:
             raise ValueError(f"mode {mode!r}: OutputDir files are opened for writing")
         path, text = self.path(name), {} if "b" in mode else {"encoding": "utf-8"}
-        with _failing(f"{self.target}/{name}"):
+        with failing(f"{self.target}/{name}"):
             self._streams.append(_open(path, mode, **text, **kwargs))  # closed at the end if not before
         return self._streams[-1]
 
     def write_text(self, name: str, text: str) -> None:
-        with _failing(f"{self.target}/{name}"), self.open(name, "w", newline="") as stream:
+        with failing(f"{self.target}/{name}"), self.open(name, "w", newline="") as stream:
             stream.write(text)
 
     def write_csv(self, name: str, frame: pd.DataFrame, float_format: str = FLOAT_FORMAT) -> None:
         """A DataFrame as CSV with a fixed float format (byte-identical reruns)."""
-        with _failing(f"{self.target}/{name}"), self.open(name, "w", newline="") as stream:
+        with failing(f"{self.target}/{name}"), self.open(name, "w", newline="") as stream:
             frame.to_csv(stream, index=False, float_format=float_format, lineterminator="\n")
 
     def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None,
@@ -247,8 +180,8 @@ class OutputDir(contextlib.AbstractContextManager["OutputDir"]):
         if kind is None:
             return self.commit()
         self.discard()
-        if isinstance(exc, OSError) and exc.errno in _DISK_ERRORS:
-            raise CellError(f"{self.target}: cannot write: {_reason(exc)}") from None
+        if isinstance(exc, OSError) and exc.errno in DISK_ERRORS:
+            raise CellError(f"{self.target}: cannot write: {reason(exc)}") from None
 
     def discard(self) -> None:
         """Remove the stage (and the parents made for it); ``target`` stays as it was."""
@@ -256,23 +189,23 @@ class OutputDir(contextlib.AbstractContextManager["OutputDir"]):
             with contextlib.suppress(Exception):  # a full disk again: the file goes anyway
                 stream.close()
         shutil.rmtree(self.stage, ignore_errors=True)
-        _remove_made(self._made)
+        remove_made(self._made)
 
     def commit(self) -> None:
         """Put the stage in place of ``target`` as a unit, then remove the old set."""
         old: Path | None = None
         try:
-            with _failing(self.target):
+            with failing(self.target):
                 for stream in self._streams:  # a stream the caller left open is flushed now
                     stream.close()
-                _sync_tree(self.stage)
+                sync_tree(self.stage)
                 try:
                     mode = os.lstat(self.dir).st_mode
                 except FileNotFoundError:
-                    os.chmod(self.stage, _DIR_MODE)
+                    os.chmod(self.stage, DIR_MODE)
                     os.rename(self.stage, self.dir)
                 else:
-                    foreign = _foreign(self.dir, self.names) if stat.S_ISDIR(mode) else ["is a file"]
+                    foreign = foreign_entries(self.dir, self.names) if stat.S_ISDIR(mode) else ["is a file"]
                     if foreign:  # changed since the check, while the command ran
                         raise CellError(f"{self.target}: changed while cell ran ({foreign[0]}); "
                                         f"nothing written; choose another {self.option}")
@@ -282,7 +215,7 @@ class OutputDir(contextlib.AbstractContextManager["OutputDir"]):
             self.discard()
             raise
         with contextlib.suppress(OSError):
-            _fsync(self.dir.parent, directory=True)
+            fsync(self.dir.parent, directory=True)
         if old is not None:
             shutil.rmtree(old, ignore_errors=True)
 
@@ -300,93 +233,16 @@ class OutputDir(contextlib.AbstractContextManager["OutputDir"]):
         return old
 
 
-def _allowed(parts: list[str], names: Iterable[str], directory: bool = False) -> bool:
-    """Whether the path ``parts`` is one of ``names`` (or, for a directory, holds one of them)."""
-    for name in names:
-        pattern = name.split("/")
-        if (len(parts) < len(pattern) if directory else len(parts) == len(pattern)) and all(
-                fnmatch.fnmatchcase(part, p) for part, p in zip(parts, pattern)):
-            return True
-    return False
-
-
-_LEFTOVER = re.compile(r"\.(.+)\.[^.]+\.tmp\Z")  # a killed atomic_path's temporary file
-
-
-def _foreign(directory: Path, names: Iterable[str], limit: int = 4) -> list[str]:
-    """Up to ``limit`` entries of ``directory`` that are none of ``names`` (shown as paths)."""
-    names, found = tuple(names), list[str]()
-    todo: list[tuple[Path, list[str]]] = [(directory, [])]
-    while todo and len(found) < limit:
-        folder, prefix = todo.pop()
-        for entry in sorted(os.scandir(folder), key=lambda e: e.name):
-            parts = prefix + [entry.name]
-            leftover = _LEFTOVER.match(entry.name)
-            if entry.is_dir(follow_symlinks=False) and _allowed(parts, names, directory=True):
-                todo.append((Path(entry.path), parts))
-            elif not (entry.name in _JUNK or _allowed(parts, names)
-                      or leftover and _allowed(prefix + [leftover.group(1)], names)):
-                found.append(_show("/".join(parts)))
-    return found[:limit]
-
-
-def _sync_tree(root: Path) -> None:
-    for folder, _, files in os.walk(root, topdown=False):
-        for name in files:
-            _fsync(Path(folder, name))
-        _fsync(Path(folder), directory=True)
-
-
-def check_file(target: str | os.PathLike[str]) -> Path:
-    """Refuse, changing nothing, a single-file ``target`` that cannot be written; its absolute path."""
-    shown, path = _show(target), _absolute(target, "file")
-    if os.path.isdir(path):
-        raise CellError(f"{shown}: is a directory; name a file")
-    _check_parent(shown, path)
-    return path
-
-
-def _clean_stale_files(path: Path) -> None:
-    """Remove ``.NAME.cell-PID-XXXX.tmp`` of dead processes (and ``.NAME.XXXXXXXX.tmp`` of old versions)."""
-    pattern = re.compile(rf"\.{re.escape(path.name)}\.(?:cell-(\d+)-.+|[a-z0-9_]{{8}})\.tmp\Z")
-    with contextlib.suppress(OSError):
-        for entry in os.scandir(path.parent):
-            match = pattern.match(entry.name)
-            if match and not (match.group(1) and _alive(int(match.group(1)))):
-                with contextlib.suppress(OSError):
-                    os.unlink(entry.path)
-
-
 @contextlib.contextmanager
 def atomic_path(target: str | os.PathLike[str]) -> Iterator[Path]:
     """Yield a temporary path; on success it replaces ``target``, on error it is removed.
 
     ``target`` is checked first (:func:`check_file`); failing to write it, or a full disk while
     the caller writes, is a one-line :class:`CellError`; temporary files of killed runs are removed.
+    Several files that belong together: :func:`~cell.output.files.atomic_paths`.
     """
-    path, shown = check_file(target), _show(target)
-    made: list[Path] = []
-    tmp: Path | None = None
-    try:
-        with _failing(shown):
-            _make_parents(path, made)
-            _clean_stale_files(path)
-            fd, name = tempfile.mkstemp(prefix=f".{path.name}.cell-{os.getpid()}-", suffix=".tmp",
-                                        dir=path.parent)
-            os.close(fd)
-        tmp = Path(name)
-        with _failing(shown, _DISK_ERRORS):
-            yield tmp
-        with _failing(shown):
-            os.chmod(tmp, _FILE_MODE)  # mkstemp makes 0600; outputs are for everyone to read
-            _fsync(tmp)
-            os.replace(tmp, path)
-        with contextlib.suppress(OSError):
-            _fsync(path.parent, directory=True)
-    finally:  # after success there is no tmp, and the directories made are not empty
-        if tmp is not None:
-            tmp.unlink(missing_ok=True)
-        _remove_made(made)
+    with atomic_paths(target) as (tmp,):
+        yield tmp
 
 
 def write_text(text: str, target: str | os.PathLike[str]) -> None:

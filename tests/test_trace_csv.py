@@ -1,0 +1,70 @@
+"""A trace CSV read without pandas (cell.arrivals.read_trace): the floats written, the
+columns and rows a spreadsheet saves, and one line on what cannot be used."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cell.arrivals import read_trace
+from cell.errors import ScenarioError
+
+
+def _trace(tmp_path: Path, text: str, name: str = "trace.csv") -> Path:
+    path = tmp_path / name
+    path.write_bytes(text.encode("utf-8"))
+    return path
+
+
+def test_values_are_the_decimal_numbers_written(tmp_path: Path) -> None:
+    rng = np.random.default_rng(7)
+    written = [repr(float(v)) for v in rng.uniform(1e-3, 1e5, 200)] + ["1e3", ".5", "5.", "+7", "0.1"]
+    times = read_trace(_trace(tmp_path, "interarrival_s\n" + "\n".join(written) + "\n"))
+    assert times.tolist() == [float(w) for w in written]  # correctly rounded, as Python reads them
+    assert not times.flags.writeable
+
+
+def test_other_columns_quotes_spaces_blank_lines_bom_and_crlf(tmp_path: Path) -> None:
+    text = '\ufeffpart,interarrival_s\r\nA, 20.5 \r\n\r\nB,"23.25"\r\n   \r\nC,21\r\n'
+    assert read_trace(_trace(tmp_path, text)).tolist() == [20.5, 23.25, 21.0]
+
+
+@pytest.mark.parametrize("text, words", [
+    ("", "not a readable CSV"),
+    ("time\n20\n", "needs a column named interarrival_s"),
+    ("interarrival_s\n", "has no inter-arrival times"),
+    ("interarrival_s\n20\n1_000\n", "row 2 has inter-arrival time '1_000'"),
+    ("interarrival_s\n20\n0x10\n", "row 2 has inter-arrival time '0x10'"),
+    ("interarrival_s\n20\nnan\n", "row 2 has inter-arrival time 'nan'"),
+    ("interarrival_s\n20\n0\n", "row 2 has inter-arrival time '0'"),
+    ("interarrival_s\n2e6\n", "row 1 has inter-arrival time '2e6'"),
+    ("a,interarrival_s\nx,20\ny\n", "row 2 has inter-arrival time ''"),
+    ("interarrival_s\n20\n21,22\n", "not a readable CSV: row 2 has 2 fields, the header 1"),
+])
+def test_unusable_traces_are_one_line_naming_file_and_key(tmp_path: Path, text: str, words: str) -> None:
+    path = _trace(tmp_path, text)
+    with pytest.raises(ScenarioError) as info:
+        read_trace(path)
+    message = str(info.value)
+    assert message.startswith(f"{path}: arrivals.trace_csv = ") and words in message, message
+    assert "\n" not in message
+
+
+def test_a_file_that_is_not_utf8_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "trace.csv"
+    path.write_bytes(b"interarrival_s\n\xff\xfe20\n")
+    with pytest.raises(ScenarioError, match="not a readable CSV"):
+        read_trace(path)
+
+
+def test_reading_a_trace_does_not_import_pandas(tmp_path: Path) -> None:
+    path = _trace(tmp_path, "interarrival_s\n20.5\n21\n")
+    code = ("import sys; from pathlib import Path; from cell.arrivals import read_trace; "
+            f"print(read_trace(Path({str(path)!r})).tolist(), 'pandas' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                          env={"CELL_NO_CACHE": "1", "PATH": ""})
+    assert done.stdout.split() == ["[20.5,", "21.0]", "False"]
