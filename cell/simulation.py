@@ -163,62 +163,59 @@ class RunLog:
         self.rows = rows
         """The kept rows (parts.csv's columns), if the run keeps them."""
         self.waiting: dict[int, PartRecord] = {}
+        """Parts done but not yet handed on (a part before them is not done)."""
         self.flags: dict[int, int] = {}
         """Limit bits of parts not yet handed on."""
-        self.next = 1
         self.per_part = bytearray()
         """What the summary needs of each part, :data:`PER_PART` values a part in that order,
         as packed doubles (``struct``'s pack is a third of ``array.extend``'s cost a part)."""
-        self._emit = self._emitter()
+        self.missed = self.delivered_part = self._logger()
+        """A part fell off at F / was set down: see :meth:`_logger`."""
 
     def flag(self, part: PartRecord, limits: int) -> None:
         self.flags[part.part] = self.flags.get(part.part, 0) | limits
 
-    def _done(self, part: PartRecord) -> None:
-        """A part is done: handed on now if every part before it is, else kept till then."""
-        i = part.part
-        if i != self.next:
-            self.waiting[i] = part
-            return
-        emit = self._emit
-        emit(part)
-        i += 1
-        waiting = self.waiting
-        while waiting and i in waiting:
-            emit(waiting.pop(i))
-            i += 1
-        self.next = i
-
-    missed = delivered_part = _done
-    """A part fell off at F / was set down."""
-
-    def _emitter(self) -> Callable[[PartRecord], None]:
-        """Completes a part's record and hands it on (the log's hot path, locals bound)."""
+    def _logger(self) -> Callable[[PartRecord], None]:
+        """``done(part)``: a part is done; it is completed and handed on now if every part
+        before it is, else kept till then.  The log's hot path, hand-written for speed
+        (locals bound, the in-order part completed in the same call)."""
         t, acct_part, flags_of = self.t, self.acct.part, self.flags.pop
         spacing_in, tol = self.spacing_in, self.tol_in + 1e-9
         note, pack = self.per_part.extend, _PACK_PER_PART
         sink = self.sink
         keep = self.rows.append if self.rows is not None else None
         names_of = LIMIT_NAMES.get  # limit_names' cache, read first
+        waiting = self.waiting
+        following = 1  # the part to hand on next
 
-        def emit(p: PartRecord) -> None:
+        def done(p: PartRecord) -> None:
+            nonlocal following
             i = p.part
-            t_next = t[i]
-            d = p.delivery_interval_s
-            p.ip_wallclock = t_next / d
-            acct_part(p, t_next)
-            flags = flags_of(i, 0)
-            sp = p.spacing_in
-            if sp == sp and abs(sp - spacing_in) > tol:
-                flags |= SPACING_OFF
-            p.limits = (names_of(flags) or limit_names(flags)) if flags else ""
-            note(pack(p.touchdown_s, p.picked, p.r4_s, p.output_speed_in_s, d, sp, flags,
-                      p.feed_delay_s))
-            if keep is not None:
-                keep(_row(p))
-            if sink is not None:
-                sink(p)
-        return emit
+            if i != following:
+                waiting[i] = p
+                return
+            while True:  # complete p (part i) and hand it on, then any waiting after it
+                t_next = t[i]
+                d = p.delivery_interval_s
+                p.ip_wallclock = t_next / d
+                acct_part(p, t_next)
+                flags = flags_of(i, 0)
+                sp = p.spacing_in
+                if sp == sp and abs(sp - spacing_in) > tol:
+                    flags |= SPACING_OFF
+                p.limits = (names_of(flags) or limit_names(flags)) if flags else ""
+                note(pack(p.touchdown_s, p.picked, p.r4_s, p.output_speed_in_s, d, sp, flags,
+                          p.feed_delay_s))
+                if keep is not None:
+                    keep(_row(p))
+                if sink is not None:
+                    sink(p)
+                i += 1
+                if not waiting or i not in waiting:
+                    following = i
+                    return
+                p = waiting.pop(i)
+        return done
 
     def column(self, name: str, start: int = 0) -> np.ndarray:
         """One of :data:`PER_PART`'s values of every part from ``start`` on (a copy)."""

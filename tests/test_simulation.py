@@ -11,10 +11,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cell import catalog
+from cell.assembly import assemble
 from cell.cli import main
-from cell.records import PART_COLUMNS, SUMMARY_COLUMNS
+from cell.records import PART_COLUMNS, SUMMARY_COLUMNS, PartRecord
 from cell.scenario import default_scenario, load_scenario
-from cell.simulation import simulate
+from cell.simulation import RunLog, simulate
 
 BASELINE = catalog.path("baseline")
 NON_ADAPTIVE = catalog.path("non_adaptive")
@@ -375,3 +376,20 @@ def test_non_adaptive_run_is_the_plain_reference_to_the_bit(ideal, seed):
     for a, b in zip(ours, ref):
         assert _bits(getattr(a, c) for c in PART_COLUMNS) == \
             _bits(getattr(b, c) for c in PART_COLUMNS), a.part
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.permutations(list(range(1, 9))))
+def test_the_run_log_hands_parts_on_in_part_order_whatever_order_they_finish(finish_order):
+    policy = assemble(default_scenario()).policy
+    handed: list[int] = []
+    log = RunLog([20.0] * 9, policy.accounting(), lambda p: handed.append(p.part), 45.0, 0.25)
+    done: set[int] = set()
+    for i in finish_order:
+        log.missed(PartRecord(i, float(i), 20.0))
+        done.add(i)
+        ready = 0  # every part up to the first not yet done has been handed on, no other
+        while ready + 1 in done:
+            ready += 1
+        assert handed == list(range(1, ready + 1))
+    assert len(log.per_part) == 8 * 8 * 8  # eight doubles a part, each part once
