@@ -102,6 +102,9 @@ class Belt:
             self._t, self._x, self._v = [t0, t1, t2], [x0, x1, x1 + v1 * (t2 - t1)], [v0, v1, v2]
             return
         k = bisect_right(ts, t1 + EPS_S)
+        if k == 0:  # would rewrite what is settled (and leave no schedule at all)
+            raise ValueError(f"a belt's plan cannot start at {t1!r}, before its earliest "
+                             f"held change ({ts[0]!r})")
         if k < len(ts):
             del ts[k:], xs[k:], vs[k:]
         n = bisect_right(ts, t1) - 1

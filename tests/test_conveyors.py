@@ -27,6 +27,17 @@ def test_new_plan_supersedes_later_changes():
     assert b.travel(25.0) == pytest.approx(30.0 + 30.0 + 20.0)
 
 
+def test_a_plan_cannot_start_before_what_the_belt_holds():
+    b = Belt(3.0)
+    b.plan(10.0, 6.0, 20.0, 1.5)
+    b.plan(30.0, 2.0)                   # settles the changes before 20 s
+    with pytest.raises(ValueError, match="before its earliest held change"):
+        b.plan(5.0, 4.0)
+    assert b.speed(25.0) == 1.5 and b.speed(35.0) == 2.0  # the schedule is as it was
+    with pytest.raises(ValueError, match="before its earliest held change"):
+        Belt(3.0).plan(-1.0, 4.0)
+
+
 def test_speed_must_be_positive():
     with pytest.raises(ValueError):
         Belt(3.0).plan(1.0, 0.0)
