@@ -369,3 +369,18 @@ def test_times_as_date_times_fit_as_their_seconds(tmp_path: Path, capsys):
         cmd_fit(parse(str(bad), "--column", "arrival_s", "--times"))
     assert err.value.key == "arrival_s[row 31]" and err.value.value == "soon"
     assert "date-time" in err.value.why
+
+
+# --------------------------------------------------------------------------- nested families
+@pytest.mark.parametrize("n", [200, 10_000])
+def test_threshold_fits_are_at_least_as_likely_as_the_exponential(n):
+    """expon(loc, scale) is weibull_min(c=1, loc, scale) and gamma(a=1, loc, scale), so the
+    three-parameter MLEs of those two can never be less likely than expon's MLE (loc = min(x)).
+    Near-exponential data put the threshold within ~scale/n of min(x), where a fixed
+    exclusion zone next to min(x) would cost them the ranking."""
+    x = 17.6 + 5.4 * np.random.default_rng(3).weibull(1.02, n)
+    fits = {f.family: f for f in fit_trace(x, families=("expon", "weibull_min", "gamma"))}
+    expon = stats.expon.logpdf(x, *stats.expon.fit(x)).sum()
+    assert fits["expon"].loglik == pytest.approx(expon)
+    for family in ("weibull_min", "gamma"):
+        assert fits[family].loglik >= expon - 1e-6, family

@@ -29,6 +29,9 @@ DEFAULT_FAMILIES: tuple[str, ...] = ("weibull_min", "gamma", "lognorm", "expon",
 THRESHOLD_FAMILIES = frozenset({"weibull_min", "gamma", "lognorm"})
 MIN_VALUES = 20  # values needed to fit
 _GRID = 48  # threshold grid points of the profile likelihood
+#: Families that are ``expon`` at shape 1 and keep a bounded likelihood as loc → min(x) for shape ≥ 1.
+SHAPE_ONE_FAMILIES = frozenset({"weibull_min", "gamma"})
+_CLOSER = 1e-6  # how much closer to min(x) than the grid's end the search goes for those
 
 
 @dataclass(frozen=True)
@@ -82,6 +85,21 @@ def _fit_fixed_loc(dist: Any, x: NDArray[np.float64], loc: float) -> tuple[list[
     return theta, _loglik(dist, x, theta)
 
 
+def _refine(dist: Any, x: NDArray[np.float64], locs: NDArray[np.float64],
+            fits: Sequence[tuple[list[float], float]], best: int, xatol: float) -> tuple[list[float], float]:
+    """Grid point ``best`` of the thresholds ``locs`` (decreasing, fitted as ``fits``), refined by
+    bounded Brent between its neighbours when that raises the log-likelihood; and that likelihood."""
+    theta, ll_best = fits[best]
+    lo, hi = float(locs[min(best + 1, locs.size - 1)]), float(locs[max(best - 1, 0)])
+    if hi > lo:
+        res = optimize.minimize_scalar(lambda loc: -_fit_fixed_loc(dist, x, loc)[1], bounds=(lo, hi),
+                                       method="bounded", options={"xatol": xatol})
+        cand, ll_cand = _fit_fixed_loc(dist, x, float(res.x))
+        if ll_cand > ll_best:
+            theta, ll_best = cand, ll_cand
+    return theta, ll_best
+
+
 def _fit_threshold(dist: Any, x: NDArray[np.float64]) -> list[float]:
     """MLE of a shape family with a threshold 0 ≤ loc < min(x), by profile likelihood.
 
@@ -92,7 +110,10 @@ def _fit_threshold(dist: Any, x: NDArray[np.float64]) -> list[float]:
     two-parameter likelihood (scipy's fit with ``floc``) on a grid of
     thresholds, denser towards min(x) and never closer than 1e-4 of the data's
     range; take the best grid point, preferring an interior local maximum to
-    the end next to min(x); refine it with bounded Brent; then run scipy's free
+    the end next to min(x); refine it with bounded Brent.  A Weibull or gamma
+    best at that end with shape ≥ 1 (bounded likelihood; expon at shape 1) is
+    searched on to 1e-10 of the range, since with n values its threshold lies
+    ~range/n from min(x).  Then run scipy's free
     fit from there and from scipy's own (moments) start, each kept only when it
     raises the log-likelihood and stays in bounds.  The grid is the set of starts whose likelihoods are
     compared, so the answer is a real (local) maximum, and deterministic.
@@ -112,17 +133,22 @@ def _fit_threshold(dist: Any, x: NDArray[np.float64]) -> list[float]:
     peaks = [i for i in range(1, _GRID)
              if np.isfinite(ll[i]) and ll[i] >= ll[i - 1] and (i == _GRID - 1 or ll[i] >= ll[i + 1])]
     best = max(peaks, key=lambda i: ll[i]) if peaks else int(np.argmax(ll))
-    lo, hi = float(locs[min(best + 1, _GRID - 1)]), float(locs[max(best - 1, 0)])
-    theta, ll_best = fits[best]
-    if hi > lo:
-        res = optimize.minimize_scalar(lambda loc: -_fit_fixed_loc(dist, x, loc)[1], bounds=(lo, hi),
-                                       method="bounded", options={"xatol": gap * 1e-3})
-        cand, ll_cand = _fit_fixed_loc(dist, x, float(res.x))
+    theta, ll_best = _refine(dist, x, locs, fits, best, gap * 1e-3)
+    corner, ll_corner = fits[0]
+    closest = gap
+    if dist.name in SHAPE_ONE_FAMILIES and corner and corner[0] >= 1.0 and ll_corner >= ll_best:
+        # Shape ≥ 1 keeps the likelihood bounded as loc → min(x): the corner is no degenerate
+        # end but where the maximum lies (within ~scale/n of min(x)), so search on, closer.
+        closest = gap * _CLOSER
+        near = xmin - np.geomspace(closest, gap, _GRID)
+        near_fits = [_fit_fixed_loc(dist, x, float(loc)) for loc in near]
+        cand, ll_cand = _refine(dist, x, near, near_fits, int(np.argmax([f[1] for f in near_fits])),
+                                closest)
         if ll_cand > ll_best:
             theta, ll_best = cand, ll_cand
     # Two more starts for scipy's free fit: the profile's answer, and scipy's own default;
     # neither may end in the degenerate corner next to min(x) unless the profile did.
-    top = xmin - gap if best <= 1 else float(locs[1])
+    top = xmin - closest if best <= 1 else float(locs[1])
     for guess in (theta, None):
         try:
             free = [float(v) for v in (dist.fit(x) if guess is None else
