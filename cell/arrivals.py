@@ -290,7 +290,7 @@ def check_arrivals(arrivals: ArrivalSpec, base_dir: Path, file: object) -> None:
                             "inter-arrival times must be non-negative with a finite, positive mean")
     if mean > MAX_INTERARRIVAL_S:
         raise ScenarioError(file, "arrivals.params", params,
-                            f"the mean inter-arrival time would be {mean:.4g} s; at most "
+                            f"the mean inter-arrival time would be {mean:.10g} s; at most "
                             f"{MAX_INTERARRIVAL_S:g} s")
     _remember(arrivals, params, mean, low)
 
@@ -325,7 +325,7 @@ def _parse_trace(path: Path) -> Any:
         return "not a readable CSV: No columns to parse from file"
     header, data = rows[0], rows[1:]
     if "interarrival_s" not in header:
-        return "needs a column named interarrival_s"
+        return "needs a column named interarrival_s" + semicolon_hint(",".join(header), "interarrival_s")
     column = header.index("interarrival_s")
     ragged = next((i for i, row in enumerate(data) if len(row) > len(header)), None)
     if ragged is not None:
@@ -341,6 +341,15 @@ def _parse_trace(path: Path) -> Any:
         return "has no inter-arrival times"
     times.setflags(write=False)
     return times
+
+
+def semicolon_hint(header: str, column: str) -> str:
+    """Why ``column`` is not found in a CSV ``header`` line whose columns are separated by ';'
+    (as spreadsheets save CSV in locales with a decimal comma), else ''."""
+    if column in header.split(",") or column not in (c.strip().strip('"') for c in header.split(";")):
+        return ""
+    return ("; the columns are separated by ';': save the CSV with a comma between columns "
+            "and a decimal point in numbers")
 
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\Z")

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 import scipy.stats
 
-from cell.arrivals import FEEDER_STREAM, interarrival_times, stream
+from cell.arrivals import FEEDER_STREAM, MAX_INTERARRIVAL_S, check_arrivals, interarrival_times, stream
+from cell.errors import ScenarioError
 from cell.scenario import ArrivalSettings as Arrivals
 from cell.scenario import default_scenario
 
@@ -65,3 +68,13 @@ def test_both_policies_see_the_same_parts():
     b = simulate(s.with_overrides({"controller.policy": "non-adaptive"}), seed=seed).parts
     np.testing.assert_array_equal(a["interarrival_s"], b["interarrival_s"])
     np.testing.assert_array_equal(a["arrival_s"], b["arrival_s"])
+
+
+def test_a_mean_just_over_the_limit_is_shown_over_it(tmp_path):
+    """A mean of 1,000,000.02 s is refused against the 1e6 s limit; the message shows it
+    with enough digits to be over the limit, not '1e+06 s; at most 1e+06 s'."""
+    spec = SimpleNamespace(distribution="expon", params={"loc": MAX_INTERARRIVAL_S, "scale": 0.02},
+                           trace_csv=None, mean_s=None, cv=None)
+    with pytest.raises(ScenarioError) as err:
+        check_arrivals(spec, tmp_path, "s.yaml")
+    assert "would be 1000000.02 s; at most 1e+06 s" in err.value.why
