@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import io
 import math
+import re
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -22,6 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, stats
 
+from cell.arrivals import MAX_INTERARRIVAL_S, semicolon_hint
 from cell.errors import ScenarioError
 
 DEFAULT_FAMILIES: tuple[str, ...] = ("weibull_min", "gamma", "lognorm", "expon", "norm")
@@ -326,22 +328,22 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
         raise ScenarioError(p, column, seen,
                             "the column never decreases, so it looks like arrival times, not gaps: "
                             "use --times to fit their differences (or --gaps if these are sorted gaps)")
-    bad = np.flatnonzero(~finite if times else ~finite | ~(values > 0.0))
+    bad = np.flatnonzero(~finite if times else ~finite | ~(values > 0.0) | (values > MAX_INTERARRIVAL_S))
     if bad.size:
         i = int(bad[0])
-        why = ("missing value" if cells.iloc[i] == "" else
-               "not a date-time (YYYY-MM-DD hh:mm:ss)" if dated else
-               "not a number" if math.isnan(values[i]) and cells.iloc[i].lower() != "nan" else
-               "arrival times must be finite" if times else "inter-arrival times must be finite and > 0")
-        raise ScenarioError(p, f"{column}[row {i + 1}]", written.iloc[i], why)
+        raise ScenarioError(p, f"{column}[row {i + 1}]", written.iloc[i],
+                            _why_unusable(cells.iloc[i], values[i], times=times, dated=dated))
     noun = "values"
     if times:
-        back = np.flatnonzero(~(np.diff(values) > 0.0))
+        step = np.diff(values)
+        back = np.flatnonzero(~(step > 0.0) | (step > MAX_INTERARRIVAL_S))
         if back.size:
             i = int(back[0]) + 1
-            raise ScenarioError(p, f"{column}[row {i + 1}]", written.iloc[i],
-                                f"arrival times must increase: not after {cells.iloc[i - 1]} in row {i}")
-        values, noun = np.diff(values), "gaps"
+            why = (f"arrival times must increase: not after {cells.iloc[i - 1]} in row {i}"
+                   if not step[i - 1] > 0.0 else
+                   f"{step[i - 1]:.10g} s after row {i}; gaps must be at most {MAX_INTERARRIVAL_S:g} s")
+            raise ScenarioError(p, f"{column}[row {i + 1}]", written.iloc[i], why)
+        values, noun = step, "gaps"
     if values.size < MIN_VALUES:
         shown = f"{cells.size} arrival times" if times else f"{values.size} values"
         need = f"{MIN_VALUES + 1} arrival times" if times else f"{MIN_VALUES} values"
@@ -350,6 +352,22 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
         raise ScenarioError(p, column, f"all {values.size} {noun} = {values[0]:g}",
                             f"{noun} without variation cannot be fitted")
     return values
+
+
+def _why_unusable(cell: str, value: float, *, times: bool, dated: bool) -> str:
+    """Why a cell of the column cannot be used (``value`` as read, NaN if not a number)."""
+    if cell == "":
+        return "missing value"
+    if dated:
+        return "not a date-time (YYYY-MM-DD hh:mm:ss)"
+    if math.isnan(value) and cell.lower() != "nan":
+        if re.fullmatch(r"[+-]?\d*,\d+", cell):
+            return "not a number: write a decimal point, not a comma"
+        return ("not a number of seconds nor an ISO date-time (YYYY-MM-DD hh:mm:ss)" if times
+                else "not a number")
+    if times:
+        return "arrival times must be finite"
+    return f"inter-arrival times must be finite, > 0 and at most {MAX_INTERARRIVAL_S:g} s"
 
 
 def _read_cells(p: Path, column: str) -> Any:
@@ -370,6 +388,9 @@ def _read_cells(p: Path, column: str) -> Any:
                             f"not UTF-8 text (byte {exc.start}); save the CSV as UTF-8") from None
     if not text.strip():
         raise ScenarioError(p, "(file)", str(p), "empty file")
+    hint = semicolon_hint(text.lstrip().splitlines()[0], column)
+    if hint:
+        raise ScenarioError(p, "(file)", str(p), f"no column {column}{hint}")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", pd.errors.ParserWarning)
@@ -381,4 +402,5 @@ def _read_cells(p: Path, column: str) -> Any:
         names = ", ".join(map(str, frame.columns))
         hint = " (is it separated by ';'? use commas)" if any(";" in str(c) for c in frame.columns) else ""
         raise ScenarioError(p, "--column", column, f"no such column; the columns are: {names}{hint}")
-    return frame[column]
+    blank = frame.apply(lambda c: c.str.strip() == "").all(axis=1)  # a spreadsheet's empty rows: ',,'
+    return frame.loc[~blank, column].reset_index(drop=True)

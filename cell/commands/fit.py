@@ -16,7 +16,9 @@ from pathlib import Path
 from cell.errors import ScenarioError
 
 HELP = "fit a distribution to observed inter-arrival times; write the arrivals block"
-DESCRIPTION = __doc__.splitlines()[2] if __doc__ else ""
+DESCRIPTION = ("Fit scipy.stats distributions to observed inter-arrival times by maximum likelihood, "
+               "rank them, and write the arrivals: block of the best one that never gives a negative "
+               "time, with a histogram of the data under the fitted densities.")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -67,6 +69,11 @@ def main(args: argparse.Namespace) -> int:
 
     trace = Path(args.trace)
     out = _destination(args.out, "--out", [trace]) if args.out is not None else None
+    if args.figure is not None and Path(args.figure).suffix.lower() != ".png":
+        raise ScenarioError("--figure", "--figure", args.figure, "the figure is a PNG: name a .png file")
+    if args.figure is None and out is not None and out.suffix.lower() == ".png":
+        raise ScenarioError(out, "--out", str(out), "the figure goes beside --out as .png, onto --out "
+                            "itself: name --out .yaml, or the figure with --figure")
     figure_arg = args.figure if args.figure is not None else out.with_suffix(".png") if out else None
     figure = _destination(figure_arg, "--figure", [trace, *([out] if out else [])]) \
         if figure_arg is not None else None

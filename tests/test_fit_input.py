@@ -1,0 +1,138 @@
+"""``cell fit`` on files as a spreadsheet exports them, and its options' refusals: what
+``cell fit`` reads agrees with what a run's trace reader (cell.arrivals.read_trace) reads."""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from cell.arrivals import MAX_INTERARRIVAL_S, read_trace
+from cell.commands.fit import DESCRIPTION, add_arguments
+from cell.commands.fit import main as cmd_fit
+from cell.errors import ScenarioError
+
+
+def parse(*argv: str) -> argparse.Namespace:
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    return parser.parse_args(list(argv))
+
+
+def gaps(n: int = 60, seed: int = 5) -> np.ndarray:
+    """Shifted-Weibull gaps (thesis eq. 6.9) by their own inverse cdf."""
+    u = np.random.default_rng(seed).random(n)
+    return 17.6019 + 5.4342 * (-np.log1p(-u)) ** 0.2038
+
+
+def write(path: Path, text: str, encoding: str = "utf-8") -> Path:
+    path.write_bytes(text.encode(encoding))
+    return path
+
+
+def fitted(capsys: pytest.CaptureFixture[str], *argv: str) -> dict:
+    assert cmd_fit(parse(*argv)) == 0
+    return yaml.safe_load(capsys.readouterr().out)
+
+
+def test_rows_of_empty_cells_are_skipped_as_the_trace_reader_skips_them(tmp_path: Path, capsys):
+    """A spreadsheet saves its empty trailing rows as bare separators (',,'), with a BOM and
+    CRLF: a run reads the same times as without them, and so does ``cell fit``."""
+    x = gaps()
+    rows = "".join(f"{i},{float(v)!r}\r\n" for i, v in enumerate(x, 1))
+    plain = write(tmp_path / "plain.csv", "part,interarrival_s\n" + rows)
+    excel = write(tmp_path / "excel.csv", "\ufeffpart,interarrival_s\r\n" + rows + ",\r\n , \r\n,\r\n",
+                  "utf-8")
+    assert read_trace(excel).tolist() == read_trace(plain).tolist() == x.tolist()
+    assert fitted(capsys, str(excel)) == fitted(capsys, str(plain))
+
+
+@pytest.mark.parametrize("rows", [
+    "".join(f"{i};{v:.3f}\n" for i, v in enumerate(gaps(), 1)),
+    "".join(f"{i};{v:.3f}\n".replace(".", ",") for i, v in enumerate(gaps(), 1)),
+], ids=["decimal point", "decimal comma"])
+def test_semicolon_separated_files_are_named_as_such(tmp_path: Path, rows: str):
+    """A CSV saved with ';' between columns (a European spreadsheet's default) is refused by
+    both readers with one line saying so, not pandas' complaint about field counts."""
+    path = write(tmp_path / "semi.csv", "part;interarrival_s\n" + rows)
+    with pytest.raises(ScenarioError) as err:
+        cmd_fit(parse(str(path), "--out", str(tmp_path / "a.yaml")))
+    assert err.value.file == str(path) and "';'" in err.value.why and "comma" in err.value.why
+    assert "\n" not in str(err.value)
+    with pytest.raises(ScenarioError) as err:
+        read_trace(path)
+    assert "';'" in err.value.why and "comma" in err.value.why
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["semi.csv"]
+
+
+def test_a_decimal_comma_is_named(tmp_path: Path):
+    values = [f"{v:.3f}" for v in gaps()]
+    values[4] = '"21,5"'
+    path = write(tmp_path / "t.csv", "interarrival_s\n" + "\n".join(values) + "\n")
+    with pytest.raises(ScenarioError) as err:
+        cmd_fit(parse(str(path)))
+    assert (err.value.key, err.value.value) == ("interarrival_s[row 5]", "21,5")
+    assert "decimal point" in err.value.why
+
+
+def test_times_that_are_neither_seconds_nor_iso_say_what_is_accepted(tmp_path: Path):
+    """--times takes seconds or ISO 8601 date-times; a log's '02.03.2026 08:15:04' is neither,
+    and the message says so rather than 'not a number'."""
+    t = np.cumsum(gaps())
+    start = np.datetime64("2026-03-02T08:15:00", "s")
+    stamps = [start + np.timedelta64(int(s), "s") for s in t]
+    german = [f"{str(s)[8:10]}.{str(s)[5:7]}.{str(s)[:4]} {str(s)[11:]}" for s in stamps]
+    path = write(tmp_path / "t.csv", "stamp\n" + "\n".join(german) + "\n")
+    with pytest.raises(ScenarioError) as err:
+        cmd_fit(parse(str(path), "--column", "stamp", "--times"))
+    assert (err.value.key, err.value.value) == ("stamp[row 1]", german[0])
+    assert "ISO" in err.value.why and "seconds" in err.value.why
+
+
+@pytest.mark.parametrize("times", [False, True], ids=["gaps", "arrival times"])
+def test_gaps_a_run_would_refuse_are_refused(tmp_path: Path, times: bool):
+    """A run refuses a trace gap over MAX_INTERARRIVAL_S; ``cell fit`` refuses it too, naming
+    the row, instead of writing an arrivals block whose mean no scenario accepts."""
+    x = gaps()
+    x[6] = 2.0 * MAX_INTERARRIVAL_S
+    column = np.concatenate([[0.0], np.cumsum(x)]) if times else x
+    path = write(tmp_path / "t.csv", "interarrival_s\n" + "".join(f"{float(v)!r}\n" for v in column))
+    out = tmp_path / "a.yaml"
+    with pytest.raises(ScenarioError) as err:
+        cmd_fit(parse(str(path), "--out", str(out), *(["--times"] if times else [])))
+    assert err.value.key == ("interarrival_s[row 8]" if times else "interarrival_s[row 7]")
+    assert f"{MAX_INTERARRIVAL_S:g}" in err.value.why
+    assert not out.exists()
+
+
+def test_figure_must_be_a_png(tmp_path: Path):
+    """The figure is a PNG whatever its name; a .pdf or .svg name is refused, not filled with PNG."""
+    path = write(tmp_path / "t.csv", "interarrival_s\n" + "".join(f"{float(v)!r}\n" for v in gaps()))
+    for name in ("fit.pdf", "fit.svg", "fit"):
+        with pytest.raises(ScenarioError) as err:
+            cmd_fit(parse(str(path), "--figure", str(tmp_path / name)))
+        assert (err.value.key, err.value.value) == ("--figure", str(tmp_path / name))
+        assert ".png" in err.value.why
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.csv"]
+
+
+def test_out_named_png_names_out(tmp_path: Path):
+    """--out fit.png puts the figure (fit.png, beside --out) on --out itself: the message names
+    --out, which the user gave, and says how to get out of it."""
+    path = write(tmp_path / "t.csv", "interarrival_s\n" + "".join(f"{float(v)!r}\n" for v in gaps()))
+    with pytest.raises(ScenarioError) as err:
+        cmd_fit(parse(str(path), "--out", str(tmp_path / "fit.png")))
+    assert err.value.key == "--out" and "--figure" in err.value.why
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.csv"]
+
+
+def test_help_describes_the_command_in_whole_sentences():
+    assert DESCRIPTION.endswith(".") and DESCRIPTION[0].isupper()
+    done = subprocess.run([sys.executable, "-m", "cell", "fit", "--help"], capture_output=True,
+                          text=True, check=True)
+    assert " ".join(DESCRIPTION.split()) in " ".join(done.stdout.split())
