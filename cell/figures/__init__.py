@@ -62,6 +62,8 @@ def make_figures(scenario: Scenario, out: str | Path, *, parts: int | None = Non
         if progress:
             progress(p)
 
+    if wanted & set(range(22, 31)):
+        runs.check_cycles(scenario)  # before anything is drawn
     with style():
         table = step_table(scenario)
         if 8 in wanted:

@@ -48,6 +48,40 @@ class Runs:
     """Keyed by the robot's cycle (Table 7.1, column 1)."""
 
 
+def _shortest_missed(s: Scenario, cycles: tuple[float, ...]) -> tuple[float, float] | None:
+    """(the first of ``cycles`` the non-adaptive robot cannot make, its shortest cycle), or None."""
+    from cell.assembly import constants, robot_timing
+    from cell.errors import ScenarioError
+    from cell.policies.fixed import fixed_plan
+
+    k = constants(s, robot_timing(s))
+    for c in cycles:
+        try:
+            fixed_plan(k, c)
+        except ScenarioError:
+            return c, k.shortest_cycle_s
+    return None
+
+
+def check_cycles(s: Scenario, cycles: tuple[float, ...] = TABLE_7_1_CYCLES) -> None:
+    """Refuse, before anything is drawn, a scenario whose non-adaptive robot cannot make one of
+    ``cycles`` (Fig. 22-30 run it at each): one line naming the scenario, the cycle, its shortest,
+    and the ``--set`` that helps when the nominal cycle (by default the arrivals' mean) is why."""
+    from cell.errors import ScenarioError
+
+    missed = _shortest_missed(s, cycles)
+    if missed is None:
+        return
+    thesis = {"controller.nominal_cycle_s": cycles[0]}
+    fix = (f" (its nominal cycle is {nominal_cycle(s):.4f} s: --set controller.nominal_cycle_s="
+           f"{cycles[0]:g} draws them)" if nominal_cycle(s) != cycles[0]
+           and _shortest_missed(s.with_overrides(thesis), cycles) is None else "")
+    raise ScenarioError(s.source, "(figures)", f"{missed[0]:g} s",
+                        f"Fig. 22-30 run the non-adaptive robot at Table 7.1's cycles "
+                        f"({', '.join(f'{x:g}' for x in cycles)} s), and this scenario's shortest "
+                        f"is {missed[1]:.4f} s{fix}")
+
+
 def simulate_runs(s: Scenario, cycles: tuple[float, ...] = TABLE_7_1_CYCLES) -> Runs:
     """The adaptive run and the non-adaptive run at each cycle, same seed throughout."""
     from cell.simulation import simulate
