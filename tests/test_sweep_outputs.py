@@ -42,3 +42,19 @@ def test_a_report_folder_that_holds_the_sweeps_results_is_planned_before_running
     assert code == 0, capsys.readouterr().err
     folder = (work / report).resolve() / "sweep"
     assert (folder / "report.md").is_file() and (work / "o" / "replications.csv").is_file()
+
+
+def test_a_shared_report_folder_keeps_the_letters_of_a_non_english_name(sweeps, tmp_path,
+                                                                       monkeypatch, capsys):
+    """The subfolder is the sweep's name with only separators replaced: 'Étude / ligne 3'
+    goes to Étude_ligne_3, not to 'tude_ligne_3'."""
+    monkeypatch.setattr("cell.sweep.simulate_summary", sweeps.bookkeeping)
+    shared = tmp_path / "reports"
+    shared.mkdir()
+    (shared / "notes.txt").write_text("mine\n")
+    path = sweeps.write(tmp_path, name="Étude / ligne 3", policies=["adaptive"],
+                        grid={"run.warmup_parts": [0, 1]})
+    code = main(["sweep", str(path), "--out", str(tmp_path / "o"), "--workers", "1",
+                 "--report", str(shared)])
+    assert code == 0, capsys.readouterr().err
+    assert sorted(p.name for p in shared.iterdir()) == ["notes.txt", "Étude_ligne_3"]

@@ -74,7 +74,7 @@ def plan_report(sweep: Sweep, target: str | os.PathLike[str], option: str = "--r
     if not (_holds(path, results) or _shared(path, names)):
         OutputDir.check(path, names, option)
         return Target(path, names, t71)
-    sub = path / (re.sub(r"[^A-Za-z0-9._-]+", "_", sweep.name).strip("._") or "sweep")
+    sub = path / (re.sub(r"[^\w.-]+", "_", sweep.name).strip("._") or "sweep")
     OutputDir.check(sub, REPORT_FILES, option)
     if t71:
         for name in TABLE_7_1_FILES:
