@@ -330,11 +330,24 @@ def _trend(h: Headline, summary: pd.DataFrame, sweep: Sweep, cols: Sequence[str]
         if len(group) < 2 or values.isna().any():
             continue
         first, last = group.iloc[0], group.iloc[-1]
-        d = decimals(max(half_width(first), half_width(last)))
-        out.append(f"{str(policy).capitalize()} goes from {float(first['mean']):.{d}f} at "
-                   f"{col} = {show(first[col])} to {float(last['mean']):.{d}f} at "
-                   f"{show(last[col])}.")
+        a, b = _ends(first, last)
+        who = str(policy).capitalize()
+        if a == b:
+            out.append(f"{who} stays at {a} from {col} = {show(first[col])} to "
+                       f"{show(last[col])}.")
+        else:
+            out.append(f"{who} goes from {a} at {col} = {show(first[col])} to {b} at "
+                       f"{show(last[col])}.")
     return out
+
+
+def _ends(first: Mapping[Any, Any], last: Mapping[Any, Any]) -> tuple[str, str]:
+    """Two summary rows' means to the precision of the wider interval; as plain figures
+    when neither varies between replications (60, not 60.0000)."""
+    if float(first["sd"]) == 0.0 and float(last["sd"]) == 0.0:
+        return number(float(first["mean"])), number(float(last["mean"]))
+    d = decimals(max(half_width(first), half_width(last)))
+    return f"{float(first['mean']):.{d}f}", f"{float(last['mean']):.{d}f}"
 
 
 __all__ = ["display_columns", "markdown", "reading", "sentence"]
