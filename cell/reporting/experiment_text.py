@@ -341,7 +341,7 @@ def _trend(h: Headline, summary: pd.DataFrame, sweep: Sweep, cols: Sequence[str]
     return out
 
 
-def _ends(first: Mapping[Any, Any], last: Mapping[Any, Any]) -> tuple[str, str]:
+def _ends(first: pd.Series, last: pd.Series) -> tuple[str, str]:
     """Two summary rows' means to the precision of the wider interval; as plain figures
     when neither varies between replications (60, not 60.0000)."""
     if float(first["sd"]) == 0.0 and float(last["sd"]) == 0.0:
