@@ -205,8 +205,11 @@ def _precision(replications: pd.DataFrame, summary: pd.DataFrame, sweep: Sweep,
         done = precision_reached({i: values}, q.precision, q.confidence, q.min_n)[i]
         short += not done
         verdict = "reached" if done else f"not reached: stopped at max = {q.max_n}"
+        if int(row["n"]) < 2:
+            verdict += f"; {int(row['n'])} of the runs gave {q.measure} a value"
+        shown = f"{rhw * 100:.2f} %" if math.isfinite(rhw) else "—"
         lines.append(table_row([*(show(row[c]) for c in cols), str(row["policy"]),
-                                str(int(row["n"])), f"{rhw * 100:.2f} %", verdict]))
+                                str(len(values)), shown, verdict]))
     lines += ["", f"{len(rows) - short} of {len(rows)} points reached the precision"
               + (f"; {short} stopped at the maximum of {q.max_n} replications." if short
                  else "."), ""]
