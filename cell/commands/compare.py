@@ -121,12 +121,28 @@ def main(args: argparse.Namespace) -> int:
     if target is not None:
         from cell.reporting.experiment import write_report
 
-        command = (f"cell compare {args.a} {args.b} --replications {args.replications} "
-                   f"--seed {seed}")
-        write_report(replications, sweep, target, command, warning, tables)
+        write_report(replications, sweep, target, command_line(args, seed), warning, tables)
         print(f"wrote {args.out}/: report.md, summary.csv, differences.csv, figures, "
               "replications.csv")
     return 0
+
+
+def _too_few(n: int) -> str:
+    """Why a measure has no paired interval: fewer than two replications give it on both sides."""
+    have = "no replication gives" if n == 0 else "only one replication gives"
+    return f"{have} it for both A and B (e.g. a run too short to deliver two parts)"
+
+
+def command_line(args: argparse.Namespace, seed: int) -> str:
+    """The command that reproduces this comparison, quoted for a shell: its scenarios,
+    replications, seed and every ``--set``."""
+    import shlex
+
+    words = ["cell", "compare", args.a, args.b, "--replications", str(args.replications),
+             "--seed", str(seed)]
+    for value in args.sets or ():
+        words += ["--set", value]
+    return shlex.join(words)
 
 
 def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> str:
@@ -139,7 +155,7 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> s
     differ = windows_apart(a.scenario, b.scenario)
     parts = a.scenario.run.parts if a.scenario.run.parts == b.scenario.run.parts else None
     level = f"{sweep.confidence * 100:g} %"
-    length = (f" of {parts} parts" if parts else
+    length = (f" of {parts} part{'s' if parts != 1 else ''}" if parts else
               f" of {a.scenario.run.parts} and {b.scenario.run.parts} parts")
     lines = [f"{la} ({a.policy}) against {lb} ({b.policy}): {sweep.replications} replications"
              f"{length}, seed {sweep.seed}, common random numbers; A - B with its paired "
@@ -157,6 +173,9 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> s
         row = d.iloc[0]
         means = summary[summary["measure"] == h.column].set_index("scenario")["mean"]
         mean, sd, lo, hi = (float(row[k]) for k in ("mean", "sd", "ci_low", "ci_high"))
+        if int(row["n"]) < 2:
+            lines.append(f"  {h.title:<{width}}  not compared: {_too_few(int(row['n']))}")
+            continue
         word = h.words[0] if mean >= 0 else h.words[1]
         unit = f" {h.unit}" if h.unit else ""
         per = f" per {parts}-part run" if h.per_run and parts else ""

@@ -57,7 +57,7 @@ def _sweep(args: argparse.Namespace) -> int:
     if args.report:
         from cell.reporting.experiment import plan_report
 
-        target = plan_report(sweep, args.report)  # checked before anything runs
+        target = plan_report(sweep, args.report, results=args.out)  # before anything runs
     try:
         outcome = run_sweep(sweep, args.out, workers=args.workers, scheduler=args.scheduler,
                             resume=args.resume, replicate=simulate_summary)

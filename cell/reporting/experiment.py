@@ -22,7 +22,8 @@ at all):
   (:mod:`cell.reporting.table_7_1`).
 
 A ``--report DIR`` that already holds files the report does not write (a shared
-folder such as the repository's ``reports/``) is left as it is: the report goes
+folder such as the repository's ``reports/``), or will hold the sweep's own
+``--out``, is left as it is: the report goes
 to ``DIR/<sweep name>/``, and Table 7.1's two files, for a sweep laid out like
 it, into ``DIR`` itself beside the others (each replaced atomically).
 """
@@ -63,20 +64,30 @@ class Target:
     beside: Path | None = None
 
 
-def plan_report(sweep: Sweep, target: str | os.PathLike[str], option: str = "--report") -> Target:
-    """Check, before anything runs, where the report can go (see the module's docstring)."""
+def plan_report(sweep: Sweep, target: str | os.PathLike[str], option: str = "--report",
+                results: str | os.PathLike[str] | None = None) -> Target:
+    """Check, before anything runs, where the report can go (see the module's docstring);
+    ``results``: the sweep's ``--out``, which makes a folder holding it a shared one."""
     t71 = is_table_7_1(sweep)
     names = REPORT_FILES + (TABLE_7_1_FILES if t71 else ())
     path = Path(target)
-    if not _shared(path, names):
+    if not (_holds(path, results) or _shared(path, names)):
         OutputDir.check(path, names, option)
         return Target(path, names, t71)
-    sub = path / (re.sub(r"[^A-Za-z0-9._-]+", "_", sweep.name).strip("._") or "sweep")
+    sub = path / (re.sub(r"[^\w.-]+", "_", sweep.name).strip("._") or "sweep")
     OutputDir.check(sub, REPORT_FILES, option)
     if t71:
         for name in TABLE_7_1_FILES:
             check_file(path / name)
     return Target(sub, REPORT_FILES, t71, path if t71 else None)
+
+
+def _holds(path: Path, results: str | os.PathLike[str] | None) -> bool:
+    """Whether the folder ``path`` is, or holds, the folder ``results``."""
+    if results is None:
+        return False
+    mine, theirs = Path(os.path.abspath(path)), Path(os.path.abspath(results))
+    return mine == theirs or mine in theirs.parents
 
 
 def _shared(path: Path, names: Sequence[str]) -> bool:

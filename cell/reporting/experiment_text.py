@@ -87,6 +87,11 @@ def _against(a: str, b: str, at: bool = True) -> str:
     return b
 
 
+def _lower(title: str) -> str:
+    """A title within a sentence: its first letter lowered, unless it starts an acronym (IP)."""
+    return title if title[1:2].isupper() else title[:1].lower() + title[1:]
+
+
 def sentence(h: Headline, d: Mapping[Any, Any], a: str, b: str, parts: int | None,
              confidence: float) -> str:
     """A paired difference in words: ``A delivers 31.2 ± 1.4 parts more than B per
@@ -96,6 +101,9 @@ def sentence(h: Headline, d: Mapping[Any, Any], a: str, b: str, parts: int | Non
     level = f"{confidence * 100:g} %"
     per = f" per {parts}-part run" if h.per_run and parts else ""
     direction = h.words[0] if mean >= 0 else h.words[1]
+    if n == 0 or not math.isfinite(mean):
+        return (f"{a} against {b}: not compared, no replication gives {_lower(h.title)} for "
+                "both (e.g. runs too short to deliver two parts).")
     if n < 2 or not math.isfinite(float(d["sd"])):
         x = number(abs(mean))
         return h.sentence.format(a=a, x=x, dir=direction, b=b) + per + \
@@ -159,7 +167,7 @@ def _parts(sweep: Sweep) -> int | None:
 
 def _replications(sweep: Sweep, parts: int | None) -> str:
     q = sweep.precision
-    of = f" of {parts} parts" if parts else ""
+    of = f" of {parts} part{'s' if parts != 1 else ''}" if parts else ""
     if q is None:
         return f"{sweep.replications} replication{'s' if sweep.replications != 1 else ''}{of} " \
                "per point"
@@ -197,8 +205,11 @@ def _precision(replications: pd.DataFrame, summary: pd.DataFrame, sweep: Sweep,
         done = precision_reached({i: values}, q.precision, q.confidence, q.min_n)[i]
         short += not done
         verdict = "reached" if done else f"not reached: stopped at max = {q.max_n}"
+        if int(row["n"]) < 2:
+            verdict += f"; {int(row['n'])} of the runs gave {q.measure} a value"
+        shown = f"{rhw * 100:.2f} %" if math.isfinite(rhw) else "—"
         lines.append(table_row([*(show(row[c]) for c in cols), str(row["policy"]),
-                                str(int(row["n"])), f"{rhw * 100:.2f} %", verdict]))
+                                str(len(values)), shown, verdict]))
     lines += ["", f"{len(rows) - short} of {len(rows)} points reached the precision"
               + (f"; {short} stopped at the maximum of {q.max_n} replications." if short
                  else "."), ""]
@@ -254,9 +265,11 @@ def _verdicts(h: Headline, differences: pd.DataFrame, cols: Sequence[str]) -> li
     for (a, b), group in rows.groupby(["policy", "versus"], sort=False):
         mean, lo, hi = (group[k].to_numpy(dtype=float) for k in ("mean", "ci_low", "ci_high"))
         up, down = int(np.sum(lo > 0)), int(np.sum(hi < 0))
-        level, n = len(group) - up - down, len(group)
+        unknown = int(np.sum(~(np.isfinite(lo) & np.isfinite(hi))))  # fewer than two pairs
+        level, n = len(group) - up - down - unknown, len(group)
         counts = [f"{h.words[0]} at {up}" if up else "", f"{h.words[1]} at {down}" if down else "",
-                  f"no difference shown at {level}" if level else ""]
+                  f"no difference shown at {level}" if level else "",
+                  f"not compared (too few values) at {unknown}" if unknown else ""]
         counts = [c for c in counts if c]
         if n == 1:
             counts[0] = counts[0].removesuffix(" at 1")
@@ -320,11 +333,24 @@ def _trend(h: Headline, summary: pd.DataFrame, sweep: Sweep, cols: Sequence[str]
         if len(group) < 2 or values.isna().any():
             continue
         first, last = group.iloc[0], group.iloc[-1]
-        d = decimals(max(half_width(first), half_width(last)))
-        out.append(f"{str(policy).capitalize()} goes from {float(first['mean']):.{d}f} at "
-                   f"{col} = {show(first[col])} to {float(last['mean']):.{d}f} at "
-                   f"{show(last[col])}.")
+        a, b = _ends(first, last)
+        who = str(policy).capitalize()
+        if a == b:
+            out.append(f"{who} stays at {a} from {col} = {show(first[col])} to "
+                       f"{show(last[col])}.")
+        else:
+            out.append(f"{who} goes from {a} at {col} = {show(first[col])} to {b} at "
+                       f"{show(last[col])}.")
     return out
+
+
+def _ends(first: pd.Series, last: pd.Series) -> tuple[str, str]:
+    """Two summary rows' means to the precision of the wider interval; as plain figures
+    when neither varies between replications (60, not 60.0000)."""
+    if float(first["sd"]) == 0.0 and float(last["sd"]) == 0.0:
+        return number(float(first["mean"])), number(float(last["mean"]))
+    d = decimals(max(half_width(first), half_width(last)))
+    return f"{float(first['mean']):.{d}f}", f"{float(last['mean']):.{d}f}"
 
 
 __all__ = ["display_columns", "markdown", "reading", "sentence"]

@@ -31,7 +31,19 @@ def check_out(out: str | Path) -> Path:
         if not manifest.is_file() or not isinstance(_manifest(manifest), dict):
             raise CellError(f"--out {out}: {manifest} is not a sweep's manifest; choose another "
                             "--out")
+    elif theirs := _results_without_manifest(path):
+        raise CellError(f"--out {out}: holds {theirs} but no {MANIFEST}: not a sweep's results, "
+                        "and a sweep would replace them; choose another --out")
     return path
+
+
+def _results_without_manifest(path: Path) -> str | None:
+    """What a sweep would replace in ``path`` (its ``replications.csv``, task files),
+    named for the message, when there is no manifest to say a sweep wrote them."""
+    found = [str(Path(p).relative_to(path)) for p in
+             ([path / "replications.csv"] if (path / "replications.csv").exists() else [])
+             + finished_tasks(path)[:1]]
+    return ", ".join(found) or None
 
 
 def finished_tasks(out: str | Path) -> list[Path]:

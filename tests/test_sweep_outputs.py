@@ -1,0 +1,60 @@
+"""Where a sweep's results and report go: a user's files are never replaced, and a
+report that could not be written is refused before any replication runs."""
+
+from __future__ import annotations
+
+import pytest
+
+from cell.cli import main
+
+
+def test_a_folder_with_a_users_replications_csv_is_refused_and_left_alone(sweeps, tmp_path,
+                                                                          capsys):
+    """No sweep.json: the replications.csv is not a sweep's, so the sweep must not replace it."""
+    mine = tmp_path / "data"
+    mine.mkdir()
+    (mine / "replications.csv").write_text("my,own,numbers\n")
+    code = main(["sweep", str(sweeps.write(tmp_path)), "--out", str(mine), "--workers", "1"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1, err
+    assert "replications.csv" in err and "sweep.json" in err
+    assert (mine / "replications.csv").read_text() == "my,own,numbers\n"
+    assert sorted(p.name for p in mine.iterdir()) == ["replications.csv"]
+
+
+def test_a_sweeps_own_folder_is_reused_without_resume(sweeps, tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr("cell.sweep.simulate_summary", sweeps.first_draw)
+    args = ["sweep", str(sweeps.write(tmp_path)), "--out", str(tmp_path / "o"), "--workers", "1"]
+    assert main(args) == 0 and main(args) == 0, capsys.readouterr().err
+
+
+@pytest.mark.parametrize("report", ["o", "o/..", "."])
+def test_a_report_folder_that_holds_the_sweeps_results_is_planned_before_running(
+        sweeps, tmp_path, monkeypatch, capsys, report):
+    """--report DIR holding --out (the same folder, or its parent): the sweep's own files
+    will be there, so the report goes to DIR/NAME/ -- decided before anything runs."""
+    monkeypatch.setattr("cell.sweep.simulate_summary", sweeps.bookkeeping)
+    work = tmp_path / "w"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    path = sweeps.write(tmp_path, policies=["adaptive"], grid={"run.warmup_parts": [0, 1]})
+    code = main(["sweep", str(path), "--out", "o", "--workers", "1", "--report", report])
+    assert code == 0, capsys.readouterr().err
+    folder = (work / report).resolve() / "sweep"
+    assert (folder / "report.md").is_file() and (work / "o" / "replications.csv").is_file()
+
+
+def test_a_shared_report_folder_keeps_the_letters_of_a_non_english_name(sweeps, tmp_path,
+                                                                       monkeypatch, capsys):
+    """The subfolder is the sweep's name with only separators replaced: 'Étude / ligne 3'
+    goes to Étude_ligne_3, not to 'tude_ligne_3'."""
+    monkeypatch.setattr("cell.sweep.simulate_summary", sweeps.bookkeeping)
+    shared = tmp_path / "reports"
+    shared.mkdir()
+    (shared / "notes.txt").write_text("mine\n")
+    path = sweeps.write(tmp_path, name="Étude / ligne 3", policies=["adaptive"],
+                        grid={"run.warmup_parts": [0, 1]})
+    code = main(["sweep", str(path), "--out", str(tmp_path / "o"), "--workers", "1",
+                 "--report", str(shared)])
+    assert code == 0, capsys.readouterr().err
+    assert sorted(p.name for p in shared.iterdir()) == ["notes.txt", "Étude_ligne_3"]
