@@ -318,7 +318,8 @@ def test_a_shared_report_folder_gets_a_subfolder_and_keeps_its_files(sweeps, tmp
     shared = tmp_path / "reports"
     shared.mkdir()
     (shared / "README.md").write_text("mine\n")
-    path = sweeps.write(tmp_path, replications=2, batch=2)  # laid out like Table 7.1
+    path = sweeps.write(tmp_path, replications=2, batch=2,  # laid out like Table 7.1
+                        set={"run.parts": 500})
     code = main(["sweep", str(path), "--out", str(tmp_path / "o"), "--workers", "1",
                  "--report", str(shared)])
     assert code == 0
@@ -329,12 +330,28 @@ def test_a_shared_report_folder_gets_a_subfolder_and_keeps_its_files(sweeps, tmp
 
 
 def test_a_report_folder_of_its_own_holds_table_7_1_beside_the_rest(sweeps, tmp_path):
-    path = sweeps.write(tmp_path, replications=2, batch=2)
+    path = sweeps.write(tmp_path, replications=2, batch=2, set={"run.parts": 500})
     assert main(["sweep", str(path), "--out", str(tmp_path / "o"), "--workers", "1",
                  "--report", str(tmp_path / "rep")]) == 0
     names = {p.name for p in (tmp_path / "rep").iterdir()}
     assert {"table_7_1.md", "table_7_1.csv", "report.md", "summary.csv",
             "differences.csv"} <= names
+
+
+@pytest.mark.parametrize("other", [
+    {"run.parts": 20},                                        # the thesis's runs are 500 parts
+    {"run.parts": 500, "arrivals": {"distribution": "gamma", "mean_s": 22.5872, "cv": 0.3}},
+    {"run.parts": 500, "belts.output_nominal_in_s": 2.5},
+])
+def test_table_7_1_only_beside_the_thesis_s_own_cell(sweeps, tmp_path, other):
+    """Laid out like Table 7.1 but on another cell: the general report, no thesis beside it."""
+    from cell.reporting.table_7_1 import is_table_7_1
+
+    sweep = load_sweep(sweeps.write(tmp_path, replications=2, batch=2, set=other))
+    assert not is_table_7_1(sweep)
+    same = load_sweep(sweeps.write(tmp_path, replications=2, batch=2,
+                                   set={"run.parts": 500, "robot.timing": "minimum-time"}))
+    assert is_table_7_1(same)  # the thesis's cell under another robot timing (make sweep-mintime)
 
 
 @pytest.mark.parametrize("make", ["file", "parent-file"])

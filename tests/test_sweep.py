@@ -246,7 +246,7 @@ def test_cli_says_it_is_reaching_a_scheduler_before_it_waits(sweeps, tmp_path, m
 # --------------------------------------------------------------------------- command line
 def test_cli_writes_replications_and_report(sweeps, tmp_path, monkeypatch, capsys):
     monkeypatch.setattr("cell.sweep.simulate_summary", sweeps.bookkeeping)
-    path = sweeps.write(tmp_path)
+    path = sweeps.write(tmp_path, set={"run.parts": 500})  # the thesis's cell: Table 7.1 too
     code = main(["sweep", str(path), "--out", str(tmp_path / "o"), "--workers", "1",
                  "--report", str(tmp_path / "rep")])
     assert code == 0, capsys.readouterr().err

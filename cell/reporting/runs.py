@@ -72,11 +72,9 @@ def thesis_figures(s: Scenario) -> dict[str, str] | None:
     run: the built-in baseline (eq. 6.9 arrivals, 500 parts), either policy, a Table 7.1
     cycle for the non-adaptive robot; None otherwise."""
     c = s.controller
-    base = load_scenario("baseline").with_overrides(
-        {"controller.policy": c.policy, "controller.ideal_cycle_s": c.ideal_cycle_s,
-         "run.seed": s.run.seed})
-    if _comparable(s) != _comparable(base):
+    if not is_thesis_cell(s):
         return None
+    base = load_scenario("baseline")
     if c.policy == "adaptive":
         return {"parts_missed": f"{published.ADAPTIVE_PARTS_MISSED}",
                 "ip_thesis": f"{published.ADAPTIVE_IP}",
@@ -90,6 +88,18 @@ def thesis_figures(s: Scenario) -> dict[str, str] | None:
     if any(v is None for v in values.values()):
         return None
     return {field: fmt.format(values[field]) for field, (_, fmt) in TABLE_7_1_SHOWN.items()}
+
+
+def is_thesis_cell(s: Scenario, *, any_timing: bool = False) -> bool:
+    """Whether ``s`` is the thesis's own run but for its policy, robot cycle and seed (and,
+    with ``any_timing``, its robot timing): the built-in baseline's cell, eq. 6.9 arrivals,
+    500 parts; names, descriptions and the planner's settings aside."""
+    c = s.controller
+    same = {"controller.policy": c.policy, "controller.ideal_cycle_s": c.ideal_cycle_s,
+            "run.seed": s.run.seed}
+    if any_timing:
+        same["robot.timing"] = s.robot.timing
+    return _comparable(s) == _comparable(load_scenario("baseline").with_overrides(same))
 
 
 def _comparable(s: Scenario) -> dict[str, Any]:

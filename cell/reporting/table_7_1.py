@@ -96,10 +96,15 @@ def ideal_cycle(point: Point) -> float:
 
 
 def is_table_7_1(sweep: Sweep) -> bool:
-    """Whether the sweep can be laid out as Table 7.1: it varies at most the robot cycle,
-    runs only policies the thesis published figures for, a fixed number of times."""
+    """Whether the sweep can be laid out as Table 7.1, beside the thesis's figures: it
+    varies at most the robot cycle, runs only policies the thesis published figures for, a
+    fixed number of times, on the thesis's own cell (any robot timing:
+    :func:`~cell.reporting.runs.is_thesis_cell`)."""
+    from cell.reporting.runs import is_thesis_cell
+
     return (set(sweep.keys) <= {VARIED_KEY} and sweep.precision is None
-            and all(p.policy in published.PUBLISHED for p in sweep.points))
+            and all(p.policy in published.PUBLISHED for p in sweep.points)
+            and all(is_thesis_cell(p.scenario, any_timing=True) for p in sweep.points))
 
 
 def statistics(values: Sequence[float] | np.ndarray) -> dict[str, float]:
