@@ -87,10 +87,30 @@ class Scenario(Section):
         """Plain YAML-able data (tuples as lists)."""
         return _plain(self.model_dump())
 
-    def with_overrides(self, overrides: Mapping[str, Any], file: object = None) -> Scenario:
-        """A new scenario with dotted keys replaced, validated as if read from ``file``."""
-        raw = apply_overrides(self.to_dict(), overrides, file or self._source, is_section)
+    def with_overrides(self, overrides: Mapping[str, Any], file: object = None,
+                       paths_from: Path | None = None) -> Scenario:
+        """A new scenario with dotted keys replaced, validated as if read from ``file``;
+        a file the overrides name by a relative path is looked for from ``paths_from``
+        (None: from this scenario's folder, as its own files are)."""
+        before = self.to_dict()
+        raw = apply_overrides(before, overrides, file or self._source, is_section)
+        if paths_from is not None:
+            _anchor_paths(before, raw, paths_from)
         return validate(raw, file or self._source, source=self._source)
+
+
+#: The settings that name a file (relative paths: from the scenario file's folder).
+PATH_KEYS = (("arrivals", "trace_csv"), ("mintime", "dynamics_file"))
+
+
+def _anchor_paths(before: Mapping[str, Any], after: dict[str, Any], where: Path) -> None:
+    """In ``after``, a file setting that differs from ``before`` (an override set it) and is
+    a relative path becomes relative to ``where`` instead of the scenario's folder."""
+    for section, key in PATH_KEYS:
+        value = (after.get(section) or {}).get(key)
+        if isinstance(value, str) and value != (before.get(section) or {}).get(key) \
+                and not Path(value).is_absolute():
+            after[section] = {**after[section], key: str(Path(where).resolve() / value)}
 
 
 def _plain(obj: Any) -> Any:
@@ -212,8 +232,9 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
         given = {**given, "name": path.stem}
     raw = merge(_DEFAULTS.to_dict(), given, (), is_section)
     try:
-        return validate(apply_overrides(raw, overrides or {}, path, is_section), path,
-                        source=str(path))
+        changed = apply_overrides(raw, overrides or {}, path, is_section)
+        _anchor_paths(raw, changed, Path.cwd())  # a file named on the command line: from here
+        return validate(changed, path, source=str(path))
     except ScenarioError as exc:  # a value from --set: the line says so
         if not overrides or not any(exc.key == k or exc.key.startswith(k + ".")
                                     or k.startswith(exc.key + ".") for k in overrides):

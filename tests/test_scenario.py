@@ -79,6 +79,23 @@ def test_an_error_in_a_set_value_says_it_came_from_set(tmp_path):
     assert "(--set)" not in str(other.value)
 
 
+def test_a_file_named_by_set_is_found_from_the_working_directory(tmp_path, monkeypatch):
+    """``--set arrivals.trace_csv=log.csv`` names ./log.csv, whatever folder the scenario is in
+    (a built-in one's is inside the package); the scenario file's own paths stay its own."""
+    (tmp_path / "log.csv").write_text("interarrival_s\n20\n25\n")
+    monkeypatch.chdir(tmp_path)
+    s = load_scenario("baseline", {"arrivals.trace_csv": "log.csv"})
+    assert s.base_dir / s.arrivals.trace_csv == tmp_path / "log.csv"
+    s = load_scenario("baseline", {"arrivals": {"trace_csv": "log.csv"}})  # a section given whole
+    assert s.base_dir / s.arrivals.trace_csv == tmp_path / "log.csv"
+    own = tmp_path / "sub"
+    own.mkdir()
+    (own / "own.csv").write_text("interarrival_s\n21\n")
+    (own / "s.yaml").write_text("arrivals: {trace_csv: own.csv}\n")
+    s = load_scenario(own / "s.yaml", {"run.parts": 3})
+    assert s.base_dir / s.arrivals.trace_csv == own / "own.csv"
+
+
 def test_known_key():
     assert known_key("controller.ideal_cycle_s")
     assert known_key("robot.motors.nominal_fraction")

@@ -108,6 +108,15 @@ def test_base_by_a_built_in_name(sweeps, tmp_path):
     assert sweep.points[0].scenario.arrivals.mean_s == 30
 
 
+def test_a_file_the_sweep_names_is_found_from_the_sweep_s_folder(sweeps, tmp_path):
+    """A trace set by the sweep file is beside the sweep file, even over a built-in base."""
+    (tmp_path / "log.csv").write_text("interarrival_s\n20\n25\n")
+    sweep = load_sweep(sweeps.write(tmp_path, base="baseline", policies=["adaptive"],
+                                    set={"run.parts": 5, "arrivals.trace_csv": "log.csv"}))
+    s = sweep.points[0].scenario
+    assert s.base_dir / s.arrivals.trace_csv == tmp_path / "log.csv"
+
+
 def test_bad_value_error_names_file_key_and_value(sweeps, tmp_path):
     path = sweeps.write(tmp_path, policies={"non-adaptive": {"controller.ideal_cycle_s":
                                                             [22.0, "fast"]}})

@@ -295,8 +295,9 @@ def load_sweep(path: str | Path) -> Sweep:
             own_names = named_by_policy.get(policy, names)
             named = tuple((k, own_names[k][j]) for k, j in zip(combined, combo, strict=True)
                           if k in own_names)
-            scenario = base.with_overrides(
-                {**fixed, "controller.policy": policy, **dict(values)}, file=path)
+            scenario = base.with_overrides(  # files the sweep names: from its folder
+                {**fixed, "controller.policy": policy, **dict(values)}, file=path,
+                paths_from=path.parent)
             _check_point(scenario, path)
             points.append(Point(policy, i, values, scenario, named))
             checking.update()
