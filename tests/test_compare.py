@@ -124,6 +124,8 @@ def test_verdict_says_which_is_better_on_each_measure():
 @pytest.mark.parametrize(("args", "shows"), [
     (["nowhere.yaml", "baseline"], "nowhere.yaml"),
     (["baseline", "non_adaptive", "--replications", "1"], "--replications 1"),
+    (["baseline", "non_adaptive", "--replications", "100000000000"],
+     "--replications 100,000,000,000: at most 5,000,000"),  # years of runs, refused at once
     (["baseline", "non_adaptive", "--workers", "0"], "--workers 0"),
     (["baseline", "non_adaptive", "--seed", "-4"], "--seed -4"),
     (["baseline", "non_adaptive", "--set", "run.partz=3"], "run.partz"),

@@ -87,13 +87,16 @@ def main(args: argparse.Namespace) -> int:
     from cell.overrides import parse_sets
     from cell.scenario import load_scenario
     from cell.sweep import run_sweep, simulate_summary
-    from cell.sweep.spec import comparison
+    from cell.sweep.spec import MAX_RUNS, comparison
 
     sets = parse_sets(args.sets)
     a, b = load_scenario(args.a, sets), load_scenario(args.b, sets)
     if args.replications < 2:
         raise CellError(f"--replications {args.replications}: must be at least 2 "
                         "(a confidence interval needs two)")
+    if 2 * args.replications > MAX_RUNS:
+        raise CellError(f"--replications {args.replications:,}: at most {MAX_RUNS // 2:,} "
+                        f"(two scenarios: {MAX_RUNS:,} runs, a sweep's limit)")
     if args.seed is not None and not 0 <= args.seed < 2**63:
         raise CellError(f"--seed {args.seed}: must be a whole number from 0 to 2**63 - 1")
     check_workers(args.workers)
