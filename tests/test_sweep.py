@@ -264,6 +264,23 @@ def test_cli_writes_replications_and_report(sweeps, tmp_path, monkeypatch, capsy
     assert (tmp_path / "rep" / "table_7_1.md").is_file()
 
 
+def test_cli_warns_of_points_that_cannot_keep_up(sweeps, tmp_path, capsys):
+    """Utilisation 1 or more at some points: one warning line, as cell run gives for a run."""
+    arrivals = {"distribution": "gamma", "mean_s": 22.0, "cv": 0.3}
+    path = sweeps.write(tmp_path, policies=["adaptive"], grid={"arrivals.mean_s": [15, 22, 17]},
+                        set={"run.parts": 20, "arrivals": arrivals,
+                             "controller.nominal_cycle_s": None})
+    assert main(["sweep", str(path), "--out", str(tmp_path / "o"), "--workers", "1"]) == 0
+    warned = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+    assert len(warned) == 1 and "2 of 3 points have utilisation 1 or more" in warned[0]
+    assert "at arrivals.mean_s 15" in warned[0]  # the worst: fastest cycle 18.08 s over 15 s
+    quiet = sweeps.write(tmp_path, policies=["adaptive"], grid={"arrivals.mean_s": [22, 25]},
+                         set={"run.parts": 20, "arrivals": arrivals,
+                              "controller.nominal_cycle_s": None})
+    assert main(["sweep", str(quiet), "--out", str(tmp_path / "q"), "--workers", "1"]) == 0
+    assert "utilisation" not in capsys.readouterr().err
+
+
 def test_cli_reports_any_sweep(sweeps, tmp_path, monkeypatch, capsys):
     """A sweep that is not Table 7.1's gets the general report, without Table 7.1."""
     monkeypatch.setattr("cell.sweep.simulate_summary", sweeps.bookkeeping)

@@ -48,7 +48,7 @@ from cell.progress import Progress
 from cell.scenario import Scenario
 from cell.sweep.columns import Column, grid_columns, point_values
 from cell.sweep.outdir import TASK_DIR, check_out, prepare
-from cell.sweep.spec import Sweep, Task
+from cell.sweep.spec import Sweep, Task, overload_warning
 from cell.sweep.windows import window_warning
 
 if TYPE_CHECKING:  # pandas is imported when first needed: local workers start without it
@@ -268,8 +268,9 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     """
     out = check_out(out)
     workers = check_workers(workers, scheduler)
-    if warn and (warning := window_warning(sweep)):
-        print(f"cell: warning: {warning}", file=sys.stderr)
+    for warning in (overload_warning(sweep), window_warning(sweep) if warn else None):
+        if warning:
+            print(f"cell: warning: {warning}", file=sys.stderr)
     executor, client = _open_executor(workers, scheduler, progress)
     window = CLUSTER_WINDOW if scheduler else 2 * workers
     columns = grid_columns(sweep)

@@ -59,6 +59,7 @@ from cell.sweep.options import (
     read_baseline,
     read_replications,
     reserved,
+    show,
     summary_measures,
     whole,
 )
@@ -87,6 +88,9 @@ class Point:
     scenario: Scenario
     names: tuple[tuple[str, str], ...] = ()
     """For keys whose grid values are named: the name of the value here."""
+    utilisation: float = math.nan
+    """The robot's fastest cycle over the mean inter-arrival time here (1 or more: the cell
+    cannot keep up on average)."""
 
     def name_of(self, key: str) -> str | None:
         """The name of this point's value of ``key``, if the sweep file named it."""
@@ -298,8 +302,8 @@ def load_sweep(path: str | Path) -> Sweep:
             scenario = base.with_overrides(  # files the sweep names: from its folder
                 {**fixed, "controller.policy": policy, **dict(values)}, file=path,
                 paths_from=path.parent)
-            _check_point(scenario, path)
-            points.append(Point(policy, i, values, scenario, named))
+            points.append(Point(policy, i, values, scenario, named,
+                                _check_point(scenario, path)))
             checking.update()
     checking.close()
 
@@ -313,13 +317,27 @@ def load_sweep(path: str | Path) -> Sweep:
     return sweep
 
 
-def _check_point(scenario: Scenario, file: object) -> None:
+def overload_warning(sweep: Sweep) -> str | None:
+    """One line if some points' cells cannot keep up on average (utilisation 1 or more,
+    as ``cell run`` warns of a run), naming the worst; else None."""
+    over = [p for p in sweep.points if p.utilisation >= 1]
+    if not over:
+        return None
+    worst = max(over, key=lambda p: p.utilisation)
+    where = ", ".join(f"{k} {show(v)}" for k, v in worst.values) or worst.policy
+    return (f"{len(over)} of {len(sweep.points)} points have utilisation 1 or more (up to "
+            f"{worst.utilisation:.3f}, at {where}): the robot's fastest cycle is not shorter "
+            "than the mean inter-arrival time there, and every policy will lose parts")
+
+
+def _check_point(scenario: Scenario, file: object) -> float:
     """Assemble a grid point's cell now, so that no bad point is found after work began;
-    an error names the sweep file, with the key and value it was about."""
+    an error names the sweep file, with the key and value it was about.  Returns the
+    point's utilisation."""
     from cell.assembly import assemble
 
     try:
-        assemble(scenario)
+        return assemble(scenario).k.utilisation
     except ScenarioError as exc:
         raise ScenarioError(file, exc.key, exc.value, exc.why) from None
 
@@ -329,9 +347,9 @@ def comparison(a: Scenario, b: Scenario, labels: tuple[str, str], replications: 
     """Two scenarios as a sweep of two points, varying the pseudo-key ``scenario`` (their
     labels): ``a`` against ``b`` (the baseline), with common random numbers."""
     la, lb = labels if labels[0] != labels[1] else (f"A: {labels[0]}", f"B: {labels[1]}")
-    pa = Point(a.controller.policy, 0, (("scenario", la),), a)
+    pa = Point(a.controller.policy, 0, (("scenario", la),), a, (), _check_point(a, a.source))
     pb = Point(b.controller.policy, int(b.controller.policy == a.controller.policy),
-               (("scenario", lb),), b)
+               (("scenario", lb),), b, (), _check_point(b, b.source))
     return Sweep(f"{la} against {lb}", "compare", f"{la} against {lb}", a, (), ("scenario",),
                  (pa, pb), replications, seed, min(batch, replications),
                  baseline=Baseline(b.controller.policy, (("scenario", lb),),
