@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import argparse
 
+from cell.output.streams import outlives_reader
+
 HELP = "print the JSON Schema of scenario files (for editor completion and checking)"
 DESCRIPTION = __doc__.splitlines()[0] if __doc__ else ""
 
@@ -17,6 +19,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", default=None, help="write it to this file (default: print it)")
 
 
+@outlives_reader
 def main(args: argparse.Namespace) -> int:
     import json
 
