@@ -51,6 +51,9 @@ IDLE_COLOUR = "0.45"
 #: Figure height and one column's width (in); the layout below is in inches too.
 HEIGHT_IN, COLUMN_IN = 7.0, 5.5
 CLOSE_IN, STRIP_IN, GAP_IN = 4.55, 0.55, 0.36
+#: A strip spans at most this many belt widths across, and a part on it is drawn at least this
+#: fraction of its length wide: a long belt (a far drop point) stays visible, squares stretched.
+STRIP_MAX_BELTS, STRIP_MIN_PART = 3.0, 1 / 250
 
 POLICY_TITLES = {"adaptive": "adaptive controller (§5.3)",
                  "non-adaptive": "fixed cycle, not adaptive (§6.3)"}
@@ -82,6 +85,8 @@ class Panel:
     texts: dict[str, Text]
     gaps: list[Text]
     """Distances between neighbours on the output belt."""
+    in_stretch: float = 1.0
+    """How much wider than they are parts are drawn on the input strip (see STRIP_MIN_PART)."""
 
     def artists(self) -> list[Artist]:
         """Everything that moves, in drawing order."""
@@ -97,10 +102,11 @@ def _axes(fig: Figure, left: float, bottom: float, width: float, height: float) 
 
 def _strip(ax: Axes, x0: float, x1: float, w: float, width_in: float,
            marks: dict[str, float], title: str, title_x: float, ha: str) -> None:
-    """A belt drawn whole along x, squares kept square (equal aspect by the limits)."""
+    """A belt drawn whole along x, squares kept square (equal aspect by the limits) unless the
+    belt would then be thinner than a third of the strip (:func:`strip_span`)."""
     y0 = -w / 2 - 1.0
     ax.set_xlim(x0, x1)
-    ax.set_ylim(y0, y0 + (x1 - x0) * STRIP_IN / width_in)
+    ax.set_ylim(y0, y0 + strip_span(x1 - x0, w, width_in))
     ax.add_patch(Rectangle((x0, -w / 2), x1 - x0, w, color=BELT_COLOUR, zorder=0))
     for name, x in marks.items():
         ax.plot([x, x], [-w / 2, w / 2 + 0.4], color="0.3", lw=0.6, zorder=1)
@@ -111,6 +117,22 @@ def _strip(ax: Axes, x0: float, x1: float, w: float, width_in: float,
     ax.grid(False)
     for side in ("left", "right", "top"):
         ax.spines[side].set_visible(False)
+
+
+def strip_span(length_in: float, w: float, width_in: float) -> float:
+    """The y-span (in) of a strip ``width_in`` wide showing ``length_in`` of a belt ``w`` wide:
+    equal aspect, or at most STRIP_MAX_BELTS belt widths."""
+    return min(length_in * STRIP_IN / width_in, STRIP_MAX_BELTS * w)
+
+
+def stretch(verts: Floats, factor: float) -> Floats:
+    """(n, 4, 2) corners widened along x by ``factor`` about each square's centre."""
+    if factor == 1.0:
+        return verts
+    centre = verts[:, :, 0].mean(axis=1, keepdims=True)
+    out = verts.copy()
+    out[:, :, 0] = centre + (verts[:, :, 0] - centre) * factor
+    return out
 
 
 def _parts_collection(linewidth: float, zorder: float) -> PolyCollection:
@@ -187,7 +209,8 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene) -> Panel
     strip_out.add_collection(parts_out)
     gaps = [strip_out.text(0, 0, "", fontsize=6.5, ha="center", va="center", color="0.1",
                            clip_on=True, zorder=3) for _ in range(4)]
-    return Panel(scene, parts, parts_in, parts_out, labels, arm, texts, gaps)
+    in_stretch = max(1.0, STRIP_MIN_PART * (f[0] + 3 - (drop - 3)) / s.part.size_in)
+    return Panel(scene, parts, parts_in, parts_out, labels, arm, texts, gaps, in_stretch)
 
 
 def _figure_in(columns: int) -> tuple[float, float]:
@@ -238,7 +261,7 @@ def draw_frame(panel: Panel, t: float) -> None:
         if shown[i]:
             label.set_position(at.xy[i])
     on_in = (at.where == INPUT) | falling
-    show(panel.parts_in, on_in, corners[on_in])
+    show(panel.parts_in, on_in, stretch(corners[on_in], panel.in_stretch))
     on_out = at.where == OUTPUT
     y_out = at.xy[on_out, 1]
     show(panel.parts_out, on_out,
