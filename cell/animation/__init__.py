@@ -81,7 +81,8 @@ def simulate_scenes(scenario: Scenario, policies: list[str], first: int, count: 
         scenes = []
         for policy in policies:
             s = scenario.with_overrides({"controller.policy": policy, "run.parts": n})
-            scenes.append(build_scene(frames_input(simulate(s), s), table, s))
+            data = frames_input(simulate(s), s)
+            scenes.append(build_scene(data, table, s, from_s=float(data.arrival_s[first - 1])))
         _, t1 = window(scenes, first, count)
         if all(sc.data.arrival_s[-1] > t1 for sc in scenes):
             return scenes

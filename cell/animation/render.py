@@ -39,6 +39,7 @@ from cell.animation.scene import (
     counts_at,
     parts_at,
     robot_at,
+    shown_between,
 )
 from cell.figures.layout import BELT_COLOUR, named_points
 from cell.figures.style import LIMIT_COLOUR, POLICY_COLOURS, REGIME_COLOURS, REGIME_LABELS, style
@@ -78,8 +79,8 @@ class Panel:
     """Parts in the close-up."""
     parts_in: PolyCollection
     parts_out: PolyCollection
-    labels: list[Text]
-    """Part numbers in the close-up."""
+    labels: dict[int, Text]
+    """Part numbers in the close-up, by part index: the parts the frames can show."""
     arm: list[Line2D]
     """Upper arm, forearm with the hand, fingers."""
     texts: dict[str, Text]
@@ -91,7 +92,7 @@ class Panel:
     def artists(self) -> list[Artist]:
         """Everything that moves, in drawing order."""
         moving: list[Artist] = [self.parts_in, self.parts_out, *self.gaps, self.parts,
-                                *self.labels, *self.arm, *self.texts.values()]
+                                *self.labels.values(), *self.arm, *self.texts.values()]
         return sorted(moving, key=lambda a: a.get_zorder())
 
 
@@ -143,7 +144,8 @@ def _parts_collection(linewidth: float, zorder: float) -> PolyCollection:
                           zorder=zorder)
 
 
-def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene) -> Panel:
+def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene,
+           span: tuple[float, float] | None) -> Panel:
     s, p = scene.scenario, scene.table.path
     w = s.cell.belt_width_in
     policy = scene.data.policy
@@ -184,8 +186,9 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene) -> Panel
            close.plot([], [], "-", lw=2.2, color="0.1", solid_capstyle="butt", zorder=7)[0]]
     parts = _parts_collection(0.6, 4)
     close.add_collection(parts)
-    labels = [close.text(0, 0, str(n), fontsize=6, ha="center", va="center", zorder=4.5,
-                         clip_on=True) for n in scene.data.part]
+    shown = range(len(scene.data.part)) if span is None else shown_between(scene, *span)
+    labels = {int(i): close.text(0, 0, str(scene.data.part[i]), fontsize=6, ha="center",
+                                 va="center", zorder=4.5, clip_on=True) for i in shown}
     mono: dict[str, Any] = {"transform": close.transAxes, "fontsize": 8, "va": "top", "ha": "left",
             "family": "monospace", "zorder": 8}
     texts = {"clock": close.text(0.02, 0.985, "", fontweight="bold", **mono),
@@ -224,13 +227,17 @@ def frame_pixels(columns: int, dpi: float) -> int:
     return round(w * dpi) * round(h * dpi)
 
 
-def build_figure(scenes: list[Scene], dpi: float) -> tuple[Figure, list[Panel]]:
-    """The figure, on an Agg canvas, and one :class:`Panel` per run, side by side."""
+def build_figure(scenes: list[Scene], dpi: float, span: tuple[float, float] | None = None
+                 ) -> tuple[Figure, list[Panel]]:
+    """The figure, on an Agg canvas, and one :class:`Panel` per run, side by side.
+
+    ``span``: the first and last frame's instants; only the parts in the scene between them
+    get a label (a window deep into a long run labels a few parts, not every one)."""
     size = _figure_in(len(scenes))
     column = size[0] / len(scenes)
     fig = Figure(figsize=size, dpi=dpi)
     FigureCanvasAgg(fig)
-    panels = [_panel(fig, i * column, column, sc) for i, sc in enumerate(scenes)]
+    panels = [_panel(fig, i * column, column, sc, span) for i, sc in enumerate(scenes)]
     return fig, panels
 
 
@@ -256,7 +263,7 @@ def draw_frame(panel: Panel, t: float) -> None:
 
     shown = at.where > 0
     show(panel.parts, shown, corners[shown])
-    for i, label in enumerate(panel.labels):
+    for i, label in panel.labels.items():
         label.set_visible(bool(shown[i] and not falling[i]))
         if shown[i]:
             label.set_position(at.xy[i])
@@ -344,7 +351,7 @@ def render(scenes: list[Scene], times: Floats, out: Path, *, fps: int, dpi: floa
 
     gif = out.suffix.lower() == ".gif"
     with style():
-        fig, panels = build_figure(scenes, dpi)
+        fig, panels = build_figure(scenes, dpi, (float(times[0]), float(times[-1])))
         canvas = fig.canvas
         assert isinstance(canvas, FigureCanvasAgg)
         moving = [a for panel in panels for a in panel.artists()]
