@@ -55,3 +55,35 @@ def test_every_part_a_frame_shows_has_its_label_and_few_others_do(deep: list[Sce
         assert len(panel.labels) < 50
         for i in needed:
             assert panel.labels[i].get_text() == str(panel.scene.data.part[i])
+
+
+@pytest.mark.parametrize("policy", ["adaptive", "non-adaptive"])
+def test_the_frames_kept_from_a_streamed_run_are_the_full_runs(scenario: Scenario, policy: str) -> None:
+    """The few fields a deep run keeps per part (flat arrays, the belts streamed) give the
+    same frames' input as the run's full records: every array equal, dtype and all."""
+    from cell.animation import simulated
+    from cell.animation.scene import frames_input
+    from cell.simulation import simulate
+
+    s = scenario.with_overrides({"controller.policy": policy, "run.parts": 400,
+                                 "arrivals.params.scale": 3.0})  # belts at their limits too
+    ours, full = frames_input(simulated(s), s), frames_input(simulate(s), s)
+    for name in full.__dataclass_fields__:
+        a, b = getattr(ours, name), getattr(full, name)
+        if isinstance(b, np.ndarray):
+            assert a.dtype == b.dtype, name
+            np.testing.assert_array_equal(a, b, err_msg=name)
+        else:
+            assert a == b, name
+
+
+def test_a_long_run_before_the_window_shows_its_progress(scenario: Scenario, monkeypatch: pytest.MonkeyPatch,
+                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    import cell.animation as animation
+
+    monkeypatch.setattr(animation, "PROGRESS_FROM_PARTS", 100)
+    animation.simulated(scenario.with_overrides({"run.parts": 300}), progress=True)
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[-1].startswith("cell animate: simulating (adaptive): 300/300 parts (100 %)")
+    animation.simulated(scenario.with_overrides({"run.parts": 99}), progress=True)
+    assert capsys.readouterr().err == ""
