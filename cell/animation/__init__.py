@@ -30,6 +30,11 @@ POLICIES = ("adaptive", "non-adaptive", "both")
 EXTRA_PARTS = 3
 #: A GIF's frames are all held (one byte a pixel) until it is written: at most this much.
 GIF_MEMORY_BYTES = 1.5e9
+#: The fields of a part's record that the frames need (:func:`~cell.animation.scene.frames_input`).
+FRAME_FIELDS = ("part", "arrival_s", "at_bot_s", "picked", "pick_s", "touchdown_s",
+                "r1_s", "r2_s", "r3_s", "r4_s")
+#: Runs of at least this many parts show their progress on stderr while they are simulated.
+PROGRESS_FROM_PARTS = 50_000
 
 
 @dataclass(frozen=True)
@@ -60,8 +65,55 @@ def check_output(out: str | Path) -> Path:
     return path
 
 
-def simulate_scenes(scenario: Scenario, policies: list[str], first: int, count: int
-                    ) -> list[Scene]:
+def simulated(scenario: Scenario, progress: bool = False) -> Any:
+    """The run, keeping of each part only :data:`FRAME_FIELDS` (as a flat array each: a
+    deep ``--from-part`` runs millions of parts); ``.parts``, ``.belts`` and ``.summary``
+    as :func:`~cell.simulation.simulate`'s result has them."""
+    from array import array
+    from operator import attrgetter
+    from types import SimpleNamespace
+
+    import numpy as np
+    import pandas as pd
+
+    from cell.progress import Progress
+    from cell.simulation import simulate
+
+    columns = {f: array("d") for f in FRAME_FIELDS}
+    appends, fields = [columns[f].append for f in FRAME_FIELDS], attrgetter(*FRAME_FIELDS)
+    n = scenario.run.parts
+    with Progress(n, f"cell animate: simulating ({scenario.controller.policy})", "parts",
+                  enabled=progress and n >= PROGRESS_FROM_PARTS) as bar:
+        step = max(1, n // 200)
+
+        def keep(record: Any) -> None:
+            for add, value in zip(appends, fields(record)):
+                add(value)
+            if bar.enabled and record.part % step == 0:
+                bar.update(step)
+
+        changes: dict[str, tuple[array[float], array[float]]] = {
+            "input": (array("d"), array("d")), "output": (array("d"), array("d"))}
+
+        def changed(change: Any) -> None:
+            at, speed = changes[change.belt]
+            at.append(change.from_s)
+            speed.append(change.speed_in_s)
+
+        result = simulate(scenario, keep_parts=False, on_part=keep, keep_belts=False,
+                          on_belt=changed)
+        bar.update(n - bar.n)
+    parts = pd.DataFrame({f: np.frombuffer(columns[f]) for f in FRAME_FIELDS})
+    parts = parts.astype({"part": np.int64, "picked": bool})
+    belts = {}
+    for belt, (at, speed) in changes.items():  # each belt's in time order, as the run's are
+        rows = np.column_stack([np.frombuffer(at), np.frombuffer(speed)]).reshape(-1, 2)
+        belts[belt] = rows[np.argsort(rows[:, 0], kind="stable")]
+    return SimpleNamespace(parts=parts, belts=belts, summary=result.summary)
+
+
+def simulate_scenes(scenario: Scenario, policies: list[str], first: int, count: int,
+                    progress: bool = False) -> list[Scene]:
     """Each policy's run, long enough that every part on the belts in the window exists.
 
     Parts are numbered as in a run of any length (the feeder's draws are the same
@@ -70,7 +122,6 @@ def simulate_scenes(scenario: Scenario, policies: list[str], first: int, count: 
     """
     from cell.animation.scene import build_scene, frames_input, window
     from cell.assembly import step_table
-    from cell.simulation import simulate
 
     if count < 1 or first < 1:
         raise CellError(f"--parts {count} --from-part {first}: both must be at least 1")
@@ -81,7 +132,8 @@ def simulate_scenes(scenario: Scenario, policies: list[str], first: int, count: 
         scenes = []
         for policy in policies:
             s = scenario.with_overrides({"controller.policy": policy, "run.parts": n})
-            scenes.append(build_scene(frames_input(simulate(s), s), table, s))
+            data = frames_input(simulated(s, progress), s)
+            scenes.append(build_scene(data, table, s, from_s=float(data.arrival_s[first - 1])))
         _, t1 = window(scenes, first, count)
         if all(sc.data.arrival_s[-1] > t1 for sc in scenes):
             return scenes
@@ -107,7 +159,7 @@ def animate(scenario: Scenario, out: str | Path, *, policy: str | None = None, p
     if chosen not in POLICIES:
         raise CellError(f"--policy {chosen!r}: one of {', '.join(POLICIES)}")
     policies = ["adaptive", "non-adaptive"] if chosen == "both" else [chosen]
-    scenes = simulate_scenes(scenario, policies, first, parts)
+    scenes = simulate_scenes(scenario, policies, first, parts, progress)
     t0, t1 = window(scenes, first, parts)
     times = frame_times(t0, t1, speed / fps)
     if path.suffix.lower() == ".gif":

@@ -39,6 +39,7 @@ from cell.animation.scene import (
     counts_at,
     parts_at,
     robot_at,
+    shown_between,
 )
 from cell.figures.layout import BELT_COLOUR, named_points
 from cell.figures.style import LIMIT_COLOUR, POLICY_COLOURS, REGIME_COLOURS, REGIME_LABELS, style
@@ -51,6 +52,9 @@ IDLE_COLOUR = "0.45"
 #: Figure height and one column's width (in); the layout below is in inches too.
 HEIGHT_IN, COLUMN_IN = 7.0, 5.5
 CLOSE_IN, STRIP_IN, GAP_IN = 4.55, 0.55, 0.36
+#: A strip spans at most this many belt widths across, and a part on it is drawn at least this
+#: fraction of its length wide: a long belt (a far drop point) stays visible, squares stretched.
+STRIP_MAX_BELTS, STRIP_MIN_PART = 3.0, 1 / 250
 
 POLICY_TITLES = {"adaptive": "adaptive controller (§5.3)",
                  "non-adaptive": "fixed cycle, not adaptive (§6.3)"}
@@ -75,18 +79,20 @@ class Panel:
     """Parts in the close-up."""
     parts_in: PolyCollection
     parts_out: PolyCollection
-    labels: list[Text]
-    """Part numbers in the close-up."""
+    labels: dict[int, Text]
+    """Part numbers in the close-up, by part index: the parts the frames can show."""
     arm: list[Line2D]
     """Upper arm, forearm with the hand, fingers."""
     texts: dict[str, Text]
     gaps: list[Text]
     """Distances between neighbours on the output belt."""
+    in_stretch: float = 1.0
+    """How much wider than they are parts are drawn on the input strip (see STRIP_MIN_PART)."""
 
     def artists(self) -> list[Artist]:
         """Everything that moves, in drawing order."""
         moving: list[Artist] = [self.parts_in, self.parts_out, *self.gaps, self.parts,
-                                *self.labels, *self.arm, *self.texts.values()]
+                                *self.labels.values(), *self.arm, *self.texts.values()]
         return sorted(moving, key=lambda a: a.get_zorder())
 
 
@@ -97,10 +103,11 @@ def _axes(fig: Figure, left: float, bottom: float, width: float, height: float) 
 
 def _strip(ax: Axes, x0: float, x1: float, w: float, width_in: float,
            marks: dict[str, float], title: str, title_x: float, ha: str) -> None:
-    """A belt drawn whole along x, squares kept square (equal aspect by the limits)."""
+    """A belt drawn whole along x, squares kept square (equal aspect by the limits) unless the
+    belt would then be thinner than a third of the strip (:func:`strip_span`)."""
     y0 = -w / 2 - 1.0
     ax.set_xlim(x0, x1)
-    ax.set_ylim(y0, y0 + (x1 - x0) * STRIP_IN / width_in)
+    ax.set_ylim(y0, y0 + strip_span(x1 - x0, w, width_in))
     ax.add_patch(Rectangle((x0, -w / 2), x1 - x0, w, color=BELT_COLOUR, zorder=0))
     for name, x in marks.items():
         ax.plot([x, x], [-w / 2, w / 2 + 0.4], color="0.3", lw=0.6, zorder=1)
@@ -113,6 +120,22 @@ def _strip(ax: Axes, x0: float, x1: float, w: float, width_in: float,
         ax.spines[side].set_visible(False)
 
 
+def strip_span(length_in: float, w: float, width_in: float) -> float:
+    """The y-span (in) of a strip ``width_in`` wide showing ``length_in`` of a belt ``w`` wide:
+    equal aspect, or at most STRIP_MAX_BELTS belt widths."""
+    return min(length_in * STRIP_IN / width_in, STRIP_MAX_BELTS * w)
+
+
+def stretch(verts: Floats, factor: float) -> Floats:
+    """(n, 4, 2) corners widened along x by ``factor`` about each square's centre."""
+    if factor == 1.0:
+        return verts
+    centre = verts[:, :, 0].mean(axis=1, keepdims=True)
+    out = verts.copy()
+    out[:, :, 0] = centre + (verts[:, :, 0] - centre) * factor
+    return out
+
+
 def _parts_collection(linewidth: float, zorder: float) -> PolyCollection:
     """Squares for parts, drawn alike however many there are: the line width is given per
     square (twice the same) so that matplotlib never takes its one-path shortcut, which lets
@@ -121,7 +144,8 @@ def _parts_collection(linewidth: float, zorder: float) -> PolyCollection:
                           zorder=zorder)
 
 
-def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene) -> Panel:
+def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene,
+           span: tuple[float, float] | None) -> Panel:
     s, p = scene.scenario, scene.table.path
     w = s.cell.belt_width_in
     policy = scene.data.policy
@@ -162,8 +186,9 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene) -> Panel
            close.plot([], [], "-", lw=2.2, color="0.1", solid_capstyle="butt", zorder=7)[0]]
     parts = _parts_collection(0.6, 4)
     close.add_collection(parts)
-    labels = [close.text(0, 0, str(n), fontsize=6, ha="center", va="center", zorder=4.5,
-                         clip_on=True) for n in scene.data.part]
+    shown = range(len(scene.data.part)) if span is None else shown_between(scene, *span)
+    labels = {int(i): close.text(0, 0, str(scene.data.part[i]), fontsize=6, ha="center",
+                                 va="center", zorder=4.5, clip_on=True) for i in shown}
     mono: dict[str, Any] = {"transform": close.transAxes, "fontsize": 8, "va": "top", "ha": "left",
             "family": "monospace", "zorder": 8}
     texts = {"clock": close.text(0.02, 0.985, "", fontweight="bold", **mono),
@@ -187,7 +212,8 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene) -> Panel
     strip_out.add_collection(parts_out)
     gaps = [strip_out.text(0, 0, "", fontsize=6.5, ha="center", va="center", color="0.1",
                            clip_on=True, zorder=3) for _ in range(4)]
-    return Panel(scene, parts, parts_in, parts_out, labels, arm, texts, gaps)
+    in_stretch = max(1.0, STRIP_MIN_PART * (f[0] + 3 - (drop - 3)) / s.part.size_in)
+    return Panel(scene, parts, parts_in, parts_out, labels, arm, texts, gaps, in_stretch)
 
 
 def _figure_in(columns: int) -> tuple[float, float]:
@@ -201,13 +227,17 @@ def frame_pixels(columns: int, dpi: float) -> int:
     return round(w * dpi) * round(h * dpi)
 
 
-def build_figure(scenes: list[Scene], dpi: float) -> tuple[Figure, list[Panel]]:
-    """The figure, on an Agg canvas, and one :class:`Panel` per run, side by side."""
+def build_figure(scenes: list[Scene], dpi: float, span: tuple[float, float] | None = None
+                 ) -> tuple[Figure, list[Panel]]:
+    """The figure, on an Agg canvas, and one :class:`Panel` per run, side by side.
+
+    ``span``: the first and last frame's instants; only the parts in the scene between them
+    get a label (a window deep into a long run labels a few parts, not every one)."""
     size = _figure_in(len(scenes))
     column = size[0] / len(scenes)
     fig = Figure(figsize=size, dpi=dpi)
     FigureCanvasAgg(fig)
-    panels = [_panel(fig, i * column, column, sc) for i, sc in enumerate(scenes)]
+    panels = [_panel(fig, i * column, column, sc, span) for i, sc in enumerate(scenes)]
     return fig, panels
 
 
@@ -233,12 +263,12 @@ def draw_frame(panel: Panel, t: float) -> None:
 
     shown = at.where > 0
     show(panel.parts, shown, corners[shown])
-    for i, label in enumerate(panel.labels):
+    for i, label in panel.labels.items():
         label.set_visible(bool(shown[i] and not falling[i]))
         if shown[i]:
             label.set_position(at.xy[i])
     on_in = (at.where == INPUT) | falling
-    show(panel.parts_in, on_in, corners[on_in])
+    show(panel.parts_in, on_in, stretch(corners[on_in], panel.in_stretch))
     on_out = at.where == OUTPUT
     y_out = at.xy[on_out, 1]
     show(panel.parts_out, on_out,
@@ -321,7 +351,7 @@ def render(scenes: list[Scene], times: Floats, out: Path, *, fps: int, dpi: floa
 
     gif = out.suffix.lower() == ".gif"
     with style():
-        fig, panels = build_figure(scenes, dpi)
+        fig, panels = build_figure(scenes, dpi, (float(times[0]), float(times[-1])))
         canvas = fig.canvas
         assert isinstance(canvas, FigureCanvasAgg)
         moving = [a for panel in panels for a in panel.artists()]

@@ -185,12 +185,18 @@ def output_gone_y(scenario: Scenario, table: StepTable) -> float:
     return max(output_end_y(scenario, table), CLOSE_Y[1]) + scenario.part.size_in
 
 
-def build_scene(data: AnimationInput, table: StepTable, scenario: Scenario) -> Scene:
-    """Time every robot cycle move by move (``timeline``, §6.1), find each lost part's fall
-    and when each part set down has left the drawn output belt."""
+def build_scene(data: AnimationInput, table: StepTable, scenario: Scenario,
+                from_s: float = -math.inf) -> Scene:
+    """Time the robot's cycles move by move (``timeline``, §6.1), find each lost part's fall
+    and when each part set down has left the drawn output belt.
+
+    ``from_s``: the scene is asked about instants from then on, so the cycles that end
+    before it are not timed (``--from-part`` deep into a long run times a few cycles, not
+    every one before them)."""
     from cell.figures.motion import record_segments, timeline
 
-    cycles = np.flatnonzero(data.picked)
+    ends = data.start_s + np.nansum(data.regime_s, axis=1)
+    cycles = np.flatnonzero(data.picked & (ends >= from_s))
     t_s = np.empty((len(cycles), table.path.n_points))
     for row, i in enumerate(cycles):
         seg = record_segments(data.start_s[i], data.pick_s[i], data.touchdown_s[i], data.regime_s[i])
@@ -343,6 +349,15 @@ def parts_at(scene: Scene, t: float, robot: tuple[RobotState, ArmPose] | None = 
     angle[out] = scene.table.path.phi_rad[scene.table.path.td]
     where[out] = OUTPUT
     return PartsAt(where, xy, angle, alpha)
+
+
+def shown_between(scene: Scene, t0: float, t1: float) -> NDArray[np.int64]:
+    """Indices of the parts that are somewhere in the scene at some instant of [t0, t1]
+    (dropped by t1, and not yet gone, off the output belt or faded after a fall, at t0)."""
+    d = scene.data
+    gone = np.where(d.picked, scene.off_output_s, scene.fall_s + FALL_S)
+    with np.errstate(invalid="ignore"):
+        return np.flatnonzero((d.arrival_s <= t1) & ~(gone < t0))
 
 
 @dataclass(frozen=True)

@@ -9,14 +9,26 @@ from __future__ import annotations
 
 import argparse
 
+from cell.output.streams import outlives_reader
+
 HELP = "print the JSON Schema of scenario files (for editor completion and checking)"
-DESCRIPTION = __doc__.splitlines()[0] if __doc__ else ""
+DESCRIPTION = ("The JSON Schema of scenario files, for a YAML editor's completion, documentation "
+               "and checking of every key; with --out, also the first line that makes a "
+               "scenario use it.")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--out", default=None, help="write it to this file (default: print it)")
+    p.add_argument("--out", default=None, metavar="FILE", help="write it to this file (default: print it)")
 
 
+def editor_line(schema_file: str) -> str:
+    """The first line of a scenario beside ``schema_file`` that names it to the YAML language server."""
+    from pathlib import Path
+
+    return f"# yaml-language-server: $schema={Path(schema_file).name}"
+
+
+@outlives_reader
 def main(args: argparse.Namespace) -> int:
     import json
 
@@ -28,7 +40,8 @@ def main(args: argparse.Namespace) -> int:
     text = json.dumps(json_schema(), indent=2, ensure_ascii=False) + "\n"
     if args.out is not None:
         write_text(text, args.out)
-        print(f"wrote {args.out}")
+        print(f"wrote {args.out}; a scenario in the same folder that starts with the line\n"
+              f"{editor_line(args.out)}\ngets completion and checking in a YAML editor")
     else:
         print(text, end="")
     return 0

@@ -1,0 +1,82 @@
+"""What a command prints, kept from ending the command when its reader goes away.
+
+A command's product is its files (or, for a listing, what it has printed); what it prints
+beside them is commentary.  If the reader of stdout or stderr leaves (``cell run ... | head -1``,
+``2>&1 | head``), :func:`outlives_reader` points that stream at the null device and the command
+carries on: its files are written whole and it ends with its own exit code, where the closed
+pipe used to stop it half-way (nothing written, exit 0) or fail the interpreter's last flush
+(exit 120).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import os
+import sys
+from collections.abc import Callable, Iterator
+from typing import Any, TextIO, TypeVar
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+class Guarded:
+    """A text stream whose writes and flushes survive a reader that has gone (see the module)."""
+
+    def __init__(self, stream: TextIO):
+        self.stream = stream
+        self.gone = False
+
+    def __getattr__(self, name: str) -> Any:  # isatty, fileno, encoding...: the stream's own
+        return getattr(self.stream, name)
+
+    def write(self, text: str) -> int:
+        if not self.gone:
+            try:
+                return self.stream.write(text)
+            except BrokenPipeError:
+                self._silence()
+        return len(text)
+
+    def flush(self) -> None:
+        if not self.gone:
+            try:
+                self.stream.flush()
+            except BrokenPipeError:
+                self._silence()
+
+    def _silence(self) -> None:
+        """Send the stream, and what its buffer still holds, to the null device from now on."""
+        self.gone = True
+        with contextlib.suppress(OSError, ValueError, AttributeError):  # no descriptor: just drop
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            try:
+                os.dup2(devnull, self.stream.fileno())
+            finally:
+                os.close(devnull)
+
+
+@contextlib.contextmanager
+def reader_may_leave() -> Iterator[None]:
+    """``sys.stdout`` and ``sys.stderr`` guarded for the block, and flushed at its end."""
+    saved = sys.stdout, sys.stderr
+    out, err = Guarded(saved[0]), Guarded(saved[1])
+    sys.stdout, sys.stderr = out, err
+    try:
+        yield
+        out.flush()
+        err.flush()
+    finally:
+        if sys.stdout is out:
+            sys.stdout = saved[0]
+        if sys.stderr is err:
+            sys.stderr = saved[1]
+
+
+def outlives_reader(main: F) -> F:
+    """A command's ``main`` run under :func:`reader_may_leave`."""
+    @functools.wraps(main)
+    def guarded(*args: Any, **kwargs: Any) -> Any:
+        with reader_may_leave():
+            return main(*args, **kwargs)
+    return guarded  # type: ignore[return-value]
