@@ -93,11 +93,14 @@ def _memory() -> str:
 def _run(args: argparse.Namespace) -> int:
     """The command; a warning that a finished command met is one line each (a refused one's are
     dropped: its error says what went wrong)."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("default")
-        code = int(_module(args.command).main(args) or 0)
-    for text in dict.fromkeys(f"{w.message} ({w.category.__name__})" for w in caught):
-        print(f"cell: warning: {one_line(text, 300)}", file=sys.stderr)
+    from cell.output.streams import reader_may_leave
+
+    with reader_may_leave():  # a reader that leaves (| head) does not stop the command
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("default")
+            code = int(_module(args.command).main(args) or 0)
+        for text in dict.fromkeys(f"{w.message} ({w.category.__name__})" for w in caught):
+            print(f"cell: warning: {one_line(text, 300)}", file=sys.stderr)
     return code
 
 

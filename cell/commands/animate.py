@@ -10,7 +10,6 @@ from __future__ import annotations
 import argparse
 
 from cell.commands import scenario_arguments, scenario_of
-from cell.output.streams import outlives_reader
 
 HELP = "watch the cell run: a GIF or MP4 of the cell from above"
 DESCRIPTION = ("Animate a run seen from above: belts, parts at their true positions, the arm, "
@@ -60,7 +59,6 @@ def check_options(args: argparse.Namespace, cycle_s: float) -> None:
                         "lower --parts or --fps")
 
 
-@outlives_reader
 def main(args: argparse.Namespace) -> int:
     from cell.animation import animate, check_output
     from cell.output import check_file

@@ -11,8 +11,6 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from cell.output.streams import outlives_reader
-
 HELP = "read the documentation: the model, the accountings, the sources, the assumptions"
 DESCRIPTION = ("The pages of docs/, as installed with the package: without PAGE a list, with "
                "PAGE the page's text (Markdown).")
@@ -41,7 +39,6 @@ def title(page: Path) -> str:
     return page.stem
 
 
-@outlives_reader
 def main(args: argparse.Namespace) -> int:
     from cell.errors import CellError
 

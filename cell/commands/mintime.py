@@ -14,7 +14,6 @@ from pathlib import Path
 from typing import Any
 
 from cell.commands import scenario_arguments, scenario_of
-from cell.output.streams import outlives_reader
 
 HELP = "minimum-time motion along the path (Shin & McKay)"
 DESCRIPTION = ("Phase-plane minimum-time parameterisation of R II and R IV; writes "
@@ -55,7 +54,6 @@ def check_out(out: str) -> None:
     OutputDir.check(out, FILES)
 
 
-@outlives_reader
 def main(args: argparse.Namespace) -> int:
     import numpy as np
 

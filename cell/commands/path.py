@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 
 from cell.commands import scenario_arguments, scenario_of
-from cell.output.streams import outlives_reader
 
 HELP = "write the joint-step table of the transfer path (CSV)"
 DESCRIPTION = ("Solve the transfer path once (thesis §4.2, eq. 6.7) and write one row per path "
@@ -17,7 +16,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, help="CSV file to write")
 
 
-@outlives_reader
 def main(args: argparse.Namespace) -> int:
     from cell.assembly import step_table
     from cell.output import check_file, write_csv

@@ -13,7 +13,6 @@ from collections.abc import Callable
 from typing import Any
 
 from cell.commands import scenario_arguments, scenario_of
-from cell.output.streams import outlives_reader
 
 HELP = "simulate one scenario; write parts.csv, summary.csv and belts.csv"
 DESCRIPTION = "Run the cell in simulated time under the scenario's policy."
@@ -32,7 +31,6 @@ RUN_FILES = ("parts.csv", "summary.csv", "belts.csv")
 PROGRESS_FROM_PARTS = 50_000
 
 
-@outlives_reader
 def main(args: argparse.Namespace) -> int:
     from cell.assembly import assemble
     from cell.csvfile import RowWriter

@@ -5,8 +5,6 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from cell.output.streams import outlives_reader
-
 HELP = "list the built-in scenarios (usable by name: cell run baseline)"
 DESCRIPTION = ("The scenario and sweep files that ship with cell; any command that takes a "
                "scenario takes one of these names, or a path to your own file.")
@@ -28,7 +26,6 @@ def describe(name: str, doc: dict[Any, Any]) -> str:
     return first.lstrip("# ").strip()
 
 
-@outlives_reader
 def main(args: argparse.Namespace) -> int:
     from cell import catalog
     from cell.yamlio import load_mapping

@@ -9,8 +9,6 @@ from __future__ import annotations
 
 import argparse
 
-from cell.output.streams import outlives_reader
-
 HELP = "print the JSON Schema of scenario files (for editor completion and checking)"
 DESCRIPTION = ("The JSON Schema of scenario files, for a YAML editor's completion, documentation "
                "and checking of every key; with --out, also the first line that makes a "
@@ -28,7 +26,6 @@ def editor_line(schema_file: str) -> str:
     return f"# yaml-language-server: $schema={Path(schema_file).name}"
 
 
-@outlives_reader
 def main(args: argparse.Namespace) -> int:
     import json
 

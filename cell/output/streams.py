@@ -2,22 +2,19 @@
 
 A command's product is its files (or, for a listing, what it has printed); what it prints
 beside them is commentary.  If the reader of stdout or stderr leaves (``cell run ... | head -1``,
-``2>&1 | head``), :func:`outlives_reader` points that stream at the null device and the command
-carries on: its files are written whole and it ends with its own exit code, where the closed
-pipe used to stop it half-way (nothing written, exit 0) or fail the interpreter's last flush
-(exit 120).
+``2>&1 | head``), :func:`reader_may_leave` (around every command, in ``cell.cli``) points that
+stream at the null device and the command carries on: its files are written whole and it ends
+with its own exit code, where the closed pipe used to stop it half-way (nothing written,
+exit 0) or fail the interpreter's last flush (exit 120).
 """
 
 from __future__ import annotations
 
 import contextlib
-import functools
 import os
 import sys
-from collections.abc import Callable, Iterator
-from typing import Any, TextIO, TypeVar
-
-F = TypeVar("F", bound=Callable[..., Any])
+from collections.abc import Iterator
+from typing import Any, TextIO
 
 
 class Guarded:
@@ -71,12 +68,3 @@ def reader_may_leave() -> Iterator[None]:
             sys.stdout = saved[0]
         if sys.stderr is err:
             sys.stderr = saved[1]
-
-
-def outlives_reader(main: F) -> F:
-    """A command's ``main`` run under :func:`reader_may_leave`."""
-    @functools.wraps(main)
-    def guarded(*args: Any, **kwargs: Any) -> Any:
-        with reader_may_leave():
-            return main(*args, **kwargs)
-    return guarded  # type: ignore[return-value]
