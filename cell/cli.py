@@ -23,7 +23,7 @@ from collections.abc import Sequence
 from typing import Any, NoReturn
 
 from cell import __version__
-from cell.errors import CellError, one_line, shown_path
+from cell.errors import CellError, ScenarioError, one_line, shown_path
 
 #: Subcommands in the order ``cell --help`` lists them; each is cell.commands.<name>.
 COMMANDS = ("run", "sweep", "compare", "fit", "figures", "animate", "path", "mintime",
@@ -115,6 +115,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return exc.code if isinstance(exc.code, int) else 0
     try:
         return _run(args)
+    except ScenarioError as exc:  # found after loading (assembling the cell): still --set's
+        sets = [pair.partition("=")[0].strip() for pair in getattr(args, "sets", None) or ()]
+        return _fail(str(exc.given_with_set(sets)))
     except CellError as exc:
         return _fail(str(exc))
     except MemoryError:

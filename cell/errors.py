@@ -8,7 +8,7 @@ from __future__ import annotations
 import itertools
 import math
 import os
-from collections.abc import Sized
+from collections.abc import Iterable, Sized
 
 
 class CellError(Exception):
@@ -26,6 +26,16 @@ class ScenarioError(CellError, ValueError):
             value = list(value)
         self.file, self.key, self.value, self.why = str(file), key, value, why
         super().__init__(f"{_line(self.file)}: {_line(key)} = {short(value)}: {_line(why, 300)}")
+
+    def given_with_set(self, keys: Iterable[str]) -> ScenarioError:
+        """This error with its file marked ``(--set)`` when its key is one of the dotted
+        ``keys`` given with ``--set`` (or lies within or around one): the value is the
+        command line's, not the file's.  Itself otherwise."""
+        key = self.key
+        if self.file.endswith(" (--set)") or not any(
+                key == k or key.startswith(k + ".") or k.startswith(key + ".") for k in keys):
+            return self
+        return ScenarioError(f"{self.file} (--set)", key, self.value, self.why)
 
 
 class UnreachableError(CellError, ValueError):

@@ -236,10 +236,10 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
         _anchor_paths(raw, changed, Path.cwd())  # a file named on the command line: from here
         return validate(changed, path, source=str(path))
     except ScenarioError as exc:  # a value from --set: the line says so
-        if not overrides or not any(exc.key == k or exc.key.startswith(k + ".")
-                                    or k.startswith(exc.key + ".") for k in overrides):
+        marked = exc.given_with_set(overrides or ())
+        if marked is exc:
             raise
-        raise ScenarioError(f"{path} (--set)", exc.key, exc.value, exc.why) from None
+        raise marked from None
 
 
 def default_scenario() -> Scenario:

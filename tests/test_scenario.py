@@ -79,6 +79,17 @@ def test_an_error_in_a_set_value_says_it_came_from_set(tmp_path):
     assert "(--set)" not in str(other.value)
 
 
+def test_a_physics_error_from_a_set_value_also_says_so(tmp_path, capsys):
+    """Found when the cell is assembled, after loading: still the command line's value."""
+    from cell.cli import main
+
+    code = main(["run", "baseline", "--set", "belts.input_nominal_in_s=1000", "--set",
+                 "belts.input_max_in_s=1000", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert code == 2 and "baseline.yaml (--set): belts.input_nominal_in_s = 1000.0" in err
+    assert not (tmp_path / "o").exists()
+
+
 def test_a_file_named_by_set_is_found_from_the_working_directory(tmp_path, monkeypatch):
     """``--set arrivals.trace_csv=log.csv`` names ./log.csv, whatever folder the scenario is in
     (a built-in one's is inside the package); the scenario file's own paths stay its own."""
