@@ -101,8 +101,8 @@ def test_full_disk_is_one_line_and_keeps_the_old_set(tmp_path, monkeypatch, writ
 
 
 @pytest.mark.parametrize("case, words", [
-    ("foreign", "holds files cell did not write (notes.txt); choose another --out"),
-    ("many foreign", "holds files cell did not write (a.txt, b.txt, c.txt, …)"),
+    ("foreign", "holds files this command does not write (notes.txt); choose another --out"),
+    ("many foreign", "holds files this command does not write (a.txt, b.txt, c.txt, …)"),
     ("a file", "is a file, not a directory; choose another --out"),
     ("under a file", "not a directory ("),
     ("empty", "'': an empty path; name a directory"),

@@ -90,7 +90,7 @@ def _targets(tmp: Path, kind: str) -> list[tuple[str, str, Path | str, str]]:
     ]
     if kind == "dir":
         cases += [("an existing file", "", blocker, "is a file"),
-                  ("a directory of the user's", "", foreign, "holds files cell did not write"),
+                  ("a directory of the user's", "", foreign, "holds files this command does not write"),
                   ("the current directory", "", ".", "holds the current directory")]
     else:
         cases += [("an existing directory", "", folder, "is a directory")]
