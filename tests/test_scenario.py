@@ -70,7 +70,9 @@ def test_an_error_in_a_set_value_says_it_came_from_set(tmp_path):
         load_scenario(path)
     assert "(--set)" not in str(from_file.value)
     for sets, key in [({"run.parts": 0}, "run.parts"), ({"run": {"parts": 0}}, "run.parts"),
-                      ({"arrivals.params.scale": -1.0}, "arrivals.params")]:
+                      ({"arrivals.params.scale": -1.0}, "arrivals.params"),
+                      ({"robot.motors.steps_per_rad": [1125, 1125, 0.5, 241, 241]},
+                       "robot.motors.steps_per_rad[2]")]:
         with pytest.raises(ScenarioError) as err:
             load_scenario("baseline", sets)
         assert err.value.key == key and "baseline.yaml (--set)" in str(err.value)
