@@ -107,6 +107,13 @@ def test_a_file_named_by_set_is_found_from_the_working_directory(tmp_path, monke
     (own / "s.yaml").write_text("arrivals: {trace_csv: own.csv}\n")
     s = load_scenario(own / "s.yaml", {"run.parts": 3})
     assert s.base_dir / s.arrivals.trace_csv == own / "own.csv"
+    s = load_scenario(own / "s.yaml", {"arrivals": {"distribution": "expon"}})  # not named
+    assert s.base_dir / s.arrivals.trace_csv == own / "own.csv"
+    (own / "log.csv").write_text("interarrival_s\n22\n")  # the file's folder has one too
+    (own / "s.yaml").write_text("arrivals: {trace_csv: log.csv}\n")
+    for sets in ({"arrivals.trace_csv": "log.csv"}, {"arrivals": {"trace_csv": "log.csv"}}):
+        s = load_scenario(own / "s.yaml", sets)  # the same name as the file's, but from --set
+        assert s.base_dir / s.arrivals.trace_csv == tmp_path / "log.csv"
 
 
 def test_known_key():
