@@ -352,9 +352,10 @@ def semicolon_hint(header: str, column: str) -> str:
             "and a decimal point in numbers")
 
 
-_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\Z")
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\Z", re.ASCII)
 
 
 def _seconds(text: str) -> float:
-    """A decimal number as a float; NaN for anything else (words, ``1_000``, ``0x10``)."""
+    """A decimal number as a float; NaN for anything else (words, ``1_000``, ``0x10``, digits
+    other than 0-9, which Python's float reads but pandas and ``cell fit`` do not)."""
     return float(text) if _NUMBER.match(text) else math.nan

@@ -7,8 +7,8 @@ an output that cannot be written (:class:`~cell.errors.CellError`), a usage
 error, memory running out, input nested past Python's recursion limit, and an
 operating-system refusal to write (permission, read-only file system, full
 disk, name too long) that got past the commands' own checks.  Ctrl-C is exit
-130; a closed pipe (``cell run ... | head``) ends quietly.  Anything else is a
-bug and keeps its traceback.
+130; a reader that leaves (``cell run ... | head``) is ignored
+(:mod:`cell.output.streams`).  Anything else is a bug and keeps its traceback.
 """
 
 from __future__ import annotations
@@ -93,19 +93,24 @@ def _memory() -> str:
 def _run(args: argparse.Namespace) -> int:
     """The command; a warning that a finished command met is one line each (a refused one's are
     dropped: its error says what went wrong)."""
-    from cell.output.streams import reader_may_leave
-
-    with reader_may_leave():  # a reader that leaves (| head) does not stop the command
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("default")
-            code = int(_module(args.command).main(args) or 0)
-        for text in dict.fromkeys(f"{w.message} ({w.category.__name__})" for w in caught):
-            print(f"cell: warning: {one_line(text, 300)}", file=sys.stderr)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("default")
+        code = int(_module(args.command).main(args) or 0)
+    for text in dict.fromkeys(f"{w.message} ({w.category.__name__})" for w in caught):
+        print(f"cell: warning: {one_line(text, 300)}", file=sys.stderr)
     return code
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run one command; the exit code (0 done, 2 refused, 130 interrupted)."""
+    """Run one command; the exit code (0 done, 2 refused, 130 interrupted).  A reader of stdout
+    or stderr that leaves (``| head``) stops neither the command nor its error line's exit code."""
+    from cell.output.streams import reader_may_leave
+
+    with reader_may_leave():
+        return _main(argv)
+
+
+def _main(argv: Sequence[str] | None) -> int:
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
@@ -130,11 +135,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("cell: interrupted", file=sys.stderr)
         return 130
-    except BrokenPipeError:
-        # the reader went away (cell run ... | head): stop quietly, as Unix tools do
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        return 0
     except OSError as exc:
         if exc.errno not in OUTPUT_ERRNOS:
             raise

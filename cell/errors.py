@@ -29,11 +29,12 @@ class ScenarioError(CellError, ValueError):
 
     def given_with_set(self, keys: Iterable[str]) -> ScenarioError:
         """This error with its file marked ``(--set)`` when its key is one of the dotted
-        ``keys`` given with ``--set`` (or lies within or around one): the value is the
-        command line's, not the file's.  Itself otherwise."""
+        ``keys`` given with ``--set`` (or lies within or around one: ``run`` holds ``run.parts``,
+        ``robot.motors.steps_per_rad`` its item ``robot.motors.steps_per_rad[2]``): the value
+        is the command line's, not the file's.  Itself otherwise."""
         key = self.key
         if self.file.endswith(" (--set)") or not any(
-                key == k or key.startswith(k + ".") or k.startswith(key + ".") for k in keys):
+                key == k or key.startswith((k + ".", k + "[")) or k.startswith(key + ".") for k in keys):
             return self
         return ScenarioError(f"{self.file} (--set)", key, self.value, self.why)
 

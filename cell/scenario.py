@@ -92,10 +92,9 @@ class Scenario(Section):
         """A new scenario with dotted keys replaced, validated as if read from ``file``;
         a file the overrides name by a relative path is looked for from ``paths_from``
         (None: from this scenario's folder, as its own files are)."""
-        before = self.to_dict()
-        raw = apply_overrides(before, overrides, file or self._source, is_section)
+        raw = apply_overrides(self.to_dict(), overrides, file or self._source, is_section)
         if paths_from is not None:
-            _anchor_paths(before, raw, paths_from)
+            _anchor_paths(overrides, raw, paths_from)
         return validate(raw, file or self._source, source=self._source)
 
 
@@ -103,14 +102,29 @@ class Scenario(Section):
 PATH_KEYS = (("arrivals", "trace_csv"), ("mintime", "dynamics_file"))
 
 
-def _anchor_paths(before: Mapping[str, Any], after: dict[str, Any], where: Path) -> None:
-    """In ``after``, a file setting that differs from ``before`` (an override set it) and is
-    a relative path becomes relative to ``where`` instead of the scenario's folder."""
+def _anchor_paths(overrides: Mapping[str, Any], after: dict[str, Any], where: Path) -> None:
+    """In ``after``, a file setting that one of ``overrides`` names (even with the value the
+    scenario has) and is a relative path becomes relative to ``where`` instead of the
+    scenario's folder."""
     for section, key in PATH_KEYS:
         value = (after.get(section) or {}).get(key)
-        if isinstance(value, str) and value != (before.get(section) or {}).get(key) \
-                and not Path(value).is_absolute():
+        if isinstance(value, str) and _names(overrides, (section, key)) and not Path(value).is_absolute():
             after[section] = {**after[section], key: str(Path(where).resolve() / value)}
+
+
+def _names(overrides: Mapping[str, Any], path: tuple[str, ...]) -> bool:
+    """Whether a dotted key of ``overrides`` is ``path``, or a section given whole that holds it."""
+    for dotted, value in overrides.items():
+        parts = tuple(str(dotted).split("."))
+        if parts != path[:len(parts)]:
+            continue
+        for part in path[len(parts):]:
+            if not (isinstance(value, Mapping) and part in value):
+                break
+            value = value[part]
+        else:
+            return True
+    return False
 
 
 def _plain(obj: Any) -> Any:
@@ -233,7 +247,7 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
     raw = merge(_DEFAULTS.to_dict(), given, (), is_section)
     try:
         changed = apply_overrides(raw, overrides or {}, path, is_section)
-        _anchor_paths(raw, changed, Path.cwd())  # a file named on the command line: from here
+        _anchor_paths(overrides or {}, changed, Path.cwd())  # a file named on the command line: from here
         return validate(changed, path, source=str(path))
     except ScenarioError as exc:  # a value from --set: the line says so
         marked = exc.given_with_set(overrides or ())

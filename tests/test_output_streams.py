@@ -70,6 +70,17 @@ def test_cell_path_ends_quietly_when_stdout_is_closed(tmp_path):
     assert len(pd.read_csv(out)) == 460
 
 
+@pytest.mark.parametrize("unbuffered", [True, False])
+def test_a_refused_command_keeps_exit_2_when_stderr_is_closed(tmp_path, unbuffered):
+    """The error line met the closed pipe outside the guard: exit 120 (its last flush), or 1
+    and a traceback unbuffered, where a refused command ends with 2."""
+    res = _with_closed_reader(["run", str(tmp_path / "missing.yaml"), "--out", str(tmp_path / "o")],
+                              tmp_path, unbuffered, closed="stderr")
+    assert (res.returncode, res.stdout) == (2, "")
+    res = _with_closed_reader(["run", "--no-such-option"], tmp_path, unbuffered, closed="stderr")
+    assert (res.returncode, res.stdout) == (2, "")
+
+
 class _Gone(io.StringIO):
     def write(self, text):
         raise BrokenPipeError(32, "Broken pipe")

@@ -70,7 +70,9 @@ def test_an_error_in_a_set_value_says_it_came_from_set(tmp_path):
         load_scenario(path)
     assert "(--set)" not in str(from_file.value)
     for sets, key in [({"run.parts": 0}, "run.parts"), ({"run": {"parts": 0}}, "run.parts"),
-                      ({"arrivals.params.scale": -1.0}, "arrivals.params")]:
+                      ({"arrivals.params.scale": -1.0}, "arrivals.params"),
+                      ({"robot.motors.steps_per_rad": [1125, 1125, 0.5, 241, 241]},
+                       "robot.motors.steps_per_rad[2]")]:
         with pytest.raises(ScenarioError) as err:
             load_scenario("baseline", sets)
         assert err.value.key == key and "baseline.yaml (--set)" in str(err.value)
@@ -105,6 +107,13 @@ def test_a_file_named_by_set_is_found_from_the_working_directory(tmp_path, monke
     (own / "s.yaml").write_text("arrivals: {trace_csv: own.csv}\n")
     s = load_scenario(own / "s.yaml", {"run.parts": 3})
     assert s.base_dir / s.arrivals.trace_csv == own / "own.csv"
+    s = load_scenario(own / "s.yaml", {"arrivals": {"distribution": "expon"}})  # not named
+    assert s.base_dir / s.arrivals.trace_csv == own / "own.csv"
+    (own / "log.csv").write_text("interarrival_s\n22\n")  # the file's folder has one too
+    (own / "s.yaml").write_text("arrivals: {trace_csv: log.csv}\n")
+    for sets in ({"arrivals.trace_csv": "log.csv"}, {"arrivals": {"trace_csv": "log.csv"}}):
+        s = load_scenario(own / "s.yaml", sets)  # the same name as the file's, but from --set
+        assert s.base_dir / s.arrivals.trace_csv == tmp_path / "log.csv"
 
 
 def test_known_key():

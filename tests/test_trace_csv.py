@@ -40,6 +40,8 @@ def test_other_columns_quotes_spaces_blank_lines_bom_and_crlf(tmp_path: Path) ->
     ("interarrival_s\n20\n1_000\n", "row 2 has inter-arrival time '1_000'"),
     ("interarrival_s\n20\n0x10\n", "row 2 has inter-arrival time '0x10'"),
     ("interarrival_s\n20\nnan\n", "row 2 has inter-arrival time 'nan'"),
+    ("interarrival_s\n20\n\u0661\u0662\n", "row 2 has inter-arrival time '\u0661\u0662'"),
+    ("interarrival_s\n20\n\uff12\uff10\n", "row 2 has inter-arrival time '\uff12\uff10'"),
     ("interarrival_s\n20\n0\n", "row 2 has inter-arrival time '0'"),
     ("interarrival_s\n2e6\n", "row 1 has inter-arrival time '2e6'"),
     ("a,interarrival_s\nx,20\ny\n", "row 2 has inter-arrival time ''"),
