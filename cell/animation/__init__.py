@@ -119,6 +119,9 @@ def simulate_scenes(scenario: Scenario, policies: list[str], first: int, count: 
     Parts are numbered as in a run of any length (the feeder's draws are the same
     whatever ``run.parts`` is), and the parts after the window keep the last one
     shown from being the run's last (whose look-ahead would find nothing coming).
+    Each scene times the robot's cycles from part ``first``'s earliest arrival in any
+    run on: a part the feeder holds back arrives at different instants under the two
+    policies, and the window starts at its arrival in the first run.
     """
     from cell.animation.scene import build_scene, frames_input, window
     from cell.assembly import step_table
@@ -129,11 +132,12 @@ def simulate_scenes(scenario: Scenario, policies: list[str], first: int, count: 
     extra = EXTRA_PARTS
     while True:
         n = first + count - 1 + extra
-        scenes = []
+        runs = []
         for policy in policies:
             s = scenario.with_overrides({"controller.policy": policy, "run.parts": n})
-            data = frames_input(simulated(s, progress), s)
-            scenes.append(build_scene(data, table, s, from_s=float(data.arrival_s[first - 1])))
+            runs.append((frames_input(simulated(s, progress), s), s))
+        from_s = min(float(data.arrival_s[first - 1]) for data, _ in runs)
+        scenes = [build_scene(data, table, s, from_s=from_s) for data, s in runs]
         _, t1 = window(scenes, first, count)
         if all(sc.data.arrival_s[-1] > t1 for sc in scenes):
             return scenes

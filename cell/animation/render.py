@@ -198,7 +198,8 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene,
              "robot": close.text(0.02, 0.755, "", fontweight="bold", **mono)}
     # the whole input belt, drop point to its end at F; the close-up's stretch dotted
     drop = b[0] - scene.data.input_length_in
-    _strip(strip_in, drop - 3, f[0] + 3, w, strip_w, {"drop": drop, "B": b[0], "F": f[0]},
+    x0, x1 = drop - 3, f[0] + 3
+    _strip(strip_in, x0, x1, w, strip_w, {"drop": drop, "B": b[0], "F": f[0]},
            "input belt, drop point → F (falls off at F)", (drop + b[0]) / 2, "center")
     strip_in.add_patch(Rectangle((CLOSE_X[0], -w / 2), f[0] - CLOSE_X[0], w, fill=False, ec="0.45",
                                  lw=0.6, ls=":", zorder=1))
@@ -212,7 +213,7 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene,
     strip_out.add_collection(parts_out)
     gaps = [strip_out.text(0, 0, "", fontsize=6.5, ha="center", va="center", color="0.1",
                            clip_on=True, zorder=3) for _ in range(4)]
-    in_stretch = max(1.0, STRIP_MIN_PART * (f[0] + 3 - (drop - 3)) / s.part.size_in)
+    in_stretch = max(1.0, STRIP_MIN_PART * (x1 - x0) / s.part.size_in)
     return Panel(scene, parts, parts_in, parts_out, labels, arm, texts, gaps, in_stretch)
 
 

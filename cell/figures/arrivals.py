@@ -57,6 +57,12 @@ def caption(s: Scenario, curve: str) -> str:
     return f"{FAMILY_NAMES.get(family, family)} {curve} of the Inter-arrival Times"
 
 
+def _cited(s: Scenario, equation: str) -> str:
+    """A legend's citation of ``equation`` (6.8, the pdf; 6.9, the inverse cdf), which are
+    the thesis's Weibull's: for a Weibull only, nothing for another family."""
+    return f" (eq. {equation})" if s.arrivals.distribution == "weibull_min" else ""
+
+
 def _grid(s: Scenario, x: NDArray[np.float64]) -> NDArray[np.float64]:
     d = distribution(s)
     lo, hi = float(x.min()), float(x.max())
@@ -74,7 +80,7 @@ def fig13_figure(s: Scenario, x: NDArray[np.float64]) -> Figure:
             label=f"the {x.size} inter-arrival times of the run (seed {s.run.seed})")
     top = float(heights.max())
     if d is not None:
-        ax.plot(t, d.pdf(t), color="black", label="pdf (eq. 6.8)")
+        ax.plot(t, d.pdf(t), color="black", label=f"pdf{_cited(s, '6.8')}")
         ax.axvline(d.mean(), color="#d62728", ls="--", lw=1.2, label=f"mean {d.mean():.4f} s")
         loc = parameters(s.arrivals).get("loc")
         if loc is not None:
@@ -105,7 +111,7 @@ def fig14_figure(s: Scenario, x: NDArray[np.float64]) -> Figure:
         u = 0.5
         tu = float(d.ppf(u))
         ax.plot([t[0], tu, tu], [u, u, 0], color="#d62728", ls="--", lw=1.1,
-                label=f"inverse cdf (eq. 6.9): u = {u} → T = {tu:.4f} s")
+                label=f"inverse cdf{_cited(s, '6.9')}: u = {u} → T = {tu:.4f} s")
         ks = scipy.stats.kstest(x, d.cdf)
         title = (f"T = F⁻¹(u) with u ~ U(0, 1); Kolmogorov-Smirnov D = {ks.statistic:.3f}, "
                  f"p = {ks.pvalue:.2f}")

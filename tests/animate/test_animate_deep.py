@@ -87,3 +87,26 @@ def test_a_long_run_before_the_window_shows_its_progress(scenario: Scenario, mon
     assert lines[-1].startswith("cell animate: simulating (adaptive): 300/300 parts (100 %)")
     animation.simulated(scenario.with_overrides({"run.parts": 99}), progress=True)
     assert capsys.readouterr().err == ""
+
+
+def test_a_part_held_back_longer_in_one_run_does_not_cut_the_others_cycles(
+        scenario: Scenario) -> None:
+    """Arrivals as bunched as these make the feeder hold parts back (§6.2 d), for longer under
+    the fixed cycle's slower belt: part 13 arrives about 1 s later there than in the adaptive
+    run, whose arrival starts the window.  The fixed-cycle robot is still in an earlier part's
+    cycle then, as the scene with every cycle timed has it, not waiting at B."""
+    bunched = scenario.with_overrides({"arrivals": {"distribution": "gamma", "mean_s": 21,
+                                                    "cv": 2.5}})
+    first = 13
+    scenes = simulate_scenes(bunched, ["adaptive", "non-adaptive"], first, 2)
+    arrived = [float(sc.data.arrival_s[first - 1]) for sc in scenes]
+    assert arrived[1] > arrived[0] + 0.5  # the premise: held back longer in the second run
+    t0, t1 = window(scenes, first, 2)
+    times = frame_times(t0, t1, 0.05)
+    for sc in scenes:
+        every = build_scene(sc.data, sc.table, sc.scenario)
+        ours, full = robot_state(sc, times), robot_state(every, times)
+        np.testing.assert_array_equal(ours.regime, full.regime)
+        np.testing.assert_array_equal(ours.q_rad, full.q_rad)
+    fixed = robot_state(scenes[1], times[times < arrived[1]])
+    assert (fixed.regime > 0).any()  # the stretch the fix is about: a cycle under way
