@@ -34,3 +34,22 @@ def test_a_measure_with_no_variation_reads_as_the_table_shows_it(sweeps, tmp_pat
 def test_a_measure_that_moves_reads_from_one_end_to_the_other(sweeps, tmp_path):
     text = trend(sweeps, tmp_path, {2.0: [40, 42, 41, 43], 2.5: [50, 52, 51, 53]})
     assert f"Adaptive goes from 41.5 at {KEY} = 2 to 51.5 at 2.5." in text
+
+
+def test_an_end_without_a_value_is_passed_over_not_read_as_nan(sweeps, tmp_path):
+    """No run at the first value gives the measure (runs too short for a rate): the reading
+    goes from the first value that has one, and prints no 'nan'."""
+    text = trend(sweeps, tmp_path, {1.5: [float("nan")] * 4, 2.0: [40, 42, 41, 43],
+                                    2.5: [50, 52, 51, 53]})
+    assert f"Adaptive goes from 41.5 at {KEY} = 2 to 51.5 at 2.5." in text
+    assert "nan" not in text
+
+
+def test_one_replication_at_an_end_takes_the_other_end_s_precision(sweeps, tmp_path):
+    """A single value has no interval: both ends are shown to the precision of the one
+    interval there is (one decimal for 51.5 ± 2.1), whichever end lacks it."""
+    one, four = [41.0], [50, 52, 51, 53]
+    assert f"Adaptive goes from 41.0 at {KEY} = 2 to 51.5 at 2.5." in trend(
+        sweeps, tmp_path, {2.0: one, 2.5: four})
+    assert f"Adaptive goes from 51.5 at {KEY} = 2 to 41.0 at 2.5." in trend(
+        sweeps, tmp_path, {2.0: four, 2.5: one})

@@ -58,3 +58,21 @@ def test_a_shared_report_folder_keeps_the_letters_of_a_non_english_name(sweeps, 
                  "--report", str(shared)])
     assert code == 0, capsys.readouterr().err
     assert sorted(p.name for p in shared.iterdir()) == ["notes.txt", "Étude_ligne_3"]
+
+
+@pytest.mark.parametrize(("report", "out"), [(".", "sweep"), ("rep", "rep/sweep/data")])
+def test_a_report_subfolder_that_would_hold_the_results_is_refused_before_running(
+        sweeps, tmp_path, monkeypatch, capsys, report, out):
+    """--report DIR holding --out sends the report to DIR/NAME/; when that is --out itself
+    (or holds it), the report could not be written there after the sweep: one line, exit 2,
+    nothing run."""
+    monkeypatch.setattr("cell.sweep.simulate_summary", sweeps.bookkeeping)
+    work = tmp_path / "w"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    path = sweeps.write(tmp_path, policies=["adaptive"], grid={"run.warmup_parts": [0, 1]})
+    code = main(["sweep", str(path), "--out", out, "--workers", "1", "--report", report])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1, err
+    assert f"--report {report}:" in err and f"--out {out}" in err
+    assert not (work / out / "replications.csv").exists()

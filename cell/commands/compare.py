@@ -115,7 +115,7 @@ def main(args: argparse.Namespace) -> int:
         print(f"cell: warning: {warning}", file=sys.stderr)
     with tempfile.TemporaryDirectory(prefix="cell-compare-") as work:
         outcome = run_sweep(sweep, work, workers=args.workers, replicate=simulate_summary,
-                            warn=False)  # said above, in compare's words
+                            warn_windows=False)  # said above, in compare's words
         replications = outcome.replications
     from cell.reporting.experiment import difference_table, summary_table
 

@@ -25,7 +25,9 @@ A ``--report DIR`` that already holds files the report does not write (a shared
 folder such as the repository's ``reports/``), or will hold the sweep's own
 ``--out``, is left as it is: the report goes
 to ``DIR/<sweep name>/``, and Table 7.1's two files, for a sweep laid out like
-it, into ``DIR`` itself beside the others (each replaced atomically).
+it, into ``DIR`` itself beside the others (each replaced atomically).  If
+``DIR/<sweep name>/`` would itself be, or hold, ``--out``, the sweep is refused
+before it runs.
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from cell.errors import CellError
 from cell.output import OutputDir, check_file
 from cell.reporting.experiment_data import difference_table, measures, summary_table
 from cell.reporting.experiment_plots import figures
@@ -75,6 +78,10 @@ def plan_report(sweep: Sweep, target: str | os.PathLike[str], option: str = "--r
         OutputDir.check(path, names, option)
         return Target(path, names, t71)
     sub = path / (re.sub(r"[^\w.-]+", "_", sweep.name).strip("._") or "sweep")
+    if _holds(sub, results):
+        raise CellError(f"{option} {target}: the report would go to {sub}, which is or holds "
+                        f"--out {results}, the sweep's own results; choose another {option} "
+                        "or --out")
     OutputDir.check(sub, REPORT_FILES, option)
     if t71:
         for name in TABLE_7_1_FILES:

@@ -323,14 +323,17 @@ def _scatter(h: Headline, summary: pd.DataFrame, cols: Sequence[str]) -> list[st
 
 
 def _trend(h: Headline, summary: pd.DataFrame, sweep: Sweep, cols: Sequence[str]) -> list[str]:
-    """Along a single numeric key: each policy's mean at its first and last value."""
+    """Along a single numeric key: each policy's mean at its first and last value that
+    have one (a run too short for a rate has none)."""
     if len(cols) != 1 or cols[0].endswith(NAME_SUFFIX):
         return []
     col, out = cols[0], []
     rows = summary[summary["measure"] == h.column]
     for policy, group in rows.groupby("policy", sort=False):
-        values = pd.to_numeric(group[col], errors="coerce")
-        if len(group) < 2 or values.isna().any():
+        if pd.to_numeric(group[col], errors="coerce").isna().any():
+            continue
+        group = group[np.isfinite(group["mean"].to_numpy(dtype=float))]
+        if len(group) < 2:
             continue
         first, last = group.iloc[0], group.iloc[-1]
         a, b = _ends(first, last)
@@ -349,7 +352,8 @@ def _ends(first: pd.Series, last: pd.Series) -> tuple[str, str]:
     when neither varies between replications (60, not 60.0000)."""
     if float(first["sd"]) == 0.0 and float(last["sd"]) == 0.0:
         return number(float(first["mean"])), number(float(last["mean"]))
-    d = decimals(max(half_width(first), half_width(last)))
+    halves = [w for w in (half_width(first), half_width(last)) if math.isfinite(w)]
+    d = decimals(max(halves, default=math.nan))  # one replication at an end: no interval
     return f"{float(first['mean']):.{d}f}", f"{float(last['mean']):.{d}f}"
 
 

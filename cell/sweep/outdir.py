@@ -19,7 +19,8 @@ TASK_FILES = "task-*.csv"
 
 def check_out(out: str | Path) -> Path:
     """Refuse, before any work, a sweep directory that cannot be used: an empty name, a
-    file, a directory under a file, or one holding a ``sweep.json`` that is not a sweep's."""
+    file, a directory under a file, one holding a ``sweep.json`` that is not a sweep's, or
+    one holding a ``replications.csv`` or task files but no ``sweep.json``."""
     if str(out) == "":
         raise CellError("--out '': an empty path; give a directory for the sweep's results")
     path = Path(out)

@@ -258,17 +258,18 @@ WORKERS_PER_CORE = 4
 def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
               scheduler: str | None = None, resume: bool = False,
               replicate: Replicate = simulate_summary, progress: bool = True,
-              warn: bool = True) -> Outcome:
+              warn_windows: bool = True) -> Outcome:
     """Run (or finish, with ``resume``) a sweep into ``out``; write replications.csv.
 
     ``replicate`` is what one replication does; the default simulates the cell.
     It must be a module-level function when tasks run in other processes.
-    ``warn``: say first, on stderr, if compared points count over different windows
-    (:func:`cell.sweep.windows.window_warning`).
+    It says first, on stderr, if some points cannot keep up on average
+    (:func:`cell.sweep.spec.overload_warning`) and, with ``warn_windows``, if compared
+    points count over different windows (:func:`cell.sweep.windows.window_warning`).
     """
     out = check_out(out)
     workers = check_workers(workers, scheduler)
-    for warning in (overload_warning(sweep), window_warning(sweep) if warn else None):
+    for warning in (overload_warning(sweep), window_warning(sweep) if warn_windows else None):
         if warning:
             print(f"cell: warning: {warning}", file=sys.stderr)
     executor, client = _open_executor(workers, scheduler, progress)
