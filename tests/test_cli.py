@@ -195,6 +195,11 @@ def test_cell_run_says_when_a_short_trace_is_replayed(tmp_path, capsys):
     assert parts["interarrival_s"].tolist() == [21.0, 24.5] * 12 + [21.0]
     assert main(["run", str(scenario), "--set", "run.parts=9", "--out", str(tmp_path / "b")]) == 0
     assert "replayed" not in capsys.readouterr().out
+    # one time a part: only the last part's look-ahead (T_{n+1}) comes round, and it says so
+    assert main(["run", str(scenario), "--set", "run.parts=10", "--out", str(tmp_path / "c")]) == 0
+    out = capsys.readouterr().out
+    assert "replayed" not in out and "the last part's next arrival" in out
+    assert pd.read_csv(tmp_path / "c" / "parts.csv")["interarrival_s"].tolist() == [21.0, 24.5] * 5
 
 
 def test_cell_docs_reads_the_pages_its_output_refers_to(tmp_path, capsys):

@@ -43,7 +43,10 @@ def run_heading(cell: AssembledCell) -> str:
         from cell.arrivals import read_trace
 
         n = len(read_trace(Path(s.base_dir) / trace))
-        if n < s.run.parts + 1:  # the run needs T_1 .. T_{parts+1}
+        if n == s.run.parts:  # every part has its own; only the look-ahead comes round again
+            heading += (f"\narrivals: {trace} holds one inter-arrival time a part; the last "
+                        "part's next arrival (for its IP) is the trace's first again")
+        elif n < s.run.parts + 1:  # the run needs T_1 .. T_{parts+1}
             held = f"{n} inter-arrival times" if n > 1 else "one inter-arrival time"
             heading += (f"\narrivals: {trace} holds {held} and the run needs {s.run.parts + 1}: "
                         f"it is replayed from the start" + (f" every {n} parts" if n > 1 else ""))
