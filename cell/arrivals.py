@@ -324,9 +324,12 @@ def _parse_trace(path: Path) -> Any:
     if not rows:
         return "not a readable CSV: No columns to parse from file"
     header, data = rows[0], rows[1:]
-    if "interarrival_s" not in header:
-        return "needs a column named interarrival_s" + semicolon_hint(",".join(header), "interarrival_s")
-    column = header.index("interarrival_s")
+    names = [name.strip() for name in header]  # a spreadsheet's ' interarrival_s' is the column
+    if "interarrival_s" not in names:
+        hint = semicolon_hint(",".join(header), "interarrival_s")
+        found = ", ".join(repr(name) for name in names[:5]) + (", ..." if len(names) > 5 else "")
+        return "needs a column named interarrival_s" + (hint or f" (found {found})")
+    column = names.index("interarrival_s")
     ragged = next((i for i, row in enumerate(data) if len(row) > len(header)), None)
     if ragged is not None:
         return (f"not a readable CSV: row {ragged + 1} has {len(data[ragged])} fields, "

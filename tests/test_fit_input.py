@@ -136,3 +136,17 @@ def test_help_describes_the_command_in_whole_sentences():
     done = subprocess.run([sys.executable, "-m", "cell", "fit", "--help"], capture_output=True,
                           text=True, check=True)
     assert " ".join(DESCRIPTION.split()) in " ".join(done.stdout.split())
+
+
+def test_a_header_name_with_spaces_around_it_is_the_column(tmp_path):
+    """As a run's trace reader takes it: ' interarrival_s' (a space after the comma) is the
+    column; two columns of that name are refused rather than one chosen."""
+    from cell.analysis.fit import read_column
+
+    gaps = [20.0 + 0.5 * (i * 7 % 11) for i in range(30)]  # not sorted: gaps, not times
+    path = tmp_path / "log.csv"
+    path.write_text("part, interarrival_s \n" + "".join(f"{i},{g}\n" for i, g in enumerate(gaps)))
+    assert read_column(path).tolist() == gaps
+    path.write_text("interarrival_s, interarrival_s\n" + "".join(f"{g},{g}\n" for g in gaps))
+    with pytest.raises(ScenarioError, match="two columns have this name"):
+        read_column(path)

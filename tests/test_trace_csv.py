@@ -35,7 +35,8 @@ def test_other_columns_quotes_spaces_blank_lines_bom_and_crlf(tmp_path: Path) ->
 
 @pytest.mark.parametrize("text, words", [
     ("", "not a readable CSV"),
-    ("time\n20\n", "needs a column named interarrival_s"),
+    ("time\n20\n", "needs a column named interarrival_s (found 'time')"),
+    ("a,b,c,d,e,f\n1,2,3,4,5,6\n", "(found 'a', 'b', 'c', 'd', 'e', ...)"),
     ("interarrival_s\n", "has no inter-arrival times"),
     ("interarrival_s\n20\n1_000\n", "row 2 has inter-arrival time '1_000'"),
     ("interarrival_s\n20\n0x10\n", "row 2 has inter-arrival time '0x10'"),
@@ -54,6 +55,11 @@ def test_unusable_traces_are_one_line_naming_file_and_key(tmp_path: Path, text: 
     message = str(info.value)
     assert message.startswith(f"{path}: arrivals.trace_csv = ") and words in message, message
     assert "\n" not in message
+
+
+def test_a_header_name_with_spaces_around_it_is_the_column(tmp_path: Path) -> None:
+    """Spreadsheets and hand-edited files leave a space after the comma: ' interarrival_s'."""
+    assert read_trace(_trace(tmp_path, "part, interarrival_s \n1,20\n2,22.5\n")).tolist() == [20.0, 22.5]
 
 
 def test_a_file_that_is_not_utf8_is_refused(tmp_path: Path) -> None:

@@ -398,6 +398,9 @@ def _read_cells(p: Path, column: str) -> Any:
     except (ValueError, pd.errors.ParserWarning) as exc:  # pandas' parser errors are ValueErrors
         why = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise ScenarioError(p, "(file)", str(p), f"not a readable CSV: {why}") from None
+    frame.columns = [str(c).strip() for c in frame.columns]  # ' interarrival_s' is the column
+    if list(frame.columns).count(column) > 1:
+        raise ScenarioError(p, "--column", column, "two columns have this name; keep one")
     if column not in frame.columns:
         names = ", ".join(map(str, frame.columns))
         hint = " (is it separated by ';'? use commas)" if any(";" in str(c) for c in frame.columns) else ""
