@@ -173,6 +173,16 @@ def known_key(dotted: str) -> bool:
     return True
 
 
+def inert_settings(s: Scenario) -> list[str]:
+    """One line for each setting given a value of its own that has no effect under the
+    others (for a warning): the planner's acceleration bounds while they are switched off."""
+    m = s.mintime
+    if not m.acceleration_bounds and tuple(m.qddot_max_rad_s2) != MinTimeSettings().qddot_max_rad_s2:
+        return [f"mintime.qddot_max_rad_s2 ([{', '.join(f'{v:g}' for v in m.qddot_max_rad_s2)}]) "
+                "has no effect while mintime.acceleration_bounds is false"]
+    return []
+
+
 def _cross_checks(s: Scenario, file: object) -> None:
     """Checks that need more than one value but no maths."""
     h = s.robot.hand

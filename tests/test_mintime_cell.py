@@ -145,3 +145,19 @@ def test_rerun_replaces_the_set_and_foreign_files_are_kept(tmp_path, capsys):
     capsys.readouterr()
     assert main(["mintime", KIN, "--out", str(out)]) == 2
     assert "notes.txt" in capsys.readouterr().err and len(pd.read_csv(out / "profile.csv")) == 120
+
+
+def test_acceleration_bounds_switched_off_make_their_values_a_warning(tmp_path, capsys):
+    """The baseline plans without acceleration bounds: bounds given anyway change nothing
+    (the same times) and the command says so; the defaults, or bounds in use, are not warned."""
+    tiny = "mintime.qddot_max_rad_s2=[1e-9, 1e-9, 1e-9, 1e-9, 1e-9]"
+    assert main(["mintime", "baseline", "--set", tiny, "--out", str(tmp_path / "a")]) == 0
+    err = capsys.readouterr().err
+    assert "mintime.qddot_max_rad_s2 ([1e-09, 1e-09, 1e-09, 1e-09, 1e-09]) has no effect" in err
+    assert main(["mintime", "baseline", "--out", str(tmp_path / "b")]) == 0
+    assert "warning" not in capsys.readouterr().err
+    a, b = (json.loads((tmp_path / d / "summary.json").read_text()) for d in "ab")
+    assert a["regimes"] == b["regimes"]  # the same motion (the limits section records the values)
+    assert main(["mintime", "baseline", "--set", "mintime.acceleration_bounds=true", "--set",
+                 "mintime.qddot_max_rad_s2=[3, 3, 5, 9, 9]", "--out", str(tmp_path / "c")]) == 0
+    assert "warning" not in capsys.readouterr().err

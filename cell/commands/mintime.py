@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -61,11 +62,13 @@ def main(args: argparse.Namespace) -> int:
     from cell.errors import CellError, InfeasibleError, NoMotionError, ScenarioError
     from cell.mintime.regimes import plan_regimes, summary
     from cell.output import OutputDir
-    from cell.scenario import MAX_TIME_S
+    from cell.scenario import MAX_TIME_S, inert_settings
 
     check_out(args.out)  # before any work
     scenario = scenario_of(args)
     step_table(scenario)  # reach and motor checks, naming their keys
+    for line in inert_settings(scenario):
+        print(f"cell: warning: {line}", file=sys.stderr)
     bounds = planner_bounds(scenario)
     rates = "robot.motors.max_rate_no_load_rad_s"
     try:

@@ -38,13 +38,15 @@ def main(args: argparse.Namespace) -> int:
     from cell.progress import Progress
     from cell.records import BELT_COLUMNS, PART_COLUMNS, SUMMARY_COLUMNS
     from cell.reporting.runs import format_summary, run_heading, thesis_figures, warnings
+    from cell.scenario import inert_settings
     from cell.simulation import simulate
 
     OutputDir.check(args.out, RUN_FILES)  # before any work
     scenario = scenario_of(args)
     cell = assemble(scenario)  # every error is raised before anything is written
     print(run_heading(cell))
-    for line in warnings(cell.k):
+    timed = scenario.robot.timing == "minimum-time"  # the planner's settings matter
+    for line in [*warnings(cell.k), *(inert_settings(scenario) if timed else [])]:
         print(f"cell: warning: {line}", file=sys.stderr)
     n = scenario.run.parts
     with OutputDir(args.out, RUN_FILES) as out, \
