@@ -15,18 +15,25 @@ from __future__ import annotations
 import math
 from bisect import bisect_right
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import simpy
 
 from cell.mailbox import Mailbox
 
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from cell.types import Array
+
 #: Two instants closer than this are the same instant (float rounding of planned times).
 EPS_S = 1e-6
 
 
-def speed_at(instants: list[float], speeds: list[float], t: float) -> float:
-    """A piecewise-constant schedule's speed at t: the last change at or before t."""
+def speed_at(instants: Sequence[float] | Array, speeds: Sequence[float] | Array,
+             t: float) -> float:
+    """A piecewise-constant schedule's speed at t: the last change at or before t
+    (``instants`` in time order; lists or arrays alike, neither copied)."""
     return speeds[max(bisect_right(instants, t) - 1, 0)]
 
 

@@ -60,7 +60,7 @@ def belt_speed_at(history: ArrayLike, when: float) -> float:
     instant already holds.  The run records the input belt's change at LO at the part's
     ``pick_s`` exactly (both are B + the look-ahead lag), so LO needs no nudge."""
     h = np.asarray(history, dtype=float).reshape(-1, 2)
-    return float(speed_at(h[:, 0].tolist(), h[:, 1].tolist(), float(when)))
+    return float(speed_at(h[:, 0], h[:, 1], float(when)))  # columns as they are: no copy
 
 
 def pick_transfer(run: Run) -> int:
