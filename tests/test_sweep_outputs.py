@@ -76,3 +76,24 @@ def test_a_report_subfolder_that_would_hold_the_results_is_refused_before_runnin
     assert code == 2 and len(err.splitlines()) == 1, err
     assert f"--report {report}:" in err and f"--out {out}" in err
     assert not (work / out / "replications.csv").exists()
+
+
+def test_a_folder_of_results_without_sweep_json_is_refused_naming_them(tmp_path):
+    """The refusal names what a sweep would replace: replications.csv, then the first task file."""
+    from cell.errors import CellError
+    from cell.sweep.outdir import check_out
+
+    out = tmp_path / "o"
+    (out / "tasks").mkdir(parents=True)
+    check_out(out)  # an empty tasks/ holds nothing of a sweep's
+    for name in ("task-000002.csv", "task-000001.csv"):
+        (out / "tasks" / name).write_text("x\n")
+    with pytest.raises(CellError) as tasks_only:
+        check_out(out)
+    (out / "replications.csv").write_text("x\n")
+    with pytest.raises(CellError) as both:
+        check_out(out)
+    said = "but no sweep.json: not a sweep's results, and a sweep would replace them; choose " \
+           "another --out"
+    assert str(tasks_only.value) == f"--out {out}: holds tasks/task-000001.csv {said}"
+    assert str(both.value) == f"--out {out}: holds replications.csv, tasks/task-000001.csv {said}"

@@ -75,3 +75,20 @@ def test_pairs_over_the_same_window_are_not_warned(sweeps, tmp_path, capsys, bas
     assert warned == [] and "Caveat" not in report
     counted = diffs[diffs["measure"] == "parts_delivered"]
     assert sorted(counted["run.warmup_parts"]) == [0, 4]
+
+
+def test_the_warning_names_each_setting_with_its_values_on_either_side(sweeps, tmp_path):
+    """Both window settings apart: each named once, its values in order of first appearance."""
+    from cell.sweep import load_sweep
+    from cell.sweep.windows import window_warning
+
+    sweep = load_sweep(sweeps.write(
+        tmp_path, policies=["non-adaptive"],
+        grid={"run.parts": [20, 30, 40], "run.warmup_parts": [0, 4]},
+        baseline={"run.parts": 20, "run.warmup_parts": 0}))
+    assert window_warning(sweep) == (
+        "5 of 5 paired comparisons are between points that count over different windows "
+        "(run.parts 30, 40 against 20; run.warmup_parts 4 against 0): their counts "
+        "(parts delivered, parts lost, spacings outside tolerance, ...) are not comparable "
+        "and are left out of differences.csv; compare the rates, or give the points the "
+        "same window")

@@ -277,7 +277,8 @@ class PointIndex:
 
     def find(self, policy: str, values: Mapping[str, Any], every: bool = True) -> list[int]:
         """Indices, ascending, of ``policy``'s points whose values equal ``values``: on every
-        key the point varies (``every``; :meth:`Point.agrees`), or on the keys both have."""
+        key the point varies (``every``: each of them must be in ``values``), or on the keys
+        both have."""
         found: list[int] = []
         for group in self._members:
             keys = group[1]

@@ -41,9 +41,8 @@ def check_out(out: str | Path) -> Path:
 def _results_without_manifest(path: Path) -> str | None:
     """What a sweep would replace in ``path`` (its ``replications.csv``, task files),
     named for the message, when there is no manifest to say a sweep wrote them."""
-    found = [str(Path(p).relative_to(path)) for p in
-             ([path / "replications.csv"] if (path / "replications.csv").exists() else [])
-             + finished_tasks(path)[:1]]
+    found = ["replications.csv"] if (path / "replications.csv").exists() else []
+    found += [str(p.relative_to(path)) for p in finished_tasks(path)[:1]]
     return ", ".join(found) or None
 
 

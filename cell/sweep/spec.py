@@ -96,10 +96,6 @@ class Point:
         """The name of this point's value of ``key``, if the sweep file named it."""
         return dict(self.names).get(key)
 
-    def agrees(self, values: dict[str, Any]) -> bool:
-        """Whether every key this point varies has the given value in ``values``."""
-        return all(k in values and values[k] == v for k, v in self.values)
-
 
 @dataclass(frozen=True)
 class Pair:

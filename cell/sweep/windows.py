@@ -50,13 +50,13 @@ def window_warning(sweep: Sweep) -> str | None:
     apart = [d for d in (pair_apart(sweep, p) for p in pairs) if d]
     if not apart:
         return None
-    keys = [k for k in WINDOW_KEYS if any(key == k for d in apart for key, _, _ in d)]
-    what = "; ".join(
-        f"run.{k} " + ", ".join(show(v) for v in distinct(a for d in apart for key, a, _ in d
-                                                          if key == k))
-        + " against " + ", ".join(show(v) for v in distinct(b for d in apart
-                                                             for key, _, b in d if key == k))
-        for k in keys)
+    settings = [s for d in apart for s in d]  # (key, the point's value, its partner's)
+
+    def side(key: str, i: int) -> str:
+        return ", ".join(show(v) for v in distinct(s[i] for s in settings if s[0] == key))
+
+    keys = [k for k in WINDOW_KEYS if any(s[0] == k for s in settings)]
+    what = "; ".join(f"run.{k} {side(k, 1)} against {side(k, 2)}" for k in keys)
     return (f"{len(apart)} of {len(pairs)} paired comparisons are between points that count "
             f"over different windows ({what}): their counts (parts delivered, parts lost, "
             "spacings outside tolerance, ...) are not comparable and are left out of "
