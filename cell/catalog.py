@@ -65,7 +65,7 @@ def shown(source: str | Path) -> str:
         inside = p.resolve().parent == BUILT_IN and p.suffix == ".yaml"
     except OSError:
         inside = False
-    return p.stem if inside and Path(source).is_absolute() else str(source)
+    return p.stem if inside and p.is_absolute() else str(source)
 
 
 def names() -> list[str]:

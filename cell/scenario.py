@@ -177,7 +177,7 @@ def inert_settings(s: Scenario) -> list[str]:
     """One line for each setting given a value of its own that has no effect under the
     others (for a warning): the planner's acceleration bounds while they are switched off."""
     m = s.mintime
-    if not m.acceleration_bounds and tuple(m.qddot_max_rad_s2) != MinTimeSettings().qddot_max_rad_s2:
+    if not m.acceleration_bounds and tuple(m.qddot_max_rad_s2) != _DEFAULTS.mintime.qddot_max_rad_s2:
         return [f"mintime.qddot_max_rad_s2 ([{', '.join(f'{v:g}' for v in m.qddot_max_rad_s2)}]) "
                 "has no effect while mintime.acceleration_bounds is false"]
     return []

@@ -101,7 +101,6 @@ def fsync(path: Path, directory: bool = False) -> None:
         os.close(fd)
 
 
-
 def allowed(parts: list[str], names: Iterable[str], directory: bool = False) -> bool:
     """Whether the path ``parts`` is one of ``names`` (or, for a directory, holds one of them)."""
     for name in names:
