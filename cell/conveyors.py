@@ -74,8 +74,11 @@ class Belt:
         return self._v[k if k > 0 else 0]
 
     def travel(self, t: float) -> float:
-        """X(t): inches the belt has moved by time t (t ≥ the last settled change)."""
+        """X(t): inches the belt has moved by time t (t ≥ the last settled change, or a
+        rounding before it: a replan within EPS_S of a change may settle up to it)."""
         k = bisect_right(self._t, t) - 1
+        if k < 0:  # max(k, 0) without the builtin call; index -1 would be the last change
+            k = 0
         return self._x[k] + self._v[k] * (t - self._t[k])
 
     def time_at(self, x: float) -> float:

@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from cell.records import LIMIT_BIT, SUMMARY_COLUMNS
@@ -101,6 +101,9 @@ def scenario(family, mean, cv, policy):
 
 @settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(family=families, load=load, cv=spread, seed=st.integers(0, 2**32 - 1))
+# a replan 3e-13 s before the input belt's change at the robot's cycle end: the feeder read the
+# belt's travel off the wrong line and dropped a part 0.94 in behind the last
+@example(family="gamma", load=0.7734375, cv=0.84375, seed=801686)
 def test_both_policies_stay_physical_under_any_arrivals(family, load, cv, seed):
     if family == "expon":
         cv = min(cv, 1.0)

@@ -38,6 +38,17 @@ def test_a_plan_cannot_start_before_what_the_belt_holds():
         Belt(3.0).plan(-1.0, 4.0)
 
 
+def test_travel_a_rounding_before_the_earliest_held_change():
+    """The controller may replan up to EPS_S before the robot's cycle ends, where the belt
+    changes speed; a replan then keeps only that change, and the belt's travel just before
+    it is still the travel there (it read the last change's line, far off)."""
+    b = Belt(3.0)
+    b.plan(10.0, 6.0, 20.0, 1.5)
+    b.plan(21.0, 4.0, 30.0, 2.0)        # settles the changes before 20 s
+    assert b.travel(20.0 - 3e-13) == pytest.approx(90.0, abs=1e-9)  # 3 x 10 + 6 x 10
+    assert b.speed(20.0 - 3e-13) == 1.5
+
+
 def test_speed_must_be_positive():
     with pytest.raises(ValueError):
         Belt(3.0).plan(1.0, 0.0)
