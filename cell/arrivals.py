@@ -318,7 +318,8 @@ def _parse_trace(path: Path) -> Any:
     """
     try:
         with path.open(encoding="utf-8-sig", newline="") as stream:
-            rows = [row for row in csv.reader(stream, strict=True) if any(c.strip() for c in row)]
+            reader = csv.reader(stream, strict=True, skipinitialspace=True)
+            rows = [row for row in reader if any(c.strip() for c in row)]
     except (OSError, UnicodeDecodeError, csv.Error) as exc:
         return f"not a readable CSV: {' '.join(str(exc).split())[:120]}"
     if not rows:

@@ -62,6 +62,12 @@ def test_a_header_name_with_spaces_around_it_is_the_column(tmp_path: Path) -> No
     assert read_trace(_trace(tmp_path, "part, interarrival_s \n1,20\n2,22.5\n")).tolist() == [20.0, 22.5]
 
 
+def test_a_quoted_field_after_a_space_is_still_quoted(tmp_path: Path) -> None:
+    """'part, "interarrival_s"': the quotes after the comma's space enclose the field."""
+    text = 'part, "interarrival_s "\r\n1, "20"\r\n2, 22.5\r\n'
+    assert read_trace(_trace(tmp_path, text)).tolist() == [20.0, 22.5]
+
+
 def test_a_file_that_is_not_utf8_is_refused(tmp_path: Path) -> None:
     path = tmp_path / "trace.csv"
     path.write_bytes(b"interarrival_s\n\xff\xfe20\n")
