@@ -5,10 +5,11 @@ numbers: replication r of both draws the same parts, so their difference is
 taken replication by replication (a paired t interval).  Prints, per headline
 measure, which is better, by how much, and whether the interval excludes zero;
 ``--out DIR`` writes the report (as ``cell sweep --report``) and the
-replications, as a unit.  Counts (parts delivered, lost, ...) are per run, after
-the warm-up: if A and B differ in ``run.parts`` or ``run.warmup_parts`` a warning
-says so, the verdict leaves counts uncompared and ``differences.csv`` leaves them
-out (:mod:`cell.sweep.windows`); rates still compare.
+replications, as a unit.  Counts (parts delivered, lost, ...) and extremes (closest
+spacing, fastest belt, ...) are per run, after the warm-up: if A and B differ in
+``run.parts`` or ``run.warmup_parts`` a warning says so, the verdict leaves them
+uncompared and ``differences.csv`` leaves them out (:mod:`cell.sweep.windows`);
+rates still compare.
 """
 
 from __future__ import annotations
@@ -64,8 +65,8 @@ def _sides(sweep: Sweep) -> tuple[tuple[str, Point], tuple[str, Point]]:
 
 
 def window_warning(sweep: Sweep) -> str | None:
-    """One line if A's and B's counts are over different windows, else None."""
-    from cell.sweep.windows import windows_apart
+    """One line if A's and B's counts and extremes are over different windows, else None."""
+    from cell.sweep.windows import WINDOW_MEASURES_TEXT, windows_apart
 
     (la, a), (lb, b) = _sides(sweep)
     differ = windows_apart(a.scenario, b.scenario)
@@ -74,8 +75,8 @@ def window_warning(sweep: Sweep) -> str | None:
     said = {"parts": "runs {} parts", "warmup_parts": "has run.warmup_parts {}"}
     what = "; ".join(f"{la} {said[k].format(va)}, {lb} {vb}" for k, va, vb in differ)
     sets = " ".join(f"--set run.{k}={_suggest(va, vb)}" for k, va, vb in differ)
-    return (f"{what}: counts (parts delivered, parts lost, spacings outside tolerance) are "
-            f"not comparable; compare the rates, or give both the same window ({sets})")
+    return (f"{what}: {WINDOW_MEASURES_TEXT} are not comparable; compare the rates, or give "
+            f"both the same window ({sets})")
 
 
 def main(args: argparse.Namespace) -> int:
@@ -150,9 +151,10 @@ def command_line(args: argparse.Namespace, seed: int) -> str:
 
 def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> str:
     """A few lines: per headline measure, which is better and by how much (A - B).  Counts
-    are not compared if A and B take them over different windows (run length, warm-up)."""
+    and extremes are not compared if A and B take them over different windows (run length,
+    warm-up)."""
     from cell.reporting.headlines import HEADLINES, better, half_width, number, plus_minus
-    from cell.sweep.windows import windows_apart
+    from cell.sweep.windows import window_kind, windows_apart
 
     (la, a), (lb, b) = _sides(sweep)
     differ = windows_apart(a.scenario, b.scenario)
@@ -167,9 +169,10 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> s
     width = max(len(h.title) for h in HEADLINES)
     for h in HEADLINES:
         d = differences[differences["measure"] == h.column]
-        if h.per_run and differ and h.column in set(summary["measure"]):
-            lines.append(f"  {h.title:<{width}}  not compared: a count, over different windows "
-                         f"({apart}); compare the rates")
+        windowed = window_kind(h.column)
+        if windowed and differ and h.column in set(summary["measure"]):
+            lines.append(f"  {h.title:<{width}}  not compared: {windowed}, over different "
+                         f"windows ({apart}); compare the rates")
             continue
         if d.empty:
             continue

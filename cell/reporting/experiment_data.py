@@ -16,7 +16,7 @@ import pandas as pd
 
 from cell.analysis.stats import PAIRED_KEYS, SUMMARY_KEYS, paired_difference, summarise
 from cell.sweep import Column, Sweep, grid_columns
-from cell.sweep.windows import count_measures, pair_apart
+from cell.sweep.windows import pair_apart, window_measures
 
 #: Columns of replications.csv that are not measures.
 NOT_MEASURES = {"policy", "point", "seed", "replication"}
@@ -66,14 +66,14 @@ def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     """``differences.csv``: each pair of points, replication by replication, per measure.
 
     The grid columns hold the compared point's values, or its partner's for a key
-    only the partner varies.  A pair whose points count over different windows
-    (:mod:`cell.sweep.windows`) has no rows for the counts.
+    only the partner varies.  A pair whose points run over different windows
+    (:mod:`cell.sweep.windows`) has no rows for the counts and extremes.
     """
     columns, names = grid_columns(sweep), measures(replications, sweep)
-    counts = set(count_measures())
+    windowed = set(window_measures())
     rows = []
     for pair in sweep.pairs():
-        compared = [m for m in names if m not in counts] if pair_apart(sweep, pair) else names
+        compared = [m for m in names if m not in windowed] if pair_apart(sweep, pair) else names
         a, b = sweep.points[pair.point], sweep.points[pair.versus]
         runs_a, runs_b = runs_of(replications, sweep, pair.point), \
             runs_of(replications, sweep, pair.versus)
