@@ -9,6 +9,7 @@ import pandas as pd
 import yaml
 
 from cell.cli import main
+from cell.reporting.headlines import too_few
 
 
 def test_a_rate_no_run_has_is_not_compared_rather_than_nan(tmp_path, capsys):
@@ -24,16 +25,25 @@ def test_a_rate_no_run_has_is_not_compared_rather_than_nan(tmp_path, capsys):
             if line.startswith("  ")}
     for rate in ("Parts per hour (wall clock)", "Actual cycle (wall clock, s)",
                  "IP (wall clock, eq. 5.1)"):
-        assert "not compared" in rows[rate], rows[rate]
+        assert rows[rate].endswith(f"not compared: {too_few(0, sides='both A and B')}")
         assert "nan" not in rows[rate] and "excludes" not in rows[rate]
     assert "3 replications of 1 part," in out.splitlines()[0]
     report = (tmp_path / "cmp" / "report.md").read_text()
     assert "nan" not in report.lower() and "— parts/hr" not in report
-    assert "no replication gives parts per hour (wall clock) for both" in report
-    assert "no replication gives IP (wall clock, eq. 5.1) for both" in report
+    assert f"not compared, {too_few(0, 'parts per hour (wall clock)')}." in report
+    assert f"not compared, {too_few(0, 'IP (wall clock, eq. 5.1)')}." in report
     reading = report.split("## Reading", 1)[1]
     ip = next(line for line in reading.splitlines() if line.startswith("**IP"))
-    assert "not compared" in ip and "no difference shown" not in ip
+    assert f"not compared ({too_few(None, why=False)})" in ip and "no difference shown" not in ip
+
+
+def test_too_few_says_how_many_replications_give_the_measure():
+    """The one wording of a difference with no interval, for the verdict and report.md."""
+    assert too_few(0, sides="both A and B") == (
+        "no replication gives it for both A and B (e.g. runs too short to deliver two parts)")
+    assert too_few(1, "IP") == ("only one replication gives IP for both "
+                                "(e.g. runs too short to deliver two parts)")
+    assert too_few(None, why=False) == "fewer than two replications give it for both"
 
 
 def test_the_reports_command_reproduces_the_comparison(tmp_path, capsys):

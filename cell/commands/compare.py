@@ -131,12 +131,6 @@ def main(args: argparse.Namespace) -> int:
     return 0
 
 
-def _too_few(n: int) -> str:
-    """Why a measure has no paired interval: fewer than two replications give it on both sides."""
-    have = "no replication gives" if n == 0 else "only one replication gives"
-    return f"{have} it for both A and B (e.g. a run too short to deliver two parts)"
-
-
 def command_line(args: argparse.Namespace, seed: int) -> str:
     """The command that reproduces this comparison, quoted for a shell: its scenarios,
     replications, seed and every ``--set``."""
@@ -153,7 +147,14 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> s
     """A few lines: per headline measure, which is better and by how much (A - B).  Counts
     and extremes are not compared if A and B take them over different windows (run length,
     warm-up)."""
-    from cell.reporting.headlines import HEADLINES, better, half_width, number, plus_minus
+    from cell.reporting.headlines import (
+        HEADLINES,
+        better,
+        half_width,
+        number,
+        plus_minus,
+        too_few,
+    )
     from cell.sweep.windows import window_kind, windows_apart
 
     (la, a), (lb, b) = _sides(sweep)
@@ -180,7 +181,8 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> s
         means = summary[summary["measure"] == h.column].set_index("scenario")["mean"]
         mean, sd, lo, hi = (float(row[k]) for k in ("mean", "sd", "ci_low", "ci_high"))
         if int(row["n"]) < 2:
-            lines.append(f"  {h.title:<{width}}  not compared: {_too_few(int(row['n']))}")
+            lines.append(f"  {h.title:<{width}}  not compared: "
+                         f"{too_few(int(row['n']), sides='both A and B')}")
             continue
         word = h.words[0] if mean >= 0 else h.words[1]
         unit = f" {h.unit}" if h.unit else ""

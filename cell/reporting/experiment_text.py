@@ -27,6 +27,7 @@ from cell.reporting.headlines import (
     plus_minus,
     table_head,
     table_row,
+    too_few,
 )
 from cell.sweep import Sweep, grid_columns
 from cell.sweep.columns import NAME_SUFFIX
@@ -102,8 +103,7 @@ def sentence(h: Headline, d: Mapping[Any, Any], a: str, b: str, parts: int | Non
     per = f" per {parts}-part run" if h.per_run and parts else ""
     direction = h.words[0] if mean >= 0 else h.words[1]
     if n == 0 or not math.isfinite(mean):
-        return (f"{a} against {b}: not compared, no replication gives {_lower(h.title)} for "
-                "both (e.g. runs too short to deliver two parts).")
+        return f"{a} against {b}: not compared, {too_few(0, _lower(h.title))}."
     if n < 2 or not math.isfinite(float(d["sd"])):
         x = number(abs(mean))
         return h.sentence.format(a=a, x=x, dir=direction, b=b) + per + \
@@ -269,7 +269,7 @@ def _verdicts(h: Headline, differences: pd.DataFrame, cols: Sequence[str]) -> li
         level, n = len(group) - up - down - unknown, len(group)
         counts = [f"{h.words[0]} at {up}" if up else "", f"{h.words[1]} at {down}" if down else "",
                   f"no difference shown at {level}" if level else "",
-                  f"not compared (too few values) at {unknown}" if unknown else ""]
+                  f"not compared ({too_few(None, why=False)}) at {unknown}" if unknown else ""]
         counts = [c for c in counts if c]
         if n == 1:
             counts[0] = counts[0].removesuffix(" at 1")

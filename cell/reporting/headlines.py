@@ -56,6 +56,15 @@ HEADLINES: tuple[Headline, ...] = (
 )
 
 
+def too_few(n: int | None, what: str = "it", sides: str = "both", why: bool = True) -> str:
+    """Why a paired difference is not compared: fewer than two replications give ``what``
+    for ``sides`` (``n`` of them, 0 or 1; None: either); ``why`` adds the usual cause."""
+    have = ("no replication gives" if n == 0 else "only one replication gives" if n == 1
+            else "fewer than two replications give")
+    cause = " (e.g. runs too short to deliver two parts)" if why else ""
+    return f"{have} {what} for {sides}{cause}"
+
+
 def decimals(half: float) -> int:
     """Decimals that show a confidence half-width to two significant figures (0 to 6)."""
     if not math.isfinite(half) or half <= 0:
