@@ -22,13 +22,18 @@ from cell.commands import check_workers, set_argument, workers_argument
 if TYPE_CHECKING:
     import pandas as pd
 
+    from cell.scenario import Scenario
     from cell.sweep import Sweep
     from cell.sweep.spec import Point
 
 HELP = "compare two scenarios, paired over common random numbers"
 DESCRIPTION = ("Run scenarios A and B with the same replications (common random numbers) and "
                "say, per headline measure, which is better, by how much (paired confidence "
-               "interval of A - B) and whether the interval excludes zero.")
+               "interval of A - B) and whether the interval excludes zero.  The verdict, "
+               "report.md and the CSVs' scenario column label A and B by each scenario's "
+               "name setting (a file without one: its file name); if the two are the same, "
+               "by their file names; if those are the same too, as 'A: <name>' and "
+               "'B: <name>'.")
 DEFAULT_REPLICATIONS = 100
 
 
@@ -46,10 +51,20 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     set_argument(p)
 
 
-def _label(arg: str) -> str:
+def _stem(arg: str) -> str:
+    """A scenario argument's file name without ``.yaml`` (a built-in's name as given)."""
     from pathlib import Path
 
     return Path(arg).stem if arg.endswith((".yaml", ".yml")) else Path(arg).name
+
+
+def labels(a: Scenario, b: Scenario, arg_a: str, arg_b: str) -> tuple[str, str]:
+    """What A and B are called (``DESCRIPTION``): their ``name:``, else their file
+    names, else ``A: ...`` and ``B: ...``: the first pair that tells them apart."""
+    for la, lb in ((a.name, b.name), (_stem(arg_a), _stem(arg_b))):
+        if la != lb:
+            return la, lb
+    return f"A: {a.name}", f"B: {b.name}"
 
 
 def _suggest(va: object, vb: object) -> object:
@@ -102,7 +117,7 @@ def main(args: argparse.Namespace) -> int:
         raise CellError(f"--seed {args.seed}: must be a whole number from 0 to 2**63 - 1")
     check_workers(args.workers)
     seed = a.run.seed if args.seed is None else args.seed
-    sweep = comparison(a, b, (_label(args.a), _label(args.b)), args.replications, seed)
+    sweep = comparison(a, b, labels(a, b, args.a, args.b), args.replications, seed)
     target = None
     if args.out:
         from cell.output import OutputDir
