@@ -264,6 +264,28 @@ def test_cli_writes_replications_and_report(sweeps, tmp_path, monkeypatch, capsy
     assert (tmp_path / "rep" / "table_7_1.md").is_file()
 
 
+def test_a_sweep_and_a_run_say_overload_in_the_same_words(sweeps, tmp_path):
+    """The sweep's line and cell run's line differ only in what opens them and in the run's
+    own times, which the run's gives."""
+    from cell.assembly import assemble
+    from cell.reporting.runs import warnings
+    from cell.sweep.spec import overload_warning
+
+    arrivals = {"distribution": "gamma", "mean_s": 15.0, "cv": 0.3}
+    sweep = load_sweep(sweeps.write(tmp_path, policies=["adaptive"],
+                                    set={"run.parts": 20, "arrivals": arrivals,
+                                         "controller.nominal_cycle_s": None}))
+    ran = warnings(assemble(sweep.points[0].scenario).k)[0]
+    swept = overload_warning(sweep)
+    assert ran.startswith("utilisation 1.206: ") and swept.startswith("1 of 1 points have ")
+    assert ran.endswith("fastest cycle (18.08 s) is not shorter than the mean inter-arrival "
+                        "time (15.00 s); the cell cannot keep up on average and every policy "
+                        "will lose parts")
+    assert swept.endswith("fastest cycle is not shorter than the mean inter-arrival time "
+                          "there; the cell cannot keep up on average and every policy will "
+                          "lose parts")
+
+
 def test_cli_warns_of_points_that_cannot_keep_up(sweeps, tmp_path, capsys):
     """Utilisation 1 or more at some points: one warning line, as cell run gives for a run."""
     arrivals = {"distribution": "gamma", "mean_s": 22.0, "cv": 0.3}

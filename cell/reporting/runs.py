@@ -58,10 +58,10 @@ def warnings(k: CellConstants) -> list[str]:
     arrivals' mean."""
     out = []
     if k.utilisation >= 1:
-        out.append(f"utilisation {k.utilisation:.3f}: the robot's fastest cycle "
-                   f"({k.fastest_cycle_s:.2f} s) is not shorter than the mean inter-arrival time "
-                   f"({k.mean_interarrival_s:.2f} s); the cell cannot keep up on average and "
-                   "every policy will lose parts")
+        from cell.sweep.spec import overloaded
+
+        out.append(overloaded(f"utilisation {k.utilisation:.3f}",
+                              (k.fastest_cycle_s, k.mean_interarrival_s)))
     gap = k.cycle_nom / k.mean_interarrival_s - 1
     if k.nominal_from == "scenario" and abs(gap) > NOMINAL_MISMATCH:
         out.append(f"controller.nominal_cycle_s ({k.cycle_nom:.4f} s) is {gap:+.1%} off the "

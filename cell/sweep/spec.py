@@ -321,9 +321,20 @@ def overload_warning(sweep: Sweep) -> str | None:
         return None
     worst = max(over, key=lambda p: p.utilisation)
     where = ", ".join(f"{k} {show(v)}" for k, v in worst.values) or worst.policy
-    return (f"{len(over)} of {len(sweep.points)} points have utilisation 1 or more (up to "
-            f"{worst.utilisation:.3f}, at {where}): the robot's fastest cycle is not shorter "
-            "than the mean inter-arrival time there, and every policy will lose parts")
+    return overloaded(f"{len(over)} of {len(sweep.points)} points have utilisation 1 or more "
+                      f"(up to {worst.utilisation:.3f}, at {where})")
+
+
+def overloaded(how_much: str, times_s: tuple[float, float] | None = None) -> str:
+    """The one line saying a cell cannot keep up on average (utilisation 1 or more), opened
+    by ``how_much``: for a sweep's points (:func:`overload_warning`) and for a run
+    (:func:`cell.reporting.runs.warnings`, with its fastest cycle and mean inter-arrival
+    time, s)."""
+    fastest, mean = (f" ({times_s[0]:.2f} s)", f" ({times_s[1]:.2f} s)") if times_s else \
+        ("", " there")
+    return (f"{how_much}: the robot's fastest cycle{fastest} is not shorter than the mean "
+            f"inter-arrival time{mean}; the cell cannot keep up on average and every policy "
+            "will lose parts")
 
 
 def _check_point(scenario: Scenario, file: object) -> float:
