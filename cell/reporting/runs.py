@@ -93,16 +93,19 @@ def thesis_figures(s: Scenario) -> dict[str, str] | None:
     return {field: fmt.format(values[field]) for field, (_, fmt) in TABLE_7_1_SHOWN.items()}
 
 
-def is_thesis_cell(s: Scenario, *, any_timing: bool = False) -> bool:
+def is_thesis_cell(s: Scenario, *, any_timing: bool = False,
+                   baseline: Scenario | None = None) -> bool:
     """Whether ``s`` is the thesis's own run but for its policy, robot cycle and seed (and,
     with ``any_timing``, its robot timing): the built-in baseline's cell, eq. 6.9 arrivals,
-    500 parts; names, descriptions and the planner's settings aside."""
+    500 parts; names, descriptions and the planner's settings aside.  ``baseline``: the
+    built-in baseline, if the caller has it already (it is read otherwise)."""
     c = s.controller
     same = {"controller.policy": c.policy, "controller.ideal_cycle_s": c.ideal_cycle_s,
             "run.seed": s.run.seed}
     if any_timing:
         same["robot.timing"] = s.robot.timing
-    return _comparable(s) == _comparable(load_scenario("baseline").with_overrides(same))
+    thesis = baseline if baseline is not None else load_scenario("baseline")
+    return _comparable(s) == _comparable(thesis.with_overrides(same))
 
 
 def _comparable(s: Scenario) -> dict[str, Any]:
