@@ -225,15 +225,12 @@ def load_sweep(path: str | Path) -> Sweep:
         if key not in SWEEP_KEYS:
             raise ScenarioError(path, str(key), raw[key],
                                 "unknown key (known: " + ", ".join(SWEEP_KEYS) + ")")
-    if "base" not in raw or not isinstance(raw["base"], str):
+    if not isinstance(raw.get("base"), str) or not raw["base"].strip():
         raise ScenarioError(path, "base", raw.get("base"),
                             "name the base scenario: a file (relative to the sweep file) or "
                             "a built-in one (`cell scenarios`)")
-    base_path = path.parent / raw["base"]
-    if not base_path.is_file() and catalog.path(raw["base"]).is_file() \
-            and Path(raw["base"]).name == raw["base"]:
-        base_path = catalog.path(raw["base"])  # a built-in scenario by name: baseline
-    if not base_path.is_file():
+    base_path = catalog.resolve(raw["base"], beside=path.parent)  # or a built-in by name
+    if not base_path.exists():
         raise ScenarioError(path, "base", raw["base"],
                             f"no such scenario file ({base_path}) nor built-in scenario "
                             "(`cell scenarios` lists them)")
