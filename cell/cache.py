@@ -128,7 +128,7 @@ class Remembered(Generic[R]):
         found = self._here.get(text)
         if found is not None:
             return found
-        plain = stored(self.kind, key)
+        plain = _stored(self.kind, text)
         if plain is None:
             return None
         try:
@@ -149,14 +149,15 @@ class Remembered(Generic[R]):
             plain = self.to_plain(value)
         except TypeError:
             return
-        store(self.kind, key, plain)
+        _store(self.kind, text, plain)
 
     def clear(self) -> None:
         self._here.clear()
 
 
 def _text(key: Any) -> str | None:
-    """A key as text (None for one that is not plain JSON data: then nothing is kept)."""
+    """A key as text (None for one that is not plain JSON data: then nothing is kept); the
+    disk cache's entries are keyed on this text too."""
     try:
         return json.dumps(key, sort_keys=True, allow_nan=True)
     except (TypeError, ValueError):
@@ -205,9 +206,10 @@ def code_fingerprint() -> str:
     return h.hexdigest()
 
 
-def _key_text(kind: str, key: Any) -> tuple[str, str]:
-    """The key as text, and the whole of what an entry must match (the code's fingerprint too)."""
-    text = f"{kind}\n{json.dumps(key, sort_keys=True)}"
+def _key_text(kind: str, key_text: str) -> tuple[str, str]:
+    """The kind and key (:func:`_text`) as text, and the whole of what an entry must match
+    (the code's fingerprint too)."""
+    text = f"{kind}\n{key_text}"
     return text, f"{code_fingerprint()}\n{text}"
 
 
@@ -227,8 +229,14 @@ def stored(kind: str, key: Any) -> Any:
     ``key`` is plain JSON data (numbers, strings, lists, mappings): the values the
     stored result depends on.  Floats are written and read back exactly.
     """
+    text = _text(key)
+    return None if text is None else _stored(kind, text)
+
+
+def _stored(kind: str, key_text: str) -> Any:
+    """:func:`stored`, the key already text (:func:`_text`)."""
     try:
-        text, whole = _key_text(kind, key)
+        text, whole = _key_text(kind, key_text)
         path = _entry(text, kind)
         if path is None:
             return None
@@ -249,9 +257,16 @@ def stored(kind: str, key: Any) -> Any:
 def store(kind: str, key: Any, value: Any) -> None:
     """Store ``value`` (plain JSON data) under (``kind``, ``key``), atomically; a cache
     that cannot be written is left alone, silently."""
+    text = _text(key)
+    if text is not None:
+        _store(kind, text, value)
+
+
+def _store(kind: str, key_text: str, value: Any) -> None:
+    """:func:`store`, the key already text (:func:`_text`)."""
     tmp = None
     try:
-        text, whole = _key_text(kind, key)
+        text, whole = _key_text(kind, key_text)
         path = _entry(text, kind)
         if path is None:
             return

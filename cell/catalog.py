@@ -19,13 +19,16 @@ def path(name: str) -> Path:
     return BUILT_IN / f"{stem}.yaml"
 
 
-def resolve(name_or_path: str | Path) -> Path:
-    """A SCENARIO argument as a file: an existing path as given, else a built-in name."""
+def resolve(name_or_path: str | Path, beside: Path | None = None) -> Path:
+    """A SCENARIO argument as a file: an existing path as given, else a built-in name.
+    ``beside``: the folder a relative path is taken from (by default the working
+    directory), as a sweep file's ``base`` is from the sweep file's."""
     given = Path(name_or_path)
-    if given.exists() or given.suffix and given.parent != Path("."):
-        return given
+    here = given if beside is None else beside / given
+    if here.exists() or given.suffix and given.parent != Path("."):
+        return here
     built_in = path(str(name_or_path))
-    return built_in if built_in.is_file() else given
+    return built_in if built_in.is_file() else here
 
 
 #: Keys only a sweep file has, and keys only a dynamics file has.

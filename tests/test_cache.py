@@ -108,6 +108,25 @@ def test_a_remembered_value_outlives_the_process_but_not_a_failed_read_back(own_
     assert kept.get({"y": 1}) is None
 
 
+def test_a_remembered_key_is_made_text_once_per_look_and_once_per_keep(own_cache, monkeypatch):
+    """A miss looks here and on disk with the one text of the key; keeping it writes both with
+    one text too; the entry is the one :func:`cache.stored` finds under the key."""
+    kept = cache.Remembered("count")
+    key = {"x": [1.5, 2]}
+    dumps, made = cache.json.dumps, []
+
+    def counting(obj, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
+        made.append(obj is key)
+        return dumps(obj, *args, **kwargs)
+
+    monkeypatch.setattr(cache.json, "dumps", counting)
+    assert kept.get(key) is None and made.count(True) == 1
+    kept.put(key, 4.0)
+    assert made.count(True) == 2
+    monkeypatch.setattr(cache.json, "dumps", dumps)
+    assert cache.stored("count", {"x": [1.5, 2]}) == 4.0
+
+
 @pytest.mark.parametrize("timing", ["constant-rate", "minimum-time"])
 def test_the_timing_read_back_is_the_solved_one(own_cache, timing):
     s = load_scenario("baseline", {"robot.timing": timing, "mintime.grid_points": 120})

@@ -354,6 +354,23 @@ def test_table_7_1_only_beside_the_thesis_s_own_cell(sweeps, tmp_path, other):
     assert is_table_7_1(same)  # the thesis's cell under another robot timing (make sweep-mintime)
 
 
+def test_table_7_1_reads_the_thesis_s_cell_once_for_all_points(sweeps, tmp_path, monkeypatch):
+    """Three points, each checked against the built-in baseline: read once, not per point."""
+    from cell import yamlio
+    from cell.reporting.table_7_1 import is_table_7_1
+
+    sweep = load_sweep(sweeps.write(tmp_path, replications=2, batch=2, set={"run.parts": 500}))
+    read, reads = yamlio.load_mapping, []
+
+    def counting(path, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
+        reads.append(Path(path) == catalog.path("baseline"))
+        return read(path, *args, **kwargs)
+
+    monkeypatch.setattr(yamlio, "load_mapping", counting)
+    assert len(sweep.points) == 3 and is_table_7_1(sweep)
+    assert reads == [True]
+
+
 @pytest.mark.parametrize("make", ["file", "parent-file"])
 def test_bad_report_target_one_line_exit_2_nothing_written(sweeps, tmp_path, capsys, make):
     blocker = tmp_path / "blocker"

@@ -7,6 +7,7 @@ small deterministic stand-ins that draw from the stream they are given.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -58,6 +59,7 @@ BAD = [
     ({"seed": -3}, "seed", "at least 0"),
     ({"set": {"run.part": 10}}, "run.part", "unknown key"),
     ({"base": "nowhere.yaml"}, "base", "no such scenario file"),
+    ({"base": " "}, "base", "name the base scenario"),
     ({"replications": {"precision": 0, "measure": "parts_missed", "max": 50}},
      "replications.precision", "above 0"),
     ({"replications": {"precision": 0.01, "measure": "parts_mised", "max": 50}},
@@ -106,6 +108,27 @@ def test_base_by_a_built_in_name(sweeps, tmp_path):
                                             "distribution: gamma}\n")
     sweep = load_sweep(sweeps.write(tmp_path, base="baseline.yaml", policies=["adaptive"]))
     assert sweep.points[0].scenario.arrivals.mean_s == 30
+
+
+@pytest.mark.parametrize("name", ["baseline", "baseline.yaml", "./non_adaptive", "mine", "mine.yaml",
+                                  "nowhere.yaml"])
+def test_base_is_found_as_cell_run_finds_its_scenario(sweeps, tmp_path, monkeypatch, name):
+    """The sweep file's folder is to ``base`` what the working folder is to cell run's
+    SCENARIO (:func:`cell.catalog.resolve`): what is there by that name wins, a folder too
+    (refused: not a scenario file), else a built-in one by name."""
+    (tmp_path / "mine.yaml").write_text("name: mine\n")
+    (tmp_path / "baseline").mkdir()
+
+    def found(load) -> str:  # noqa: ANN001
+        try:
+            return str(Path(load()).resolve())
+        except ScenarioError as exc:
+            return next(w for w in ("no such scenario file", "is a directory") if w in str(exc))
+
+    path = sweeps.write(tmp_path, base=name)
+    swept = found(lambda: load_sweep(path).base.source)
+    monkeypatch.chdir(tmp_path)
+    assert swept == found(lambda: load_scenario(name).source)
 
 
 def test_a_file_the_sweep_names_is_found_from_the_sweep_s_folder(sweeps, tmp_path):
@@ -262,6 +285,28 @@ def test_cli_writes_replications_and_report(sweeps, tmp_path, monkeypatch, capsy
     assert (tmp_path / "o" / "replications.csv").is_file()
     assert (tmp_path / "rep" / "table_7_1.csv").is_file()
     assert (tmp_path / "rep" / "table_7_1.md").is_file()
+
+
+def test_a_sweep_and_a_run_say_overload_in_the_same_words(sweeps, tmp_path):
+    """The sweep's line and cell run's line differ only in what opens them and in the run's
+    own times, which the run's gives."""
+    from cell.assembly import assemble
+    from cell.reporting.runs import warnings
+    from cell.sweep.spec import overload_warning
+
+    arrivals = {"distribution": "gamma", "mean_s": 15.0, "cv": 0.3}
+    sweep = load_sweep(sweeps.write(tmp_path, policies=["adaptive"],
+                                    set={"run.parts": 20, "arrivals": arrivals,
+                                         "controller.nominal_cycle_s": None}))
+    ran = warnings(assemble(sweep.points[0].scenario).k)[0]
+    swept = overload_warning(sweep)
+    assert ran.startswith("utilisation 1.206: ") and swept.startswith("1 of 1 points have ")
+    assert ran.endswith("fastest cycle (18.08 s) is not shorter than the mean inter-arrival "
+                        "time (15.00 s); the cell cannot keep up on average and every policy "
+                        "will lose parts")
+    assert swept.endswith("fastest cycle is not shorter than the mean inter-arrival time "
+                          "there; the cell cannot keep up on average and every policy will "
+                          "lose parts")
 
 
 def test_cli_warns_of_points_that_cannot_keep_up(sweeps, tmp_path, capsys):

@@ -44,6 +44,40 @@ def test_a_report_folder_that_holds_the_sweeps_results_is_planned_before_running
     assert (folder / "report.md").is_file() and (work / "o" / "replications.csv").is_file()
 
 
+@pytest.mark.parametrize("reaches", ["real", "real/o"])
+def test_a_report_folder_reached_through_a_symlink_is_planned_like_the_plain_one(
+        sweeps, tmp_path, monkeypatch, capsys, reaches):
+    """--report LINK where LINK leads to --out or to its parent: the same folder as the plain
+    case, so the report goes to LINK/NAME/, decided before the run, not refused after it."""
+    monkeypatch.setattr("cell.sweep.simulate_summary", sweeps.bookkeeping)
+    (tmp_path / "real").mkdir()  # empty: the sweep makes --out (a LINK to it dangles till then)
+    link = tmp_path / "link"
+    link.symlink_to(tmp_path / reaches, target_is_directory=True)
+    path = sweeps.write(tmp_path, policies=["adaptive"], grid={"run.warmup_parts": [0, 1]})
+    code = main(["sweep", str(path), "--out", str(tmp_path / "real" / "o"), "--workers", "1",
+                 "--report", str(link)])
+    assert code == 0, capsys.readouterr().err
+    assert (tmp_path / reaches / "sweep" / "report.md").is_file()
+    assert (tmp_path / "real" / "o" / "replications.csv").is_file()
+
+
+def test_a_report_subfolder_reached_through_a_symlink_that_is_the_results_is_refused(
+        sweeps, tmp_path, monkeypatch, capsys):
+    """--report LINK, LINK leading to --out's parent and --out being LINK/NAME: refused in one
+    line before anything runs, as without the link."""
+    monkeypatch.setattr("cell.sweep.simulate_summary", sweeps.Interrupt(0))
+    (tmp_path / "real").mkdir()
+    link = tmp_path / "link"
+    link.symlink_to(tmp_path / "real", target_is_directory=True)
+    path = sweeps.write(tmp_path, policies=["adaptive"], grid={"run.warmup_parts": [0, 1]})
+    out = tmp_path / "real" / "sweep"
+    code = main(["sweep", str(path), "--out", str(out), "--workers", "1", "--report", str(link)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1, err
+    assert f"--report {link}:" in err and f"--out {out}" in err
+    assert not (out / "replications.csv").exists()
+
+
 def test_a_shared_report_folder_keeps_the_letters_of_a_non_english_name(sweeps, tmp_path,
                                                                        monkeypatch, capsys):
     """The subfolder is the sweep's name with only separators replaced: 'Étude / ligne 3'

@@ -73,8 +73,9 @@ def check_cycles(s: Scenario, cycles: tuple[float, ...] = TABLE_7_1_CYCLES) -> N
     if missed is None:
         return
     thesis = {"controller.nominal_cycle_s": cycles[0]}
-    fix = (f" (its nominal cycle is {nominal_cycle(s):.4f} s: --set controller.nominal_cycle_s="
-           f"{cycles[0]:g} draws them)" if nominal_cycle(s) != cycles[0]
+    nominal = nominal_cycle(s)
+    fix = (f" (its nominal cycle is {nominal:.4f} s: --set controller.nominal_cycle_s="
+           f"{cycles[0]:g} draws them)" if nominal != cycles[0]
            and _shortest_missed(s.with_overrides(thesis), cycles) is None else "")
     raise ScenarioError(s.source, "(figures)", f"{missed[0]:g} s",
                         f"Fig. 22-30 run the non-adaptive robot at Table 7.1's cycles "

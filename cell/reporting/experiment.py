@@ -90,10 +90,11 @@ def plan_report(sweep: Sweep, target: str | os.PathLike[str], option: str = "--r
 
 
 def _holds(path: Path, results: str | os.PathLike[str] | None) -> bool:
-    """Whether the folder ``path`` is, or holds, the folder ``results``."""
+    """Whether the folder ``path`` is, or holds, the folder ``results``, either reached
+    through symbolic links: compared where they lead."""
     if results is None:
         return False
-    mine, theirs = Path(os.path.abspath(path)), Path(os.path.abspath(results))
+    mine, theirs = Path(path).resolve(), Path(results).resolve()
     return mine == theirs or mine in theirs.parents
 
 

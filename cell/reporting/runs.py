@@ -58,10 +58,10 @@ def warnings(k: CellConstants) -> list[str]:
     arrivals' mean."""
     out = []
     if k.utilisation >= 1:
-        out.append(f"utilisation {k.utilisation:.3f}: the robot's fastest cycle "
-                   f"({k.fastest_cycle_s:.2f} s) is not shorter than the mean inter-arrival time "
-                   f"({k.mean_interarrival_s:.2f} s); the cell cannot keep up on average and "
-                   "every policy will lose parts")
+        from cell.sweep.spec import overloaded
+
+        out.append(overloaded(f"utilisation {k.utilisation:.3f}",
+                              (k.fastest_cycle_s, k.mean_interarrival_s)))
     gap = k.cycle_nom / k.mean_interarrival_s - 1
     if k.nominal_from == "scenario" and abs(gap) > NOMINAL_MISMATCH:
         out.append(f"controller.nominal_cycle_s ({k.cycle_nom:.4f} s) is {gap:+.1%} off the "
@@ -93,16 +93,19 @@ def thesis_figures(s: Scenario) -> dict[str, str] | None:
     return {field: fmt.format(values[field]) for field, (_, fmt) in TABLE_7_1_SHOWN.items()}
 
 
-def is_thesis_cell(s: Scenario, *, any_timing: bool = False) -> bool:
+def is_thesis_cell(s: Scenario, *, any_timing: bool = False,
+                   baseline: Scenario | None = None) -> bool:
     """Whether ``s`` is the thesis's own run but for its policy, robot cycle and seed (and,
     with ``any_timing``, its robot timing): the built-in baseline's cell, eq. 6.9 arrivals,
-    500 parts; names, descriptions and the planner's settings aside."""
+    500 parts; names, descriptions and the planner's settings aside.  ``baseline``: the
+    built-in baseline, if the caller has it already (it is read otherwise)."""
     c = s.controller
     same = {"controller.policy": c.policy, "controller.ideal_cycle_s": c.ideal_cycle_s,
             "run.seed": s.run.seed}
     if any_timing:
         same["robot.timing"] = s.robot.timing
-    return _comparable(s) == _comparable(load_scenario("baseline").with_overrides(same))
+    thesis = baseline if baseline is not None else load_scenario("baseline")
+    return _comparable(s) == _comparable(thesis.with_overrides(same))
 
 
 def _comparable(s: Scenario) -> dict[str, Any]:

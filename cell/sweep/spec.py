@@ -225,15 +225,12 @@ def load_sweep(path: str | Path) -> Sweep:
         if key not in SWEEP_KEYS:
             raise ScenarioError(path, str(key), raw[key],
                                 "unknown key (known: " + ", ".join(SWEEP_KEYS) + ")")
-    if "base" not in raw or not isinstance(raw["base"], str):
+    if not isinstance(raw.get("base"), str) or not raw["base"].strip():
         raise ScenarioError(path, "base", raw.get("base"),
                             "name the base scenario: a file (relative to the sweep file) or "
                             "a built-in one (`cell scenarios`)")
-    base_path = path.parent / raw["base"]
-    if not base_path.is_file() and catalog.path(raw["base"]).is_file() \
-            and Path(raw["base"]).name == raw["base"]:
-        base_path = catalog.path(raw["base"])  # a built-in scenario by name: baseline
-    if not base_path.is_file():
+    base_path = catalog.resolve(raw["base"], beside=path.parent)  # or a built-in by name
+    if not base_path.exists():
         raise ScenarioError(path, "base", raw["base"],
                             f"no such scenario file ({base_path}) nor built-in scenario "
                             "(`cell scenarios` lists them)")
@@ -321,9 +318,20 @@ def overload_warning(sweep: Sweep) -> str | None:
         return None
     worst = max(over, key=lambda p: p.utilisation)
     where = ", ".join(f"{k} {show(v)}" for k, v in worst.values) or worst.policy
-    return (f"{len(over)} of {len(sweep.points)} points have utilisation 1 or more (up to "
-            f"{worst.utilisation:.3f}, at {where}): the robot's fastest cycle is not shorter "
-            "than the mean inter-arrival time there, and every policy will lose parts")
+    return overloaded(f"{len(over)} of {len(sweep.points)} points have utilisation 1 or more "
+                      f"(up to {worst.utilisation:.3f}, at {where})")
+
+
+def overloaded(how_much: str, times_s: tuple[float, float] | None = None) -> str:
+    """The one line saying a cell cannot keep up on average (utilisation 1 or more), opened
+    by ``how_much``: for a sweep's points (:func:`overload_warning`) and for a run
+    (:func:`cell.reporting.runs.warnings`, with its fastest cycle and mean inter-arrival
+    time, s)."""
+    fastest, mean = (f" ({times_s[0]:.2f} s)", f" ({times_s[1]:.2f} s)") if times_s else \
+        ("", " there")
+    return (f"{how_much}: the robot's fastest cycle{fastest} is not shorter than the mean "
+            f"inter-arrival time{mean}; the cell cannot keep up on average and every policy "
+            "will lose parts")
 
 
 def _check_point(scenario: Scenario, file: object) -> float:
