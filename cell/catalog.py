@@ -7,10 +7,15 @@ scenarios`` lists them with their one-line descriptions.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 #: The folder of the built-in scenario and sweep files.
 BUILT_IN = Path(__file__).resolve().parent / "scenarios"
+
+
+#: What separates folders in a path as a user may type it.
+_SEPARATORS = frozenset({"/", os.sep} | ({os.altsep} if os.altsep else set()))
 
 
 def path(name: str) -> Path:
@@ -22,10 +27,12 @@ def path(name: str) -> Path:
 def resolve(name_or_path: str | Path, beside: Path | None = None) -> Path:
     """A SCENARIO argument as a file: an existing path as given, else a built-in name.
     ``beside``: the folder a relative path is taken from (by default the working
-    directory), as a sweep file's ``base`` is from the sweep file's."""
+    directory), as a sweep file's ``base`` is from the sweep file's.  Only a plain name
+    (no folder in it) may be a built-in one: ``../scenarios/baseline`` that is not there
+    is a missing file, not the built-in baseline."""
     given = Path(name_or_path)
     here = given if beside is None else beside / given
-    if here.exists() or given.suffix and given.parent != Path("."):
+    if here.exists() or any(sep in str(name_or_path) for sep in _SEPARATORS):
         return here
     built_in = path(str(name_or_path))
     return built_in if built_in.is_file() else here

@@ -181,6 +181,21 @@ def test_a_built_in_file_is_named_in_reports_as_a_user_would_type_it(tmp_path):
     assert catalog.shown(own) == str(own)
 
 
+def test_only_a_plain_name_falls_back_to_a_built_in_scenario(tmp_path, monkeypatch, capsys):
+    """``baseline`` is the built-in scenario from any folder; a path with a folder in it
+    that is not there is a missing file, named as typed, not the built-in of that name."""
+    from cell import catalog
+
+    monkeypatch.chdir(tmp_path)
+    assert catalog.resolve("baseline") == catalog.path("baseline")
+    for typed in ("../scenarios/baseline", "./baseline", "sub/baseline.yaml"):
+        assert catalog.resolve(typed) == Path(typed)
+        assert main(["run", typed, "--out", "o"]) == 2
+        shown = Path(typed)  # as pathlib writes it: ./baseline is baseline
+        assert f"{shown}: (file) = '{shown}': no such scenario file" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
 def test_cell_run_says_when_a_short_trace_is_replayed(tmp_path, capsys):
     """A trace shorter than the run's T_1 .. T_{n+1} is replayed from its start, and
     ``cell run`` says so, by how many times; a long enough trace is not mentioned."""
