@@ -349,8 +349,11 @@ def _check_point(scenario: Scenario, file: object) -> float:
 def comparison(a: Scenario, b: Scenario, labels: tuple[str, str], replications: int, seed: int,
                batch: int = 20) -> Sweep:
     """Two scenarios as a sweep of two points, varying the pseudo-key ``scenario`` (their
-    labels): ``a`` against ``b`` (the baseline), with common random numbers."""
-    la, lb = labels if labels[0] != labels[1] else (f"A: {labels[0]}", f"B: {labels[1]}")
+    labels, which must differ: :func:`cell.commands.compare.labels`): ``a`` against ``b``
+    (the baseline), with common random numbers."""
+    la, lb = labels
+    if la == lb:
+        raise ValueError(f"the two sides of a comparison need different labels, not {la!r} twice")
     pa = Point(a.controller.policy, 0, (("scenario", la),), a, (), _check_point(a, a.source))
     pb = Point(b.controller.policy, int(b.controller.policy == a.controller.policy),
                (("scenario", lb),), b, (), _check_point(b, b.source))
