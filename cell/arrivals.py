@@ -15,7 +15,7 @@ from __future__ import annotations
 import csv
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -325,12 +325,9 @@ def _parse_trace(path: Path) -> Any:
     if not rows:
         return "not a readable CSV: No columns to parse from file"
     header, data = rows[0], rows[1:]
-    names = [name.strip() for name in header]  # a spreadsheet's ' interarrival_s' is the column
-    if "interarrival_s" not in names:
-        hint = semicolon_hint(",".join(header), "interarrival_s")
-        found = ", ".join(repr(name) for name in names[:5]) + (", ..." if len(names) > 5 else "")
-        return "needs a column named interarrival_s" + (hint or f" (found {found})")
-    column = names.index("interarrival_s")
+    column = find_column(header, "interarrival_s")
+    if isinstance(column, str):
+        return column
     ragged = next((i for i, row in enumerate(data) if len(row) > len(header)), None)
     if ragged is not None:
         return (f"not a readable CSV: row {ragged + 1} has {len(data[ragged])} fields, "
@@ -347,13 +344,21 @@ def _parse_trace(path: Path) -> Any:
     return times
 
 
-def semicolon_hint(header: str, column: str) -> str:
-    """Why ``column`` is not found in a CSV ``header`` line whose columns are separated by ';'
-    (as spreadsheets save CSV in locales with a decimal comma), else ''."""
-    if column in header.split(",") or column not in (c.strip().strip('"') for c in header.split(";")):
-        return ""
-    return ("; the columns are separated by ';': save the CSV with a comma between columns "
-            "and a decimal point in numbers")
+def find_column(header: Sequence[str], column: str) -> int | str:
+    """Where ``column`` is among a CSV's ``header`` fields (spaces around a name ignored, as
+    spreadsheets leave them), or why it cannot be read there: there is no such column (the
+    names found are listed, and a header whose columns are separated by ';', as spreadsheets
+    save CSV in locales with a decimal comma, is said to be), or two columns have the name."""
+    names = [name.strip() for name in header]
+    if names.count(column) > 1:
+        return f"two columns are named {column}: keep one"
+    if column in names:
+        return names.index(column)
+    if any(";" in name for name in names):
+        return (f"needs a column named {column}; the columns are separated by ';': save the CSV "
+                "with a comma between columns and a decimal point in numbers")
+    found = ", ".join(repr(name) for name in names[:5]) + (", ..." if len(names) > 5 else "")
+    return f"needs a column named {column} (found {found})"
 
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\Z", re.ASCII)

@@ -140,13 +140,17 @@ def test_help_describes_the_command_in_whole_sentences():
 
 def test_a_header_name_with_spaces_around_it_is_the_column(tmp_path):
     """As a run's trace reader takes it: ' interarrival_s' (a space after the comma) is the
-    column; two columns of that name are refused rather than one chosen."""
+    column; two columns of that name are refused rather than one chosen, by both readers (pandas
+    would have read a second 'interarrival_s' as 'interarrival_s.1' and fitted the first)."""
     from cell.analysis.fit import read_column
 
     gaps = [20.0 + 0.5 * (i * 7 % 11) for i in range(30)]  # not sorted: gaps, not times
     path = tmp_path / "log.csv"
     path.write_text("part, interarrival_s \n" + "".join(f"{i},{g}\n" for i, g in enumerate(gaps)))
     assert read_column(path).tolist() == gaps
-    path.write_text("interarrival_s, interarrival_s\n" + "".join(f"{g},{g}\n" for g in gaps))
-    with pytest.raises(ScenarioError, match="two columns have this name"):
-        read_column(path)
+    for header in ("interarrival_s, interarrival_s", "interarrival_s,interarrival_s"):
+        path.write_text(f"{header}\n" + "".join(f"{g},{g + 1}\n" for g in gaps))
+        with pytest.raises(ScenarioError, match="two columns are named interarrival_s"):
+            read_column(path)
+        with pytest.raises(ScenarioError, match="two columns are named interarrival_s"):
+            read_trace(path)

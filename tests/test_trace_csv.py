@@ -47,6 +47,9 @@ def test_other_columns_quotes_spaces_blank_lines_bom_and_crlf(tmp_path: Path) ->
     ("interarrival_s\n2e6\n", "row 1 has inter-arrival time '2e6'"),
     ("a,interarrival_s\nx,20\ny\n", "row 2 has inter-arrival time ''"),
     ("interarrival_s\n20\n21,22\n", "not a readable CSV: row 2 has 2 fields, the header 1"),
+    ("interarrival_s,interarrival_s\n20,30\n", "two columns are named interarrival_s: keep one"),
+    ("interarrival_s, interarrival_s \n20,30\n", "two columns are named interarrival_s: keep one"),
+    ("part;interarrival_s\n1;20,5\n", "the columns are separated by ';'"),
 ])
 def test_unusable_traces_are_one_line_naming_file_and_key(tmp_path: Path, text: str, words: str) -> None:
     path = _trace(tmp_path, text)

@@ -10,6 +10,7 @@ column holds arrival times, and the gaps between them are fitted.
 
 from __future__ import annotations
 
+import csv
 import io
 import math
 import re
@@ -23,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, stats
 
-from cell.arrivals import MAX_INTERARRIVAL_S, semicolon_hint
+from cell.arrivals import MAX_INTERARRIVAL_S, find_column
 from cell.errors import ScenarioError
 
 DEFAULT_FAMILIES: tuple[str, ...] = ("weibull_min", "gamma", "lognorm", "expon", "norm")
@@ -388,9 +389,9 @@ def _read_cells(p: Path, column: str) -> Any:
                             f"not UTF-8 text (byte {exc.start}); save the CSV as UTF-8") from None
     if not text.strip():
         raise ScenarioError(p, "(file)", str(p), "empty file")
-    hint = semicolon_hint(text.lstrip().splitlines()[0], column)
-    if hint:
-        raise ScenarioError(p, "(file)", str(p), f"no column {column}{hint}")
+    index = find_column(next(csv.reader([text.lstrip().splitlines()[0]], skipinitialspace=True)), column)
+    if isinstance(index, str):  # before pandas, which renames a second X to X.1 and miscounts ';' rows
+        raise ScenarioError(p, "--column", column, index)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", pd.errors.ParserWarning)
@@ -398,12 +399,5 @@ def _read_cells(p: Path, column: str) -> Any:
     except (ValueError, pd.errors.ParserWarning) as exc:  # pandas' parser errors are ValueErrors
         why = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise ScenarioError(p, "(file)", str(p), f"not a readable CSV: {why}") from None
-    frame.columns = [str(c).strip() for c in frame.columns]  # ' interarrival_s' is the column
-    if list(frame.columns).count(column) > 1:
-        raise ScenarioError(p, "--column", column, "two columns have this name; keep one")
-    if column not in frame.columns:
-        names = ", ".join(map(str, frame.columns))
-        hint = " (is it separated by ';'? use commas)" if any(";" in str(c) for c in frame.columns) else ""
-        raise ScenarioError(p, "--column", column, f"no such column; the columns are: {names}{hint}")
     blank = frame.apply(lambda c: c.str.strip() == "").all(axis=1)  # a spreadsheet's empty rows: ',,'
-    return frame.loc[~blank, column].reset_index(drop=True)
+    return frame.loc[~blank].iloc[:, index].reset_index(drop=True)
