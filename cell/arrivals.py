@@ -296,7 +296,9 @@ def check_arrivals(arrivals: ArrivalSpec, base_dir: Path, file: object) -> None:
 
 
 def read_trace(path: Path, file: object = None) -> NDArray[np.float64]:
-    """Inter-arrival times from a CSV trace: one column ``interarrival_s``, all > 0.
+    """Inter-arrival times from a CSV trace: one column ``interarrival_s``, all ≥ 0 (a line's
+    log stamped to the second has 0 between parts that came in the same second; the feeder
+    holds such a part until the belt has carried the last one clear), their mean > 0.
 
     Parsed once per version of the file (path, size, modification time), so a
     sweep's replications do not read it again.  The array is read-only.
@@ -334,12 +336,14 @@ def _parse_trace(path: Path) -> Any:
                 f"the header {len(header)}")
     text = [row[column].strip() if column < len(row) else "" for row in data]
     times = np.array([_seconds(t) for t in text], dtype=float)
-    bad = np.flatnonzero(~np.isfinite(times) | (times <= 0) | (times > MAX_INTERARRIVAL_S))
+    bad = np.flatnonzero(~np.isfinite(times) | (times < 0) | (times > MAX_INTERARRIVAL_S))
     if bad.size:
         return (f"row {bad[0] + 1} has inter-arrival time {text[bad[0]][:40]!r}; times "
-                f"must be positive numbers of seconds, at most {MAX_INTERARRIVAL_S:g}")
+                f"must be 0 or positive numbers of seconds, at most {MAX_INTERARRIVAL_S:g}")
     if times.size == 0:
         return "has no inter-arrival times"
+    if not times.any():
+        return f"all {times.size} inter-arrival times are 0; their mean must be positive"
     times.setflags(write=False)
     return times
 
