@@ -154,3 +154,28 @@ def test_a_header_name_with_spaces_around_it_is_the_column(tmp_path):
             read_column(path)
         with pytest.raises(ScenarioError, match="two columns are named interarrival_s"):
             read_trace(path)
+
+
+@pytest.mark.parametrize("times", [False, True], ids=["gaps", "arrival times"])
+def test_zero_gaps_are_refused_with_their_count(tmp_path: Path, times: bool):
+    """A log stamped to the second has zero gaps, which a run replays but no continuous family
+    fits (Weibull, gamma and lognorm have no likelihood there; dropping them would lengthen
+    the mean): ``cell fit`` refuses them in one line, counting them and naming the first."""
+    stamps = np.floor(np.cumsum(np.concatenate([gaps(60), [0.4, 0.3, 0.2]])))
+    stamps = np.sort(np.concatenate([stamps, stamps[[10, 40]]]))  # two more parts in a second
+    step = np.diff(stamps, prepend=0.0)
+    zeros = int((step == 0).sum())
+    assert zeros >= 3
+    column = stamps if times else step
+    path = write(tmp_path / "log.csv", "interarrival_s\n" + "".join(f"{v:.0f}\n" for v in column))
+    out = tmp_path / "a.yaml"
+    with pytest.raises(ScenarioError) as err:
+        cmd_fit(parse(str(path), "--out", str(out), *(["--times"] if times else [])))
+    first = int(np.flatnonzero(step == 0)[0])
+    assert err.value.key == f"interarrival_s[row {first + 1}]"
+    assert f"{zeros} of {column.size - times} gaps are 0" in err.value.why
+    assert ("the same time as row" in err.value.why) == times
+    assert "more finely" in err.value.why and "arrivals.trace_csv" in err.value.why
+    assert "\n" not in str(err.value) and not out.exists()
+    if not times:
+        assert read_trace(path).tolist() == column.tolist()  # a run replays them as they are
