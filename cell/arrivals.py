@@ -15,7 +15,7 @@ from __future__ import annotations
 import csv
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -296,7 +296,9 @@ def check_arrivals(arrivals: ArrivalSpec, base_dir: Path, file: object) -> None:
 
 
 def read_trace(path: Path, file: object = None) -> NDArray[np.float64]:
-    """Inter-arrival times from a CSV trace: one column ``interarrival_s``, all > 0.
+    """Inter-arrival times from a CSV trace: one column ``interarrival_s``, all ≥ 0 (a line's
+    log stamped to the second has 0 between parts that came in the same second; the feeder
+    holds such a part until the belt has carried the last one clear), their mean > 0.
 
     Parsed once per version of the file (path, size, modification time), so a
     sweep's replications do not read it again.  The array is read-only.
@@ -325,35 +327,42 @@ def _parse_trace(path: Path) -> Any:
     if not rows:
         return "not a readable CSV: No columns to parse from file"
     header, data = rows[0], rows[1:]
-    names = [name.strip() for name in header]  # a spreadsheet's ' interarrival_s' is the column
-    if "interarrival_s" not in names:
-        hint = semicolon_hint(",".join(header), "interarrival_s")
-        found = ", ".join(repr(name) for name in names[:5]) + (", ..." if len(names) > 5 else "")
-        return "needs a column named interarrival_s" + (hint or f" (found {found})")
-    column = names.index("interarrival_s")
+    column = find_column(header, "interarrival_s")
+    if isinstance(column, str):
+        return column
     ragged = next((i for i, row in enumerate(data) if len(row) > len(header)), None)
     if ragged is not None:
         return (f"not a readable CSV: row {ragged + 1} has {len(data[ragged])} fields, "
                 f"the header {len(header)}")
     text = [row[column].strip() if column < len(row) else "" for row in data]
     times = np.array([_seconds(t) for t in text], dtype=float)
-    bad = np.flatnonzero(~np.isfinite(times) | (times <= 0) | (times > MAX_INTERARRIVAL_S))
+    bad = np.flatnonzero(~np.isfinite(times) | (times < 0) | (times > MAX_INTERARRIVAL_S))
     if bad.size:
         return (f"row {bad[0] + 1} has inter-arrival time {text[bad[0]][:40]!r}; times "
-                f"must be positive numbers of seconds, at most {MAX_INTERARRIVAL_S:g}")
+                f"must be 0 or positive numbers of seconds, at most {MAX_INTERARRIVAL_S:g}")
     if times.size == 0:
         return "has no inter-arrival times"
+    if not times.any():
+        return f"all {times.size} inter-arrival times are 0; their mean must be positive"
     times.setflags(write=False)
     return times
 
 
-def semicolon_hint(header: str, column: str) -> str:
-    """Why ``column`` is not found in a CSV ``header`` line whose columns are separated by ';'
-    (as spreadsheets save CSV in locales with a decimal comma), else ''."""
-    if column in header.split(",") or column not in (c.strip().strip('"') for c in header.split(";")):
-        return ""
-    return ("; the columns are separated by ';': save the CSV with a comma between columns "
-            "and a decimal point in numbers")
+def find_column(header: Sequence[str], column: str) -> int | str:
+    """Where ``column`` is among a CSV's ``header`` fields (spaces around a name ignored, as
+    spreadsheets leave them), or why it cannot be read there: there is no such column (the
+    names found are listed, and a header whose columns are separated by ';', as spreadsheets
+    save CSV in locales with a decimal comma, is said to be), or two columns have the name."""
+    names = [name.strip() for name in header]
+    if names.count(column) > 1:
+        return f"two columns are named {column}: keep one"
+    if column in names:
+        return names.index(column)
+    if any(";" in name for name in names):
+        return (f"needs a column named {column}; the columns are separated by ';': save the CSV "
+                "with a comma between columns and a decimal point in numbers")
+    found = ", ".join(repr(name) for name in names[:5]) + (", ..." if len(names) > 5 else "")
+    return f"needs a column named {column} (found {found})"
 
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\Z", re.ASCII)

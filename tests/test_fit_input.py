@@ -140,13 +140,42 @@ def test_help_describes_the_command_in_whole_sentences():
 
 def test_a_header_name_with_spaces_around_it_is_the_column(tmp_path):
     """As a run's trace reader takes it: ' interarrival_s' (a space after the comma) is the
-    column; two columns of that name are refused rather than one chosen."""
+    column; two columns of that name are refused rather than one chosen, by both readers (pandas
+    would have read a second 'interarrival_s' as 'interarrival_s.1' and fitted the first)."""
     from cell.analysis.fit import read_column
 
     gaps = [20.0 + 0.5 * (i * 7 % 11) for i in range(30)]  # not sorted: gaps, not times
     path = tmp_path / "log.csv"
     path.write_text("part, interarrival_s \n" + "".join(f"{i},{g}\n" for i, g in enumerate(gaps)))
     assert read_column(path).tolist() == gaps
-    path.write_text("interarrival_s, interarrival_s\n" + "".join(f"{g},{g}\n" for g in gaps))
-    with pytest.raises(ScenarioError, match="two columns have this name"):
-        read_column(path)
+    for header in ("interarrival_s, interarrival_s", "interarrival_s,interarrival_s"):
+        path.write_text(f"{header}\n" + "".join(f"{g},{g + 1}\n" for g in gaps))
+        with pytest.raises(ScenarioError, match="two columns are named interarrival_s"):
+            read_column(path)
+        with pytest.raises(ScenarioError, match="two columns are named interarrival_s"):
+            read_trace(path)
+
+
+@pytest.mark.parametrize("times", [False, True], ids=["gaps", "arrival times"])
+def test_zero_gaps_are_refused_with_their_count(tmp_path: Path, times: bool):
+    """A log stamped to the second has zero gaps, which a run replays but no continuous family
+    fits (Weibull, gamma and lognorm have no likelihood there; dropping them would lengthen
+    the mean): ``cell fit`` refuses them in one line, counting them and naming the first."""
+    stamps = np.floor(np.cumsum(np.concatenate([gaps(60), [0.4, 0.3, 0.2]])))
+    stamps = np.sort(np.concatenate([stamps, stamps[[10, 40]]]))  # two more parts in a second
+    step = np.diff(stamps, prepend=0.0)
+    zeros = int((step == 0).sum())
+    assert zeros >= 3
+    column = stamps if times else step
+    path = write(tmp_path / "log.csv", "interarrival_s\n" + "".join(f"{v:.0f}\n" for v in column))
+    out = tmp_path / "a.yaml"
+    with pytest.raises(ScenarioError) as err:
+        cmd_fit(parse(str(path), "--out", str(out), *(["--times"] if times else [])))
+    first = int(np.flatnonzero(step == 0)[0])
+    assert err.value.key == f"interarrival_s[row {first + 1}]"
+    assert f"{zeros} of {column.size - times} gaps are 0" in err.value.why
+    assert ("the same time as row" in err.value.why) == times
+    assert "more finely" in err.value.why and "arrivals.trace_csv" in err.value.why
+    assert "\n" not in str(err.value) and not out.exists()
+    if not times:
+        assert read_trace(path).tolist() == column.tolist()  # a run replays them as they are

@@ -43,10 +43,14 @@ def test_other_columns_quotes_spaces_blank_lines_bom_and_crlf(tmp_path: Path) ->
     ("interarrival_s\n20\nnan\n", "row 2 has inter-arrival time 'nan'"),
     ("interarrival_s\n20\n\u0661\u0662\n", "row 2 has inter-arrival time '\u0661\u0662'"),
     ("interarrival_s\n20\n\uff12\uff10\n", "row 2 has inter-arrival time '\uff12\uff10'"),
-    ("interarrival_s\n20\n0\n", "row 2 has inter-arrival time '0'"),
+    ("interarrival_s\n20\n-0.5\n", "row 2 has inter-arrival time '-0.5'; times must be 0 or positive"),
+    ("interarrival_s\n0\n0.0\n0e3\n", "all 3 inter-arrival times are 0; their mean must be positive"),
     ("interarrival_s\n2e6\n", "row 1 has inter-arrival time '2e6'"),
     ("a,interarrival_s\nx,20\ny\n", "row 2 has inter-arrival time ''"),
     ("interarrival_s\n20\n21,22\n", "not a readable CSV: row 2 has 2 fields, the header 1"),
+    ("interarrival_s,interarrival_s\n20,30\n", "two columns are named interarrival_s: keep one"),
+    ("interarrival_s, interarrival_s \n20,30\n", "two columns are named interarrival_s: keep one"),
+    ("part;interarrival_s\n1;20,5\n", "the columns are separated by ';'"),
 ])
 def test_unusable_traces_are_one_line_naming_file_and_key(tmp_path: Path, text: str, words: str) -> None:
     path = _trace(tmp_path, text)
@@ -55,6 +59,12 @@ def test_unusable_traces_are_one_line_naming_file_and_key(tmp_path: Path, text: 
     message = str(info.value)
     assert message.startswith(f"{path}: arrivals.trace_csv = ") and words in message, message
     assert "\n" not in message
+
+
+def test_zero_gaps_are_parts_stamped_in_the_same_second(tmp_path: Path) -> None:
+    """A line's log stamped to the second has 0 between two parts of the same second."""
+    assert read_trace(_trace(tmp_path, "interarrival_s\n0\n21\n0.0\n-0\n19\n")).tolist() == \
+        [0.0, 21.0, 0.0, 0.0, 19.0]
 
 
 def test_a_header_name_with_spaces_around_it_is_the_column(tmp_path: Path) -> None:

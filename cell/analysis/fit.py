@@ -10,6 +10,7 @@ column holds arrival times, and the gaps between them are fitted.
 
 from __future__ import annotations
 
+import csv
 import io
 import math
 import re
@@ -23,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, stats
 
-from cell.arrivals import MAX_INTERARRIVAL_S, semicolon_hint
+from cell.arrivals import MAX_INTERARRIVAL_S, find_column
 from cell.errors import ScenarioError
 
 DEFAULT_FAMILIES: tuple[str, ...] = ("weibull_min", "gamma", "lognorm", "expon", "norm")
@@ -297,7 +298,8 @@ def draw(values: ArrayLike, fits: Sequence[Fit], out_png: str | Path, *, best: F
 # --------------------------------------------------------------------------- command line
 def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool = False,
                 sorted_ok: bool = False) -> NDArray[np.float64]:
-    """The inter-arrival gaps in a CSV column: at least :data:`MIN_VALUES`, finite, > 0, not all equal.
+    """The inter-arrival gaps in a CSV column: at least :data:`MIN_VALUES`, finite, > 0, not all equal
+    (zero gaps, from a log stamped to the second, are refused, counted: see ``cell fit --help``).
 
     With ``times`` the column holds arrival times (finite, strictly increasing), as
     numbers of seconds or as ISO 8601 date-times, and their differences (s) are
@@ -328,7 +330,7 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
         raise ScenarioError(p, column, seen,
                             "the column never decreases, so it looks like arrival times, not gaps: "
                             "use --times to fit their differences (or --gaps if these are sorted gaps)")
-    bad = np.flatnonzero(~finite if times else ~finite | ~(values > 0.0) | (values > MAX_INTERARRIVAL_S))
+    bad = np.flatnonzero(~finite if times else ~finite | (values < 0.0) | (values > MAX_INTERARRIVAL_S))
     if bad.size:
         i = int(bad[0])
         raise ScenarioError(p, f"{column}[row {i + 1}]", written.iloc[i],
@@ -337,13 +339,21 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
     if times:
         step = np.diff(values)
         back = np.flatnonzero(~(step > 0.0) | (step > MAX_INTERARRIVAL_S))
-        if back.size:
+        if back.size and step[back[0]] != 0.0:  # a first repeated time is said below
             i = int(back[0]) + 1
             why = (f"arrival times must increase: not after {cells.iloc[i - 1]} in row {i}"
-                   if not step[i - 1] > 0.0 else
+                   if step[i - 1] < 0.0 else
                    f"{step[i - 1]:.10g} s after row {i}; gaps must be at most {MAX_INTERARRIVAL_S:g} s")
             raise ScenarioError(p, f"{column}[row {i + 1}]", written.iloc[i], why)
         values, noun = step, "gaps"
+    zero = np.flatnonzero(values == 0.0)  # Weibull's, gamma's, lognorm's likelihood is 0 or inf there
+    if zero.size:
+        i = int(zero[0]) + times
+        same = f"the same time as row {i}: " if times else ""
+        raise ScenarioError(p, f"{column}[row {i + 1}]", written.iloc[i],
+                            f"{same}{zero.size} of {values.size} gaps are 0 (logged in the same second?): no "
+                            "continuous distribution fits them; log the times more finely, or replay the "
+                            "gaps as a trace (arrivals.trace_csv takes zeros)")
     if values.size < MIN_VALUES:
         shown = f"{cells.size} arrival times" if times else f"{values.size} values"
         need = f"{MIN_VALUES + 1} arrival times" if times else f"{MIN_VALUES} values"
@@ -388,9 +398,9 @@ def _read_cells(p: Path, column: str) -> Any:
                             f"not UTF-8 text (byte {exc.start}); save the CSV as UTF-8") from None
     if not text.strip():
         raise ScenarioError(p, "(file)", str(p), "empty file")
-    hint = semicolon_hint(text.lstrip().splitlines()[0], column)
-    if hint:
-        raise ScenarioError(p, "(file)", str(p), f"no column {column}{hint}")
+    index = find_column(next(csv.reader([text.lstrip().splitlines()[0]], skipinitialspace=True)), column)
+    if isinstance(index, str):  # before pandas, which renames a second X to X.1 and miscounts ';' rows
+        raise ScenarioError(p, "--column", column, index)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", pd.errors.ParserWarning)
@@ -398,12 +408,5 @@ def _read_cells(p: Path, column: str) -> Any:
     except (ValueError, pd.errors.ParserWarning) as exc:  # pandas' parser errors are ValueErrors
         why = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise ScenarioError(p, "(file)", str(p), f"not a readable CSV: {why}") from None
-    frame.columns = [str(c).strip() for c in frame.columns]  # ' interarrival_s' is the column
-    if list(frame.columns).count(column) > 1:
-        raise ScenarioError(p, "--column", column, "two columns have this name; keep one")
-    if column not in frame.columns:
-        names = ", ".join(map(str, frame.columns))
-        hint = " (is it separated by ';'? use commas)" if any(";" in str(c) for c in frame.columns) else ""
-        raise ScenarioError(p, "--column", column, f"no such column; the columns are: {names}{hint}")
     blank = frame.apply(lambda c: c.str.strip() == "").all(axis=1)  # a spreadsheet's empty rows: ',,'
-    return frame.loc[~blank, column].reset_index(drop=True)
+    return frame.loc[~blank].iloc[:, index].reset_index(drop=True)

@@ -18,7 +18,10 @@ from cell.errors import ScenarioError
 HELP = "fit a distribution to observed inter-arrival times; write the arrivals block"
 DESCRIPTION = ("Fit scipy.stats distributions to observed inter-arrival times by maximum likelihood, "
                "rank them, and write the arrivals: block of the best one that never gives a negative "
-               "time, with a histogram of the data under the fitted densities.")
+               "time, with a histogram of the data under the fitted densities. Zero gaps (two parts "
+               "logged in the same second) are refused, counted: no continuous distribution fits them, "
+               "and leaving them out would lengthen the mean; log the times more finely, or replay the "
+               "gaps as a trace (arrivals.trace_csv takes zeros).")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

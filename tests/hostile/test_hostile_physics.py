@@ -54,7 +54,7 @@ REFUSE = [
     ("bogus distribution beside a trace", ["arrivals.distribution=bogus", "arrivals.trace_csv={trace:22}"],
      ("arrivals.distribution",)),
     ("trace value True", ["arrivals.trace_csv={trace:True}"], ("arrivals.trace_csv", "True")),
-    ("trace value 0", ["arrivals.trace_csv={trace:0}"], ("arrivals.trace_csv",)),
+    ("trace value -0.5", ["arrivals.trace_csv={trace:-0.5}"], ("arrivals.trace_csv", "row 2")),
     ("trace value nan", ["arrivals.trace_csv={trace:nan}"], ("arrivals.trace_csv",)),
     ("trace value -inf", ["arrivals.trace_csv={trace:-inf}"], ("arrivals.trace_csv",)),
     ("trace missing", ["arrivals.trace_csv=nowhere.csv"], ("arrivals.trace_csv", "no such file")),
@@ -124,6 +124,15 @@ def test_a_trace_is_used_whatever_the_distribution_says(tmp_path: Path) -> None:
     out = tmp_path / "out"
     ran_sanely(cli("run", "baseline", "--set", "run.parts=4", "--set", f"arrivals.trace_csv={trace}",
                    "--set", "arrivals.distribution=norm", "--out", out), out, 4)
+
+
+def test_a_trace_with_zero_gaps_runs(tmp_path: Path) -> None:
+    """Two parts logged in the same second: the second is held at the feeder, not refused."""
+    trace = _trace(tmp_path, ["0", "22.5", "0", "23.5", "0"])
+    out = tmp_path / "out"
+    summary = ran_sanely(cli("run", "baseline", "--set", "run.parts=6", "--set",
+                             f"arrivals.trace_csv={trace}", "--out", out), out, 6)
+    assert summary.parts_held >= 2
 
 
 # --- sweeps ------------------------------------------------------------------------------------
