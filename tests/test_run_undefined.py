@@ -9,8 +9,8 @@ import re
 from pathlib import Path
 
 from cell.cli import main
-from cell.commands.run import Undefined, printable
 from cell.records import RunSummary
+from cell.reporting.runs import UNDEFINED, format_summary, shown_figure
 
 NO_CYCLE = ("actual_cycle_wallclock_s", "parts_per_hr_wallclock", "ip_wallclock")
 
@@ -37,11 +37,11 @@ def test_a_run_of_one_delivery_prints_its_undefined_figures_as_dashes(tmp_path: 
     assert row["parts_delivered"] == "1" and float(row["actual_cycle_thesis_s"]) > 0
 
 
-def test_printable_replaces_nan_only_and_leaves_the_summary_as_it_was():
+def test_the_summary_table_prints_every_nan_figure_as_a_dash_and_the_rest_as_ever():
     s = RunSummary(policy="adaptive", actual_cycle_thesis_s=18.5, parts_delivered=1)
-    p = printable(s)
-    assert math.isnan(s.actual_cycle_wallclock_s) and type(s.actual_cycle_wallclock_s) is float
-    assert isinstance(p.actual_cycle_wallclock_s, Undefined) and math.isnan(p.actual_cycle_wallclock_s)
-    assert f"{p.actual_cycle_wallclock_s:.4f}" == str(p.actual_cycle_wallclock_s) == "—"
-    assert (p.actual_cycle_thesis_s, p.parts_delivered, p.policy) == (18.5, 1, "adaptive")
-    assert type(p.actual_cycle_thesis_s) is float
+    assert math.isnan(s.actual_cycle_wallclock_s)
+    table = format_summary(s)
+    assert not re.search(r"\bnan\b", table, re.IGNORECASE), table
+    assert re.search(r"actual cycle, wall clock, s\s+—$", table, re.MULTILINE)
+    assert re.search(r"actual cycle, thesis's accounting, s\s+18\.5000$", table, re.MULTILINE)
+    assert shown_figure(math.nan) == UNDEFINED and shown_figure(2.0, "{:.1f}") == "2.0"

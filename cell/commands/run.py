@@ -10,12 +10,9 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from cell.commands import scenario_arguments, scenario_of
-
-if TYPE_CHECKING:
-    from cell.records import RunSummary
 
 HELP = "simulate one scenario; write parts.csv, summary.csv and belts.csv"
 DESCRIPTION = "Run the cell in simulated time under the scenario's policy."
@@ -32,29 +29,6 @@ RUN_FILES = ("parts.csv", "summary.csv", "belts.csv")
 #: Runs of at least this many parts show their progress on stderr (a bar on a terminal,
 #: a line every tenth of the run in a log).
 PROGRESS_FROM_PARTS = 50_000
-
-
-class Undefined(float):
-    """NaN that prints as "—", as the other commands' tables print a figure with no value
-    (one delivery has no cycle); summary.csv leaves the cell empty."""
-
-    def __new__(cls) -> Undefined:
-        return super().__new__(cls, "nan")
-
-    def __format__(self, spec: str) -> str:
-        return "—"
-
-    def __str__(self) -> str:
-        return "—"
-
-
-def printable(summary: RunSummary) -> RunSummary:
-    """A copy of a run's summary to print: every NaN figure :class:`Undefined`."""
-    from dataclasses import fields, replace
-
-    undefined: dict[str, Any] = {f.name: Undefined() for f in fields(summary)
-                                 if (v := getattr(summary, f.name)) != v}  # NaN only
-    return replace(summary, **undefined)
 
 
 def main(args: argparse.Namespace) -> int:
@@ -95,7 +69,7 @@ def main(args: argparse.Namespace) -> int:
             progress.update(n - progress.n)
         with out.open("summary.csv", newline="") as sf:
             RowWriter(sf, SUMMARY_COLUMNS).record(result.summary)
-    print(format_summary(printable(result.summary), thesis_figures(scenario)))
+    print(format_summary(result.summary, thesis_figures(scenario)))
     shown = out.target
     print(f"wrote {shown}/parts.csv, summary.csv and belts.csv")
     return 0

@@ -115,13 +115,22 @@ def _comparable(s: Scenario) -> dict[str, Any]:
     return d
 
 
+#: A figure with no value (NaN: one delivery has no cycle), as every table prints it;
+#: summary.csv leaves its cell empty.
+UNDEFINED = "—"
+
+
+def shown_figure(value: float, fmt: str = "{:.4f}") -> str:
+    """A figure as printed: ``fmt``, or :data:`UNDEFINED` for NaN."""
+    return fmt.format(value) if value == value else UNDEFINED
+
+
 def format_summary(r: RunSummary, thesis: dict[str, str] | None = None) -> str:
     """The summary as a two-column table; the thesis's figures beside ours when given."""
     rows: list[tuple[str, str]] = []
 
     def add(label: str, value: Any, fmt: str = "{:.4f}", field: str = "") -> None:
-        text = fmt.format(value) if isinstance(value, (int, float)) and value == value \
-            else str(value)
+        text = value if isinstance(value, str) else shown_figure(value, fmt)
         shown = (thesis or {}).get(field)
         rows.append((label, text + (f"   (thesis: {shown})" if shown else "")))
 
@@ -141,7 +150,8 @@ def format_summary(r: RunSummary, thesis: dict[str, str] | None = None) -> str:
         "cycle_vs_nominal_pct")
     if r.ip_thesis_memoryless == r.ip_thesis_memoryless:
         add("IP, next arrivals counted from each pick-up", r.ip_thesis_memoryless, field="ip_thesis")
-    add("spacing min / max, in", f"{r.spacing_min_in:.3f} / {r.spacing_max_in:.3f}", "{}")
+    add("spacing min / max, in", f"{shown_figure(r.spacing_min_in, '{:.3f}')} / "
+        f"{shown_figure(r.spacing_max_in, '{:.3f}')}")
     add("spacings outside 45 ± 0.25 in", r.spacing_outside_tol, "{:d}")
     hit = [f"{label} {getattr(r, field)}" for field, label in LIMIT_COUNTS.values()
            if getattr(r, field)]
