@@ -67,8 +67,8 @@ def main(args: argparse.Namespace) -> int:
         family_of,
         fit_trace,
         format_table,
-        read_column,
     )
+    from cell.analysis.fit_input import read_column
 
     trace = Path(args.trace)
     out = _destination(args.out, "--out", [trace]) if args.out is not None else None

@@ -35,7 +35,7 @@ COMMANDS: dict[str, tuple[list[str], str, str]] = {
     "animate": (["animate", "baseline", "--parts", "1"], "cell.scenario.load_scenario", "file.gif"),
     "bench": (["bench"], "cell.bench.benchmarks", "file"),
     "schema": (["schema"], "cell.scenario.json_schema", "file"),
-    "fit": (["fit", "{trace}"], "cell.analysis.fit.read_column", "file.yaml"),
+    "fit": (["fit", "{trace}"], "cell.analysis.fit_input.read_column", "file.yaml"),
 }
 
 

@@ -1,0 +1,138 @@
+"""The column ``cell fit`` reads: a CSV's inter-arrival gaps, or arrival times made gaps.
+
+Every problem is one :class:`~cell.errors.ScenarioError` line naming the file, the
+column (and row) and the value as written; :mod:`cell.analysis.fit` fits what is read.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import re
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cell.analysis.fit import MIN_VALUES
+from cell.arrivals import MAX_INTERARRIVAL_S, find_column
+from cell.errors import ScenarioError
+
+
+def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool = False,
+                sorted_ok: bool = False) -> NDArray[np.float64]:
+    """The inter-arrival gaps in a CSV column: at least :data:`MIN_VALUES`, finite, > 0, not all equal
+    (zero gaps, from a log stamped to the second, are refused, counted: see ``cell fit --help``).
+
+    With ``times`` the column holds arrival times (finite, strictly increasing), as
+    numbers of seconds or as ISO 8601 date-times, and their differences (s) are
+    returned.  Without it, a column of :data:`MIN_VALUES` or more values that never
+    decreases is refused as arrival times (n iid gaps come
+    in increasing order with probability 1/n!, < 1e-18 at n = 20), unless
+    ``sorted_ok`` says they are gaps in sorted order.  Any problem raises
+    :class:`~cell.errors.ScenarioError` naming the file, the key (``(file)``,
+    ``--column``, ``COLUMN`` or ``COLUMN[row N]``, data rows counted from 1) and
+    the value as written.
+    """
+    import pandas as pd
+
+    p = Path(path)
+    written = _read_cells(p, column)
+    cells = written.astype(str).str.strip()
+    values = pd.to_numeric(cells, errors="coerce").to_numpy(dtype=float)
+    dated = times and bool(np.isnan(values).all())
+    if dated:  # arrival times as date-times (ISO 8601, e.g. 2026-03-02 08:15:04.5): seconds
+        stamps = pd.to_datetime(cells, format="ISO8601", errors="coerce", utc=True)
+        dated = bool(stamps.notna().any())
+        if dated:
+            values = (stamps - stamps.min()).dt.total_seconds().to_numpy(dtype=float)
+    finite = np.isfinite(values)
+    if not (times or sorted_ok) and values.size >= MIN_VALUES and finite.all() \
+            and np.all(np.diff(values) >= 0.0) and np.ptp(values) > 0.0:
+        seen = f"{values.size} values rising from {cells.iloc[0]} to {cells.iloc[-1]}"
+        raise ScenarioError(p, column, seen,
+                            "the column never decreases, so it looks like arrival times, not gaps: "
+                            "use --times to fit their differences (or --gaps if these are sorted gaps)")
+    bad = np.flatnonzero(~finite if times else ~finite | (values < 0.0) | (values > MAX_INTERARRIVAL_S))
+    if bad.size:
+        i = int(bad[0])
+        raise ScenarioError(p, f"{column}[row {i + 1}]", written.iloc[i],
+                            _why_unusable(cells.iloc[i], values[i], times=times, dated=dated))
+    noun = "values"
+    if times:
+        step = np.diff(values)
+        back = np.flatnonzero(~(step > 0.0) | (step > MAX_INTERARRIVAL_S))
+        if back.size and step[back[0]] != 0.0:  # a first repeated time is said below
+            i = int(back[0]) + 1
+            why = (f"arrival times must increase: not after {cells.iloc[i - 1]} in row {i}"
+                   if step[i - 1] < 0.0 else
+                   f"{step[i - 1]:.10g} s after row {i}; gaps must be at most {MAX_INTERARRIVAL_S:g} s")
+            raise ScenarioError(p, f"{column}[row {i + 1}]", written.iloc[i], why)
+        values, noun = step, "gaps"
+    zero = np.flatnonzero(values == 0.0)  # Weibull's, gamma's, lognorm's likelihood is 0 or inf there
+    if zero.size:
+        i = int(zero[0]) + times
+        same = f"the same time as row {i}: " if times else ""
+        raise ScenarioError(p, f"{column}[row {i + 1}]", written.iloc[i],
+                            f"{same}{zero.size} of {values.size} gaps are 0 (logged in the same second?): no "
+                            "continuous distribution fits them; log the times more finely, or replay the "
+                            "gaps as a trace (arrivals.trace_csv takes zeros)")
+    if values.size < MIN_VALUES:
+        shown = f"{cells.size} arrival times" if times else f"{values.size} values"
+        need = f"{MIN_VALUES + 1} arrival times" if times else f"{MIN_VALUES} values"
+        raise ScenarioError(p, column, shown, f"needs at least {need} to fit a distribution")
+    if np.ptp(values) == 0.0:
+        raise ScenarioError(p, column, f"all {values.size} {noun} = {values[0]:g}",
+                            f"{noun} without variation cannot be fitted")
+    return values
+
+
+def _why_unusable(cell: str, value: float, *, times: bool, dated: bool) -> str:
+    """Why a cell of the column cannot be used (``value`` as read, NaN if not a number)."""
+    if cell == "":
+        return "missing value"
+    if dated:
+        return "not a date-time (YYYY-MM-DD hh:mm:ss)"
+    if math.isnan(value) and cell.lower() != "nan":
+        if re.fullmatch(r"[+-]?\d*,\d+", cell):
+            return "not a number: write a decimal point, not a comma"
+        return ("not a number of seconds nor an ISO date-time (YYYY-MM-DD hh:mm:ss)" if times
+                else "not a number")
+    if times:
+        return "arrival times must be finite"
+    return f"inter-arrival times must be finite, > 0 and at most {MAX_INTERARRIVAL_S:g} s"
+
+
+def _read_cells(p: Path, column: str) -> Any:
+    """The cells of ``column`` in the CSV file ``p``, as written (a pandas Series of str)."""
+    import pandas as pd
+
+    if not p.is_file():
+        raise ScenarioError(p, "(file)", str(p), "no such file")
+    try:
+        raw = p.read_bytes()
+        if b"\x00" in raw:
+            raise ScenarioError(p, "(file)", str(p), "binary data, not a CSV text file")
+        text = raw.decode("utf-8-sig")
+    except OSError as exc:
+        raise ScenarioError(p, "(file)", str(p), f"cannot read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(p, "(file)", str(p),
+                            f"not UTF-8 text (byte {exc.start}); save the CSV as UTF-8") from None
+    if not text.strip():
+        raise ScenarioError(p, "(file)", str(p), "empty file")
+    index = find_column(next(csv.reader([text.lstrip().splitlines()[0]], skipinitialspace=True)), column)
+    if isinstance(index, str):  # before pandas, which renames a second X to X.1 and miscounts ';' rows
+        raise ScenarioError(p, "--column", column, index)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", pd.errors.ParserWarning)
+            frame = pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False, index_col=False)
+    except (ValueError, pd.errors.ParserWarning) as exc:  # pandas' parser errors are ValueErrors
+        why = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise ScenarioError(p, "(file)", str(p), f"not a readable CSV: {why}") from None
+    blank = frame.apply(lambda c: c.str.strip() == "").all(axis=1)  # a spreadsheet's empty rows: ',,'
+    return frame.loc[~blank].iloc[:, index].reset_index(drop=True)
