@@ -51,7 +51,7 @@ class LimitCount(NamedTuple):
 LIMIT_COUNTS: dict[str, LimitCount] = {
     "r4_peak": LimitCount("limit_r4_peak", "R IV at the base's peak rate"),
     "r2_peak": LimitCount("limit_r2_peak", "R II at the motors' peak"),
-    "input_floor": LimitCount("limit_input_floor", "input belt at its floor (part let go)"),
+    "input_floor": LimitCount("limit_input_floor", "input belt at its floor (next part let go)"),
     "input_ceiling": LimitCount("limit_input_ceiling", "input belt at its ceiling (robot waited)"),
     "input_tracking": LimitCount("limit_input_tracking",
                                  "input belt held to the robot's tracking limit"),
@@ -183,7 +183,9 @@ class RunSummary:
     spacing_outside_tol: int = 0
     """Spacings outside 45 ± 0.25 in (§4.3 f)."""
     limit_input_floor: int = 0
-    """Parts whose input belt was held at its floor (the part was let go early)."""
+    """Parts after whose pick-up step 3.2 held the input belt at its floor, R IV and R II at
+    their fastest: the *next* part still reaches B before the robot is back and is let go
+    (counted in ``parts_missed``); the part counted here was picked."""
     limit_input_ceiling: int = 0
     """Parts whose input belt was held at its ceiling (the robot waited)."""
     limit_input_tracking: int = 0

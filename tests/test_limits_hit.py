@@ -1,0 +1,25 @@
+"""What the limits-hit counts of ``cell run`` and summary.csv mean, on whole runs."""
+
+from __future__ import annotations
+
+from cell import catalog
+from cell.records import LIMIT_COUNTS
+from cell.scenario import load_scenario
+from cell.simulation import simulate
+
+OVERLOADED = {"run.parts": 200, "controller.nominal_cycle_s": None,
+              "arrivals.distribution": "gamma", "arrivals.cv": 0.05,
+              "arrivals.mean_s": 16.2757}  # 0.9 of the robot's fastest cycle
+
+
+def test_input_floor_counts_picked_parts_whose_next_part_is_let_go():
+    """The flag is on the part picked; the floor's effect is on the next part, which the
+    label names (entry 8: it read as if the counted part itself was let go)."""
+    r = simulate(load_scenario(catalog.path("baseline"), OVERLOADED))
+    p = r.parts
+    floor = p["limits"].fillna("").str.contains("input_floor").to_numpy()
+    missed = p["missed"].to_numpy()
+    assert floor.sum() > 20 and r.summary["limit_input_floor"] == floor.sum()
+    assert p["picked"].to_numpy()[floor].all()            # the counted parts were picked
+    assert missed[1:][floor[:-1]].all()                   # and each one's next part let go
+    assert "next part let go" in LIMIT_COUNTS["input_floor"].label
