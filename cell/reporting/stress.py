@@ -133,9 +133,11 @@ def reading(t: pd.DataFrame) -> list[str]:
             f"{over['parts_lost'].max():.0f} per 500, the fixed one "
             f"{fx_over['parts_lost'].min():.0f}-{fx_over['parts_lost'].max():.0f}. The adaptive "
             f"robot's throughput reaches {over['parts_per_hr'].max() / ceiling:.0%} of the "
-            f"{ceiling:.0f} parts/hr its fastest cycle allows; the parts it lets go are those that "
-            f"would reach B before it is back even with the input belt at its floor "
-            f"({over['limit_input_floor'].mean():.0f} a run on average).")
+            f"{ceiling:.0f} parts/hr its fastest cycle allows. Of the "
+            f"{over['parts_lost'].mean():.0f} parts a run it lets go on average, "
+            f"{over['limit_input_floor'].mean():.0f} reach B before it is back even though it "
+            "slowed the input belt to its floor for them (limit_input_floor, counted on the part "
+            "picked before each).")
     wide = ad[ad["cv"] >= 0.75]
     narrow = ad[(ad["cv"] <= 0.25) & (ad["load"] >= 1.0)]
     if len(wide) and len(narrow):
@@ -144,10 +146,11 @@ def reading(t: pd.DataFrame) -> list[str]:
             f"{wide['delivered_vs_fixed'].mean():.1f} parts per 500 on average against "
             f"{narrow['delivered_vs_fixed'].mean():.1f} for cv up to 0.25 with the robot fast "
             "enough. With so much spread many parts come closer together than any cycle of the "
-            "robot (its fastest is 18.08 s), and no controller can catch both; the adaptive "
-            f"robot then holds its belt at the floor ({wide['limit_input_floor'].mean():.0f} parts "
-            "a run) and lets the early part go, and some parts come so close that the feeder "
-            f"must hold them back ({wide['parts_held'].mean():.1f} a run).")
+            "robot (its fastest is 18.08 s), and no controller can catch both: the adaptive "
+            "robot slows its input belt to the floor for the next part and still lets it go "
+            f"({wide['limit_input_floor'].mean():.0f} of the {wide['parts_lost'].mean():.0f} "
+            "parts a run it loses), and some parts come so close that the feeder must hold them "
+            f"back ({wide['parts_held'].mean():.1f} a run).")
     slack = ad[ad["load"] >= 1.2]
     mid = ad[(ad["load"] > 1.0) & (ad["load"] < 1.2)]
     if len(slack) and len(mid) and slack["parts_lost"].mean() > mid["parts_lost"].mean():
