@@ -14,7 +14,7 @@ import copy
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-from cell.errors import ScenarioError
+from cell.errors import CellError, ScenarioError, short
 
 #: Does this dotted path (as a tuple of names) name a section of the schema?
 IsSection = Callable[[tuple[str, ...]], bool]
@@ -33,7 +33,7 @@ def parse_sets(pairs: Sequence[str] | None) -> dict[str, Any]:
         key, sep, text = pair.partition("=")
         key = key.strip()
         if not sep or not key:
-            raise ScenarioError("--set", pair, pair, "expected KEY=VALUE, e.g. run.parts=100")
+            raise CellError(f"--set {short(pair)}: expected KEY=VALUE, e.g. run.parts=100")
         out[key] = parse_value(text, origin=f"--set {key}")
     return out
 
