@@ -61,8 +61,18 @@ def error_from_validation(exc: ValidationError, raw: Any, file: object,
     elif kind == "value_error":
         why = str(ctx.get("error", err["msg"]))
     else:
-        why = _PHRASES.get(kind, err["msg"][0].lower() + err["msg"][1:])
+        why = _PHRASES.get(kind, err["msg"][0].lower() + err["msg"][1:]) + _instead(kind, value)
     return ScenarioError(file, key or "(top level)", value, why)
+
+
+def _instead(kind: str, value: Any) -> str:
+    """What to write where a value was plainly meant but has the wrong type: a count written
+    as a float (1e3).  Counts stay strict, as every int setting is: a float is not silently
+    taken for one."""
+    exact = isinstance(value, float) and value.is_integer() and abs(value) < 2.0 ** 53
+    if kind in ("int_type", "int_from_float") and exact:
+        return f"; write {int(value)}"
+    return ""
 
 
 def _lookup(raw: Any, loc: list[Any]) -> Any:

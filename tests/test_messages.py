@@ -23,3 +23,16 @@ def test_a_set_without_key_and_value_names_the_option_once(capsys, tmp_path: Pat
     line = refused(capsys, "run", "baseline", "--set", pair, "--out", out)
     assert line == f"--set {pair!r}: expected KEY=VALUE, e.g. run.parts=100"
     assert not out.exists()
+
+
+@pytest.mark.parametrize("text,expected", [
+    ("run: {parts: 1e3}\n", "run.parts = 1000.0: must be a whole number; write 1000"),
+    ("run: {seed: 7.0}\n", "run.seed = 7.0: must be a whole number; write 7"),
+    ("run: {parts: 10.5}\n", "run.parts = 10.5: must be a whole number"),
+])
+def test_a_value_of_the_wrong_type_says_what_to_write(capsys, tmp_path: Path, text, expected):
+    """Counts stay strict, as every int setting is (a float is refused, not rounded), but a
+    whole float says how to write it; text that YAML read as a number says to quote it."""
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(text)
+    assert refused(capsys, "run", scenario, "--out", tmp_path / "out") == f"{scenario}: {expected}"
