@@ -67,11 +67,13 @@ def error_from_validation(exc: ValidationError, raw: Any, file: object,
 
 def _instead(kind: str, value: Any) -> str:
     """What to write where a value was plainly meant but has the wrong type: a count written
-    as a float (1e3).  Counts stay strict, as every int setting is: a float is not silently
-    taken for one."""
+    as a float (1e3), text that YAML read as a number (``name: 2026``).  Counts stay strict, as
+    every int setting is: a float is not silently taken for one."""
     exact = isinstance(value, float) and value.is_integer() and abs(value) < 2.0 ** 53
     if kind in ("int_type", "int_from_float") and exact:
         return f"; write {int(value)}"
+    if kind == "string_type" and isinstance(value, (int, float)) and not isinstance(value, bool):
+        return f"; quote it: '{value}'"
     return ""
 
 

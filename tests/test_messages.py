@@ -29,6 +29,8 @@ def test_a_set_without_key_and_value_names_the_option_once(capsys, tmp_path: Pat
     ("run: {parts: 1e3}\n", "run.parts = 1000.0: must be a whole number; write 1000"),
     ("run: {seed: 7.0}\n", "run.seed = 7.0: must be a whole number; write 7"),
     ("run: {parts: 10.5}\n", "run.parts = 10.5: must be a whole number"),
+    ("name: 2026\n", "name = 2026: must be text; quote it: '2026'"),
+    ("name: true\n", "name = True: must be text"),
 ])
 def test_a_value_of_the_wrong_type_says_what_to_write(capsys, tmp_path: Path, text, expected):
     """Counts stay strict, as every int setting is (a float is refused, not rounded), but a
