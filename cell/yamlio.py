@@ -158,6 +158,11 @@ class _Source:
             line -= 1
         return _oneline(self.lines[line].strip(), 60) if self.echo else f"<line {line + 1}>"
 
+    def char(self, line: int, column: int) -> str:
+        """The character at a place (0-based), or "" past a line's end."""
+        text = self.lines[line] if line < len(self.lines) else ""
+        return text[column:column + 1]
+
     def where(self, line: int, column: int) -> str:
         end = line >= len(self.lines) or (line == len(self.lines) - 1 and column >= len(self.lines[line]))
         return "the end" if end else f"column {column + 1}" if self.inline and len(self.lines) == 1 \
@@ -294,6 +299,8 @@ def _syntax_error(src: _Source, path: KeyPath, exc: yaml.MarkedYAMLError) -> NoR
         src.fail(path, "", f"invalid YAML: {problem or context}", "(syntax)")
     if "nesting depth" in problem:  # libyaml's own bound (1000 levels), met while looking ahead
         src.fail_at(path, mark, _TOO_DEEP)
+    if src.char(mark.line, mark.column) == "\t":  # "cannot start any token", "violates indentation"
+        problem, context = "a tab: YAML indents with spaces only", ""
     if problem.startswith("but "):
         problem = f"{context}, {problem}"
     elif context and cmark and (cmark.line, cmark.column) != (mark.line, mark.column):

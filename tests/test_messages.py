@@ -38,3 +38,15 @@ def test_a_value_of_the_wrong_type_says_what_to_write(capsys, tmp_path: Path, te
     scenario = tmp_path / "s.yaml"
     scenario.write_text(text)
     assert refused(capsys, "run", scenario, "--out", tmp_path / "out") == f"{scenario}: {expected}"
+
+
+@pytest.mark.parametrize("text,where", [
+    ("run:\n\tparts: 10\n", "line 2, column 1"),            # "cannot start any token"
+    ("run:\n  parts: 10\n\tseed: 3\n", "line 3, column 1"),  # "violates indentation"
+    ("run:\n    \tparts: 10\n", "line 2, column 5"),
+])
+def test_a_tab_in_the_indentation_is_called_a_tab(capsys, tmp_path: Path, text, where):
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(text)
+    line = refused(capsys, "run", scenario, "--out", tmp_path / "out")
+    assert line.endswith(f": invalid YAML at {where}: a tab: YAML indents with spaces only")
