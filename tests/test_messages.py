@@ -50,3 +50,12 @@ def test_a_tab_in_the_indentation_is_called_a_tab(capsys, tmp_path: Path, text, 
     scenario.write_text(text)
     line = refused(capsys, "run", scenario, "--out", tmp_path / "out")
     assert line.endswith(f": invalid YAML at {where}: a tab: YAML indents with spaces only")
+
+
+def test_path_refuses_a_dash_for_out_instead_of_writing_a_file_named_dash(capsys, tmp_path,
+                                                                         monkeypatch):
+    """No command writes its output to stdout, so '-' is refused, not taken as a file name."""
+    monkeypatch.chdir(tmp_path)
+    line = refused(capsys, "path", "baseline", "--out", "-")
+    assert line.startswith("--out -: cell path writes a CSV file, not standard output")
+    assert list(tmp_path.iterdir()) == []
