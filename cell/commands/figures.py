@@ -1,4 +1,4 @@
-"""``cell figures [--out DIR] [--scenario FILE]``: the thesis's Fig. 8-30 as PNG.
+"""``cell figures [--out DIR] [--scenario SCENARIO] [--set KEY=VALUE]``: the thesis's Fig. 8-30 as PNG.
 
 The PNGs are one set (:class:`~cell.output.OutputDir`): DIR is checked before
 anything is drawn, and the new figures replace the old ones together.
@@ -15,7 +15,8 @@ DESCRIPTION = "Write figNN_<slug>.png for the thesis's Fig. 8-30 into --out."
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--out", default="reports/figures", help="directory for the PNGs")
+    p.add_argument("--out", default="reports/figures", metavar="DIR",
+                   help="directory for the PNGs (default: reports/figures)")
     p.add_argument("--scenario", default="baseline",
                    help="scenario to draw: a file or a built-in name (default: baseline)")
     set_argument(p)
