@@ -99,14 +99,16 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
                 flags |= R4_PEAK
                 w = b / (cycle - a)
                 if w < k.input_min:           # departure: the belt's floor, R II first
-                    spare = min(r2 - t.r2_min_s, cycle - (a + b / k.input_min))
+                    over = cycle - (a + b / k.input_min)  # the cycle past the floor's arrival
+                    spare = min(r2 - t.r2_min_s, over)
                     if spare > 0:
                         r2 -= spare
                         cycle -= spare
                         w = b / (cycle - a)
-                    if w < k.input_min:
+                    if w < k.input_min:  # also by a rounding once R II took it all up
                         w = k.input_min
-                        flags |= INPUT_FLOOR
+                        if spare < over:  # R II could not: the next part comes early
+                            flags |= INPUT_FLOOR
     # 6.3: decay toward nominal after the cycle; departure: never below what R II absorbs.
     v_next = 0.5 * (w + k.v_nom) if w > k.v_nom else \
         (k.input_absorb if k.input_absorb > w else w)  # max(w, absorb)
