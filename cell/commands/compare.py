@@ -15,6 +15,7 @@ rates still compare.
 from __future__ import annotations
 
 import argparse
+import math
 from typing import TYPE_CHECKING
 
 from cell.commands import check_workers, set_argument, workers_argument
@@ -94,6 +95,22 @@ def window_warning(sweep: Sweep) -> str | None:
             f"both the same window ({sets})")
 
 
+def nominal_warning(sweep: Sweep) -> str | None:
+    """One line if A's or B's controller aims at a nominal cycle it states that is off its
+    arrivals' mean (as ``cell run`` warns of a run), else None."""
+    from cell.sweep.spec import NOMINAL_MISMATCH, nominal_mismatch, nominal_off
+
+    said: dict[str, list[str]] = {}
+    for label, p in _sides(sweep):
+        if abs(p.nominal_gap) > NOMINAL_MISMATCH:  # NaN: it follows the arrivals
+            cycle = float(p.scenario.controller.nominal_cycle_s or math.nan)
+            said.setdefault(nominal_mismatch(cycle, cycle / (1 + p.nominal_gap)), []).append(label)
+    if not said:
+        return None
+    return nominal_off("; ".join(f"{' and '.join(who)}: {text}" for text, who in said.items()),
+                       " (--set controller.nominal_cycle_s=null)")
+
+
 def main(args: argparse.Namespace) -> int:
     import sys
     import tempfile
@@ -126,6 +143,8 @@ def main(args: argparse.Namespace) -> int:
         names = (*REPORT_FILES, "replications.csv")
         OutputDir.check(args.out, names)  # before anything runs
         target = Target(Path(args.out), names, False)
+    if nominal := nominal_warning(sweep):
+        print(f"cell: warning: {nominal}", file=sys.stderr)
     warning = window_warning(sweep)
     if warning:
         print(f"cell: warning: {warning}", file=sys.stderr)

@@ -13,9 +13,6 @@ from cell.policies.base import CellConstants
 from cell.records import LIMIT_COUNTS, RunSummary
 from cell.scenario import Scenario, load_scenario
 
-#: Relative difference between the nominal cycle and the arrivals' mean worth a warning.
-NOMINAL_MISMATCH = 0.01
-
 IP_LINE = ("IP (eq. 5.1) = the next part's inter-arrival time / the time between deliveries: "
            "1 means the cell keeps pace with its parts.  The thesis's accounting is how the "
            "thesis counted (docs/accounting.md, or `cell docs accounting`); the wall clock is what "
@@ -56,17 +53,20 @@ def run_heading(cell: AssembledCell) -> str:
 def warnings(k: CellConstants) -> list[str]:
     """One line each: the cell cannot keep up on average; the nominal cycle is not the
     arrivals' mean."""
+    from cell.sweep.spec import (
+        NOMINAL_MISMATCH,
+        nominal_gap,
+        nominal_mismatch,
+        nominal_off,
+        overloaded,
+    )
+
     out = []
     if k.utilisation >= 1:
-        from cell.sweep.spec import overloaded
-
         out.append(overloaded(f"utilisation {k.utilisation:.3f}",
                               (k.fastest_cycle_s, k.mean_interarrival_s)))
-    gap = k.cycle_nom / k.mean_interarrival_s - 1
-    if k.nominal_from == "scenario" and abs(gap) > NOMINAL_MISMATCH:
-        out.append(f"controller.nominal_cycle_s ({k.cycle_nom:.4f} s) is {gap:+.1%} off the "
-                   f"arrivals' mean ({k.mean_interarrival_s:.4f} s): the controller aims at it, "
-                   "not at the arrivals; set it to null to follow them")
+    if abs(nominal_gap(k)) > NOMINAL_MISMATCH:  # NaN: the cycle follows the arrivals
+        out.append(nominal_off(nominal_mismatch(k.cycle_nom, k.mean_interarrival_s)))
     return out
 
 

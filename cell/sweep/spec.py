@@ -41,7 +41,7 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -64,11 +64,16 @@ from cell.sweep.options import (
     whole,
 )
 
+if TYPE_CHECKING:
+    from cell.policies.base import CellConstants
+
 #: At most this many grid points, and this many runs (points x replications), in a sweep.
 MAX_POINTS = 100_000
 MAX_RUNS = 10_000_000
 #: Checking this many points or more shows progress.
 SHOW_CHECKING = 1_000
+#: Relative difference between a stated nominal cycle and the arrivals' mean worth a warning.
+NOMINAL_MISMATCH = 0.01
 
 SWEEP_KEYS = ("name", "description", "base", "set", "grid", "policies",
               "replications", "seed", "batch", "baseline")
@@ -91,6 +96,9 @@ class Point:
     utilisation: float = math.nan
     """The robot's fastest cycle over the mean inter-arrival time here (1 or more: the cell
     cannot keep up on average)."""
+    nominal_gap: float = math.nan
+    """How far the nominal cycle the scenario states (``controller.nominal_cycle_s``) is off
+    the arrivals' mean here, relative and signed; NaN where the cycle follows the arrivals."""
 
     def name_of(self, key: str) -> str | None:
         """The name of this point's value of ``key``, if the sweep file named it."""
@@ -296,7 +304,7 @@ def load_sweep(path: str | Path) -> Sweep:
                 {**fixed, "controller.policy": policy, **dict(values)}, file=path,
                 paths_from=path.parent)
             points.append(Point(policy, i, values, scenario, named,
-                                _check_point(scenario, path)))
+                                **_check_point(scenario, path)))
             checking.update()
     checking.close()
 
@@ -317,9 +325,49 @@ def overload_warning(sweep: Sweep) -> str | None:
     if not over:
         return None
     worst = max(over, key=lambda p: p.utilisation)
-    where = ", ".join(f"{k} {show(v)}" for k, v in worst.values) or worst.policy
     return overloaded(f"{len(over)} of {len(sweep.points)} points have utilisation 1 or more "
-                      f"(up to {worst.utilisation:.3f}, at {where})")
+                      f"(up to {worst.utilisation:.3f}, at {_where(worst)})")
+
+
+def nominal_warning(sweep: Sweep) -> str | None:
+    """One line if some points' controllers aim at a nominal cycle more than
+    :data:`NOMINAL_MISMATCH` off their arrivals' mean, as ``cell run`` warns of a run, that
+    the sweep took from its base (one it sets or varies itself it chose), naming the
+    worst; else None."""
+    key = "controller.nominal_cycle_s"
+    if key in sweep.keys or key in dict(sweep.fixed):
+        return None
+    off = [p for p in sweep.points if abs(p.nominal_gap) > NOMINAL_MISMATCH]  # NaN: never
+    if not off:
+        return None
+    worst = max(off, key=lambda p: abs(p.nominal_gap))
+    cycle = float(worst.scenario.controller.nominal_cycle_s or math.nan)
+    return nominal_off(f"{len(off)} of {len(sweep.points)} points keep {key} from the base, "
+                       f"up to {worst.nominal_gap:+.1%} off their arrivals' mean ({cycle:.4f} s "
+                       f"against {cycle / (1 + worst.nominal_gap):.4f} s, at {_where(worst)})",
+                       f" (set: {{{key}: null}} in the sweep file)")
+
+
+def nominal_mismatch(cycle_s: float, mean_s: float) -> str:
+    """``controller.nominal_cycle_s (X s) is +N% off the arrivals' mean (Y s)``."""
+    return (f"controller.nominal_cycle_s ({cycle_s:.4f} s) is {cycle_s / mean_s - 1:+.1%} off "
+            f"the arrivals' mean ({mean_s:.4f} s)")
+
+
+def nominal_off(how_much: str, how_to: str = "") -> str:
+    """The one line saying the controller aims at a stated nominal cycle that is not the
+    arrivals' mean, opened by ``how_much`` (:func:`nominal_mismatch`, for a run:
+    :func:`cell.reporting.runs.warnings`), ``how_to`` saying where to set it to null:
+    for a sweep (:func:`nominal_warning`) and a comparison."""
+    return (f"{how_much}: the controller aims at it, not at the arrivals; set it to null to "
+            f"follow them{how_to}")
+
+
+def _where(point: Point) -> str:
+    """A point in a warning: its varied keys and values, by name where the sweep file names
+    them (its policy, if none)."""
+    return ", ".join(f"{k} {point.name_of(k) or show(v)}" for k, v in point.values) \
+        or point.policy
 
 
 def overloaded(how_much: str, times_s: tuple[float, float] | None = None) -> str:
@@ -334,16 +382,23 @@ def overloaded(how_much: str, times_s: tuple[float, float] | None = None) -> str
             "will lose parts")
 
 
-def _check_point(scenario: Scenario, file: object) -> float:
+def _check_point(scenario: Scenario, file: object) -> dict[str, float]:
     """Assemble a grid point's cell now, so that no bad point is found after work began;
     an error names the sweep file, with the key and value it was about.  Returns the
-    point's utilisation."""
+    point's utilisation and nominal_gap (:class:`Point`)."""
     from cell.assembly import assemble
 
     try:
-        return assemble(scenario).k.utilisation
+        k = assemble(scenario).k
     except ScenarioError as exc:
         raise ScenarioError(file, exc.key, exc.value, exc.why) from None
+    return {"utilisation": k.utilisation, "nominal_gap": nominal_gap(k)}
+
+
+def nominal_gap(k: CellConstants) -> float:
+    """How far the nominal cycle a scenario states is off its arrivals' mean, relative and
+    signed; NaN where the cycle follows the arrivals (or the robot)."""
+    return k.cycle_nom / k.mean_interarrival_s - 1 if k.nominal_from == "scenario" else math.nan
 
 
 def comparison(a: Scenario, b: Scenario, labels: tuple[str, str], replications: int, seed: int,
@@ -354,9 +409,9 @@ def comparison(a: Scenario, b: Scenario, labels: tuple[str, str], replications: 
     la, lb = labels
     if la == lb:
         raise ValueError(f"the two sides of a comparison need different labels, not {la!r} twice")
-    pa = Point(a.controller.policy, 0, (("scenario", la),), a, (), _check_point(a, a.source))
+    pa = Point(a.controller.policy, 0, (("scenario", la),), a, (), **_check_point(a, a.source))
     pb = Point(b.controller.policy, int(b.controller.policy == a.controller.policy),
-               (("scenario", lb),), b, (), _check_point(b, b.source))
+               (("scenario", lb),), b, (), **_check_point(b, b.source))
     return Sweep(f"{la} against {lb}", "compare", f"{la} against {lb}", a, (), ("scenario",),
                  (pa, pb), replications, seed, min(batch, replications),
                  baseline=Baseline(b.controller.policy, (("scenario", lb),),
