@@ -100,23 +100,20 @@ def sentence(h: Headline, d: Mapping[Any, Any], a: str, b: str, parts: int | Non
     n, mean = int(d["n"]), float(d["mean"])
     b = _against(a, b)
     level = f"{confidence * 100:g} %"
-    per = f" per {parts}-part run" if h.per_run and parts else ""
-    direction = h.words[0] if mean >= 0 else h.words[1]
     if n == 0 or not math.isfinite(mean):
         return f"{a} against {b}: not compared, {too_few(0, _lower(h.title))}."
     if n < 2 or not math.isfinite(float(d["sd"])):
-        x = number(abs(mean))
-        return h.sentence.format(a=a, x=x, dir=direction, b=b) + per + \
+        return h.says(a, number(abs(mean)), mean, b, parts) + \
             f" ({n} replication{'s' if n != 1 else ''}: no interval)."
     if float(d["sd"]) == 0.0:
         if mean == 0.0:
             return f"{a} is the same as {b} in every replication ({h.title.lower()}: " \
                    f"no variation between replications)."
-        return h.sentence.format(a=a, x=number(abs(mean)), dir=direction, b=b) + per + \
+        return h.says(a, number(abs(mean)), mean, b, parts) + \
             f" in every one of {n} replications (no variation between replications)."
     lo, hi = float(d["ci_low"]), float(d["ci_high"])
-    text = h.sentence.format(a=a, x=plus_minus(abs(mean), half_width(d)), dir=direction, b=b)
-    text += f"{per} ({level} CI, paired over {n} replications)"
+    text = h.says(a, plus_minus(abs(mean), half_width(d)), mean, b, parts)
+    text += f" ({level} CI, paired over {n} replications)"
     if lo <= 0.0 <= hi:
         text += "; the interval includes zero: no difference shown"
     return text + "."
