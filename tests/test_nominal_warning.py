@@ -6,9 +6,10 @@ from __future__ import annotations
 import pytest
 
 from cell.cli import main
+from cell.reporting.runs import nominal_warning
 from cell.scenario import load_scenario
 from cell.sweep import load_sweep
-from cell.sweep.spec import comparison, nominal_warning
+from cell.sweep.spec import comparison
 
 GAMMA = {"distribution": "gamma", "mean_s": 22.5872, "cv": 0.3}
 #: What every such line ends with, run, sweep or compare.

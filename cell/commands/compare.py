@@ -98,7 +98,7 @@ def window_warning(sweep: Sweep) -> str | None:
 def nominal_warning(sweep: Sweep) -> str | None:
     """One line if A's or B's controller aims at a nominal cycle it states that is off its
     arrivals' mean (as ``cell run`` warns of a run), else None."""
-    from cell.sweep.spec import NOMINAL_MISMATCH, nominal_mismatch, nominal_off
+    from cell.reporting.runs import NOMINAL_MISMATCH, nominal_mismatch, nominal_off
 
     said: dict[str, list[str]] = {}
     for label, p in _sides(sweep):

@@ -58,7 +58,7 @@ def _sweep(args: argparse.Namespace) -> int:
         from cell.reporting.experiment import plan_report
 
         target = plan_report(sweep, args.report, results=args.out)  # before anything runs
-    from cell.sweep.spec import nominal_warning
+    from cell.reporting.runs import nominal_warning
 
     if warning := nominal_warning(sweep):  # run_sweep adds the overload warning
         print(f"cell: warning: {warning}", file=sys.stderr)

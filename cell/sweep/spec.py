@@ -72,8 +72,6 @@ MAX_POINTS = 100_000
 MAX_RUNS = 10_000_000
 #: Checking this many points or more shows progress.
 SHOW_CHECKING = 1_000
-#: Relative difference between a stated nominal cycle and the arrivals' mean worth a warning.
-NOMINAL_MISMATCH = 0.01
 
 SWEEP_KEYS = ("name", "description", "base", "set", "grid", "policies",
               "replications", "seed", "batch", "baseline")
@@ -325,49 +323,9 @@ def overload_warning(sweep: Sweep) -> str | None:
     if not over:
         return None
     worst = max(over, key=lambda p: p.utilisation)
+    where = ", ".join(f"{k} {show(v)}" for k, v in worst.values) or worst.policy
     return overloaded(f"{len(over)} of {len(sweep.points)} points have utilisation 1 or more "
-                      f"(up to {worst.utilisation:.3f}, at {_where(worst)})")
-
-
-def nominal_warning(sweep: Sweep) -> str | None:
-    """One line if some points' controllers aim at a nominal cycle more than
-    :data:`NOMINAL_MISMATCH` off their arrivals' mean, as ``cell run`` warns of a run, that
-    the sweep took from its base (one it sets or varies itself it chose), naming the
-    worst; else None."""
-    key = "controller.nominal_cycle_s"
-    if key in sweep.keys or key in dict(sweep.fixed):
-        return None
-    off = [p for p in sweep.points if abs(p.nominal_gap) > NOMINAL_MISMATCH]  # NaN: never
-    if not off:
-        return None
-    worst = max(off, key=lambda p: abs(p.nominal_gap))
-    cycle = float(worst.scenario.controller.nominal_cycle_s or math.nan)
-    return nominal_off(f"{len(off)} of {len(sweep.points)} points keep {key} from the base, "
-                       f"up to {worst.nominal_gap:+.1%} off their arrivals' mean ({cycle:.4f} s "
-                       f"against {cycle / (1 + worst.nominal_gap):.4f} s, at {_where(worst)})",
-                       f" (set: {{{key}: null}} in the sweep file)")
-
-
-def nominal_mismatch(cycle_s: float, mean_s: float) -> str:
-    """``controller.nominal_cycle_s (X s) is +N% off the arrivals' mean (Y s)``."""
-    return (f"controller.nominal_cycle_s ({cycle_s:.4f} s) is {cycle_s / mean_s - 1:+.1%} off "
-            f"the arrivals' mean ({mean_s:.4f} s)")
-
-
-def nominal_off(how_much: str, how_to: str = "") -> str:
-    """The one line saying the controller aims at a stated nominal cycle that is not the
-    arrivals' mean, opened by ``how_much`` (:func:`nominal_mismatch`, for a run:
-    :func:`cell.reporting.runs.warnings`), ``how_to`` saying where to set it to null:
-    for a sweep (:func:`nominal_warning`) and a comparison."""
-    return (f"{how_much}: the controller aims at it, not at the arrivals; set it to null to "
-            f"follow them{how_to}")
-
-
-def _where(point: Point) -> str:
-    """A point in a warning: its varied keys and values, by name where the sweep file names
-    them (its policy, if none)."""
-    return ", ".join(f"{k} {point.name_of(k) or show(v)}" for k, v in point.values) \
-        or point.policy
+                      f"(up to {worst.utilisation:.3f}, at {where})")
 
 
 def overloaded(how_much: str, times_s: tuple[float, float] | None = None) -> str:
@@ -397,7 +355,8 @@ def _check_point(scenario: Scenario, file: object) -> dict[str, float]:
 
 def nominal_gap(k: CellConstants) -> float:
     """How far the nominal cycle a scenario states is off its arrivals' mean, relative and
-    signed; NaN where the cycle follows the arrivals (or the robot)."""
+    signed; NaN where the cycle follows the arrivals (or the robot): for
+    :attr:`Point.nominal_gap` and :func:`cell.reporting.runs.warnings`."""
     return k.cycle_nom / k.mean_interarrival_s - 1 if k.nominal_from == "scenario" else math.nan
 
 
