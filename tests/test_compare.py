@@ -114,8 +114,10 @@ def test_verdict_says_which_is_better_on_each_measure():
                                 ("actual_cycle_wallclock_s", -0.5, 2.0, -1.9, 0.9))])
     text = verdict(summary, diffs, sweep)
     lines = {line.split("  ")[1].strip(): line for line in text.splitlines()[1:]}
-    assert "a better: 100.0 ± 2.0 parts more" in lines["Parts delivered"]
-    assert "a better: 100.0 ± 2.0 parts fewer" in lines["Parts lost (wall clock)"]
+    assert "a better: a delivers 100.0 ± 2.0 parts more than b per 500-part run" \
+        in lines["Parts delivered"]
+    assert "a better: a loses 100.0 ± 2.0 parts fewer than b per 500-part run" \
+        in lines["Parts lost (wall clock)"]
     assert "a better (nearer 1)" in lines["IP (wall clock, eq. 5.1)"]
     assert "neither" in lines["Actual cycle (wall clock, s)"]
     assert "interval includes 0: no difference shown" in lines["Actual cycle (wall clock, s)"]

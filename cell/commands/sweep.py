@@ -58,6 +58,10 @@ def _sweep(args: argparse.Namespace) -> int:
         from cell.reporting.experiment import plan_report
 
         target = plan_report(sweep, args.report, results=args.out)  # before anything runs
+    from cell.reporting.runs import nominal_warning
+
+    if warning := nominal_warning(sweep):  # run_sweep adds the overload warning
+        print(f"cell: warning: {warning}", file=sys.stderr)
     try:
         outcome = run_sweep(sweep, args.out, workers=args.workers, scheduler=args.scheduler,
                             resume=args.resume, replicate=simulate_summary)

@@ -9,7 +9,7 @@ is said to, rather than shown with a zero-width interval.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -73,12 +73,19 @@ def cell(s: Mapping[Any, Any], whole: bool = False) -> str:
         return "—"
     if n == 1:
         return f"{number(mean)} (one run)"
-    half = half_width(s)
     if float(s["sd"]) == 0.0:
         return f"{number(mean)} (no variation)"
+    lo, hi = single_runs(s, whole)
+    return f"{plus_minus(mean, half_width(s))} [{lo}–{hi}]"
+
+
+def single_runs(s: Mapping[Any, Any], whole: bool = False) -> tuple[str, str]:
+    """A summary row's 2.5 and 97.5 % points of single runs, as its table cell shows them:
+    whole numbers for a count (``whole``, or both already whole), else to the interval's
+    precision."""
     lo, hi = float(s["run_p2_5"]), float(s["run_p97_5"])
-    r = 0 if whole or lo == round(lo) and hi == round(hi) else decimals(half)
-    return f"{plus_minus(mean, half)} [{number(lo, r)}–{number(hi, r)}]"
+    r = 0 if whole or lo == round(lo) and hi == round(hi) else decimals(half_width(s))
+    return number(lo, r), number(hi, r)
 
 
 def _against(a: str, b: str, at: bool = True) -> str:
@@ -100,23 +107,20 @@ def sentence(h: Headline, d: Mapping[Any, Any], a: str, b: str, parts: int | Non
     n, mean = int(d["n"]), float(d["mean"])
     b = _against(a, b)
     level = f"{confidence * 100:g} %"
-    per = f" per {parts}-part run" if h.per_run and parts else ""
-    direction = h.words[0] if mean >= 0 else h.words[1]
     if n == 0 or not math.isfinite(mean):
         return f"{a} against {b}: not compared, {too_few(0, _lower(h.title))}."
     if n < 2 or not math.isfinite(float(d["sd"])):
-        x = number(abs(mean))
-        return h.sentence.format(a=a, x=x, dir=direction, b=b) + per + \
+        return h.says(a, number(abs(mean)), mean, b, parts) + \
             f" ({n} replication{'s' if n != 1 else ''}: no interval)."
     if float(d["sd"]) == 0.0:
         if mean == 0.0:
             return f"{a} is the same as {b} in every replication ({h.title.lower()}: " \
                    f"no variation between replications)."
-        return h.sentence.format(a=a, x=number(abs(mean)), dir=direction, b=b) + per + \
+        return h.says(a, number(abs(mean)), mean, b, parts) + \
             f" in every one of {n} replications (no variation between replications)."
     lo, hi = float(d["ci_low"]), float(d["ci_high"])
-    text = h.sentence.format(a=a, x=plus_minus(abs(mean), half_width(d)), dir=direction, b=b)
-    text += f"{per} ({level} CI, paired over {n} replications)"
+    text = h.says(a, plus_minus(abs(mean), half_width(d)), mean, b, parts)
+    text += f" ({level} CI, paired over {n} replications)"
     if lo <= 0.0 <= hi:
         text += "; the interval includes zero: no difference shown"
     return text + "."
@@ -146,16 +150,18 @@ def markdown(summary: pd.DataFrame, differences: pd.DataFrame, replications: pd.
     lines += _variation(summary, sweep)
     lines += _precision(replications, summary, sweep, cols)
     present = [h for h in HEADLINES if h.column in set(summary["measure"])]
+    whole = {h.column for h in present  # counts: every run's value a whole number
+             if np.all(np.mod(replications[h.column].dropna().to_numpy(float), 1) == 0)}
     for h in present:
         lines += [f"## {h.title}" + (f", per {parts}-part run" if h.per_run and parts else ""),
                   ""]
-        whole = bool(np.all(np.mod(replications[h.column].dropna().to_numpy(float), 1) == 0))
-        lines += _table(summary[summary["measure"] == h.column], cols, policies, whole)
+        lines += _table(summary[summary["measure"] == h.column], cols, policies,
+                        h.column in whole)
         if f"fig_{h.column}.png" in figures:
             lines += ["", f"![{h.title}](fig_{h.column}.png)"]
         lines += [""] + _sentences(h, differences, cols, parts, sweep.confidence)
     lines += ["## Reading", ""]
-    for text in reading(summary, differences, sweep, cols, present):
+    for text in reading(summary, differences, sweep, cols, present, whole):
         lines += [text, ""]
     return "\n".join(lines).rstrip() + "\n"
 
@@ -244,16 +250,18 @@ def _sentences(h: Headline, differences: pd.DataFrame, cols: Sequence[str], part
 
 
 def reading(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
-            cols: Sequence[str], present: Sequence[Headline]) -> list[str]:
+            cols: Sequence[str], present: Sequence[Headline],
+            whole: Collection[str] = ()) -> list[str]:
     """Sentences drawn from the numbers: who is ahead where, by how much, trends, and
-    where single runs scatter so widely that the mean says little."""
+    where single runs scatter so widely that the mean says little; ``whole``: the measures
+    that count things (shown as whole numbers, as in their tables)."""
     out: list[str] = []
     if differences.empty:
         out.append("No paired differences: the sweep runs one policy and names no "
                    "`baseline:`; name a point there to compare the others with it.")
     for h in present:
         text = _verdicts(h, differences, cols) + _trend(h, summary, sweep, cols) \
-            + _scatter(h, summary, cols)
+            + _scatter(h, summary, cols, h.column in whole)
         if text:
             out.append(f"**{h.title}.** " + " ".join(text))
     return out
@@ -300,25 +308,35 @@ def _signed(row: Mapping[Any, Any]) -> str:
     return f"{mean:+.3g}" if abs(mean) >= HUGE else f"{mean:+.{decimals(half)}f}"
 
 
-def _scatter(h: Headline, summary: pd.DataFrame, cols: Sequence[str]) -> list[str]:
+def _scatter(h: Headline, summary: pd.DataFrame, cols: Sequence[str],
+             whole: bool = False) -> list[str]:
     """Points whose interval is wider than their mean: runs far apart, or a mean made
-    by a few extreme runs (it lies outside the range of 95 % of them)."""
+    by a few extreme runs (it lies outside the range of 95 % of them).  A count (``whole``)
+    is read in whole runs' counts: runs within one of each other (0 or 1) are not far apart,
+    and when 95 % of runs give one same count the rest make the mean."""
     out = []
     rows = summary[(summary["measure"] == h.column) & (summary["n"] >= 2)]
     for r in rows.to_dict("records"):
-        mean, lo, hi = (float(r[k]) for k in ("mean", "run_p2_5", "run_p97_5"))
-        half = half_width(r)
+        mean, half = float(r["mean"]), half_width(r)
         if not half > abs(mean) / 2:
             continue
+        shown = single_runs(r, whole)
+        lo, hi = (float(r["run_p2_5"]), float(r["run_p97_5"])) if not whole else \
+            (float(shown[0]), float(shown[1]))
         at = where(r, cols)
         who = f"{str(r['policy']).capitalize()}{' at ' + at if at else ''}"
-        runs = f"95 % of single runs {lo:.4g} to {hi:.4g}"
+        runs = f"95 % of single runs {shown[0]} to {shown[1]}"
+        mean_shown = plus_minus(mean, half)
         if lo <= mean <= hi:
-            out.append(f"{who} scatters widely between runs ({runs}; mean {mean:.4g} ± "
-                       f"{half:.2g}).")
+            if whole and hi - lo <= 1:
+                continue
+            out.append(f"{who} scatters widely between runs ({runs}; mean {mean_shown}).")
+        elif whole and lo == hi:
+            out.append(f"{who}: {shown[0]} in 95 % of single runs; the mean, {mean_shown}, "
+                       "comes from the few others (look at the replications).")
         else:
             out.append(f"{who}: a few runs lie far outside the others ({runs}, yet the mean is "
-                       f"{mean:.4g} ± {half:.2g}): the mean is theirs; look at the replications.")
+                       f"{mean_shown}): the mean is theirs; look at the replications.")
     return out
 
 

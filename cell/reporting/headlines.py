@@ -34,25 +34,31 @@ class Headline:
     """``higher``, ``lower`` or ``one`` (nearer 1 is better)."""
     per_run: bool = False
     """A count per run: the sentence says ``per N-part run``."""
-    unit: str = ""
+
+    def says(self, a: str, x: str, mean: float, b: str, parts: int | None) -> str:
+        """``a``'s paired difference ``mean`` from ``b`` in words, ``x`` its size as shown:
+        ``a delivers 3.1 ± 0.4 parts more than b per 500-part run``."""
+        direction = self.words[0] if mean >= 0 else self.words[1]
+        per = f" per {parts}-part run" if self.per_run and parts else ""
+        return self.sentence.format(a=a, x=x, dir=direction, b=b) + per
 
 
 HEADLINES: tuple[Headline, ...] = (
     Headline("parts_delivered", "Parts delivered", "{a} delivers {x} parts {dir} than {b}",
-             ("more", "fewer"), "higher", per_run=True, unit="parts"),
+             ("more", "fewer"), "higher", per_run=True),
     Headline("parts_missed", "Parts lost (wall clock)", "{a} loses {x} parts {dir} than {b}",
-             ("more", "fewer"), "lower", per_run=True, unit="parts"),
+             ("more", "fewer"), "lower", per_run=True),
     Headline("parts_per_hr_wallclock", "Parts per hour (wall clock)",
              "{a} delivers {x} parts/hr {dir} than {b} on the wall clock",
-             ("more", "fewer"), "higher", unit="parts/hr"),
+             ("more", "fewer"), "higher"),
     Headline("actual_cycle_wallclock_s", "Actual cycle (wall clock, s)",
              "{a} runs a wall-clock actual cycle {x} s {dir} than {b}",
-             ("longer", "shorter"), "lower", unit="s"),
+             ("longer", "shorter"), "lower"),
     Headline("ip_wallclock", "IP (wall clock, eq. 5.1)",
              "{a} reaches a wall-clock IP {x} {dir} than {b}", ("higher", "lower"), "one"),
     Headline("spacing_outside_tol", "Spacings outside 45 ± 0.25 in",
              "{a} leaves {x} {dir} spacings outside 45 ± 0.25 in than {b}",
-             ("more", "fewer"), "lower", per_run=True, unit="spacings"),
+             ("more", "fewer"), "lower", per_run=True),
 )
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from cell import thesis as published
 from cell.assembly import AssembledCell
@@ -13,9 +13,11 @@ from cell.policies.base import CellConstants
 from cell.records import LIMIT_COUNTS, RunSummary
 from cell.scenario import Scenario, load_scenario
 
+if TYPE_CHECKING:
+    from cell.sweep.spec import Sweep
+
 #: Relative difference between the nominal cycle and the arrivals' mean worth a warning.
 NOMINAL_MISMATCH = 0.01
-
 IP_LINE = ("IP (eq. 5.1) = the next part's inter-arrival time / the time between deliveries: "
            "1 means the cell keeps pace with its parts.  The thesis's accounting is how the "
            "thesis counted (docs/accounting.md, or `cell docs accounting`); the wall clock is what "
@@ -56,18 +58,50 @@ def run_heading(cell: AssembledCell) -> str:
 def warnings(k: CellConstants) -> list[str]:
     """One line each: the cell cannot keep up on average; the nominal cycle is not the
     arrivals' mean."""
+    from cell.sweep.spec import nominal_gap, overloaded
+
     out = []
     if k.utilisation >= 1:
-        from cell.sweep.spec import overloaded
-
         out.append(overloaded(f"utilisation {k.utilisation:.3f}",
                               (k.fastest_cycle_s, k.mean_interarrival_s)))
-    gap = k.cycle_nom / k.mean_interarrival_s - 1
-    if k.nominal_from == "scenario" and abs(gap) > NOMINAL_MISMATCH:
-        out.append(f"controller.nominal_cycle_s ({k.cycle_nom:.4f} s) is {gap:+.1%} off the "
-                   f"arrivals' mean ({k.mean_interarrival_s:.4f} s): the controller aims at it, "
-                   "not at the arrivals; set it to null to follow them")
+    if abs(nominal_gap(k)) > NOMINAL_MISMATCH:  # NaN: the cycle follows the arrivals
+        out.append(nominal_off(nominal_mismatch(k.cycle_nom, k.mean_interarrival_s)))
     return out
+
+
+def nominal_warning(sweep: Sweep) -> str | None:
+    """One line if some of a sweep's points keep a nominal cycle from its base that is more
+    than :data:`NOMINAL_MISMATCH` off their arrivals' mean (a sweep that sets or varies
+    ``controller.nominal_cycle_s`` itself chose it), naming the worst; else None."""
+    from cell.sweep.options import show
+
+    key = "controller.nominal_cycle_s"
+    if key in sweep.keys or key in dict(sweep.fixed):
+        return None
+    off = [p for p in sweep.points if abs(p.nominal_gap) > NOMINAL_MISMATCH]  # NaN: never
+    if not off:
+        return None
+    worst = max(off, key=lambda p: abs(p.nominal_gap))
+    cycle = float(worst.scenario.controller.nominal_cycle_s or math.nan)
+    where = ", ".join(f"{k} {worst.name_of(k) or show(v)}" for k, v in worst.values)
+    return nominal_off(f"{len(off)} of {len(sweep.points)} points keep {key} from the base, "
+                       f"up to {worst.nominal_gap:+.1%} off their arrivals' mean ({cycle:.4f} s "
+                       f"against {cycle / (1 + worst.nominal_gap):.4f} s, at "
+                       f"{where or worst.policy})", f" (set: {{{key}: null}} in the sweep file)")
+
+
+def nominal_mismatch(cycle_s: float, mean_s: float) -> str:
+    """``controller.nominal_cycle_s (X s) is +N% off the arrivals' mean (Y s)``."""
+    return (f"controller.nominal_cycle_s ({cycle_s:.4f} s) is {cycle_s / mean_s - 1:+.1%} off "
+            f"the arrivals' mean ({mean_s:.4f} s)")
+
+
+def nominal_off(how_much: str, how_to: str = "") -> str:
+    """The one line, for a run, a sweep (:func:`nominal_warning`) or a comparison, saying the
+    controller aims at a stated nominal cycle that is not the arrivals' mean: opened by
+    ``how_much``, ``how_to`` saying where to set it to null."""
+    return (f"{how_much}: the controller aims at it, not at the arrivals; set it to null to "
+            f"follow them{how_to}")
 
 
 def thesis_figures(s: Scenario) -> dict[str, str] | None:

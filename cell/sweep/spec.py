@@ -41,7 +41,7 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -63,6 +63,9 @@ from cell.sweep.options import (
     summary_measures,
     whole,
 )
+
+if TYPE_CHECKING:
+    from cell.policies.base import CellConstants
 
 #: At most this many grid points, and this many runs (points x replications), in a sweep.
 MAX_POINTS = 100_000
@@ -91,6 +94,9 @@ class Point:
     utilisation: float = math.nan
     """The robot's fastest cycle over the mean inter-arrival time here (1 or more: the cell
     cannot keep up on average)."""
+    nominal_gap: float = math.nan
+    """How far the nominal cycle the scenario states (``controller.nominal_cycle_s``) is off
+    the arrivals' mean here, relative and signed; NaN where the cycle follows the arrivals."""
 
     def name_of(self, key: str) -> str | None:
         """The name of this point's value of ``key``, if the sweep file named it."""
@@ -296,7 +302,7 @@ def load_sweep(path: str | Path) -> Sweep:
                 {**fixed, "controller.policy": policy, **dict(values)}, file=path,
                 paths_from=path.parent)
             points.append(Point(policy, i, values, scenario, named,
-                                _check_point(scenario, path)))
+                                **_check_point(scenario, path)))
             checking.update()
     checking.close()
 
@@ -334,16 +340,24 @@ def overloaded(how_much: str, times_s: tuple[float, float] | None = None) -> str
             "will lose parts")
 
 
-def _check_point(scenario: Scenario, file: object) -> float:
+def _check_point(scenario: Scenario, file: object) -> dict[str, float]:
     """Assemble a grid point's cell now, so that no bad point is found after work began;
     an error names the sweep file, with the key and value it was about.  Returns the
-    point's utilisation."""
+    point's utilisation and nominal_gap (:class:`Point`)."""
     from cell.assembly import assemble
 
     try:
-        return assemble(scenario).k.utilisation
+        k = assemble(scenario).k
     except ScenarioError as exc:
         raise ScenarioError(file, exc.key, exc.value, exc.why) from None
+    return {"utilisation": k.utilisation, "nominal_gap": nominal_gap(k)}
+
+
+def nominal_gap(k: CellConstants) -> float:
+    """How far the nominal cycle a scenario states is off its arrivals' mean, relative and
+    signed; NaN where the cycle follows the arrivals (or the robot): for
+    :attr:`Point.nominal_gap` and :func:`cell.reporting.runs.warnings`."""
+    return k.cycle_nom / k.mean_interarrival_s - 1 if k.nominal_from == "scenario" else math.nan
 
 
 def comparison(a: Scenario, b: Scenario, labels: tuple[str, str], replications: int, seed: int,
@@ -354,9 +368,9 @@ def comparison(a: Scenario, b: Scenario, labels: tuple[str, str], replications: 
     la, lb = labels
     if la == lb:
         raise ValueError(f"the two sides of a comparison need different labels, not {la!r} twice")
-    pa = Point(a.controller.policy, 0, (("scenario", la),), a, (), _check_point(a, a.source))
+    pa = Point(a.controller.policy, 0, (("scenario", la),), a, (), **_check_point(a, a.source))
     pb = Point(b.controller.policy, int(b.controller.policy == a.controller.policy),
-               (("scenario", lb),), b, (), _check_point(b, b.source))
+               (("scenario", lb),), b, (), **_check_point(b, b.source))
     return Sweep(f"{la} against {lb}", "compare", f"{la} against {lb}", a, (), ("scenario",),
                  (pa, pb), replications, seed, min(batch, replications),
                  baseline=Baseline(b.controller.policy, (("scenario", lb),),
