@@ -4,6 +4,7 @@ bounds, a drive too weak for the arm, and ``cell mintime``'s files."""
 from __future__ import annotations
 
 from cell.assembly import geometry_of, motors_of, planner_bounds
+from cell.cli import main
 from cell.mintime.regimes import fastest_regime_times
 from cell.scenario import load_scenario
 
@@ -27,3 +28,26 @@ def test_a_small_file_under_minimum_time_plans_as_the_baseline(tmp_path):
     heavy.write_text("links: {mass_kg: [1.6, 0.6, 0.5, 0.10, 0.20]}\n")
     own = load_scenario(mine, {"mintime.dynamics_file": str(heavy)})
     assert _fastest(own)["R2"] > _fastest(s)["R2"]
+
+
+def test_cell_run_and_cell_mintime_name_the_planners_bounds(tmp_path, capsys):
+    """Under minimum-time timing the heading names the bounds in one line; the two planners
+    (dynamic model, assumed acceleration bounds) can be told apart from the output alone."""
+    runs = {"dynamic": ["baseline"],
+            "kinematic": ["mintime_kinematic", "--set", "mintime.rate_fraction=0.5"]}
+    lines = {}
+    for label, args in runs.items():
+        assert main(["run", *args, "--set", "robot.timing=minimum-time", "--set", "run.parts=3",
+                     "--out", str(tmp_path / label)]) == 0
+        out = capsys.readouterr().out.splitlines()
+        lines[label] = [ln for ln in out if ln.startswith("minimum-time planner:")]
+    dyn, = lines["dynamic"]
+    assert "dynamic model " in dyn and dyn.endswith("microbot_dynamics.yaml")
+    assert "acceleration" not in dyn and "at the motors' peak rates" in dyn
+    kin, = lines["kinematic"]
+    assert "dynamic model" not in kin and "0.5 × the motors' peak rates" in kin
+    assert kin.endswith("assumed acceleration bounds [2, 2, 4, 8, 8] rad/s²")
+    assert main(["run", "baseline", "--set", "run.parts=3", "--out", str(tmp_path / "c")]) == 0
+    assert "planner" not in capsys.readouterr().out       # constant-rate timing plans nothing
+    assert main(["mintime", "baseline", "--out", str(tmp_path / "m")]) == 0
+    assert dyn in capsys.readouterr().out.splitlines()

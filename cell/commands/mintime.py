@@ -90,6 +90,9 @@ def main(args: argparse.Namespace) -> int:
     with OutputDir(args.out, FILES) as out:
         out.write_csv("profile.csv", table.replace([np.inf], np.nan))
         out.write_text("summary.json", doc)
+    from cell.reporting.mintime import planner_line
+
+    print(planner_line(scenario))
     times = ", ".join(f"{r} {res.profile.time_s:.4f} s" for r, res in results.items())
     print(f"wrote {out.target}/profile.csv and summary.json: {times}")
     return 0
