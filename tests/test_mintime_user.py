@@ -51,3 +51,46 @@ def test_cell_run_and_cell_mintime_name_the_planners_bounds(tmp_path, capsys):
     assert "planner" not in capsys.readouterr().out       # constant-rate timing plans nothing
     assert main(["mintime", "baseline", "--out", str(tmp_path / "m")]) == 0
     assert dyn in capsys.readouterr().out.splitlines()
+
+
+def _dynamics(tmp_path, name, key, values):
+    """A copy of the built-in dynamics file with one list replaced."""
+    import re
+
+    from cell import catalog
+
+    text = catalog.path("microbot_dynamics.yaml").read_text()
+    text, n = re.subn(rf"(?m)^(\s*{key}:).*$", rf"\1 {values}", text)
+    assert n == 1
+    (tmp_path / name).write_text(text)
+    return str(tmp_path / name)
+
+
+def test_a_drive_too_weak_for_the_arm_names_the_file_key_joint_and_torques(tmp_path, capsys):
+    """The shoulder's stall torque below what holding the arm at rest takes: one line naming
+    the dynamics file, its key and value, the joint and both torques; nothing written.  The
+    torque named is where the planner's own boundary lies: a little more passes that point."""
+    out = tmp_path / "out"
+    for stall, regime, needed in (("0.5", "R2", "1.4"), ("1.39", "R2", "1.4"),
+                                  ("1.42", "R4", "1.62")):
+        weak = _dynamics(tmp_path, "weak.yaml", "stall_torque_nm", f"[3.1, {stall}, 1.66, 1.14, 1.14]")
+        for command in (["mintime"], ["run", "--set", "robot.timing=minimum-time"]):
+            args = [command[0], "baseline", *command[1:], "--set", f"mintime.dynamics_file={weak}"]
+            assert main([*args, "--out", str(out)]) == 2
+            err = capsys.readouterr().err
+            assert err.count("\n") == 1 and not out.exists()
+            assert err.startswith(f"cell: error: {weak}: drives.stall_torque_nm = [3.1, {stall}, ")
+            assert (f"the shoulder (joint 2) needs {needed} N·m to hold the arm against gravity "
+                    f"at the start of {regime}, more than its stall torque {stall} N·m") in err
+    assert main(["mintime", "baseline", "--set", "mintime.dynamics_file=" + _dynamics(
+        tmp_path, "ok.yaml", "stall_torque_nm", "[3.1, 1.7, 1.66, 1.14, 1.14]"),
+        "--out", str(out)]) == 0
+
+
+def test_links_too_heavy_name_the_masses(tmp_path, capsys):
+    heavy = _dynamics(tmp_path, "heavy.yaml", "mass_kg", "[1.6, 0.9, 0.75, 0.30, 0.40]")
+    assert main(["mintime", "baseline", "--set", f"mintime.dynamics_file={heavy}",
+                 "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert f"{heavy}: links.mass_kg = [1.6, 0.9, 0.75, 0.3, 0.4]: the shoulder (joint 2)" in err
+    assert "more than its stall torque 3.4 N·m" in err and "baseline.yaml" in err

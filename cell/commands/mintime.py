@@ -58,8 +58,8 @@ def check_out(out: str) -> None:
 def main(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from cell.assembly import geometry_of, motors_of, planner_bounds, step_table
-    from cell.errors import CellError, InfeasibleError, NoMotionError, ScenarioError
+    from cell.assembly import geometry_of, motors_of, planner_bounds, planner_error, step_table
+    from cell.errors import InfeasibleError, NoMotionError, ScenarioError
     from cell.mintime.regimes import plan_regimes, summary
     from cell.output import OutputDir
     from cell.scenario import MAX_TIME_S, inert_settings
@@ -74,7 +74,7 @@ def main(args: argparse.Namespace) -> int:
     try:
         results = plan_regimes(geometry_of(scenario), motors_of(scenario), bounds)
     except NoMotionError as exc:
-        raise CellError(f"{scenario.source}: mintime: {exc}") from None
+        raise planner_error(scenario, exc, "mintime") from None
     except InfeasibleError as exc:  # the drives cannot turn at the motors' rates (dynamics file)
         raise ScenarioError(scenario.source, rates, scenario.get(rates),
                             f"{exc} (drives of {scenario.mintime.dynamics_file})") from None
