@@ -3,10 +3,14 @@ bounds, a drive too weak for the arm, and ``cell mintime``'s files."""
 
 from __future__ import annotations
 
+import pytest
+
 from cell.assembly import geometry_of, motors_of, planner_bounds
 from cell.cli import main
-from cell.mintime.regimes import fastest_regime_times
+from cell.mintime.regimes import fastest_regime_times, plan_regimes
 from cell.scenario import load_scenario
+
+KIN = load_scenario("mintime_kinematic")
 
 
 def _fastest(s):
@@ -94,3 +98,23 @@ def test_links_too_heavy_name_the_masses(tmp_path, capsys):
     err = capsys.readouterr().err
     assert f"{heavy}: links.mass_kg = [1.6, 0.9, 0.75, 0.3, 0.4]: the shoulder (joint 2)" in err
     assert "more than its stall torque 3.4 N·m" in err and "baseline.yaml" in err
+
+
+def test_elapsed_time_is_the_planners_time_sum():
+    """t_s: 0 at the start, the profile's time_s bit for bit at the end (math.fsum), and s
+    itself where ṡ = 1 throughout."""
+    import math
+
+    import numpy as np
+
+    from cell.mintime.planner import elapsed_s
+
+    s = np.linspace(0.0, 1.0, 7) ** 2
+    assert elapsed_s(s, np.ones(7)) == pytest.approx(s, abs=1e-15)
+    sdot = np.array([0.0, 0.3, 0.7, 1e-3, 2.0, 0.5, 0.0])
+    t = elapsed_s(s, sdot)
+    terms = 2 * np.diff(s) / (sdot[1:] + sdot[:-1])
+    assert t[0] == 0 and list(t[1:]) == [math.fsum(terms[:i]) for i in range(1, 7)]
+    res = plan_regimes(geometry_of(KIN), motors_of(KIN), planner_bounds(KIN))
+    for r in res.values():
+        assert elapsed_s(r.profile.s, r.profile.sdot)[-1] == r.profile.time_s

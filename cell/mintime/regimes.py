@@ -171,17 +171,18 @@ def summary(results: dict[str, RegimeResult], bounds: PlannerBounds) -> dict[str
 
     ``limits.qdot_max_rad_s`` is the elementwise tightest over the regimes (R II
     carries the part, so its rates are lower); each regime also lists its own.
+    ``limits.qddot_max_rad_s2`` is there only when the acceleration bounds applied.
     """
     v = np.min([res.qdot_max_rad_s for res in results.values()], axis=0)
+    limits: dict[str, Any] = {"qdot_max_rad_s": v.tolist()}
+    if bounds.acceleration_bounds:
+        limits["qddot_max_rad_s2"] = list(bounds.qddot_max_rad_s2)
+    limits["acceleration_bounds"] = bounds.acceleration_bounds
+    limits["torque"] = bounds.dynamics is not None
     return {
         "regimes": {r: {"time_s": res.profile.time_s, "switching_s": res.profile.switching_s,
                         "qdot_max_rad_s": res.qdot_max_rad_s.tolist(),
                         "grid_points": len(res.profile.s)}
                     for r, res in results.items()},
-        "limits": {
-            "qdot_max_rad_s": v.tolist(),
-            "qddot_max_rad_s2": list(bounds.qddot_max_rad_s2),
-            "acceleration_bounds": bounds.acceleration_bounds,
-            "torque": bounds.dynamics is not None,
-        },
+        "limits": limits,
     }
