@@ -186,7 +186,32 @@ def _solved_timing(s: Scenario) -> RobotTiming:
         raise ScenarioError(s.source, key, s.get(key),
                             f"{exc} of the dynamic model ({s.mintime.dynamics_file})") from None
     except NoMotionError as exc:
-        raise CellError(f"{s.source}: robot.timing = 'minimum-time': {exc}") from None
+        raise planner_error(s, exc, "robot.timing = 'minimum-time'") from None
+
+
+def planner_error(s: Scenario, exc: NoMotionError, asked: str) -> CellError:
+    """The planner's "no motion" as one line naming its cause: a drive too weak to hold the
+    arm (the dynamics file, the key that made it so, the torques), no bound on the
+    accelerations at all (``mintime.acceleration_bounds``), else the scenario and ``asked``, the
+    key that asked for the planner, with the dynamic model planned with."""
+    from cell.dynamics import Drives, Links
+    from cell.mintime.regimes import WeakDriveError
+
+    mt = s.mintime
+    if not mt.acceleration_bounds and mt.dynamics_file is None:
+        return ScenarioError(s.source, "mintime.acceleration_bounds", False, "with "
+                             "mintime.dynamics_file empty too, nothing bounds the minimum-time "
+                             "planner's accelerations: the fastest motion would need infinite "
+                             "acceleration (set either)")
+    path = dynamics_path(s)
+    if isinstance(exc, WeakDriveError) and path is not None:
+        model = planner_bounds(s).dynamics
+        key, value = "drives.stall_torque_nm", model.drives.stall_torque_nm
+        if value == Drives.stall_torque_nm and model.links.mass_kg != Links.mass_kg:
+            key, value = "links.mass_kg", model.links.mass_kg
+        return ScenarioError(path, key, value, f"{exc} (the dynamic model of {s.source})")
+    model_used = f" (dynamic model {path})" if path is not None else ""
+    return CellError(f"{s.source}: {asked}: {exc}{model_used}")
 
 
 #: The scenario sections the robot's timing is solved from: the cell's layout, the path,

@@ -261,10 +261,11 @@ class MinTimeSettings(Section):
     rate_fraction: float = _num(1.0, gt=0.0, le=1.0)
     """Joint velocity bounds = the motors' step rates at the regime's load (§6.1) times
     this: 1.0 is the peak, as in the thesis's minimum feasible cycle (§7.2)."""
-    acceleration_bounds: bool = Field(True, strict=True)
-    """Apply ``qddot_max_rad_s2``; switch off when the dynamic model is to set the
+    acceleration_bounds: bool = Field(False, strict=True)
+    """Apply ``qddot_max_rad_s2``; off, as in baseline.yaml: the dynamic model sets the
     accelerations alone."""
     qddot_max_rad_s2: PositiveFive = (2.0, 2.0, 4.0, 8.0, 8.0)
     """Joint acceleration bounds; ASSUMED (a stepper indexer's ramp; the thesis has none)."""
-    dynamics_file: str | None = None
-    """YAML of the rigid-body model (relative to the scenario file); empty: no torque bounds."""
+    dynamics_file: str | None = "microbot_dynamics.yaml"
+    """YAML of the rigid-body model (beside the scenario file, else the built-in file of that
+    name), as in baseline.yaml; empty: no torque bounds."""

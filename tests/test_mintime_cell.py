@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -70,17 +71,23 @@ def test_cli_writes_profile_and_summary(tmp_path, scenario, torque):
     assert sorted(p.name for p in out.iterdir()) == ["profile.csv", "summary.json"]
     assert set(doc["regimes"]) == {"R2", "R4"}
     assert doc["limits"]["torque"] is torque
-    assert len(doc["limits"]["qdot_max_rad_s"]) == 5 and len(doc["limits"]["qddot_max_rad_s2"]) == 5
+    assert len(doc["limits"]["qdot_max_rad_s"]) == 5
+    # the acceleration bounds are listed only where they applied (the kinematic planner)
+    assert doc["limits"]["acceleration_bounds"] is not torque
+    assert len(doc["limits"].get("qddot_max_rad_s2", [])) == (0 if torque else 5)
     frame = pd.read_csv(out / "profile.csv")
-    assert list(frame.columns) == ["regime", "s", "theta1_rad", "theta2_rad", "theta3_rad",
+    assert list(frame.columns) == ["regime", "s", "t_s", "theta1_rad", "theta2_rad", "theta3_rad",
                                    "theta4_rad", "theta5_rad", "sdot", "sdot_limit"]
     assert (frame.groupby("regime").size() == 460).all()
     assert (frame["sdot"] <= frame["sdot_limit"] * (1 + 1e-9)).all()
-    # The CSV's own profile gives the JSON's time: T = Σ 2Δs/(ṡ_i + ṡ_{i+1}).
+    # The CSV's own profile gives the JSON's time: T = Σ 2Δs/(ṡ_i + ṡ_{i+1}), and t_s runs
+    # from 0 to T, its steps those of the sum.
     for r, g in frame.groupby("regime"):
-        sd, s = g["sdot"].to_numpy(), g["s"].to_numpy()
-        t = (2 * (s[1:] - s[:-1]) / (sd[1:] + sd[:-1])).sum()
-        assert t == pytest.approx(doc["regimes"][r]["time_s"], rel=1e-8)
+        sd, s, t_s = g["sdot"].to_numpy(), g["s"].to_numpy(), g["t_s"].to_numpy()
+        steps = 2 * (s[1:] - s[:-1]) / (sd[1:] + sd[:-1])
+        assert steps.sum() == pytest.approx(doc["regimes"][r]["time_s"], rel=1e-8)
+        assert t_s[0] == 0 and t_s[-1] == pytest.approx(doc["regimes"][r]["time_s"], rel=1e-9)
+        assert np.diff(t_s) == pytest.approx(steps, abs=1e-7)  # to the CSV's 10 digits
 
 
 def test_cli_bad_dynamics_file_is_one_line_and_no_output(tmp_path, capsys):
@@ -157,7 +164,7 @@ def test_acceleration_bounds_switched_off_make_their_values_a_warning(tmp_path, 
     assert main(["mintime", "baseline", "--out", str(tmp_path / "b")]) == 0
     assert "warning" not in capsys.readouterr().err
     a, b = (json.loads((tmp_path / d / "summary.json").read_text()) for d in "ab")
-    assert a["regimes"] == b["regimes"]  # the same motion (the limits section records the values)
+    assert a == b  # the same motion, and the unused bounds are not listed as limits
     assert main(["mintime", "baseline", "--set", "mintime.acceleration_bounds=true", "--set",
                  "mintime.qddot_max_rad_s2=[3, 3, 5, 9, 9]", "--out", str(tmp_path / "c")]) == 0
     assert "warning" not in capsys.readouterr().err

@@ -1,9 +1,10 @@
 """``cell mintime SCENARIO --out DIR``: the minimum-time R II and R IV (Shin & McKay 1983).
 
 Writes DIR/profile.csv (one row per grid point of each regime: regime, s, the
-joint angles, ṡ and the velocity-limit curve) and DIR/summary.json (each
-regime's time and switching points, and the limits used) as one set: both
-appear together or neither does.
+time from the regime's start, the joint angles, ṡ and the velocity-limit curve)
+and DIR/summary.json (each regime's time and switching points, and the limits
+used) as one set: both appear together or neither does.  README.md describes
+every column and key.
 """
 
 from __future__ import annotations
@@ -19,8 +20,8 @@ from cell.commands import scenario_arguments, scenario_of
 HELP = "minimum-time motion along the path (Shin & McKay)"
 DESCRIPTION = ("Phase-plane minimum-time parameterisation of R II and R IV; writes "
                "DIR/profile.csv and DIR/summary.json.")
-COLUMNS = ["regime", "s", "theta1_rad", "theta2_rad", "theta3_rad", "theta4_rad", "theta5_rad",
-           "sdot", "sdot_limit"]
+COLUMNS = ["regime", "s", "t_s", "theta1_rad", "theta2_rad", "theta3_rad", "theta4_rad",
+           "theta5_rad", "sdot", "sdot_limit"]
 #: The files of ``cell mintime``, written as one set.
 FILES = ("profile.csv", "summary.json")
 
@@ -28,10 +29,12 @@ FILES = ("profile.csv", "summary.json")
 def frame(results: dict[str, Any]) -> Any:
     import pandas as pd
 
+    from cell.mintime.planner import elapsed_s
+
     parts = []
     for r, res in results.items():
         p = res.profile
-        data = {"regime": r, "s": p.s}
+        data = {"regime": r, "s": p.s, "t_s": elapsed_s(p.s, p.sdot)}
         data.update({f"theta{j + 1}_rad": res.q[:, j] for j in range(5)})
         data.update({"sdot": p.sdot, "sdot_limit": p.sdot_limit})
         parts.append(pd.DataFrame(data, columns=COLUMNS))
@@ -58,8 +61,8 @@ def check_out(out: str) -> None:
 def main(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from cell.assembly import geometry_of, motors_of, planner_bounds, step_table
-    from cell.errors import CellError, InfeasibleError, NoMotionError, ScenarioError
+    from cell.assembly import geometry_of, motors_of, planner_bounds, planner_error, step_table
+    from cell.errors import InfeasibleError, NoMotionError, ScenarioError
     from cell.mintime.regimes import plan_regimes, summary
     from cell.output import OutputDir
     from cell.scenario import MAX_TIME_S, inert_settings
@@ -74,7 +77,7 @@ def main(args: argparse.Namespace) -> int:
     try:
         results = plan_regimes(geometry_of(scenario), motors_of(scenario), bounds)
     except NoMotionError as exc:
-        raise CellError(f"{scenario.source}: mintime: {exc}") from None
+        raise planner_error(scenario, exc, "mintime") from None
     except InfeasibleError as exc:  # the drives cannot turn at the motors' rates (dynamics file)
         raise ScenarioError(scenario.source, rates, scenario.get(rates),
                             f"{exc} (drives of {scenario.mintime.dynamics_file})") from None
@@ -90,6 +93,9 @@ def main(args: argparse.Namespace) -> int:
     with OutputDir(args.out, FILES) as out:
         out.write_csv("profile.csv", table.replace([np.inf], np.nan))
         out.write_text("summary.json", doc)
+    from cell.reporting.mintime import planner_line
+
+    print(planner_line(scenario))
     times = ", ".join(f"{r} {res.profile.time_s:.4f} s" for r, res in results.items())
     print(f"wrote {out.target}/profile.csv and summary.json: {times}")
     return 0

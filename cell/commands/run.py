@@ -46,6 +46,9 @@ def main(args: argparse.Namespace) -> int:
     cell = assemble(scenario)  # every error is raised before anything is written
     print(run_heading(cell))
     timed = scenario.robot.timing == "minimum-time"  # the planner's settings matter
+    if timed:
+        from cell.reporting.mintime import planner_line
+        print(planner_line(scenario))
     for line in [*warnings(cell.k), *(inert_settings(scenario) if timed else [])]:
         print(f"cell: warning: {line}", file=sys.stderr)
     n = scenario.run.parts

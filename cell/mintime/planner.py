@@ -36,6 +36,7 @@ run and whichever SIMD code paths numpy picks on the machine.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -48,8 +49,8 @@ from cell.types import Array
 
 from .rows import PathRows, acceleration_rows, torque_rows, velocity_rows
 
-__all__ = ["NoMotionError", "PathRows", "Profile", "acceleration_rows", "path_grid", "plan",
-           "torque_rows", "velocity_limit", "velocity_rows"]
+__all__ = ["NoMotionError", "PathRows", "Profile", "acceleration_rows", "elapsed_s", "path_grid",
+           "plan", "torque_rows", "velocity_limit", "velocity_rows"]
 
 
 #: |a| below this fraction of the row's largest |a| along the path counts as
@@ -368,9 +369,19 @@ def plan(rows: PathRows, sdot_start: float = 0.0, sdot_end: float = 0.0) -> Prof
     if np.any(speed <= 0):
         i = int(np.flatnonzero(speed <= 0)[0])
         raise NoMotionError(f"no motion possible at {_where(s, i)}: the path velocity is zero")
-    # math.fsum is correctly rounded: T does not depend on the order of the terms.
-    time_s = math.fsum((2.0 * np.diff(s) / speed).tolist())
+    time_s = float(elapsed_s(s, sdot)[-1])
     return Profile(s, sdot, limit, phase, time_s, _switches(s, phase))
+
+
+def elapsed_s(s: Array, sdot: Array) -> Array:
+    """(N,) the time at each grid point from the start, t_0 = 0: the partial sums of
+    T = Σ 2Δs / (ṡ_i + ṡ_{i+1}) (ṡ_i + ṡ_{i+1} > 0), each correctly rounded, as math.fsum
+    rounds: the sums are exact in integers (every float is an integer over a power of two),
+    so the last is ``time_s`` bit for bit on every machine, whatever the order of the terms."""
+    ratios = [x.as_integer_ratio() for x in (2.0 * np.diff(s) / (sdot[:-1] + sdot[1:])).tolist()]
+    den = max((d for _, d in ratios), default=1)      # powers of two: the largest is their lcm
+    sums = itertools.accumulate(n * (den // d) for n, d in ratios)
+    return np.array([0.0, *(total / den for total in sums)])   # int / int: correctly rounded
 
 
 def _switches(s: Array, phase: NDArray[np.int8]) -> list[float]:

@@ -23,7 +23,7 @@ from scipy.interpolate import CubicSpline
 from cell.cache import memo
 from cell.dynamics import DynamicsModel, chain, free_speed
 from cell.errors import CellError, NoMotionError
-from cell.kinematics import hand_length
+from cell.kinematics import JOINT_NAMES, hand_length
 from cell.motors import Motors, max_rates
 from cell.path import CellGeometry
 from cell.steptable import StepTable
@@ -100,6 +100,37 @@ def regime_rows(rp: RegimePath, motors: Motors, bounds: PlannerBounds, geometry:
     return s, q, PathRows.join(*parts), vmax
 
 
+class WeakDriveError(NoMotionError):
+    """No motion where a drive cannot hold the arm against gravity at rest: joint ``joint``
+    (0-4) needs ``needed_nm`` at ``s`` of ``regime``, more than its stall torque ``stall_nm``."""
+
+    def __init__(self, regime: str, s: float, joint: int, needed_nm: float, stall_nm: float):
+        self.regime, self.s, self.joint = regime, s, joint
+        self.needed_nm, self.stall_nm = needed_nm, stall_nm
+        where = "at the start of" if s == 0 else "at the end of" if s == 1 else f"at s = {s:.4f} of"
+        super().__init__(f"the {JOINT_NAMES[joint]} (joint {joint + 1}) needs {needed_nm:.3g} N·m "
+                         f"to hold the arm against gravity {where} {regime}, more than its "
+                         f"stall torque {stall_nm:.3g} N·m")
+
+
+def weak_drive(rp: RegimePath, model: DynamicsModel | None, geometry: CellGeometry,
+               s: NDArray[np.float64], q: NDArray[np.float64]) -> WeakDriveError | None:
+    """The first grid point of ``rp`` where a drive's stall torque cannot hold the arm still
+    (gravity alone; the joint whose shortfall is largest there), or None."""
+    if model is None:
+        return None
+    ch = chain(model, geometry.arm.l2, geometry.arm.l3, rp.load_oz, rp.tcp_in)
+    zero = np.zeros_like(q)
+    hold = np.abs(ch.rnea(q, zero, zero, friction=False, gravity=True))
+    stall = np.asarray(model.drives.stall_torque_nm, float)
+    short = np.flatnonzero((hold > stall).any(axis=1))
+    if len(short) == 0:
+        return None
+    i = int(short[0])
+    j = int(np.argmax(hold[i] / stall))
+    return WeakDriveError(rp.regime, float(s[i]), j, float(hold[i, j]), float(stall[j]))
+
+
 @dataclass(frozen=True)
 class RegimeResult:
     regime: str
@@ -120,7 +151,8 @@ def plan_regimes(geometry: CellGeometry, motors: Motors, bounds: PlannerBounds,
         try:
             profile = plan(rows)
         except CellError as exc:
-            raise NoMotionError(f"regime {r}: {exc}") from None
+            weak = weak_drive(rp, bounds.dynamics, geometry, s, q)
+            raise weak or NoMotionError(f"regime {r}: {exc}") from None
         out[r] = RegimeResult(r, q, profile, vmax)
     return out
 
@@ -139,17 +171,18 @@ def summary(results: dict[str, RegimeResult], bounds: PlannerBounds) -> dict[str
 
     ``limits.qdot_max_rad_s`` is the elementwise tightest over the regimes (R II
     carries the part, so its rates are lower); each regime also lists its own.
+    ``limits.qddot_max_rad_s2`` is there only when the acceleration bounds applied.
     """
     v = np.min([res.qdot_max_rad_s for res in results.values()], axis=0)
+    limits: dict[str, Any] = {"qdot_max_rad_s": v.tolist()}
+    if bounds.acceleration_bounds:
+        limits["qddot_max_rad_s2"] = list(bounds.qddot_max_rad_s2)
+    limits["acceleration_bounds"] = bounds.acceleration_bounds
+    limits["torque"] = bounds.dynamics is not None
     return {
         "regimes": {r: {"time_s": res.profile.time_s, "switching_s": res.profile.switching_s,
                         "qdot_max_rad_s": res.qdot_max_rad_s.tolist(),
                         "grid_points": len(res.profile.s)}
                     for r, res in results.items()},
-        "limits": {
-            "qdot_max_rad_s": v.tolist(),
-            "qddot_max_rad_s2": list(bounds.qddot_max_rad_s2),
-            "acceleration_bounds": bounds.acceleration_bounds,
-            "torque": bounds.dynamics is not None,
-        },
+        "limits": limits,
     }

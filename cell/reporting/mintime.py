@@ -14,24 +14,43 @@ from pathlib import Path
 
 from cell.assembly import (
     constants,
+    dynamics_path,
     geometry_of,
     motors_of,
     planner_bounds,
     robot_timing,
     step_table,
 )
-from cell.mintime.regimes import plan_regimes, summary
+from cell.errors import shown_path
 from cell.output import OutputDir
 from cell.reporting.headlines import table_head, table_row
-from cell.scenario import load_scenario
+from cell.scenario import Scenario, load_scenario
 
 SCENARIOS = {"kinematic": "mintime_kinematic.yaml", "dynamic": "baseline.yaml"}
 #: The files this report writes.
 FILES = ("kinematic.json", "dynamic.json", "cycles.json", "README.md")
 
 
+def planner_line(s: Scenario) -> str:
+    """One line naming the bounds the minimum-time planner works under (``cell run``'s
+    heading under minimum-time timing, and ``cell mintime``)."""
+    m = s.mintime
+    rates = "the motors' peak rates" if m.rate_fraction == 1 else \
+        f"{m.rate_fraction:g} × the motors' peak rates"
+    bounds = [f"joint velocities at {rates}"]
+    path = dynamics_path(s)
+    if path is not None:
+        bounds.append(f"dynamic model {shown_path(path)}")
+    if m.acceleration_bounds:
+        bounds.append("assumed acceleration bounds "
+                      f"[{', '.join(f'{v:g}' for v in m.qddot_max_rad_s2)}] rad/s²")
+    return "minimum-time planner: " + "; ".join(bounds)
+
+
 def cycles(docs: dict[str, dict] | None = None) -> dict:
     """The minimum cycle under each timing model; ``docs`` receives each planner summary."""
+    from cell.mintime.regimes import plan_regimes, summary
+
     docs = {} if docs is None else docs
     base = load_scenario("baseline")
     table = step_table(base)
@@ -125,8 +144,9 @@ def readme(c: dict) -> str:
         "  depends on the acceleration the stepper drives can really give, which the thesis",
         "  does not measure.",
         "",
-        "`kinematic.json` and `dynamic.json` are `cell mintime` outputs (times and switching",
-        "points of R II and R IV, and the limits); `cycles.json` holds the table above.",
+        "`kinematic.json` and `dynamic.json` are `cell mintime`'s `summary.json` for each scenario",
+        "(times and switching points of R II and R IV, and the limits; the top README's",
+        "minimum-time section describes each key); `cycles.json` holds the table above.",
         "",
         "## Table 7.1 under minimum-time timing",
         "",

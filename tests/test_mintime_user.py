@@ -1,0 +1,120 @@
+"""What a user of minimum-time timing sees: the planner's defaults, the line naming its
+bounds, a drive too weak for the arm, and ``cell mintime``'s files."""
+
+from __future__ import annotations
+
+import pytest
+
+from cell.assembly import geometry_of, motors_of, planner_bounds
+from cell.cli import main
+from cell.mintime.regimes import fastest_regime_times, plan_regimes
+from cell.scenario import load_scenario
+
+KIN = load_scenario("mintime_kinematic")
+
+
+def _fastest(s):
+    return fastest_regime_times(geometry_of(s), motors_of(s), planner_bounds(s))
+
+
+def test_a_small_file_under_minimum_time_plans_as_the_baseline(tmp_path):
+    """A key left out of a what-if file is baseline.yaml's: the dynamic model, no assumed
+    acceleration bounds, so the same R II and R IV as the baseline under minimum-time timing."""
+    mine = tmp_path / "mt_only.yaml"
+    mine.write_text("name: mt-only\nrobot:\n  timing: minimum-time\n")
+    s = load_scenario(mine)
+    assert s.mintime.dynamics_file == "microbot_dynamics.yaml"
+    assert s.mintime.acceleration_bounds is False
+    base = load_scenario("baseline", {"robot.timing": "minimum-time"})
+    assert _fastest(s) == _fastest(base)
+    # a dynamics file of the user's own is then the only bound on the accelerations
+    heavy = tmp_path / "heavy_dyn.yaml"
+    heavy.write_text("links: {mass_kg: [1.6, 0.6, 0.5, 0.10, 0.20]}\n")
+    own = load_scenario(mine, {"mintime.dynamics_file": str(heavy)})
+    assert _fastest(own)["R2"] > _fastest(s)["R2"]
+
+
+def test_cell_run_and_cell_mintime_name_the_planners_bounds(tmp_path, capsys):
+    """Under minimum-time timing the heading names the bounds in one line; the two planners
+    (dynamic model, assumed acceleration bounds) can be told apart from the output alone."""
+    runs = {"dynamic": ["baseline"],
+            "kinematic": ["mintime_kinematic", "--set", "mintime.rate_fraction=0.5"]}
+    lines = {}
+    for label, args in runs.items():
+        assert main(["run", *args, "--set", "robot.timing=minimum-time", "--set", "run.parts=3",
+                     "--out", str(tmp_path / label)]) == 0
+        out = capsys.readouterr().out.splitlines()
+        lines[label] = [ln for ln in out if ln.startswith("minimum-time planner:")]
+    dyn, = lines["dynamic"]
+    assert "dynamic model " in dyn and dyn.endswith("microbot_dynamics.yaml")
+    assert "acceleration" not in dyn and "at the motors' peak rates" in dyn
+    kin, = lines["kinematic"]
+    assert "dynamic model" not in kin and "0.5 × the motors' peak rates" in kin
+    assert kin.endswith("assumed acceleration bounds [2, 2, 4, 8, 8] rad/s²")
+    assert main(["run", "baseline", "--set", "run.parts=3", "--out", str(tmp_path / "c")]) == 0
+    assert "planner" not in capsys.readouterr().out       # constant-rate timing plans nothing
+    assert main(["mintime", "baseline", "--out", str(tmp_path / "m")]) == 0
+    assert dyn in capsys.readouterr().out.splitlines()
+
+
+def _dynamics(tmp_path, name, key, values):
+    """A copy of the built-in dynamics file with one list replaced."""
+    import re
+
+    from cell import catalog
+
+    text = catalog.path("microbot_dynamics.yaml").read_text()
+    text, n = re.subn(rf"(?m)^(\s*{key}:).*$", rf"\1 {values}", text)
+    assert n == 1
+    (tmp_path / name).write_text(text)
+    return str(tmp_path / name)
+
+
+def test_a_drive_too_weak_for_the_arm_names_the_file_key_joint_and_torques(tmp_path, capsys):
+    """The shoulder's stall torque below what holding the arm at rest takes: one line naming
+    the dynamics file, its key and value, the joint and both torques; nothing written.  The
+    torque named is where the planner's own boundary lies: a little more passes that point."""
+    out = tmp_path / "out"
+    for stall, regime, needed in (("0.5", "R2", "1.4"), ("1.39", "R2", "1.4"),
+                                  ("1.42", "R4", "1.62")):
+        weak = _dynamics(tmp_path, "weak.yaml", "stall_torque_nm", f"[3.1, {stall}, 1.66, 1.14, 1.14]")
+        for command in (["mintime"], ["run", "--set", "robot.timing=minimum-time"]):
+            args = [command[0], "baseline", *command[1:], "--set", f"mintime.dynamics_file={weak}"]
+            assert main([*args, "--out", str(out)]) == 2
+            err = capsys.readouterr().err
+            assert err.count("\n") == 1 and not out.exists()
+            assert err.startswith(f"cell: error: {weak}: drives.stall_torque_nm = [3.1, {stall}, ")
+            assert (f"the shoulder (joint 2) needs {needed} N·m to hold the arm against gravity "
+                    f"at the start of {regime}, more than its stall torque {stall} N·m") in err
+    assert main(["mintime", "baseline", "--set", "mintime.dynamics_file=" + _dynamics(
+        tmp_path, "ok.yaml", "stall_torque_nm", "[3.1, 1.7, 1.66, 1.14, 1.14]"),
+        "--out", str(out)]) == 0
+
+
+def test_links_too_heavy_name_the_masses(tmp_path, capsys):
+    heavy = _dynamics(tmp_path, "heavy.yaml", "mass_kg", "[1.6, 0.9, 0.75, 0.30, 0.40]")
+    assert main(["mintime", "baseline", "--set", f"mintime.dynamics_file={heavy}",
+                 "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert f"{heavy}: links.mass_kg = [1.6, 0.9, 0.75, 0.3, 0.4]: the shoulder (joint 2)" in err
+    assert "more than its stall torque 3.4 N·m" in err and "baseline.yaml" in err
+
+
+def test_elapsed_time_is_the_planners_time_sum():
+    """t_s: 0 at the start, the profile's time_s bit for bit at the end (math.fsum), and s
+    itself where ṡ = 1 throughout."""
+    import math
+
+    import numpy as np
+
+    from cell.mintime.planner import elapsed_s
+
+    s = np.linspace(0.0, 1.0, 7) ** 2
+    assert elapsed_s(s, np.ones(7)) == pytest.approx(s, abs=1e-15)
+    sdot = np.array([0.0, 0.3, 0.7, 1e-3, 2.0, 0.5, 0.0])
+    t = elapsed_s(s, sdot)
+    terms = 2 * np.diff(s) / (sdot[1:] + sdot[:-1])
+    assert t[0] == 0 and list(t[1:]) == [math.fsum(terms[:i]) for i in range(1, 7)]
+    res = plan_regimes(geometry_of(KIN), motors_of(KIN), planner_bounds(KIN))
+    for r in res.values():
+        assert elapsed_s(r.profile.s, r.profile.sdot)[-1] == r.profile.time_s
