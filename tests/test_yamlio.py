@@ -17,6 +17,9 @@ from cell.yamlio import MAX_BYTES, load_mapping, parse_value
 
 LOADERS = ["python"] + (["libyaml"] if yaml.__with_libyaml__ else [])
 SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
+#: How long a hostile input may take before it counts as a hang: far above any normal time
+#: (milliseconds) even on a loaded machine, far below what an unguarded blow-up takes.
+HANG_S = 10.0
 
 
 @pytest.fixture(params=LOADERS, autouse=True)
@@ -98,7 +101,7 @@ def test_hostile_files_give_one_short_line(name, tmp_path):
     start = time.perf_counter()
     with pytest.raises(ScenarioError) as info:
         load_mapping(path)
-    assert time.perf_counter() - start < 1.0
+    assert time.perf_counter() - start < HANG_S  # a guard against blow-ups, not a speed test
     assert words in _assert_one_line(info.value, path, key)
 
 
@@ -109,7 +112,7 @@ def test_alias_bombs_are_refused_fast(tmp_path):
         start = time.perf_counter()
         with pytest.raises(ScenarioError, match="more than 10,000 values"):
             load_mapping(path)
-        assert time.perf_counter() - start < 0.2
+        assert time.perf_counter() - start < HANG_S  # unguarded, a 30-level bomb never ends
 
 
 @pytest.mark.parametrize("problem, words", [
@@ -227,7 +230,7 @@ def test_short_is_short_and_cheap():
     for value, size in cases:
         start = time.perf_counter()
         text = short(value)
-        assert time.perf_counter() - start < 0.05
+        assert time.perf_counter() - start < HANG_S  # an unbounded repr of these takes minutes
         assert len(text) < 120 and "\n" not in text and text.endswith(size), text
     assert short("abc") == "'abc'" and short([1, "a", None]) == "[1, 'a', None]" and short((1,)) == "(1,)"
     assert short({"a": [1, 2]}) == "{'a': [1, 2]}" and short(set()) == "set()" and short(2.5) == "2.5"

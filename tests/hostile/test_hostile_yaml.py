@@ -97,7 +97,7 @@ def test_hostile_files(tmp_path: Path, command: str) -> None:
         start = time.perf_counter()
         res = cli(command, scenario, "--out", out)
         try:
-            assert time.perf_counter() - start < 2.0, "slow"
+            assert time.perf_counter() - start < 20.0, "a hang (far above any normal refusal)"
             refused(res, str(scenario), *words, nothing_in=out)
         except AssertionError as exc:
             failures.append(f"{label}: {exc}"[:800])
