@@ -1,6 +1,7 @@
 """``cell figures`` of a user's own scenario: Fig. 23/24 draw the non-adaptive robot that
 ``cell run`` runs and say at which cycle, Fig. 25-30 do not call a Table 7.1 cycle the
-scenario's ideal; no figure says "nan" or lets a numpy warning out, however short the run."""
+scenario's ideal; no figure says "nan" or lets a numpy warning out, however short the run;
+an overloaded cell is said up front as ``cell run`` says it."""
 
 from __future__ import annotations
 
@@ -15,8 +16,11 @@ import pytest
 from matplotlib.figure import Figure
 from matplotlib.text import Text
 
+from cell.assembly import assemble
+from cell.cli import main
 from cell.figures import FILES, make_figures
 from cell.figures.runs import LOT, lot_means
+from cell.reporting.runs import warnings as run_warnings
 from cell.scenario import default_scenario, load_scenario
 from cell.simulation import simulate
 
@@ -107,3 +111,14 @@ def test_no_part_delivered_says_so(tmp_path: Path):
     note = texts(s, tmp_path / "figs", [23])[23]
     assert "by the parts delivered: no part delivered, so no actual cycle [2]" in note
     assert not re.search(r"\bnan\b", note)
+
+
+def test_the_command_warns_of_an_overload_as_cell_run_does(tmp_path: Path,
+                                                          capsys: pytest.CaptureFixture[str]):
+    scenario = tmp_path / "overload.yaml"
+    scenario.write_text(OVERLOAD + "run: {parts: 12}\n")
+    assert main(["figures", "--scenario", str(scenario), "--out", str(tmp_path / "f")]) == 0
+    err = capsys.readouterr().err
+    expected = run_warnings(assemble(load_scenario(scenario)).k)
+    assert expected and expected[0].startswith("utilisation ")
+    assert err.splitlines() == [f"cell: warning: {line}" for line in expected]
