@@ -23,13 +23,23 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    import sys
+
+    from cell.assembly import assemble
     from cell.figures import FILES, make_figures
     from cell.output import OutputDir
+    from cell.reporting.runs import warnings
+
+    def warn(line: str) -> None:
+        print(f"cell: warning: {line}", file=sys.stderr)
 
     names = [f"{stem}.png" for stem in FILES.values()]
     OutputDir.check(args.out, names)  # before any work
     scenario = scenario_of(args)
+    for line in warnings(assemble(scenario).k):  # as cell run says them: overload, nominal cycle
+        warn(line)
     with OutputDir(args.out, names) as out:
-        drawn = make_figures(scenario, out.stage, progress=lambda p: print(f"drew {p.name}"))
+        drawn = make_figures(scenario, out.stage, warn=warn,
+                             progress=lambda p: print(f"drew {p.name}"))
     print(f"wrote {len(drawn)} figures into {out.target}")
     return 0

@@ -2,8 +2,9 @@
 
 Writes ``figNN_<slug>.png`` for Fig. 8, 9, 12-30 of the thesis's list of
 illustrations, each titled with its number and caption.  Fig. 8-21 need only the
-path and the motors; Fig. 22-30 run the simulation (adaptive and non-adaptive,
-the six robot cycles of Table 7.1).
+path and the motors; Fig. 22-30 run the simulation (adaptive, and non-adaptive at
+the scenario's own cycle for Fig. 23/24 and at the six robot cycles of Table 7.1
+for Fig. 25-30: those the robot cannot make are left out).
 """
 
 from __future__ import annotations
@@ -44,11 +45,13 @@ FILES: dict[int, str] = {
 
 def make_figures(scenario: Scenario, out: str | Path, *, parts: int | None = None,
                  only: Iterable[int] | None = None,
-                 progress: Callable[[Path], None] | None = None) -> list[Path]:
+                 progress: Callable[[Path], None] | None = None,
+                 warn: Callable[[str], None] | None = None) -> list[Path]:
     """Draw the figures of ``scenario`` into ``out``; return the files written.
 
     ``parts`` overrides ``run.parts`` (fewer parts draw faster); ``only`` limits
-    the figure numbers drawn.
+    the figure numbers drawn.  Fig. 25-30 whose Table 7.1 cycle the non-adaptive
+    robot cannot make are left out, and ``warn`` is told so in one line first.
     """
     out = Path(out)
     if parts is not None:
@@ -62,8 +65,10 @@ def make_figures(scenario: Scenario, out: str | Path, *, parts: int | None = Non
         if progress:
             progress(p)
 
-    if wanted & set(range(22, 31)):
-        runs.check_cycles(scenario)  # before anything is drawn
+    skipped, note = runs.skipped_note(scenario, wanted)
+    if note and warn:
+        warn(note)  # before anything is drawn
+    wanted -= set(skipped)
     with style():
         table = step_table(scenario)
         if 8 in wanted:
@@ -90,14 +95,15 @@ def make_figures(scenario: Scenario, out: str | Path, *, parts: int | None = Non
                 done(motion.fig_joint_rate(table, tl, steps_tl, scenario, joint,
                                             path[17 + joint]))
         if wanted & set(range(22, 31)):
-            sims = runs.simulate_runs(scenario)
+            sims = runs.simulate_runs(scenario, tuple(
+                c for n, c in runs.IP_FIGURES.items() if n in wanted))
             if 22 in wanted:
                 done(tip.fig22_tip_velocity(sims, table, scenario, path[22]))
             if 23 in wanted:
                 done(runs.fig23_lumped(sims, scenario, path[23]))
             if 24 in wanted:
                 done(runs.fig24_running(sims, scenario, path[24]))
-            for number, cycle in zip(range(25, 31), runs.TABLE_7_1_CYCLES, strict=True):
+            for number, cycle in runs.IP_FIGURES.items():
                 if number in wanted:
                     done(runs.fig_ip(sims, cycle, number, path[number]))
     return written

@@ -31,9 +31,14 @@ def draws(s: Scenario, n: int) -> NDArray[np.float64]:
     return interarrival_times(s.arrivals, n, s.run.seed, s.base_dir)
 
 
+def _times(n: int) -> str:
+    return f"{n} inter-arrival time" + ("s" if n > 1 else "")
+
+
 def _params_note(s: Scenario, x: NDArray[np.float64]) -> str:
     d = distribution(s)
-    seen = f"{x.size} draws: mean {x.mean():.3f} s, sd {x.std(ddof=1):.3f} s"
+    seen = (f"{x.size} draws: mean {x.mean():.3f} s, sd {x.std(ddof=1):.3f} s" if x.size > 1
+            else f"1 draw: {x[0]:.3f} s")  # one draw has no sample sd
     if d is None:
         return f"the trace {s.arrivals.trace_csv}, replayed in order; {seen}"
     p = ", ".join(f"{k} = {v:.4f}" for k, v in parameters(s.arrivals).items())
@@ -77,7 +82,7 @@ def fig13_figure(s: Scenario, x: NDArray[np.float64]) -> Figure:
     d = distribution(s)
     t = _grid(s, x)
     heights, _, _ = ax.hist(x, bins=30, density=True, color="#9ecae1", edgecolor="white",
-            label=f"the {x.size} inter-arrival times of the run (seed {s.run.seed})")
+            label=f"the {_times(x.size)} of the run (seed {s.run.seed})")
     top = float(heights.max())
     if d is not None:
         ax.plot(t, d.pdf(t), color="black", label=f"pdf{_cited(s, '6.8')}")
@@ -105,7 +110,7 @@ def fig14_figure(s: Scenario, x: NDArray[np.float64]) -> Figure:
     t = _grid(s, x)
     xs = np.sort(x)
     ax.step(xs, np.arange(1, xs.size + 1) / xs.size, where="post", color="#6baed6", lw=2.2,
-            label=f"empirical cdf of the run's {x.size} draws")
+            label=f"empirical cdf of the run's {x.size} draw{'s' if x.size > 1 else ''}")
     if d is not None:
         ax.plot(t, d.cdf(t), color="black", lw=1.3, label="cdf F(T)")
         u = 0.5

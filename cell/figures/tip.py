@@ -130,8 +130,9 @@ def fig22_figure(runs: Runs, table: StepTable, s: Scenario) -> Figure:
                                 if r == 1 else None))
     lag_box = ax.axvspan(-lag, 0, facecolor="none", hatch="///", edgecolor="0.6", lw=0)
     mark_events(ax, {"LO": 0.0, "TD": float(tl.t_s[p.td] - lag)})
-    nxt = float(run.parts["interarrival_s"].iloc[i + 1]) if i + 1 < len(run.parts) else np.nan
-    ax.set_title(f"adaptive run, part {int(row['part'])}: next part {nxt:.3f} s behind "
+    nxt = (f"next part {float(run.parts['interarrival_s'].iloc[i + 1]):.3f} s behind"
+           if i + 1 < len(run.parts) else "the run's last")
+    ax.set_title(f"adaptive run, part {int(row['part'])}: {nxt} "
                  f"(ideal {nominal_cycle(s):g} s); input belt {before:.3f} → "
                  f"{after:.3f} in/s at LO; cycle {tl.t_s[-1]:.3f} s", loc="left", fontsize=9,
                  pad=16)
