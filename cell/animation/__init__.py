@@ -13,7 +13,6 @@ stays fast.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -173,13 +172,8 @@ def animate(scenario: Scenario, out: str | Path, *, policy: str | None = None, p
         if need > GIF_MEMORY_BYTES:
             raise CellError(f"{len(times)} frames would hold {need / 1e9:.1f} GB while the GIF "
                             f"is built; raise --speed, lower --dpi or --parts, or write a .mp4")
-    with atomic_path(path) as tmp:
-        staged = tmp.with_name(tmp.name + path.suffix)  # the writers go by the suffix
-        try:
-            render(scenes, times, staged, fps=fps, dpi=dpi, progress=progress)
-            os.replace(staged, tmp)
-        finally:
-            staged.unlink(missing_ok=True)
+    with atomic_path(path) as tmp:  # written in place: a killed run's .tmp is swept later
+        render(scenes, times, tmp, fps=fps, dpi=dpi, progress=progress, target=path)
     return Rendered(path, len(times), float(times[0]), float(times[-1]), path.stat().st_size)
 
 

@@ -11,13 +11,11 @@ Nothing here computes a position: :mod:`cell.animation.scene` does.
 from __future__ import annotations
 
 import sys
-from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from matplotlib.animation import FFMpegWriter, PillowWriter
 from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -41,6 +39,8 @@ from cell.animation.scene import (
     robot_at,
     shown_between,
 )
+from cell.animation.writers import CanvasGifWriter, Mp4Writer
+from cell.errors import shown_path
 from cell.figures.layout import BELT_COLOUR, named_points
 from cell.figures.style import LIMIT_COLOUR, POLICY_COLOURS, REGIME_COLOURS, REGIME_LABELS, style
 from cell.figures.tip import belt_speed_at
@@ -302,55 +302,18 @@ def draw_frame(panel: Panel, t: float) -> None:
     texts["robot"].set_color(colour)
 
 
-class CanvasGifWriter(PillowWriter):
-    """matplotlib's Pillow GIF writer, taking each frame as last drawn on the Agg canvas
-    and keeping it at one byte a pixel.
-
-    PillowWriter redraws the whole figure for every frame and holds each as RGB(A)
-    to the end: a few hundred 1100 x 700 frames would take most of a gigabyte.
-    Here the caller draws (only what moved), each frame is reduced to its own
-    palette at once (a frame of this drawing has some 250 colours), and each is
-    let go as Pillow takes its copy.
-    """
-
-    def setup(self, fig: Figure, outfile: Any, dpi: float | None = None) -> None:
-        super().setup(fig, outfile, dpi=dpi)
-        self._paletted: list[Any] = []
-
-    def grab_frame(self, **savefig_kwargs: Any) -> None:
-        from PIL import Image
-
-        rgba = np.asarray(self.fig.canvas.buffer_rgba())  # type: ignore[attr-defined]
-        self._paletted.append(Image.fromarray(rgba[..., :3]).quantize(
-            256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE))
-
-    def finish(self) -> None:
-        frames = self._paletted
-        if not frames:
-            return
-        # GIF delays are whole hundredths of a second: alternate them to keep the mean rate
-        ticks = np.round(np.arange(len(frames) + 1) * 100 / self.fps)
-        duration = [int(10 * d) for d in np.diff(ticks)]
-        frames.reverse()
-
-        def handed_over() -> Iterator[Any]:   # Pillow copies each frame: let go of ours
-            while frames:
-                yield frames.pop()
-
-        first = frames.pop()
-        first.save(self.outfile, save_all=True, append_images=handed_over(),
-                   duration=duration, loop=0)
-
-
 def render(scenes: list[Scene], times: Floats, out: Path, *, fps: int, dpi: float,
-           progress: bool = True) -> None:
-    """Draw one frame per instant of ``times`` into ``out`` (.gif or .mp4, by its suffix).
+           progress: bool = True, target: Path | None = None) -> None:
+    """Draw one frame per instant of ``times`` into ``out``, as a GIF or an MP4 by the suffix
+    of ``target`` (the file ``out`` is to become, which errors name; default ``out``).
 
-    ``out`` is written as given; making it atomic is the caller's business.
+    ``out`` is written as given; making it atomic is the caller's business.  Stopped
+    half-way (Ctrl-C, an error), the writer is abandoned: ffmpeg is stopped, not waited on.
     """
     from cell.progress import progress as counted
 
-    gif = out.suffix.lower() == ".gif"
+    target = out if target is None else target
+    gif = target.suffix.lower() == ".gif"
     with style():
         fig, panels = build_figure(scenes, dpi, (float(times[0]), float(times[-1])))
         canvas = fig.canvas
@@ -362,17 +325,20 @@ def render(scenes: list[Scene], times: Floats, out: Path, *, fps: int, dpi: floa
         background = canvas.copy_from_bbox(fig.bbox)
         for a in moving:
             a.set_visible(True)
-        writer: PillowWriter | FFMpegWriter = CanvasGifWriter(fps=fps) if gif \
-            else FFMpegWriter(fps=fps, codec="h264")
+        writer = CanvasGifWriter(fps=fps) if gif else Mp4Writer(fps, shown_path(target))
         label = " | ".join(sc.data.policy for sc in scenes)
         with writer.saving(fig, str(out), dpi):
-            for t in counted(times, f"cell animate ({label})", "frames", file=sys.stderr,
-                             enabled=progress):
-                for panel in panels:
-                    draw_frame(panel, float(t))
-                if gif:  # ffmpeg's writer redraws the whole figure itself
-                    canvas.restore_region(background)
-                    for a in moving:
-                        if a.get_visible():  # most parts' labels are hidden in any frame
-                            fig.draw_artist(a)
-                writer.grab_frame()
+            try:
+                for t in counted(times, f"cell animate ({label})", "frames", file=sys.stderr,
+                                 enabled=progress):
+                    for panel in panels:
+                        draw_frame(panel, float(t))
+                    if gif:  # ffmpeg's writer redraws the whole figure itself
+                        canvas.restore_region(background)
+                        for a in moving:
+                            if a.get_visible():  # most parts' labels are hidden in any frame
+                                fig.draw_artist(a)
+                    writer.grab_frame()
+            except BaseException:
+                writer.abandon()
+                raise
