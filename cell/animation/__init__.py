@@ -56,12 +56,16 @@ def check_output(out: str | Path) -> Path:
     if suffix not in SUFFIXES:
         raise CellError(f"--out {str(out)!r}: the animation is written as .gif or .mp4, "
                         f"not {suffix or 'a file without a suffix'!r}")
-    if suffix == ".mp4":
-        from matplotlib.animation import writers
-
-        if not writers.is_available("ffmpeg"):
-            raise CellError("MP4 needs ffmpeg on the PATH; write a .gif instead")
+    if suffix == ".mp4" and not has_ffmpeg():
+        raise CellError("MP4 needs ffmpeg on the PATH; write a .gif instead")
     return path
+
+
+def has_ffmpeg() -> bool:
+    """Whether ffmpeg is on the PATH (what an MP4 needs)."""
+    from matplotlib.animation import writers
+
+    return bool(writers.is_available("ffmpeg"))
 
 
 def simulated(scenario: Scenario, progress: bool = False) -> Any:
@@ -171,7 +175,8 @@ def animate(scenario: Scenario, out: str | Path, *, policy: str | None = None, p
         need = len(times) * frame_pixels(len(scenes), dpi)
         if need > GIF_MEMORY_BYTES:
             raise CellError(f"{len(times)} frames would hold {need / 1e9:.1f} GB while the GIF "
-                            f"is built; raise --speed, lower --dpi or --parts, or write a .mp4")
+                            f"is built; raise --speed, lower --dpi or --parts"
+                            + (", or write a .mp4" if has_ffmpeg() else ""))
     with atomic_path(path) as tmp:  # written in place: a killed run's .tmp is swept later
         render(scenes, times, tmp, fps=fps, dpi=dpi, progress=progress, target=path)
     return Rendered(path, len(times), float(times[0]), float(times[-1]), path.stat().st_size)
