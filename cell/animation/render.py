@@ -40,7 +40,7 @@ from cell.animation.scene import (
     shown_between,
 )
 from cell.animation.writers import CanvasGifWriter, Mp4Writer
-from cell.errors import shown_path
+from cell.errors import one_line, shown_path
 from cell.figures.layout import BELT_COLOUR, named_points
 from cell.figures.style import LIMIT_COLOUR, POLICY_COLOURS, REGIME_COLOURS, REGIME_LABELS, style
 from cell.figures.tip import belt_speed_at
@@ -58,6 +58,15 @@ STRIP_MAX_BELTS, STRIP_MIN_PART = 3.0, 1 / 250
 
 POLICY_TITLES = {"adaptive": "adaptive controller (§5.3)",
                  "non-adaptive": "fixed cycle, not adaptive (§6.3)"}
+
+
+def header(scene: Scene) -> str:
+    """What a panel shows, under its title: the scenario, the seed, a fixed robot's cycle."""
+    s = scene.scenario
+    line = f"{one_line(s.name, 40)} · seed {s.run.seed}"
+    if scene.data.policy == "non-adaptive":
+        line += f" · fixed cycle {scene.data.cycle_s:.4f} s"
+    return line
 
 
 def _square(xy: Floats, angle: Floats, size: float) -> Floats:
@@ -149,9 +158,11 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene,
     s, p = scene.scenario, scene.table.path
     w = s.cell.belt_width_in
     policy = scene.data.policy
-    fig.text((left_in + column_in / 2) / fig.get_size_inches()[0], 1 - 0.2 / HEIGHT_IN,
-             POLICY_TITLES.get(policy, policy), ha="center", va="center", fontsize=11,
-             fontweight="bold", color=POLICY_COLOURS.get(policy, "black"))
+    centre = (left_in + column_in / 2) / fig.get_size_inches()[0]
+    fig.text(centre, 1 - 0.13 / HEIGHT_IN, POLICY_TITLES.get(policy, policy), ha="center",
+             va="center", fontsize=11, fontweight="bold", color=POLICY_COLOURS.get(policy, "black"))
+    fig.text(centre, 1 - 0.32 / HEIGHT_IN, header(scene), ha="center", va="center", fontsize=7.5,
+             color="0.25")
     close_bottom = HEIGHT_IN - 0.42 - CLOSE_IN
     close = _axes(fig, left_in + (column_in - CLOSE_IN) / 2 + 0.12, close_bottom, CLOSE_IN, CLOSE_IN)
     strip_w = column_in - 0.45
