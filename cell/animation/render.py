@@ -58,6 +58,9 @@ STRIP_MAX_BELTS, STRIP_MIN_PART = 3.0, 1 / 250
 
 POLICY_TITLES = {"adaptive": "adaptive controller (§5.3)",
                  "non-adaptive": "fixed cycle, not adaptive (§6.3)"}
+#: A part's number is drawn at most this size (pt), and smaller if it is wider than this
+#: fraction of its square, down to this size (pt, and a pixel: at a very low --dpi nothing fits).
+LABEL_PT, LABEL_FILL, LABEL_MIN_PT = 6.0, 0.95, 1.5
 
 
 def header(scene: Scene) -> str:
@@ -67,6 +70,27 @@ def header(scene: Scene) -> str:
     if scene.data.policy == "non-adaptive":
         line += f" · fixed cycle {scene.data.cycle_s:.4f} s"
     return line
+
+
+def clock(t: float) -> str:
+    """The frame's instant: seconds, or h:mm:ss.s from an hour on."""
+    if t < 3600:
+        return f"t = {t:6.1f} s"
+    minutes, seconds = divmod(round(t, 1), 60)
+    hours, minutes = divmod(int(minutes), 60)
+    return f"t = {hours}:{minutes:02d}:{seconds:04.1f}"
+
+
+def fitted(label: Text, width_px: float, renderer: Any) -> Text:
+    """``label`` made smaller until it is at most ``width_px`` wide, as drawn (small glyphs are
+    whole pixels wide, so the width steps with the size: it is measured, not estimated)."""
+    least = max(LABEL_MIN_PT, 72 / renderer.dpi)  # a glyph under a pixel cannot be drawn
+    for _ in range(10):
+        width, size = label.get_window_extent(renderer).width, float(label.get_fontsize())
+        if width <= width_px or size <= least:
+            break
+        label.set_fontsize(max(least, size * max(0.5, 0.97 * width_px / width)))
+    return label
 
 
 def _square(xy: Floats, angle: Floats, size: float) -> Floats:
@@ -198,8 +222,11 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene,
     parts = _parts_collection(0.6, 4)
     close.add_collection(parts)
     shown = range(len(scene.data.part)) if span is None else shown_between(scene, *span)
-    labels = {int(i): close.text(0, 0, str(scene.data.part[i]), fontsize=6, ha="center",
-                                 va="center", zorder=4.5, clip_on=True) for i in shown}
+    side_px = s.part.size_in * CLOSE_IN / (CLOSE_X[1] - CLOSE_X[0]) * fig.dpi
+    renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
+    labels = {int(i): fitted(close.text(0, 0, str(scene.data.part[i]), fontsize=LABEL_PT,
+                                        ha="center", va="center", zorder=4.5, clip_on=True),
+                             LABEL_FILL * side_px, renderer) for i in shown}
     mono: dict[str, Any] = {"transform": close.transAxes, "fontsize": 8, "va": "top", "ha": "left",
             "family": "monospace", "zorder": 8}
     texts = {"clock": close.text(0.02, 0.985, "", fontweight="bold", **mono),
@@ -302,7 +329,7 @@ def draw_frame(panel: Panel, t: float) -> None:
     fingers.set_data(pose.fingers[0, :, 0], pose.fingers[0, :, 1])
     n = counts_at(sc, t)
     texts = panel.texts
-    texts["clock"].set_text(f"t = {t:6.1f} s")
+    texts["clock"].set_text(clock(t))
     texts["tally"].set_text(f"arrived {n.arrived:3d}   delivered {n.delivered:3d}")
     texts["lost"].set_text(f"lost {n.lost:3d} (fell off at F)")
     texts["lost"].set_color(LOST_COLOUR if n.lost else "black")
