@@ -13,7 +13,6 @@ stays fast.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -57,12 +56,16 @@ def check_output(out: str | Path) -> Path:
     if suffix not in SUFFIXES:
         raise CellError(f"--out {str(out)!r}: the animation is written as .gif or .mp4, "
                         f"not {suffix or 'a file without a suffix'!r}")
-    if suffix == ".mp4":
-        from matplotlib.animation import writers
-
-        if not writers.is_available("ffmpeg"):
-            raise CellError("MP4 needs ffmpeg on the PATH; write a .gif instead")
+    if suffix == ".mp4" and not has_ffmpeg():
+        raise CellError("MP4 needs ffmpeg on the PATH; write a .gif instead")
     return path
+
+
+def has_ffmpeg() -> bool:
+    """Whether ffmpeg is on the PATH (what an MP4 needs)."""
+    from matplotlib.animation import writers
+
+    return bool(writers.is_available("ffmpeg"))
 
 
 def simulated(scenario: Scenario, progress: bool = False) -> Any:
@@ -172,14 +175,10 @@ def animate(scenario: Scenario, out: str | Path, *, policy: str | None = None, p
         need = len(times) * frame_pixels(len(scenes), dpi)
         if need > GIF_MEMORY_BYTES:
             raise CellError(f"{len(times)} frames would hold {need / 1e9:.1f} GB while the GIF "
-                            f"is built; raise --speed, lower --dpi or --parts, or write a .mp4")
-    with atomic_path(path) as tmp:
-        staged = tmp.with_name(tmp.name + path.suffix)  # the writers go by the suffix
-        try:
-            render(scenes, times, staged, fps=fps, dpi=dpi, progress=progress)
-            os.replace(staged, tmp)
-        finally:
-            staged.unlink(missing_ok=True)
+                            f"is built; raise --speed, lower --dpi or --parts"
+                            + (", or write a .mp4" if has_ffmpeg() else ""))
+    with atomic_path(path) as tmp:  # written in place: a killed run's .tmp is swept later
+        render(scenes, times, tmp, fps=fps, dpi=dpi, progress=progress, target=path)
     return Rendered(path, len(times), float(times[0]), float(times[-1]), path.stat().st_size)
 
 

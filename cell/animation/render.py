@@ -11,13 +11,11 @@ Nothing here computes a position: :mod:`cell.animation.scene` does.
 from __future__ import annotations
 
 import sys
-from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from matplotlib.animation import FFMpegWriter, PillowWriter
 from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -41,6 +39,8 @@ from cell.animation.scene import (
     robot_at,
     shown_between,
 )
+from cell.animation.writers import CanvasGifWriter, Mp4Writer
+from cell.errors import one_line, shown_path
 from cell.figures.layout import BELT_COLOUR, named_points
 from cell.figures.style import LIMIT_COLOUR, POLICY_COLOURS, REGIME_COLOURS, REGIME_LABELS, style
 from cell.figures.tip import belt_speed_at
@@ -58,6 +58,39 @@ STRIP_MAX_BELTS, STRIP_MIN_PART = 3.0, 1 / 250
 
 POLICY_TITLES = {"adaptive": "adaptive controller (§5.3)",
                  "non-adaptive": "fixed cycle, not adaptive (§6.3)"}
+#: A part's number is drawn at most this size (pt), and smaller if it is wider than this
+#: fraction of its square, down to this size (pt, and a pixel: at a very low --dpi nothing fits).
+LABEL_PT, LABEL_FILL, LABEL_MIN_PT = 6.0, 0.95, 1.5
+
+
+def header(scene: Scene) -> str:
+    """What a panel shows, under its title: the scenario, the seed, a fixed robot's cycle."""
+    s = scene.scenario
+    line = f"{one_line(s.name, 40)} · seed {s.run.seed}"
+    if scene.data.policy == "non-adaptive":
+        line += f" · fixed cycle {scene.data.cycle_s:.4f} s"
+    return line
+
+
+def clock(t: float) -> str:
+    """The frame's instant: seconds, or h:mm:ss.s from an hour on."""
+    if t < 3600:
+        return f"t = {t:6.1f} s"
+    minutes, seconds = divmod(round(t, 1), 60)
+    hours, minutes = divmod(int(minutes), 60)
+    return f"t = {hours}:{minutes:02d}:{seconds:04.1f}"
+
+
+def fitted(label: Text, width_px: float, renderer: Any) -> Text:
+    """``label`` made smaller until it is at most ``width_px`` wide, as drawn (small glyphs are
+    whole pixels wide, so the width steps with the size: it is measured, not estimated)."""
+    least = max(LABEL_MIN_PT, 72 / renderer.dpi)  # a glyph under a pixel cannot be drawn
+    for _ in range(10):
+        width, size = label.get_window_extent(renderer).width, float(label.get_fontsize())
+        if width <= width_px or size <= least:
+            break
+        label.set_fontsize(max(least, size * max(0.5, 0.97 * width_px / width)))
+    return label
 
 
 def _square(xy: Floats, angle: Floats, size: float) -> Floats:
@@ -149,9 +182,11 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene,
     s, p = scene.scenario, scene.table.path
     w = s.cell.belt_width_in
     policy = scene.data.policy
-    fig.text((left_in + column_in / 2) / fig.get_size_inches()[0], 1 - 0.2 / HEIGHT_IN,
-             POLICY_TITLES.get(policy, policy), ha="center", va="center", fontsize=11,
-             fontweight="bold", color=POLICY_COLOURS.get(policy, "black"))
+    centre = (left_in + column_in / 2) / fig.get_size_inches()[0]
+    fig.text(centre, 1 - 0.13 / HEIGHT_IN, POLICY_TITLES.get(policy, policy), ha="center",
+             va="center", fontsize=11, fontweight="bold", color=POLICY_COLOURS.get(policy, "black"))
+    fig.text(centre, 1 - 0.32 / HEIGHT_IN, header(scene), ha="center", va="center", fontsize=7.5,
+             color="0.25")
     close_bottom = HEIGHT_IN - 0.42 - CLOSE_IN
     close = _axes(fig, left_in + (column_in - CLOSE_IN) / 2 + 0.12, close_bottom, CLOSE_IN, CLOSE_IN)
     strip_w = column_in - 0.45
@@ -187,8 +222,11 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene,
     parts = _parts_collection(0.6, 4)
     close.add_collection(parts)
     shown = range(len(scene.data.part)) if span is None else shown_between(scene, *span)
-    labels = {int(i): close.text(0, 0, str(scene.data.part[i]), fontsize=6, ha="center",
-                                 va="center", zorder=4.5, clip_on=True) for i in shown}
+    side_px = s.part.size_in * CLOSE_IN / (CLOSE_X[1] - CLOSE_X[0]) * fig.dpi
+    renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
+    labels = {int(i): fitted(close.text(0, 0, str(scene.data.part[i]), fontsize=LABEL_PT,
+                                        ha="center", va="center", zorder=4.5, clip_on=True),
+                             LABEL_FILL * side_px, renderer) for i in shown}
     mono: dict[str, Any] = {"transform": close.transAxes, "fontsize": 8, "va": "top", "ha": "left",
             "family": "monospace", "zorder": 8}
     texts = {"clock": close.text(0.02, 0.985, "", fontweight="bold", **mono),
@@ -291,7 +329,7 @@ def draw_frame(panel: Panel, t: float) -> None:
     fingers.set_data(pose.fingers[0, :, 0], pose.fingers[0, :, 1])
     n = counts_at(sc, t)
     texts = panel.texts
-    texts["clock"].set_text(f"t = {t:6.1f} s")
+    texts["clock"].set_text(clock(t))
     texts["tally"].set_text(f"arrived {n.arrived:3d}   delivered {n.delivered:3d}")
     texts["lost"].set_text(f"lost {n.lost:3d} (fell off at F)")
     texts["lost"].set_color(LOST_COLOUR if n.lost else "black")
@@ -302,55 +340,18 @@ def draw_frame(panel: Panel, t: float) -> None:
     texts["robot"].set_color(colour)
 
 
-class CanvasGifWriter(PillowWriter):
-    """matplotlib's Pillow GIF writer, taking each frame as last drawn on the Agg canvas
-    and keeping it at one byte a pixel.
-
-    PillowWriter redraws the whole figure for every frame and holds each as RGB(A)
-    to the end: a few hundred 1100 x 700 frames would take most of a gigabyte.
-    Here the caller draws (only what moved), each frame is reduced to its own
-    palette at once (a frame of this drawing has some 250 colours), and each is
-    let go as Pillow takes its copy.
-    """
-
-    def setup(self, fig: Figure, outfile: Any, dpi: float | None = None) -> None:
-        super().setup(fig, outfile, dpi=dpi)
-        self._paletted: list[Any] = []
-
-    def grab_frame(self, **savefig_kwargs: Any) -> None:
-        from PIL import Image
-
-        rgba = np.asarray(self.fig.canvas.buffer_rgba())  # type: ignore[attr-defined]
-        self._paletted.append(Image.fromarray(rgba[..., :3]).quantize(
-            256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE))
-
-    def finish(self) -> None:
-        frames = self._paletted
-        if not frames:
-            return
-        # GIF delays are whole hundredths of a second: alternate them to keep the mean rate
-        ticks = np.round(np.arange(len(frames) + 1) * 100 / self.fps)
-        duration = [int(10 * d) for d in np.diff(ticks)]
-        frames.reverse()
-
-        def handed_over() -> Iterator[Any]:   # Pillow copies each frame: let go of ours
-            while frames:
-                yield frames.pop()
-
-        first = frames.pop()
-        first.save(self.outfile, save_all=True, append_images=handed_over(),
-                   duration=duration, loop=0)
-
-
 def render(scenes: list[Scene], times: Floats, out: Path, *, fps: int, dpi: float,
-           progress: bool = True) -> None:
-    """Draw one frame per instant of ``times`` into ``out`` (.gif or .mp4, by its suffix).
+           progress: bool = True, target: Path | None = None) -> None:
+    """Draw one frame per instant of ``times`` into ``out``, as a GIF or an MP4 by the suffix
+    of ``target`` (the file ``out`` is to become, which errors name; default ``out``).
 
-    ``out`` is written as given; making it atomic is the caller's business.
+    ``out`` is written as given; making it atomic is the caller's business.  Stopped
+    half-way (Ctrl-C, an error), the writer is abandoned: ffmpeg is stopped, not waited on.
     """
     from cell.progress import progress as counted
 
-    gif = out.suffix.lower() == ".gif"
+    target = out if target is None else target
+    gif = target.suffix.lower() == ".gif"
     with style():
         fig, panels = build_figure(scenes, dpi, (float(times[0]), float(times[-1])))
         canvas = fig.canvas
@@ -362,17 +363,20 @@ def render(scenes: list[Scene], times: Floats, out: Path, *, fps: int, dpi: floa
         background = canvas.copy_from_bbox(fig.bbox)
         for a in moving:
             a.set_visible(True)
-        writer: PillowWriter | FFMpegWriter = CanvasGifWriter(fps=fps) if gif \
-            else FFMpegWriter(fps=fps, codec="h264")
+        writer = CanvasGifWriter(fps=fps) if gif else Mp4Writer(fps, shown_path(target))
         label = " | ".join(sc.data.policy for sc in scenes)
         with writer.saving(fig, str(out), dpi):
-            for t in counted(times, f"cell animate ({label})", "frames", file=sys.stderr,
-                             enabled=progress):
-                for panel in panels:
-                    draw_frame(panel, float(t))
-                if gif:  # ffmpeg's writer redraws the whole figure itself
-                    canvas.restore_region(background)
-                    for a in moving:
-                        if a.get_visible():  # most parts' labels are hidden in any frame
-                            fig.draw_artist(a)
-                writer.grab_frame()
+            try:
+                for t in counted(times, f"cell animate ({label})", "frames", file=sys.stderr,
+                                 enabled=progress):
+                    for panel in panels:
+                        draw_frame(panel, float(t))
+                    if gif:  # ffmpeg's writer redraws the whole figure itself
+                        canvas.restore_region(background)
+                        for a in moving:
+                            if a.get_visible():  # most parts' labels are hidden in any frame
+                                fig.draw_artist(a)
+                    writer.grab_frame()
+            except BaseException:
+                writer.abandon()
+                raise

@@ -72,6 +72,8 @@ class AnimationInput:
     """(k, 2) the same for the output belt."""
     input_length_in: float
     """Feeder drop point to B."""
+    cycle_s: float
+    """The cycle the robot plans for: a non-adaptive robot's fixed cycle (the run's ideal_cycle_s)."""
 
 
 def belt_history(result: Any, belt: str) -> Floats:
@@ -106,7 +108,8 @@ def frames_input(result: Any, scenario: Scenario) -> AnimationInput:
                           d[[f"r{r}_s" for r in (1, 2, 3, 4)]].to_numpy(dtype=float), np.nan),
         input_belt=belt_history(result, "input"),
         output_belt=belt_history(result, "output"),
-        input_length_in=float(constants(scenario, robot_timing(scenario)).input_length))
+        input_length_in=float(constants(scenario, robot_timing(scenario)).input_length),
+        cycle_s=float(result.summary.ideal_cycle_s))
 
 
 # --------------------------------------------------------------------------- belts

@@ -8,8 +8,13 @@ the clock, the counts and the belt speeds (:mod:`cell.animation`).
 from __future__ import annotations
 
 import argparse
+import sys
+from typing import TYPE_CHECKING
 
 from cell.commands import scenario_arguments, scenario_of
+
+if TYPE_CHECKING:
+    from cell.scenario import Scenario
 
 HELP = "watch the cell run: a GIF or MP4 of the cell from above"
 DESCRIPTION = ("Animate a run seen from above: belts, parts at their true positions, the arm, "
@@ -59,6 +64,20 @@ def check_options(args: argparse.Namespace, cycle_s: float) -> None:
                         "lower --parts or --fps")
 
 
+def notes(scenario: Scenario, first: int, parts: int) -> list[str]:
+    """``cell run``'s warnings (an overloaded cell), and a note if the parts shown go past
+    the scenario's ``run.parts`` (the run is simulated on to reach them)."""
+    from cell.assembly import assemble
+    from cell.reporting.runs import warnings
+
+    out = [f"warning: {line}" for line in warnings(assemble(scenario).k)]
+    last, n = first + parts - 1, scenario.run.parts
+    if last > n:
+        out.append(f"note: --from-part {first} --parts {parts} shows parts up to {last:,}, past "
+                   f"run.parts = {n:,}: the run is simulated on past its end to show them")
+    return out
+
+
 def main(args: argparse.Namespace) -> int:
     from cell.animation import animate, check_output
     from cell.output import check_file
@@ -70,6 +89,8 @@ def main(args: argparse.Namespace) -> int:
 
     check_options(args, max(scenario.controller.nominal_cycle_s or 0.0,
                             mean_interarrival(scenario.arrivals, scenario.base_dir)))
+    for line in notes(scenario, args.from_part, args.parts):
+        print(f"cell: {line}", file=sys.stderr)
     done = animate(scenario, args.out, policy=args.policy, parts=args.parts, first=args.from_part,
                    speed=args.speed, fps=args.fps, dpi=args.dpi)
     print(f"wrote {done.path}: {done.frames} frames, simulated {done.t0_s:.1f}-{done.t1_s:.1f} s, "

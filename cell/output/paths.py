@@ -148,8 +148,10 @@ def check_file(target: str | os.PathLike[str]) -> Path:
 
 
 def clean_stale_files(path: Path) -> None:
-    """Remove ``.NAME.cell-PID-XXXX.tmp`` of dead processes (and ``.NAME.XXXXXXXX.tmp`` of old versions)."""
-    pattern = re.compile(rf"\.{re.escape(path.name)}\.(?:cell-(\d+)-.+|[a-z0-9_]{{8}})\.tmp\Z")
+    """Remove ``.NAME.cell-PID-XXXX.tmp`` of dead processes (and ``.NAME.XXXXXXXX.tmp`` of old
+    versions, and the ``.NAME.cell-PID-XXXX.tmp.SUFFIX`` their animations staged beside it)."""
+    name, suffix = re.escape(path.name), re.escape(path.suffix)
+    pattern = re.compile(rf"\.{name}\.(?:cell-(\d+)-.+\.tmp(?:{suffix})?|[a-z0-9_]{{8}}\.tmp)\Z")
     with contextlib.suppress(OSError):
         for entry in os.scandir(path.parent):
             match = pattern.match(entry.name)

@@ -1,0 +1,56 @@
+"""What ``cell animate`` says besides the file: the memory refusal's advice fits the
+machine, an overloaded cell is warned of as ``cell run`` warns, and parts past the
+scenario's run get a note."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from cell.animation import animate
+from cell.cli import main as cli
+from cell.errors import CellError
+from cell.scenario import Scenario
+
+
+@pytest.mark.parametrize("ffmpeg", [True, False])
+def test_the_memory_refusal_suggests_an_mp4_only_with_ffmpeg(
+        tmp_path: Path, scenario: Scenario, monkeypatch: pytest.MonkeyPatch, ffmpeg: bool) -> None:
+    from matplotlib.animation import writers
+
+    monkeypatch.setattr(writers, "is_available", lambda name: ffmpeg)
+    with pytest.raises(CellError, match="raise --speed, lower --dpi or --parts") as info:
+        animate(scenario, tmp_path / "a.gif", parts=12, speed=0.05, progress=False)
+    assert ("write a .mp4" in str(info.value)) == ffmpeg
+    assert list(tmp_path.iterdir()) == []
+
+
+def said(capsys: pytest.CaptureFixture[str]) -> list[str]:
+    """The lines on stderr that are not progress."""
+    return [line for line in capsys.readouterr().err.splitlines() if " frames (" not in line]
+
+
+def test_an_overloaded_cell_is_warned_of_as_cell_run_warns(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    scenario = tmp_path / "overload.yaml"
+    scenario.write_text("name: overload\n"
+                        "arrivals: {distribution: weibull_min, mean_s: 16.0, cv: 0.05}\n"
+                        "run: {parts: 20}\n")
+    assert cli(["run", str(scenario), "--out", str(tmp_path / "run")]) == 0
+    run = said(capsys)
+    assert len(run) == 1 and run[0].startswith("cell: warning: utilisation 1.130: ")
+    assert cli(["animate", str(scenario), "--out", str(tmp_path / "a.gif"), "--parts", "1",
+                "--speed", "200", "--dpi", "20"]) == 0
+    assert said(capsys) == run
+
+
+def test_parts_past_the_run_get_a_note(tmp_path: Path,
+                                       capsys: pytest.CaptureFixture[str]) -> None:
+    common = ["animate", "baseline", "--set", "run.parts=5", "--out", str(tmp_path / "a.gif"),
+              "--speed", "200", "--dpi", "20", "--parts", "2"]
+    assert cli([*common, "--from-part", "4"]) == 0  # parts 4-5: within the run
+    assert said(capsys) == []
+    assert cli([*common, "--from-part", "5"]) == 0
+    assert said(capsys) == ["cell: note: --from-part 5 --parts 2 shows parts up to 6, past "
+                            "run.parts = 5: the run is simulated on past its end to show them"]
