@@ -137,7 +137,10 @@ def simulate_scenes(scenario: Scenario, policies: list[str], first: int, count: 
         n = first + count - 1 + extra
         runs = []
         for policy in policies:
-            s = scenario.with_overrides({"controller.policy": policy, "run.parts": n})
+            # the adaptive robot runs at the nominal cycle: a fixed robot's own cycle
+            # (controller.ideal_cycle_s) is the non-adaptive panel's alone, as in cell figures
+            own = {"controller.ideal_cycle_s": None} if policy == "adaptive" else {}
+            s = scenario.with_overrides({"controller.policy": policy, "run.parts": n, **own})
             runs.append((frames_input(simulated(s, progress), s), s))
         from_s = min(float(data.arrival_s[first - 1]) for data, _ in runs)
         scenes = [build_scene(data, table, s, from_s=from_s) for data, s in runs]

@@ -54,3 +54,19 @@ def test_parts_past_the_run_get_a_note(tmp_path: Path,
     assert cli([*common, "--from-part", "5"]) == 0
     assert said(capsys) == ["cell: note: --from-part 5 --parts 2 shows parts up to 6, past "
                             "run.parts = 5: the run is simulated on past its end to show them"]
+
+
+def test_both_policies_show_a_fixed_robot_at_its_own_cycle(tmp_path: Path) -> None:
+    """``--policy both`` of a non-adaptive scenario with its own cycle: the fixed panel runs
+    at that cycle, the adaptive one at the nominal cycle (it used to be refused: the adaptive
+    policy takes no ideal_cycle_s)."""
+    from cell.animation import simulate_scenes
+    from cell.scenario import load_scenario
+
+    s = load_scenario("non_adaptive", {"controller.ideal_cycle_s": 21.0})
+    adaptive, fixed = simulate_scenes(s, ["adaptive", "non-adaptive"], 1, 2, progress=False)
+    assert adaptive.scenario.controller.ideal_cycle_s is None
+    assert fixed.scenario.controller.ideal_cycle_s == 21.0
+    assert cli(["animate", "non_adaptive", "--set", "controller.ideal_cycle_s=21.0", "--policy",
+                "both", "--out", str(tmp_path / "b.gif"), "--parts", "1", "--speed", "200",
+                "--dpi", "20"]) == 0
