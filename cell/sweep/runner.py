@@ -279,6 +279,7 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     counts = dict.fromkeys(range(len(sweep.points)), 0)
     values: dict[int, list[float]] = {p: [] for p in counts}
     run = reused = 0
+    rounds: list[dict[int, tuple[int, int]]] = []  # each round's replications, by point
     try:
         prepare(sweep, out, resume)
         bar = Progress(sweep.total_replications, sweep.name, "replications", file=sys.stderr,
@@ -302,6 +303,7 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
         ranges = {p: (0, sweep.first_round) for p in counts}
         with bar:
             while ranges:
+                rounds.append(ranges)
                 _run_tasks(sweep, todo(ranges), replicate, executor, window, done)
                 for p, (_, last) in ranges.items():
                     counts[p] = last
@@ -320,8 +322,10 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
         _close(executor, client, wait=False)
         raise
     _close(executor, client, wait=True)
-    final = {p: (0, n) for p, n in counts.items()}
-    path = _assemble(sweep, task_dir, list(sweep.iter_tasks(final)), out / "replications.csv")
+    # The files the rounds wrote, point by point: a round's tasks start where it does
+    # (``min`` need not be a multiple of ``batch``), not where cutting from 0 would.
+    tasks = (t for p in counts for r in rounds if p in r for t in sweep.iter_tasks({p: r[p]}))
+    path = _assemble(sweep, task_dir, tasks, out / "replications.csv")
     return Outcome(path, run, reused, counts)
 
 
@@ -344,7 +348,7 @@ def _measure(sweep: Sweep, task_dir: Path, task: Task, measure: str) -> list[flo
     return [float(v) for v in pd.to_numeric(frame[measure], errors="coerce")]
 
 
-def _assemble(sweep: Sweep, task_dir: Path, tasks: Sequence[Task], target: Path) -> Path:
+def _assemble(sweep: Sweep, task_dir: Path, tasks: Iterable[Task], target: Path) -> Path:
     """``replications.csv`` from the task files, in the tasks' order (each file read once).
 
     Assembled from the files, never from the results in memory: a resumed sweep and
