@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import os
 import shlex
 import signal
 import sys
@@ -31,22 +33,64 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "holds other files)")
 
 
-def _interrupt(signum: int, frame: Any) -> None:
-    raise KeyboardInterrupt
+class _Stop:
+    """The handler of Ctrl-C (SIGINT) and kill (SIGTERM) during ``cell sweep``: the first
+    stops the sweep (KeyboardInterrupt: pending tasks cancelled, workers killed, finished
+    tasks kept); the ones after it are ignored, so nothing cuts the stopping short
+    (``timeout`` sends its signal twice, a terminal's Ctrl-C reaches the workers too)."""
+
+    #: The signals handled: those the local workers ignore (cell.sweep.runner.STOP_SIGNALS).
+    SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+    def __init__(self) -> None:
+        self.signum: int | None = None
+
+    def __call__(self, signum: int, frame: Any) -> None:
+        self.signum = signum
+        for number in self.SIGNALS:
+            signal.signal(number, signal.SIG_IGN)
+        raise KeyboardInterrupt
+
+    @property
+    def code(self) -> int:
+        """The exit code: 128 + the signal, 130 for Ctrl-C and 143 for kill, as a shell
+        reports ``cell run`` stopped by either."""
+        return 128 + (self.signum or signal.SIGINT)
 
 
 def main(args: argparse.Namespace) -> int:
     if threading.current_thread() is not threading.main_thread():
-        return _sweep(args)
-    # kill (SIGTERM) stops like Ctrl-C: pending tasks cancelled, finished ones kept.
-    previous = signal.signal(signal.SIGTERM, _interrupt)
+        return _sweep(args, _Stop())
+    stop = _Stop()
+    previous = {number: signal.signal(number, stop) for number in stop.SIGNALS}
     try:
-        return _sweep(args)
+        code = _sweep(args, stop)
+    except BaseException:
+        if stop.signum is None:
+            raise
+        print("cell: interrupted", file=sys.stderr)  # loading, or writing the report
+        code = stop.code
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        if stop.signum is None:
+            for number, handler in previous.items():
+                signal.signal(number, signal.SIG_DFL if handler is None else handler)
+    if stop.signum is not None:
+        _exit(code)
+    return code
 
 
-def _sweep(args: argparse.Namespace) -> int:
+def _exit(code: int) -> None:
+    """End a stopped sweep now, with ``code``.  Its workers are gone and its files whole;
+    a normal exit could still turn the code into a death by SIGINT (CPython does, if the
+    KeyboardInterrupt went through an ``exec`` of a string: a dataclass or namedtuple
+    being made while a module was imported)."""
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    os._exit(code)
+
+
+def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
     from cell.sweep import load_sweep, run_sweep, simulate_summary
     from cell.sweep.outdir import check_out
 
@@ -65,13 +109,15 @@ def _sweep(args: argparse.Namespace) -> int:
     try:
         outcome = run_sweep(sweep, args.out, workers=args.workers, scheduler=args.scheduler,
                             resume=args.resume, replicate=simulate_summary)
-    except KeyboardInterrupt:
+    except BaseException as exc:  # stopped: by Ctrl-C or kill, whatever it broke on the way
+        if stop.signum is None and not isinstance(exc, KeyboardInterrupt):
+            raise
         from cell.sweep.outdir import finished_tasks
 
         kept = len(finished_tasks(args.out))
         print(f"cell sweep: stopped; {kept} finished task{'s' if kept != 1 else ''} kept in "
               f"{args.out}: the same command with --resume runs only the rest", file=sys.stderr)
-        raise
+        return stop.code
     counts = sorted(set(outcome.counts.values()))
     reps = (f"{counts[0]}" if len(counts) == 1 else f"{counts[0]}-{counts[-1]}")
     print(f"wrote {Path(args.out) / 'replications.csv'}: {len(sweep.points)} points x "

@@ -184,10 +184,33 @@ def _open_executor(workers: int, scheduler: str | None, say: bool = True
                                   initargs=(os.getpid(),)), None
 
 
+#: Ctrl-C and kill: the sweep's to act on, never a local worker's (see :func:`_submit`).
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+#: Whether signals can be blocked (not on Windows, where workers are not forked).
+_MASKS = hasattr(signal, "pthread_sigmask")
+
+
+def _submit(executor: cf.Executor, *args: Any) -> cf.Future[list[dict[str, Any]]]:
+    """``executor.submit(run_task, *args)`` with :data:`STOP_SIGNALS` blocked: a local worker
+    is forked in there and starts with them blocked, so none reaches it before
+    :func:`_worker_init` ignores them.  One that comes meanwhile acts when this returns."""
+    if not _MASKS:
+        return executor.submit(run_task, *args)
+    signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
+    try:
+        return executor.submit(run_task, *args)
+    finally:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)
+
+
 def _worker_init(parent: int) -> None:
-    """In each local worker: leave Ctrl-C to the sweep, and exit if the sweep dies
-    (even by kill -9), so no orphan keeps running."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    """In each local worker (started with :data:`STOP_SIGNALS` blocked): ignore them, as
+    the sweep stops its workers itself (:func:`_close`); and exit if the sweep dies (even
+    by kill -9), so no orphan keeps running."""
+    for number in STOP_SIGNALS:
+        signal.signal(number, signal.SIG_IGN)  # drops one that came while blocked
+    if _MASKS:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)
 
     def watch() -> None:
         while os.getppid() == parent:
@@ -216,7 +239,7 @@ def _run_tasks(sweep: Sweep, todo: Iterable[Task], replicate: Replicate,
     try:
         while True:
             for task in queue:
-                pending[executor.submit(run_task, *args(task))] = task
+                pending[_submit(executor, *args(task))] = task
                 if len(pending) >= window:
                     break
             if not pending:
@@ -243,8 +266,15 @@ def _guarded(sweep: Sweep, task: Task, call: Callable[[], list[dict[str, Any]]]
 
 
 def _close(executor: cf.Executor | None, client: Any, wait: bool) -> None:
+    """Shut the executor down; without ``wait`` (a stop: Ctrl-C, kill, an error) kill and reap
+    local workers at once, as Python 3.14's ``kill_workers()``: a worker left to finish a task
+    whose result is thrown away would outlive the sweep, or hang its exit."""
     if isinstance(executor, cf.ProcessPoolExecutor):
+        workers = [] if wait else list((executor._processes or {}).values())
         executor.shutdown(wait=wait, cancel_futures=not wait)
+        for process in workers:
+            process.kill()
+            process.join()
     elif executor is not None:
         executor.shutdown(wait=wait)
     if client is not None:
@@ -279,6 +309,7 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     counts = dict.fromkeys(range(len(sweep.points)), 0)
     values: dict[int, list[float]] = {p: [] for p in counts}
     run = reused = 0
+    rounds: list[dict[int, tuple[int, int]]] = []  # each round's replications, by point
     try:
         prepare(sweep, out, resume)
         bar = Progress(sweep.total_replications, sweep.name, "replications", file=sys.stderr,
@@ -302,6 +333,7 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
         ranges = {p: (0, sweep.first_round) for p in counts}
         with bar:
             while ranges:
+                rounds.append(ranges)
                 _run_tasks(sweep, todo(ranges), replicate, executor, window, done)
                 for p, (_, last) in ranges.items():
                     counts[p] = last
@@ -316,12 +348,14 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
                 more = next_round(counts, reached, sweep.batch, q.max_n)
                 ranges = {p: (counts[p], counts[p] + k) for p, k in more.items() if k}
                 bar.grow(sum(more.values()))
+        _close(executor, client, wait=True)
     except BaseException:
         _close(executor, client, wait=False)
         raise
-    _close(executor, client, wait=True)
-    final = {p: (0, n) for p, n in counts.items()}
-    path = _assemble(sweep, task_dir, list(sweep.iter_tasks(final)), out / "replications.csv")
+    # The files the rounds wrote, point by point: a round's tasks start where it does
+    # (``min`` need not be a multiple of ``batch``), not where cutting from 0 would.
+    tasks = (t for p in counts for r in rounds if p in r for t in sweep.iter_tasks({p: r[p]}))
+    path = _assemble(sweep, task_dir, tasks, out / "replications.csv")
     return Outcome(path, run, reused, counts)
 
 
@@ -344,7 +378,7 @@ def _measure(sweep: Sweep, task_dir: Path, task: Task, measure: str) -> list[flo
     return [float(v) for v in pd.to_numeric(frame[measure], errors="coerce")]
 
 
-def _assemble(sweep: Sweep, task_dir: Path, tasks: Sequence[Task], target: Path) -> Path:
+def _assemble(sweep: Sweep, task_dir: Path, tasks: Iterable[Task], target: Path) -> Path:
     """``replications.csv`` from the task files, in the tasks' order (each file read once).
 
     Assembled from the files, never from the results in memory: a resumed sweep and
