@@ -49,6 +49,7 @@ from cell import registry
 from cell.errors import ScenarioError
 from cell.progress import Progress
 from cell.scenario import Scenario, known_key, load_scenario
+from cell.sweep.checks import refuse_measure_unset, refuse_set_and_varied
 from cell.sweep.options import (
     RESERVED,
     Baseline,
@@ -268,7 +269,11 @@ def load_sweep(path: str | Path) -> Sweep:
             raise ScenarioError(path, f"policies.{policy}", key,
                                 "varied both in 'grid' and under the policy; keep one")
 
+    refuse_set_and_varied(fixed, {"grid": shared, **{f"policies.{p}": g
+                                                      for p, g in per_policy.items()}}, path)
     replications, precision = read_replications(raw, path)
+    if precision is not None:
+        refuse_measure_unset(precision.measure, list(per_policy), path)
     seed = whole(raw, "seed", base.run.seed, 0, path)
     batch = whole(raw, "batch", min(20, precision.min_n if precision else replications), 1, path)
 
