@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import shlex
 import signal
 import sys
@@ -48,19 +49,24 @@ def main(args: argparse.Namespace) -> int:
 
 def _sweep(args: argparse.Namespace) -> int:
     from cell.sweep import load_sweep, run_sweep, simulate_summary
-    from cell.sweep.outdir import check_out
+    from cell.sweep.checks import size_note
+    from cell.sweep.outdir import check_out, check_owner, lock
 
-    check_out(args.out)  # before the sweep file's points are built and checked
+    out = check_out(args.out)  # before the sweep file's points are built and checked
     check_workers(args.workers, args.scheduler)
     sweep = load_sweep(args.sweep)
+    check_owner(sweep, out, args.resume)  # no results of another sweep, nor this one's, lost
     target = None
     if args.report:
         from cell.reporting.experiment import plan_report
 
         target = plan_report(sweep, args.report, results=args.out)  # before anything runs
+    if note := size_note(sweep, None if args.scheduler else args.workers or os.cpu_count()):
+        print(f"cell sweep: {note}", file=sys.stderr)
     try:
-        outcome = run_sweep(sweep, args.out, workers=args.workers, scheduler=args.scheduler,
-                            resume=args.resume, replicate=simulate_summary)
+        with lock(out):  # a second sweep into the same --out is refused
+            outcome = run_sweep(sweep, out, workers=args.workers, scheduler=args.scheduler,
+                                resume=args.resume, replicate=simulate_summary)
     except KeyboardInterrupt:
         from cell.sweep.outdir import finished_tasks
 

@@ -180,11 +180,17 @@ class Sweep:
         return len(self.points) * self.first_round
 
     def fingerprint(self) -> str:
-        """Hash of everything that decides the results (for ``--resume``)."""
+        """Hash of everything that decides the results (for ``--resume``): the settings,
+        the content of every file the points name (:mod:`cell.sweep.inputs`) and the
+        version of cell."""
+        from cell import __version__
+        from cell.sweep.inputs import digest, sweep_files
+
         doc: dict[str, Any] = {
             "base": self.base.to_dict(), "fixed": [list(kv) for kv in self.fixed],
             "points": [[p.policy, [list(kv) for kv in p.values]] for p in self.points],
-            "replications": self.replications, "seed": self.seed, "batch": self.batch}
+            "replications": self.replications, "seed": self.seed, "batch": self.batch,
+            "files": sorted(str(digest(f)) for f in sweep_files(self)), "version": __version__}
         if self.precision is not None:
             doc["precision"] = self.precision.as_dict()
         text = json.dumps(doc, sort_keys=True, default=str)
