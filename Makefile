@@ -20,16 +20,22 @@ venv: $(STAMP)
 test: $(STAMP)
 	$(PY) -m pytest -q
 
+# Each sweep target starts from an empty build folder: a sweep refuses to replace results
+# without --resume, and a report regenerated here must come from this code, not reused tasks.
 sweep: $(STAMP)
+	rm -rf build/sweep
 	$(PY) -m cell sweep scenarios/table_7_1.yaml --out build/sweep --workers $(WORKERS) --report reports/table_7_1
 
 sweep-mintime: $(STAMP)
+	rm -rf build/sweep_mintime
 	$(PY) -m cell sweep scenarios/table_7_1_mintime.yaml --out build/sweep_mintime --workers $(WORKERS) --report reports/table_7_1_mintime
 
 whatif: $(STAMP)
+	rm -rf build/whatif
 	MPLBACKEND=Agg $(PY) -m cell sweep scenarios/whatif.yaml --out build/whatif --workers $(WORKERS) --report reports/whatif
 
 stress: $(STAMP)
+	rm -rf build/stress
 	$(PY) -m cell sweep scenarios/stress.yaml --out build/stress --workers $(WORKERS)
 	MPLBACKEND=Agg $(PY) -m cell.reporting.stress build/stress/replications.csv reports/stress
 

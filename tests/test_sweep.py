@@ -225,17 +225,24 @@ def test_resume_refuses_a_different_sweep(sweeps, tmp_path):
     run_sweep(load_sweep(sweeps.write(tmp_path)), tmp_path / "o", workers=1,
               replicate=sweeps.first_draw, progress=False)
     other = load_sweep(sweeps.write(tmp_path, seed=8))
-    with pytest.raises(CellError, match="different sweep"):
+    with pytest.raises(CellError, match=r"\(--resume\): holds the results of this sweep "
+                       r"\(sweep\) as it was before .*sweep.yaml changed: choose another "
+                       "--out or remove it$"):
         run_sweep(other, tmp_path / "o", workers=1, resume=True, replicate=sweeps.first_draw,
                   progress=False)
 
 
-def test_fresh_run_discards_stale_task_files(sweeps, tmp_path):
+def test_a_fresh_run_of_an_edited_sweep_keeps_the_old_results(sweeps, tmp_path):
+    """Without --resume, results of the sweep as it was are not deleted: refused first."""
     run_sweep(load_sweep(sweeps.write(tmp_path)), tmp_path / "o", workers=1,
               replicate=sweeps.first_draw, progress=False)
+    before = sorted((tmp_path / "o").rglob("*"))
     smaller = load_sweep(sweeps.write(tmp_path, replications=2))
-    run_sweep(smaller, tmp_path / "o", workers=1, replicate=sweeps.first_draw, progress=False)
-    assert len(list((tmp_path / "o" / "tasks").glob("task-*.csv"))) == 3
+    with pytest.raises(CellError, match="holds the results of this sweep"):
+        run_sweep(smaller, tmp_path / "o", workers=1, replicate=sweeps.first_draw,
+                  progress=False)
+    assert sorted((tmp_path / "o").rglob("*")) == before
+    assert len(list((tmp_path / "o" / "tasks").glob("task-*.csv"))) == 9
 
 
 # --------------------------------------------------------------------------- dask

@@ -22,10 +22,21 @@ def test_a_folder_with_a_users_replications_csv_is_refused_and_left_alone(sweeps
     assert sorted(p.name for p in mine.iterdir()) == ["replications.csv"]
 
 
-def test_a_sweeps_own_folder_is_reused_without_resume(sweeps, tmp_path, monkeypatch, capsys):
+def test_a_finished_run_of_the_same_sweep_wants_resume(sweeps, tmp_path, monkeypatch, capsys):
+    """Run twice without --resume: the second is refused, nothing lost; with it, nothing runs."""
     monkeypatch.setattr("cell.sweep.simulate_summary", sweeps.first_draw)
     args = ["sweep", str(sweeps.write(tmp_path)), "--out", str(tmp_path / "o"), "--workers", "1"]
-    assert main(args) == 0 and main(args) == 0, capsys.readouterr().err
+    assert main(args) == 0, capsys.readouterr().err
+    before = {p: p.read_bytes() for p in (tmp_path / "o").rglob("*") if p.is_file()}
+    capsys.readouterr()
+    assert main(args) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err == [f"cell: error: --out {tmp_path / 'o'}: holds a finished run of this sweep "
+                   "(9 tasks): add --resume to reuse it (nothing runs again), or remove the "
+                   "folder"]
+    assert {p: p.read_bytes() for p in (tmp_path / "o").rglob("*") if p.is_file()} == before
+    assert main([*args, "--resume"]) == 0
+    assert "(0 tasks run, 9 reused)" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("report", ["o", "o/..", "."])

@@ -52,7 +52,7 @@ def test_the_extremes_are_every_min_and_max_of_a_run_and_its_end():
 def test_a_baseline_over_another_run_length_is_warned_and_its_counts_left_out(
         sweeps, tmp_path, capsys):
     warned, diffs, report = sweep_run(
-        sweeps, tmp_path, capsys, policies=["non-adaptive"],
+        sweeps, tmp_path, capsys, policies=["non-adaptive"], set=None,
         grid={"run.parts": [20, 30]}, baseline={"run.parts": 20})
     assert len(warned) == 1, warned
     assert "1 of 1 paired comparisons" in warned[0] and "run.parts 30 against 20" in warned[0]
@@ -96,7 +96,7 @@ def test_the_warning_names_each_setting_with_its_values_on_either_side(sweeps, t
     from cell.sweep.windows import window_warning
 
     sweep = load_sweep(sweeps.write(
-        tmp_path, policies=["non-adaptive"],
+        tmp_path, policies=["non-adaptive"], set=None,
         grid={"run.parts": [20, 30, 40], "run.warmup_parts": [0, 4]},
         baseline={"run.parts": 20, "run.warmup_parts": 0}))
     assert window_warning(sweep) == (

@@ -92,11 +92,13 @@ def _exit(code: int) -> None:
 
 def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
     from cell.sweep import load_sweep, run_sweep, simulate_summary
-    from cell.sweep.outdir import check_out
+    from cell.sweep.checks import size_note
+    from cell.sweep.outdir import check_out, check_owner, lock
 
-    check_out(args.out)  # before the sweep file's points are built and checked
+    out = check_out(args.out)  # before the sweep file's points are built and checked
     check_workers(args.workers, args.scheduler)
     sweep = load_sweep(args.sweep)
+    check_owner(sweep, out, args.resume)  # no results of another sweep, nor this one's, lost
     target = None
     if args.report:
         from cell.reporting.experiment import plan_report
@@ -106,9 +108,12 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
 
     if warning := nominal_warning(sweep):  # run_sweep adds the overload warning
         print(f"cell: warning: {warning}", file=sys.stderr)
+    if note := size_note(sweep, None if args.scheduler else args.workers or os.cpu_count()):
+        print(f"cell sweep: {note}", file=sys.stderr)
     try:
-        outcome = run_sweep(sweep, args.out, workers=args.workers, scheduler=args.scheduler,
-                            resume=args.resume, replicate=simulate_summary)
+        with lock(out):  # a second sweep into the same --out is refused
+            outcome = run_sweep(sweep, out, workers=args.workers, scheduler=args.scheduler,
+                                resume=args.resume, replicate=simulate_summary)
     except BaseException as exc:  # stopped: by Ctrl-C or kill, whatever it broke on the way
         if stop.signum is None and not isinstance(exc, KeyboardInterrupt):
             raise

@@ -3,7 +3,11 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
+import os
+import socket
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +19,8 @@ MANIFEST = "sweep.json"
 TASK_DIR = "tasks"
 #: A finished task's file (:attr:`cell.sweep.spec.Task.filename`).
 TASK_FILES = "task-*.csv"
+#: The lock a running sweep holds in its folder (:func:`lock`).
+LOCK = ".sweep.lock"
 
 
 def check_out(out: str | Path) -> Path:
@@ -59,28 +65,118 @@ def _manifest(path: Path) -> Any:
         return None
 
 
+def check_owner(sweep: Sweep, out: Path, resume: bool) -> None:
+    """Refuse, before any work, to run ``sweep`` into ``out`` if that would lose results:
+    those of another sweep (or of this one before a file it reads changed, or written by
+    another version of cell), or this sweep's finished tasks without ``resume``."""
+    manifest = out / MANIFEST
+    found = _manifest(manifest) if manifest.is_file() else None
+    tasks = len(finished_tasks(out))
+    if not isinstance(found, dict) or not (tasks or (out / "replications.csv").exists()):
+        return
+    if found.get("fingerprint") != sweep.fingerprint():
+        flag = f"--out {out}" + (" (--resume)" if resume else "")
+        raise CellError(f"{flag}: holds the results of {_whose(found, sweep)}: choose another "
+                        "--out or remove it")
+    if resume:
+        return
+    if (out / "replications.csv").exists():
+        raise CellError(f"--out {out}: holds a finished run of this sweep ({tasks} tasks): add "
+                        "--resume to reuse it (nothing runs again), or remove the folder")
+    raise CellError(f"--out {out}: holds {tasks} finished task{'s' if tasks != 1 else ''} of "
+                    "this sweep: add --resume to go on, or remove the folder")
+
+
+def _whose(found: dict[str, Any], sweep: Sweep) -> str:
+    """Whose results a manifest's are, for a refusal: which file changed if it can say."""
+    from cell import __version__
+    from cell.sweep.inputs import changed
+
+    name = found.get("name", "unnamed")
+    edited = ", ".join(changed(found.get("inputs")))
+    if edited and found.get("sweep") == sweep.source:
+        return f"this sweep ({name}) as it was before {edited} changed"
+    if edited:
+        return f"another sweep ({name}; {edited} changed since)"
+    if found.get("version", __version__) != __version__:
+        return f"another sweep ({name}), written by cell {found['version']} (this is " \
+               f"{__version__})"
+    return f"another sweep ({name})"
+
+
+@contextlib.contextmanager
+def lock(out: Path) -> Iterator[None]:
+    """Hold ``out``'s lock while a sweep runs into it: a second sweep into the same
+    folder is refused.  A lock left by a process that is gone (on this machine) is taken
+    over.  Folders it had to make are removed again if nothing was written into them."""
+    made = [d for d in (out, *out.parents) if not d.exists()]
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / LOCK
+    mine = f"{os.getpid()} {socket.gethostname()}\n"
+    for _ in range(2):
+        try:
+            fd = os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+        except FileExistsError:
+            holder = _holder(path)
+            if holder is not None:
+                raise CellError(f"--out {out}: another sweep is running into it ({holder}; "
+                                f"its lock: {path}): wait for it, or choose another --out"
+                                ) from None
+            path.unlink(missing_ok=True)  # stale: its process is gone
+            continue
+        with os.fdopen(fd, "w", encoding="utf-8") as stream:
+            stream.write(mine)
+        break
+    else:
+        raise CellError(f"--out {out}: cannot take its lock {path}; choose another --out")
+    try:
+        yield
+    finally:
+        with contextlib.suppress(OSError):
+            if path.read_text(encoding="utf-8") == mine:
+                path.unlink()
+        with contextlib.suppress(OSError):
+            for folder in made:  # innermost first; one not empty is kept, and those above it
+                folder.rmdir()
+
+
+def _holder(path: Path) -> str | None:
+    """Who holds a lock (``process PID on HOST``), or None if its process is gone."""
+    try:
+        pid_text, host = path.read_text(encoding="utf-8").split()
+        pid = int(pid_text)
+    except (OSError, ValueError):
+        return "a lock being written" if path.exists() else None
+    if host == socket.gethostname():
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return None
+        except PermissionError:
+            pass  # alive, another user's
+    return f"process {pid} on {host}"
+
+
 def prepare(sweep: Sweep, out: Path, resume: bool) -> None:
-    """Check a resumed directory is this sweep's, or clear a fresh one; write the manifest.
-    Either way the temporary files of a killed run are removed."""
+    """Check ``out`` may take this sweep's results (:func:`check_owner`), clear a fresh run's
+    folder, write the manifest.  Either way the temporary files of a killed run are removed."""
+    from cell import __version__
+    from cell.sweep.inputs import inputs
+
     task_dir, manifest = out / TASK_DIR, out / MANIFEST
-    fingerprint = sweep.fingerprint()
+    check_owner(sweep, out, resume)
     for leftover in task_dir.glob(".task-*.tmp") if task_dir.is_dir() else ():
         leftover.unlink(missing_ok=True)
-    if resume and manifest.is_file():
-        found = _manifest(manifest)
-        previous = found.get("fingerprint") if isinstance(found, dict) else None
-        if previous != fingerprint:
-            raise CellError(f"--resume: {out} holds the results of a different sweep "
-                            f"(or of {sweep.source} before it was edited); "
-                            "run without --resume or choose another --out")
-    else:
+    if not resume:  # nothing of this sweep's, nor of another's, is lost (check_owner)
         for stale in finished_tasks(out):
             stale.unlink()
         (out / "replications.csv").unlink(missing_ok=True)
-    doc: dict[str, Any] = {"sweep": sweep.source, "name": sweep.name, "fingerprint": fingerprint,
+    doc: dict[str, Any] = {"sweep": sweep.source, "name": sweep.name,
+                           "fingerprint": sweep.fingerprint(),
                            "tasks": len(sweep.points) * -(-sweep.first_round // sweep.batch),
                            "replications": sweep.replications, "seed": sweep.seed,
                            "batch": sweep.batch}
     if sweep.precision is not None:
         doc["precision"] = sweep.precision.as_dict()
+    doc |= {"version": __version__, "inputs": inputs(sweep)}
     write_text(json.dumps(doc, indent=2) + "\n", manifest)

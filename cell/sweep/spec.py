@@ -49,6 +49,7 @@ from cell import registry
 from cell.errors import ScenarioError
 from cell.progress import Progress
 from cell.scenario import Scenario, known_key, load_scenario
+from cell.sweep.checks import refuse_measure_unset, refuse_set_and_varied
 from cell.sweep.options import (
     RESERVED,
     Baseline,
@@ -185,11 +186,17 @@ class Sweep:
         return len(self.points) * self.first_round
 
     def fingerprint(self) -> str:
-        """Hash of everything that decides the results (for ``--resume``)."""
+        """Hash of everything that decides the results (for ``--resume``): the settings,
+        the content of every file the points name (:mod:`cell.sweep.inputs`) and the
+        version of cell."""
+        from cell import __version__
+        from cell.sweep.inputs import digest, sweep_files
+
         doc: dict[str, Any] = {
             "base": self.base.to_dict(), "fixed": [list(kv) for kv in self.fixed],
             "points": [[p.policy, [list(kv) for kv in p.values]] for p in self.points],
-            "replications": self.replications, "seed": self.seed, "batch": self.batch}
+            "replications": self.replications, "seed": self.seed, "batch": self.batch,
+            "files": sorted(str(digest(f)) for f in sweep_files(self)), "version": __version__}
         if self.precision is not None:
             doc["precision"] = self.precision.as_dict()
         text = json.dumps(doc, sort_keys=True, default=str)
@@ -274,7 +281,11 @@ def load_sweep(path: str | Path) -> Sweep:
             raise ScenarioError(path, f"policies.{policy}", key,
                                 "varied both in 'grid' and under the policy; keep one")
 
+    refuse_set_and_varied(fixed, {"grid": shared, **{f"policies.{p}": g
+                                                      for p, g in per_policy.items()}}, path)
     replications, precision = read_replications(raw, path)
+    if precision is not None:
+        refuse_measure_unset(precision.measure, list(per_policy), path)
     seed = whole(raw, "seed", base.run.seed, 0, path)
     batch = whole(raw, "batch", min(20, precision.min_n if precision else replications), 1, path)
 

@@ -29,6 +29,9 @@ if TYPE_CHECKING:
 #: The ``run`` settings that decide a run's window.
 WINDOW_KEYS = ("parts", "warmup_parts")
 
+#: The warm-up MSER-5 chooses run by run (``run.warmup_parts: auto``).
+AUTO = "auto"
+
 #: The words of a summary column's name that make it an extreme over the window.
 EXTREME_WORDS = frozenset({"min", "max"})
 
@@ -70,15 +73,24 @@ def window_kind(measure: str) -> str | None:
     return "an extreme" if measure in extreme_measures() else None
 
 
-def windows_apart(a: Scenario, b: Scenario) -> list[tuple[str, Any, Any]]:
-    """The window settings on which ``a`` and ``b`` differ: (key, a's value, b's value)."""
-    return [(key, getattr(a.run, key), getattr(b.run, key))
-            for key in WINDOW_KEYS if getattr(a.run, key) != getattr(b.run, key)]
+def windows_apart(a: Scenario, b: Scenario, auto_apart: bool = False
+                  ) -> list[tuple[str, Any, Any]]:
+    """The window settings on which ``a`` and ``b`` differ: (key, a's value, b's value).
+    With ``auto_apart``, a warm-up of ``auto`` on either side differs even from ``auto``:
+    MSER-5 cuts each run where its own output settles, so two points (of different
+    policies or settings) count over windows of different lengths."""
+    def apart(key: str) -> bool:
+        va, vb = getattr(a.run, key), getattr(b.run, key)
+        return va != vb or (auto_apart and key == "warmup_parts" and AUTO in (va, vb))
+
+    return [(key, getattr(a.run, key), getattr(b.run, key)) for key in WINDOW_KEYS if apart(key)]
 
 
 def pair_apart(sweep: Sweep, pair: Pair) -> list[tuple[str, Any, Any]]:
-    """:func:`windows_apart` of a pair's point and the point it is compared with."""
-    return windows_apart(sweep.points[pair.point].scenario, sweep.points[pair.versus].scenario)
+    """:func:`windows_apart` of a pair's point and the point it is compared with (a
+    warm-up of ``auto`` differs between them)."""
+    return windows_apart(sweep.points[pair.point].scenario, sweep.points[pair.versus].scenario,
+                         auto_apart=True)
 
 
 def window_warning(sweep: Sweep) -> str | None:
@@ -95,7 +107,9 @@ def window_warning(sweep: Sweep) -> str | None:
 
     keys = [k for k in WINDOW_KEYS if any(s[0] == k for s in settings)]
     what = "; ".join(f"run.{k} {side(k, 1)} against {side(k, 2)}" for k in keys)
+    auto = (" (auto: MSER-5 cuts each run's warm-up where its own output settles, so no two "
+            "points share a window)") if any(AUTO in s[1:] for s in settings) else ""
     return (f"{len(apart)} of {len(pairs)} paired comparisons are between points that run "
-            f"over different windows ({what}): their {WINDOW_MEASURES_TEXT} are not "
+            f"over different windows ({what}{auto}): their {WINDOW_MEASURES_TEXT} are not "
             "comparable and are left out of differences.csv; compare the rates, or give the "
             "points the same window")
