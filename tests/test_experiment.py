@@ -323,10 +323,21 @@ def test_a_shared_report_folder_gets_a_subfolder_and_keeps_its_files(sweeps, tmp
     code = main(["sweep", str(path), "--out", str(tmp_path / "o"), "--workers", "1",
                  "--report", str(shared)])
     assert code == 0
+    assert sorted(p.name for p in shared.iterdir()) == ["README.md", "sweep"]
     assert (shared / "README.md").read_text() == "mine\n"
-    assert (shared / "table_7_1.md").is_file() and (shared / "table_7_1.csv").is_file()
-    assert (shared / "sweep" / "report.md").is_file()
-    assert not (shared / "sweep" / "table_7_1.md").exists()
+    assert {"report.md", "table_7_1.md", "table_7_1.csv"} <= {
+        p.name for p in (shared / "sweep").iterdir()}
+
+
+def test_a_report_into_the_results_folder_keeps_table_7_1_with_the_report(sweeps, tmp_path):
+    path = sweeps.write(tmp_path, replications=2, batch=2, set={"run.parts": 500})
+    out = tmp_path / "o"
+    assert main(["sweep", str(path), "--out", str(out), "--workers", "1"]) == 0
+    assert main(["sweep", str(path), "--out", str(out), "--workers", "1", "--resume",
+                 "--report", str(out)]) == 0
+    assert not (out / "table_7_1.md").exists() and not (out / "table_7_1.csv").exists()
+    assert {"report.md", "table_7_1.md", "table_7_1.csv"} <= {
+        p.name for p in (out / "sweep").iterdir()}
 
 
 def test_a_report_folder_of_its_own_holds_table_7_1_beside_the_rest(sweeps, tmp_path):
@@ -336,6 +347,9 @@ def test_a_report_folder_of_its_own_holds_table_7_1_beside_the_rest(sweeps, tmp_
     names = {p.name for p in (tmp_path / "rep").iterdir()}
     assert {"table_7_1.md", "table_7_1.csv", "report.md", "summary.csv",
             "differences.csv"} <= names
+    text = (tmp_path / "rep" / "report.md").read_text()
+    link = "[`table_7_1.md`](table_7_1.md); its numbers: [`table_7_1.csv`](table_7_1.csv)."
+    assert link in text and text.index(link) < text.index("\n## ")
 
 
 @pytest.mark.parametrize("other", [

@@ -19,13 +19,11 @@ at all):
   (:mod:`cell.reporting.experiment_text`);
 - ``fig_<measure>.png`` per headline measure (:mod:`cell.reporting.experiment_plots`);
 - for a sweep laid out like Table 7.1, ``table_7_1.csv`` and ``table_7_1.md``
-  (:mod:`cell.reporting.table_7_1`).
+  (:mod:`cell.reporting.table_7_1`), linked from ``report.md``.
 
 A ``--report DIR`` that already holds files the report does not write (a shared
 folder such as the repository's ``reports/``), or will hold the sweep's own
-``--out``, is left as it is: the report goes
-to ``DIR/<sweep name>/``, and Table 7.1's two files, for a sweep laid out like
-it, into ``DIR`` itself beside the others (each replaced atomically).  If
+``--out``, is left as it is: the whole set goes to ``DIR/<sweep name>/``.  If
 ``DIR/<sweep name>/`` would itself be, or hold, ``--out``, the sweep is refused
 before it runs.
 """
@@ -42,11 +40,11 @@ from pathlib import Path
 import pandas as pd
 
 from cell.errors import CellError
-from cell.output import OutputDir, check_file
+from cell.output import OutputDir
 from cell.reporting.experiment_data import difference_table, measures, summary_table
 from cell.reporting.experiment_plots import figures
 from cell.reporting.experiment_text import markdown
-from cell.reporting.table_7_1 import is_table_7_1, table_7_1_files, write_table_7_1
+from cell.reporting.table_7_1 import is_table_7_1, table_7_1_files
 from cell.sweep import Sweep
 from cell.sweep.windows import window_warning
 
@@ -58,13 +56,12 @@ __all__ = ["Target", "difference_table", "measures", "plan_report", "summary_tab
 
 @dataclass(frozen=True)
 class Target:
-    """Where a report goes: the unit's directory and files, and where Table 7.1's own
-    two files go when they cannot be part of the unit (None: inside it, or none)."""
+    """Where a report goes: the unit's directory and files, and whether Table 7.1's
+    two files are among them."""
 
     directory: Path
     names: tuple[str, ...]
     table_7_1: bool
-    beside: Path | None = None
 
 
 def plan_report(sweep: Sweep, target: str | os.PathLike[str], option: str = "--report",
@@ -82,11 +79,8 @@ def plan_report(sweep: Sweep, target: str | os.PathLike[str], option: str = "--r
         raise CellError(f"{option} {target}: the report would go to {sub}, which is or holds "
                         f"--out {results}, the sweep's own results; choose another {option} "
                         "or --out")
-    OutputDir.check(sub, REPORT_FILES, option)
-    if t71:
-        for name in TABLE_7_1_FILES:
-            check_file(path / name)
-    return Target(sub, REPORT_FILES, t71, path if t71 else None)
+    OutputDir.check(sub, names, option)
+    return Target(sub, names, t71)
 
 
 def _holds(path: Path, results: str | os.PathLike[str] | None) -> bool:
@@ -122,6 +116,8 @@ def write_report(replications: pd.DataFrame, sweep: Sweep, target: Target,
                                       difference_table(replications, sweep))
     pngs = figures(summary, replications, sweep)
     text = markdown(summary, differences, replications, sweep, command, list(pngs), caveat)
+    if target.table_7_1:
+        text = _link_table_7_1(text)
     written = []
     with OutputDir(target.directory, target.names, "--report") as out:
         out.write_text("report.md", text)
@@ -134,12 +130,18 @@ def write_report(replications: pd.DataFrame, sweep: Sweep, target: Target,
         if "replications.csv" in target.names:
             out.write_csv("replications.csv", replications)
             written.append("replications.csv")
-        if target.table_7_1 and target.beside is None:
+        if target.table_7_1:
             table, t71_text = table_7_1_files(replications, sweep)
             out.write_csv("table_7_1.csv", table)
             out.write_text("table_7_1.md", t71_text)
             written += list(TABLE_7_1_FILES)
-    paths = [target.directory / name for name in written]
-    if target.table_7_1 and target.beside is not None:
-        paths += write_table_7_1(replications, sweep, target.beside)
-    return paths
+    return [target.directory / name for name in written]
+
+
+def _link_table_7_1(text: str) -> str:
+    """``report.md`` with a paragraph pointing at Table 7.1's two files, before its
+    first section."""
+    link = ("Table 7.1 beside the thesis's: [`table_7_1.md`](table_7_1.md); its numbers: "
+            "[`table_7_1.csv`](table_7_1.csv).")
+    head, sep, rest = text.partition("\n## ")
+    return f"{head}\n{link}\n\n## {rest}" if sep else f"{text.rstrip()}\n\n{link}\n"
