@@ -15,7 +15,7 @@ from __future__ import annotations
 import csv
 import math
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -320,25 +320,16 @@ def _parse_trace(path: Path) -> Any:
     """
     try:
         with path.open(encoding="utf-8-sig", newline="") as stream:
-            reader = csv.reader(stream, strict=True, skipinitialspace=True)
-            rows = [row for row in reader if any(c.strip() for c in row)]
+            cells = column_cells(stream, "interarrival_s")
     except (OSError, UnicodeDecodeError, csv.Error) as exc:
         return f"not a readable CSV: {' '.join(str(exc).split())[:120]}"
-    if not rows:
-        return "not a readable CSV: No columns to parse from file"
-    header, data = rows[0], rows[1:]
-    column = find_column(header, "interarrival_s")
-    if isinstance(column, str):
-        return column
-    ragged = next((i for i, row in enumerate(data) if len(row) > len(header)), None)
-    if ragged is not None:
-        return (f"not a readable CSV: row {ragged + 1} has {len(data[ragged])} fields, "
-                f"the header {len(header)}")
-    text = [row[column].strip() if column < len(row) else "" for row in data]
+    if isinstance(cells, str):
+        return cells
+    lines, text = cells
     times = np.array([_seconds(t) for t in text], dtype=float)
     bad = np.flatnonzero(~np.isfinite(times) | (times < 0) | (times > MAX_INTERARRIVAL_S))
     if bad.size:
-        return (f"row {bad[0] + 1} has inter-arrival time {text[bad[0]][:40]!r}; times "
+        return (f"line {lines[bad[0]]} has inter-arrival time {text[bad[0]][:40]!r}; times "
                 f"must be 0 or positive numbers of seconds, at most {MAX_INTERARRIVAL_S:g}")
     if times.size == 0:
         return "has no inter-arrival times"
@@ -346,6 +337,33 @@ def _parse_trace(path: Path) -> Any:
         return f"all {times.size} inter-arrival times are 0; their mean must be positive"
     times.setflags(write=False)
     return times
+
+
+def column_cells(stream: Iterable[str], column: str) -> tuple[list[int], list[str]] | str:
+    """The cells of ``column`` in a CSV text, spaces around them dropped ('' in a short row),
+    each with the file line its row starts on (the header's line is 1 if nothing precedes it,
+    as a spreadsheet numbers its rows); or why they cannot be read (:func:`find_column`, a row
+    with more fields than the header).  Blank lines, and a spreadsheet's rows of empty cells
+    (',,'), are skipped.  csv.Error on a malformed quote."""
+    reader = csv.reader(stream, strict=True, skipinitialspace=True)
+    records: list[tuple[int, list[str]]] = []
+    start = 1
+    for row in reader:
+        if any(c.strip() for c in row):
+            records.append((start, row))
+        start = reader.line_num + 1
+    if not records:
+        return "not a readable CSV: No columns to parse from file"
+    (_, header), data = records[0], records[1:]
+    index = find_column(header, column)
+    if isinstance(index, str):
+        return index
+    ragged = next(((line, row) for line, row in data if len(row) > len(header)), None)
+    if ragged is not None:
+        return (f"not a readable CSV: line {ragged[0]} has {len(ragged[1])} fields, "
+                f"the header {len(header)}")
+    return ([line for line, _ in data],
+            [row[index].strip() if index < len(row) else "" for _, row in data])
 
 
 def find_column(header: Sequence[str], column: str) -> int | str:

@@ -167,7 +167,7 @@ def test_trace_with_negative_time(tmp_path):
     (tmp_path / "trace.csv").write_text("interarrival_s\n20.0\n-1.5\n21.0\n")
     f = tmp_path / "s.yaml"
     f.write_text("arrivals:\n  trace_csv: trace.csv\n")
-    with pytest.raises(ScenarioError, match=r"trace_csv = .*row 2 .*-1.5.*positive"):
+    with pytest.raises(ScenarioError, match=r"trace_csv = .*line 3 .*-1.5.*positive"):
         load_scenario(f)
 
 
