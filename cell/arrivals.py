@@ -315,8 +315,8 @@ def read_trace(path: Path, file: object = None) -> NDArray[np.float64]:
 def _parse_trace(path: Path) -> Any:
     """The trace's times, or why they cannot be used (a message).
 
-    Read with the csv module (no pandas at a run's start), as pandas would read it:
-    blank lines skipped, a UTF-8 byte-order mark dropped, numbers as Python's float.
+    Read with the csv module (no pandas at a run's start), by :func:`column_cells`: blank
+    lines only at the ends, a UTF-8 byte-order mark dropped, numbers as Python's float.
     """
     try:
         with path.open(encoding="utf-8-sig", newline="") as stream:
@@ -343,14 +343,21 @@ def column_cells(stream: Iterable[str], column: str) -> tuple[list[int], list[st
     """The cells of ``column`` in a CSV text, spaces around them dropped ('' in a short row),
     each with the file line its row starts on (the header's line is 1 if nothing precedes it,
     as a spreadsheet numbers its rows); or why they cannot be read (:func:`find_column`, a row
-    with more fields than the header).  Blank lines, and a spreadsheet's rows of empty cells
-    (',,'), are skipped.  csv.Error on a malformed quote."""
+    with more fields than the header, a blank line between readings).  Blank lines, and a
+    spreadsheet's rows of empty cells (',,'), are skipped before the header and after the last
+    reading; one between readings is a missing reading, and skipping it would shift every later
+    gap.  csv.Error on a malformed quote."""
     reader = csv.reader(stream, strict=True, skipinitialspace=True)
     records: list[tuple[int, list[str]]] = []
-    start = 1
+    start, blank = 1, 0
     for row in reader:
         if any(c.strip() for c in row):
+            if blank:
+                return (f"line {blank} is blank and readings follow it: a missing reading (skipping "
+                        "it would shift every later gap): remove the line or fill it")
             records.append((start, row))
+        elif records and not blank:
+            blank = start
         start = reader.line_num + 1
     if not records:
         return "not a readable CSV: No columns to parse from file"

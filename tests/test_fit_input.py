@@ -198,3 +198,19 @@ def test_both_readers_name_the_same_file_line(tmp_path: Path):
     from cell.analysis.fit_input import read_column
 
     assert read_column(path).tolist() == read_trace(path).tolist()
+
+
+def test_a_blank_line_between_readings_is_refused_as_by_the_trace_reader(tmp_path: Path):
+    """A PLC export's empty line is a missing reading: ``cell fit`` refuses it as a run does,
+    naming its line, rather than fit gaps shifted by one part from there on."""
+    rows = [f"{i},{float(v)!r}\n" for i, v in enumerate(gaps(), 1)]
+    rows.insert(30, ",\n")
+    path = write(tmp_path / "t.csv", "part,interarrival_s\n" + "".join(rows))
+    out = tmp_path / "a.yaml"
+    with pytest.raises(ScenarioError) as err:
+        cmd_fit(parse(str(path), "--out", str(out)))
+    assert err.value.key == "(file)" and err.value.why.startswith("line 32 is blank and readings follow")
+    with pytest.raises(ScenarioError) as err:
+        read_trace(path)
+    assert err.value.why.startswith("line 32 is blank and readings follow")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.csv"]

@@ -29,8 +29,21 @@ def test_values_are_the_decimal_numbers_written(tmp_path: Path) -> None:
 
 
 def test_other_columns_quotes_spaces_blank_lines_bom_and_crlf(tmp_path: Path) -> None:
-    text = '\ufeffpart,interarrival_s\r\nA, 20.5 \r\n\r\nB,"23.25"\r\n   \r\nC,21\r\n'
+    text = '\ufeff\r\npart,interarrival_s\r\nA, 20.5 \r\nB,"23.25"\r\nC,21\r\n\r\n   \r\n,\r\n'
     assert read_trace(_trace(tmp_path, text)).tolist() == [20.5, 23.25, 21.0]
+
+
+@pytest.mark.parametrize("text, line", [
+    ("interarrival_s\n20\n\n25\n\n", 3),
+    ("interarrival_s\n\n20\n25\n", 2),
+    ("part,interarrival_s\r\n1,20\r\n2,21\r\n,\r\n   \r\n4,25\r\n", 4),
+])
+def test_a_blank_line_between_readings_is_a_missing_reading(tmp_path: Path, text: str, line: int) -> None:
+    """Skipping it would shift every later gap by one part: refused, naming its line."""
+    with pytest.raises(ScenarioError) as info:
+        read_trace(_trace(tmp_path, text))
+    assert info.value.why.startswith(f"line {line} is blank and readings follow it: a missing reading")
+    assert "remove the line or fill it" in info.value.why
 
 
 @pytest.mark.parametrize("text, words", [
