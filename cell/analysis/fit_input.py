@@ -17,8 +17,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cell.analysis.fit import MIN_VALUES
-from cell.arrivals import MAX_INTERARRIVAL_S, column_cells, find_column
+from cell.arrivals import MAX_INTERARRIVAL_S
 from cell.errors import ScenarioError
+from cell.trace_file import column_cells, find_column
 
 
 def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool = False,
@@ -106,7 +107,7 @@ def _why_unusable(cell: str, value: float, *, times: bool, dated: bool) -> str:
 
 def _read_cells(p: Path, column: str) -> tuple[list[int], Any]:
     """The cells of ``column`` in the CSV file ``p`` as a pandas Series of str (read as a run's
-    trace reader reads them, :func:`~cell.arrivals.column_cells`), and each one's file line."""
+    trace reader reads them, :func:`~cell.trace_file.column_cells`), and each one's file line."""
     import pandas as pd
 
     if not p.is_file():
