@@ -279,6 +279,9 @@ def check_arrivals(arrivals: ArrivalSpec, base_dir: Path, file: object) -> None:
     import scipy.stats
 
     dist = getattr(scipy.stats, arrivals.distribution)
+    mismatch = _misnamed(arrivals.distribution, params)
+    if mismatch:
+        raise ScenarioError(file, "arrivals.params", params, mismatch)
     try:
         frozen = dist(**params)
         mean = float(frozen.mean())
@@ -294,6 +297,30 @@ def check_arrivals(arrivals: ArrivalSpec, base_dir: Path, file: object) -> None:
                             f"the mean inter-arrival time would be {mean:.10g} s; at most "
                             f"{MAX_INTERARRIVAL_S:g} s")
     _remember(arrivals, params, mean, low)
+
+
+def param_names(dist: Any) -> list[str]:
+    """A scipy.stats distribution's parameters by name: its shapes, ``loc``, ``scale``."""
+    return [*(s.strip() for s in (dist.shapes or "").split(",") if s.strip()), "loc", "scale"]
+
+
+def _misnamed(family: str, params: Mapping[str, float]) -> str:
+    """Why ``params`` are not ``family``'s by name (another family's, a shape missing), with
+    the fix; "" when the names fit (scipy.stats then judges the values)."""
+    import scipy.stats
+
+    names = param_names(getattr(scipy.stats, family))
+    alien = [k for k in params if k not in names]
+    missing = [k for k in names[:-2] if k not in params]
+    if not alien and not missing:
+        return ""
+    owners = [f for f in BY_MEAN_AND_CV if f != family and alien and
+              set(params) <= set(param_names(getattr(scipy.stats, f)))]
+    wrong = (f"not {', '.join(alien)}" + (f" ({owners[0]}'s)" if owners else "") if alien else
+             f"{', '.join(missing)} missing")
+    fix = f"give arrivals.params for {family}" + \
+        (", or arrivals.mean_s and arrivals.cv" if family in BY_MEAN_AND_CV else "")
+    return f"arrivals.distribution {family} takes {', '.join(names)}, {wrong}: {fix}"
 
 
 def read_trace(path: Path, file: object = None) -> NDArray[np.float64]:

@@ -140,7 +140,7 @@ BAD = [
     ({"arrivals": {"distribution": "no_such_dist"}}, "arrivals.distribution", "scipy.stats"),
     ({"arrivals": {"distribution": "poisson"}}, "arrivals.distribution", "continuous"),
     ({"arrivals": {"distribution": "norm", "params": {"mu": 3}}}, "arrivals.params",
-     "not accepted"),
+     "norm takes loc, scale, not mu: give arrivals.params for norm"),
     ({"arrivals": {"distribution": "norm", "params": {"loc": 20, "scale": 1}}},
      "arrivals.params", "non-negative"),
     ({"arrivals": {"trace_csv": "missing.csv"}}, "arrivals.trace_csv", "no such file"),

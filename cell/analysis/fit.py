@@ -21,6 +21,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, stats
 
+from cell.arrivals import param_names
+
 DEFAULT_FAMILIES: tuple[str, ...] = ("weibull_min", "gamma", "lognorm", "expon", "norm")
 #: Families fitted with a free threshold by profile likelihood (see :func:`_fit_threshold`).
 THRESHOLD_FAMILIES = frozenset({"weibull_min", "gamma", "lognorm"})
@@ -60,11 +62,6 @@ def family_of(family: str) -> Any:
     if not isinstance(dist, stats.rv_continuous):
         raise ValueError(f"{family!r} is not a continuous distribution in scipy.stats")
     return dist
-
-
-def _param_names(dist: Any) -> list[str]:
-    shapes = [s.strip() for s in (dist.shapes or "").split(",") if s.strip()]
-    return [*shapes, "loc", "scale"]
 
 
 def _loglik(dist: Any, x: NDArray[np.float64], theta: Sequence[float]) -> float:
@@ -168,7 +165,7 @@ def _fit_one(family: str, x: NDArray[np.float64]) -> Fit:
         if not (np.all(np.isfinite(theta)) and math.isfinite(ll)):
             raise RuntimeError(f"{family}: the fit did not converge")
         ks = stats.kstest(x, dist.cdf, args=tuple(theta))
-    params = dict(zip(_param_names(dist), theta))
+    params = dict(zip(param_names(dist), theta))
     return Fit(family, params, float(ks.statistic), float(ks.pvalue), ll, 2.0 * len(theta) - 2.0 * ll)
 
 
