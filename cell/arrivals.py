@@ -15,7 +15,7 @@ from __future__ import annotations
 import csv
 import math
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 from cell.cache import Remembered, file_key, memo
 from cell.errors import ScenarioError
+from cell.trace_file import column_cells
 
 #: The feeder's child stream of the root SeedSequence (other streams take other keys).
 FEEDER_STREAM = 0
@@ -278,6 +279,9 @@ def check_arrivals(arrivals: ArrivalSpec, base_dir: Path, file: object) -> None:
     import scipy.stats
 
     dist = getattr(scipy.stats, arrivals.distribution)
+    mismatch = _misnamed(arrivals.distribution, params)
+    if mismatch:
+        raise ScenarioError(file, "arrivals.params", params, mismatch)
     try:
         frozen = dist(**params)
         mean = float(frozen.mean())
@@ -293,6 +297,30 @@ def check_arrivals(arrivals: ArrivalSpec, base_dir: Path, file: object) -> None:
                             f"the mean inter-arrival time would be {mean:.10g} s; at most "
                             f"{MAX_INTERARRIVAL_S:g} s")
     _remember(arrivals, params, mean, low)
+
+
+def param_names(dist: Any) -> list[str]:
+    """A scipy.stats distribution's parameters by name: its shapes, ``loc``, ``scale``."""
+    return [*(s.strip() for s in (dist.shapes or "").split(",") if s.strip()), "loc", "scale"]
+
+
+def _misnamed(family: str, params: Mapping[str, float]) -> str:
+    """Why ``params`` are not ``family``'s by name (another family's, a shape missing), with
+    the fix; "" when the names fit (scipy.stats then judges the values)."""
+    import scipy.stats
+
+    names = param_names(getattr(scipy.stats, family))
+    alien = [k for k in params if k not in names]
+    missing = [k for k in names[:-2] if k not in params]
+    if not alien and not missing:
+        return ""
+    owners = [f for f in BY_MEAN_AND_CV if f != family and alien and
+              set(params) <= set(param_names(getattr(scipy.stats, f)))]
+    wrong = (f"not {', '.join(alien)}" + (f" ({owners[0]}'s)" if owners else "") if alien else
+             f"{', '.join(missing)} missing")
+    fix = f"give arrivals.params for {family}" + \
+        (", or arrivals.mean_s and arrivals.cv" if family in BY_MEAN_AND_CV else "")
+    return f"arrivals.distribution {family} takes {', '.join(names)}, {wrong}: {fix}"
 
 
 def read_trace(path: Path, file: object = None) -> NDArray[np.float64]:
@@ -315,30 +343,21 @@ def read_trace(path: Path, file: object = None) -> NDArray[np.float64]:
 def _parse_trace(path: Path) -> Any:
     """The trace's times, or why they cannot be used (a message).
 
-    Read with the csv module (no pandas at a run's start), as pandas would read it:
-    blank lines skipped, a UTF-8 byte-order mark dropped, numbers as Python's float.
+    Read with the csv module (no pandas at a run's start), by :func:`column_cells`: blank
+    lines only at the ends, a UTF-8 byte-order mark dropped, numbers as Python's float.
     """
     try:
         with path.open(encoding="utf-8-sig", newline="") as stream:
-            reader = csv.reader(stream, strict=True, skipinitialspace=True)
-            rows = [row for row in reader if any(c.strip() for c in row)]
+            cells = column_cells(stream, "interarrival_s")
     except (OSError, UnicodeDecodeError, csv.Error) as exc:
         return f"not a readable CSV: {' '.join(str(exc).split())[:120]}"
-    if not rows:
-        return "not a readable CSV: No columns to parse from file"
-    header, data = rows[0], rows[1:]
-    column = find_column(header, "interarrival_s")
-    if isinstance(column, str):
-        return column
-    ragged = next((i for i, row in enumerate(data) if len(row) > len(header)), None)
-    if ragged is not None:
-        return (f"not a readable CSV: row {ragged + 1} has {len(data[ragged])} fields, "
-                f"the header {len(header)}")
-    text = [row[column].strip() if column < len(row) else "" for row in data]
+    if isinstance(cells, str):
+        return cells
+    lines, text = cells
     times = np.array([_seconds(t) for t in text], dtype=float)
     bad = np.flatnonzero(~np.isfinite(times) | (times < 0) | (times > MAX_INTERARRIVAL_S))
     if bad.size:
-        return (f"row {bad[0] + 1} has inter-arrival time {text[bad[0]][:40]!r}; times "
+        return (f"line {lines[bad[0]]} has inter-arrival time {text[bad[0]][:40]!r}; times "
                 f"must be 0 or positive numbers of seconds, at most {MAX_INTERARRIVAL_S:g}")
     if times.size == 0:
         return "has no inter-arrival times"
@@ -346,23 +365,6 @@ def _parse_trace(path: Path) -> Any:
         return f"all {times.size} inter-arrival times are 0; their mean must be positive"
     times.setflags(write=False)
     return times
-
-
-def find_column(header: Sequence[str], column: str) -> int | str:
-    """Where ``column`` is among a CSV's ``header`` fields (spaces around a name ignored, as
-    spreadsheets leave them), or why it cannot be read there: there is no such column (the
-    names found are listed, and a header whose columns are separated by ';', as spreadsheets
-    save CSV in locales with a decimal comma, is said to be), or two columns have the name."""
-    names = [name.strip() for name in header]
-    if names.count(column) > 1:
-        return f"two columns are named {column}: keep one"
-    if column in names:
-        return names.index(column)
-    if any(";" in name for name in names):
-        return (f"needs a column named {column}; the columns are separated by ';': save the CSV "
-                "with a comma between columns and a decimal point in numbers")
-    found = ", ".join(repr(name) for name in names[:5]) + (", ..." if len(names) > 5 else "")
-    return f"needs a column named {column} (found {found})"
 
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\Z", re.ASCII)

@@ -78,3 +78,24 @@ def test_a_mean_just_over_the_limit_is_shown_over_it(tmp_path):
     with pytest.raises(ScenarioError) as err:
         check_arrivals(spec, tmp_path, "s.yaml")
     assert "would be 1000000.02 s; at most 1e+06 s" in err.value.why
+
+
+@pytest.mark.parametrize("distribution, params, words", [
+    ("gamma", {"c": 4.9, "loc": 17.6, "scale": 5.4},
+     "arrivals.distribution gamma takes a, loc, scale, not c (weibull_min's): give arrivals.params "
+     "for gamma, or arrivals.mean_s and arrivals.cv"),
+    ("weibull_min", {"s": 0.5, "loc": 17.6, "scale": 5.4},
+     "arrivals.distribution weibull_min takes c, loc, scale, not s (lognorm's): give"),
+    ("gamma", {"loc": 17.6, "scale": 5.4}, "gamma takes a, loc, scale, a missing: give arrivals.params"),
+    ("norm", {"c": 4.9, "loc": 17.6, "scale": 5.4},
+     "norm takes loc, scale, not c (weibull_min's): give arrivals.params for norm"),
+])
+def test_parameters_of_another_family_are_named_with_the_fix(tmp_path, distribution, params, words):
+    """Changing only the distribution (--set arrivals.distribution=gamma on the baseline) leaves
+    the Weibull's c: the line says whose parameters they are and what to give, not scipy's
+    '_parse_args() got an unexpected keyword argument'."""
+    spec = SimpleNamespace(distribution=distribution, params=params, trace_csv=None, mean_s=None, cv=None)
+    with pytest.raises(ScenarioError) as err:
+        check_arrivals(spec, tmp_path, "s.yaml")
+    assert err.value.key == "arrivals.params" and words in err.value.why, err.value.why
+    assert "_parse_args" not in str(err.value) and (distribution != "norm" or "mean_s" not in err.value.why)

@@ -182,14 +182,14 @@ def _column(values: list[str]) -> str:
 
 BAD_TRACES = [
     ("wrong column", "gap_s\n" + "\n".join(["21.0"] * 30) + "\n", "--column", "interarrival_s"),
-    ("negative", _column(["21.5", "-3.0"]), "interarrival_s[row 2]", "-3.0"),
-    ("zero", _column(["0"]), "interarrival_s[row 1]", "0"),
-    ("boolean", _column(["21.5", "22.0", "True"]), "interarrival_s[row 3]", "True"),
-    ("text", _column(["abc"]), "interarrival_s[row 1]", "abc"),
-    ("infinite", _column(["inf"]), "interarrival_s[row 1]", "inf"),
-    ("not a number", _column(["nan"]), "interarrival_s[row 1]", "nan"),
+    ("negative", _column(["21.5", "-3.0"]), "interarrival_s[line 3]", "-3.0"),
+    ("zero", _column(["0"]), "interarrival_s[line 2]", "0"),
+    ("boolean", _column(["21.5", "22.0", "True"]), "interarrival_s[line 4]", "True"),
+    ("text", _column(["abc"]), "interarrival_s[line 2]", "abc"),
+    ("infinite", _column(["inf"]), "interarrival_s[line 2]", "inf"),
+    ("not a number", _column(["nan"]), "interarrival_s[line 2]", "nan"),
     ("missing cell", "part,interarrival_s\n1,\n" + "".join(f"{i},21.0\n" for i in range(30)),
-     "interarrival_s[row 1]", ""),
+     "interarrival_s[line 2]", ""),
     ("too few", "interarrival_s\n" + "\n".join(["21.0", "22.5"] * 5) + "\n", "interarrival_s", "10 values"),
     ("all equal", "interarrival_s\n" + "\n".join(["21.0"] * 30) + "\n", "interarrival_s",
      "all 30 values = 21"),
@@ -320,11 +320,11 @@ def _times(values: list[str]) -> str:
 
 
 BAD_TIMES = [
-    ("goes back", _times(["0", "21.5", "20.0"]), "arrival_s[row 3]", "20.0", "not after 21.5 in row 2"),
-    ("repeated", _times(["0", "21.5", "21.5"]), "arrival_s[row 3]", "21.5",
-     "the same time as row 2: 1 of 32 gaps are 0"),
-    ("not a number", _times(["0", "abc"]), "arrival_s[row 2]", "abc", "not a number"),
-    ("infinite", _times(["0", "inf"]), "arrival_s[row 2]", "inf", "must be finite"),
+    ("goes back", _times(["0", "21.5", "20.0"]), "arrival_s[line 4]", "20.0", "not after 21.5 on line 3"),
+    ("repeated", _times(["0", "21.5", "21.5"]), "arrival_s[line 4]", "21.5",
+     "the same time as line 3: 1 of 32 gaps are 0"),
+    ("not a number", _times(["0", "abc"]), "arrival_s[line 3]", "abc", "not a number"),
+    ("infinite", _times(["0", "inf"]), "arrival_s[line 3]", "inf", "must be finite"),
     ("too few", "arrival_s\n" + "\n".join(_arrival_times(19)) + "\n", "arrival_s", "20 arrival times",
      "at least 21 arrival times"),
     ("evenly spaced", "arrival_s\n" + "\n".join(str(22 * i) for i in range(30)) + "\n", "arrival_s",
@@ -368,7 +368,7 @@ def test_times_as_date_times_fit_as_their_seconds(tmp_path: Path, capsys):
     bad = _write(tmp_path / "bad.csv", "arrival_s", [*stamps[:30], "soon", *stamps[31:]])
     with pytest.raises(ScenarioError) as err:
         cmd_fit(parse(str(bad), "--column", "arrival_s", "--times"))
-    assert err.value.key == "arrival_s[row 31]" and err.value.value == "soon"
+    assert err.value.key == "arrival_s[line 32]" and err.value.value == "soon"
     assert "date-time" in err.value.why
 
 

@@ -76,7 +76,7 @@ def test_a_decimal_comma_is_named(tmp_path: Path):
     path = write(tmp_path / "t.csv", "interarrival_s\n" + "\n".join(values) + "\n")
     with pytest.raises(ScenarioError) as err:
         cmd_fit(parse(str(path)))
-    assert (err.value.key, err.value.value) == ("interarrival_s[row 5]", "21,5")
+    assert (err.value.key, err.value.value) == ("interarrival_s[line 6]", "21,5")
     assert "decimal point" in err.value.why
 
 
@@ -90,7 +90,7 @@ def test_times_that_are_neither_seconds_nor_iso_say_what_is_accepted(tmp_path: P
     path = write(tmp_path / "t.csv", "stamp\n" + "\n".join(german) + "\n")
     with pytest.raises(ScenarioError) as err:
         cmd_fit(parse(str(path), "--column", "stamp", "--times"))
-    assert (err.value.key, err.value.value) == ("stamp[row 1]", german[0])
+    assert (err.value.key, err.value.value) == ("stamp[line 2]", german[0])
     assert "ISO" in err.value.why and "seconds" in err.value.why
 
 
@@ -105,7 +105,7 @@ def test_gaps_a_run_would_refuse_are_refused(tmp_path: Path, times: bool):
     out = tmp_path / "a.yaml"
     with pytest.raises(ScenarioError) as err:
         cmd_fit(parse(str(path), "--out", str(out), *(["--times"] if times else [])))
-    assert err.value.key == ("interarrival_s[row 8]" if times else "interarrival_s[row 7]")
+    assert err.value.key == ("interarrival_s[line 9]" if times else "interarrival_s[line 8]")
     assert f"{MAX_INTERARRIVAL_S:g}" in err.value.why
     assert not out.exists()
 
@@ -172,10 +172,45 @@ def test_zero_gaps_are_refused_with_their_count(tmp_path: Path, times: bool):
     with pytest.raises(ScenarioError) as err:
         cmd_fit(parse(str(path), "--out", str(out), *(["--times"] if times else [])))
     first = int(np.flatnonzero(step == 0)[0])
-    assert err.value.key == f"interarrival_s[row {first + 1}]"
+    assert err.value.key == f"interarrival_s[line {first + 2}]"
     assert f"{zeros} of {column.size - times} gaps are 0" in err.value.why
-    assert ("the same time as row" in err.value.why) == times
+    assert ("the same time as line" in err.value.why) == times
     assert "more finely" in err.value.why and "arrivals.trace_csv" in err.value.why
     assert "\n" not in str(err.value) and not out.exists()
     if not times:
         assert read_trace(path).tolist() == column.tolist()  # a run replays them as they are
+
+
+def test_both_readers_name_the_same_file_line(tmp_path: Path):
+    """A bad value is named by its line in the file (the header's is 1, as a spreadsheet numbers
+    rows; blank lines before it counted), by ``cell fit`` and by a run's trace reader alike, and
+    both read a quoted field after a space ('1, "20"') as the number."""
+    values = [f'"{v:.3f}"' for v in gaps()]
+    values[9] = "-2.5"
+    path = write(tmp_path / "t.csv", "\n\npart, interarrival_s\n" +
+                 "".join(f"{i}, {v}\n" for i, v in enumerate(values, 1)))
+    with pytest.raises(ScenarioError) as err:
+        cmd_fit(parse(str(path)))
+    assert (err.value.key, err.value.value) == ("interarrival_s[line 13]", "-2.5")
+    with pytest.raises(ScenarioError, match="line 13 has inter-arrival time '-2.5'"):
+        read_trace(path)
+    write(path, path.read_text().replace("-2.5", "21.5"))
+    from cell.analysis.fit_input import read_column
+
+    assert read_column(path).tolist() == read_trace(path).tolist()
+
+
+def test_a_blank_line_between_readings_is_refused_as_by_the_trace_reader(tmp_path: Path):
+    """A PLC export's empty line is a missing reading: ``cell fit`` refuses it as a run does,
+    naming its line, rather than fit gaps shifted by one part from there on."""
+    rows = [f"{i},{float(v)!r}\n" for i, v in enumerate(gaps(), 1)]
+    rows.insert(30, ",\n")
+    path = write(tmp_path / "t.csv", "part,interarrival_s\n" + "".join(rows))
+    out = tmp_path / "a.yaml"
+    with pytest.raises(ScenarioError) as err:
+        cmd_fit(parse(str(path), "--out", str(out)))
+    assert err.value.key == "(file)" and err.value.why.startswith("line 32 is blank and readings follow")
+    with pytest.raises(ScenarioError) as err:
+        read_trace(path)
+    assert err.value.why.startswith("line 32 is blank and readings follow")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.csv"]

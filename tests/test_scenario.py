@@ -140,7 +140,7 @@ BAD = [
     ({"arrivals": {"distribution": "no_such_dist"}}, "arrivals.distribution", "scipy.stats"),
     ({"arrivals": {"distribution": "poisson"}}, "arrivals.distribution", "continuous"),
     ({"arrivals": {"distribution": "norm", "params": {"mu": 3}}}, "arrivals.params",
-     "not accepted"),
+     "norm takes loc, scale, not mu: give arrivals.params for norm"),
     ({"arrivals": {"distribution": "norm", "params": {"loc": 20, "scale": 1}}},
      "arrivals.params", "non-negative"),
     ({"arrivals": {"trace_csv": "missing.csv"}}, "arrivals.trace_csv", "no such file"),
@@ -167,7 +167,7 @@ def test_trace_with_negative_time(tmp_path):
     (tmp_path / "trace.csv").write_text("interarrival_s\n20.0\n-1.5\n21.0\n")
     f = tmp_path / "s.yaml"
     f.write_text("arrivals:\n  trace_csv: trace.csv\n")
-    with pytest.raises(ScenarioError, match=r"trace_csv = .*row 2 .*-1.5.*positive"):
+    with pytest.raises(ScenarioError, match=r"trace_csv = .*line 3 .*-1.5.*positive"):
         load_scenario(f)
 
 

@@ -1,7 +1,7 @@
 """The column ``cell fit`` reads: a CSV's inter-arrival gaps, or arrival times made gaps.
 
 Every problem is one :class:`~cell.errors.ScenarioError` line naming the file, the
-column (and row) and the value as written; :mod:`cell.analysis.fit` fits what is read.
+column (and the file's line) and the value as written; :mod:`cell.analysis.fit` fits what is read.
 """
 
 from __future__ import annotations
@@ -10,7 +10,6 @@ import csv
 import io
 import math
 import re
-import warnings
 from pathlib import Path
 from typing import Any
 
@@ -18,8 +17,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cell.analysis.fit import MIN_VALUES
-from cell.arrivals import MAX_INTERARRIVAL_S, find_column
+from cell.arrivals import MAX_INTERARRIVAL_S
 from cell.errors import ScenarioError
+from cell.trace_file import column_cells, find_column
 
 
 def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool = False,
@@ -34,14 +34,13 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
     in increasing order with probability 1/n!, < 1e-18 at n = 20), unless
     ``sorted_ok`` says they are gaps in sorted order.  Any problem raises
     :class:`~cell.errors.ScenarioError` naming the file, the key (``(file)``,
-    ``--column``, ``COLUMN`` or ``COLUMN[row N]``, data rows counted from 1) and
-    the value as written.
+    ``--column``, ``COLUMN`` or ``COLUMN[line N]``, N the file's line, the header's 1, as a
+    spreadsheet numbers its rows) and the value as written.
     """
     import pandas as pd
 
     p = Path(path)
-    written = _read_cells(p, column)
-    cells = written.astype(str).str.strip()
+    lines, cells = _read_cells(p, column)
     values = pd.to_numeric(cells, errors="coerce").to_numpy(dtype=float)
     dated = times and bool(np.isnan(values).all())
     if dated:  # arrival times as date-times (ISO 8601, e.g. 2026-03-02 08:15:04.5): seconds
@@ -59,7 +58,7 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
     bad = np.flatnonzero(~finite if times else ~finite | (values < 0.0) | (values > MAX_INTERARRIVAL_S))
     if bad.size:
         i = int(bad[0])
-        raise ScenarioError(p, f"{column}[row {i + 1}]", written.iloc[i],
+        raise ScenarioError(p, f"{column}[line {lines[i]}]", cells.iloc[i],
                             _why_unusable(cells.iloc[i], values[i], times=times, dated=dated))
     noun = "values"
     if times:
@@ -67,16 +66,16 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
         back = np.flatnonzero(~(step > 0.0) | (step > MAX_INTERARRIVAL_S))
         if back.size and step[back[0]] != 0.0:  # a first repeated time is said below
             i = int(back[0]) + 1
-            why = (f"arrival times must increase: not after {cells.iloc[i - 1]} in row {i}"
-                   if step[i - 1] < 0.0 else
-                   f"{step[i - 1]:.10g} s after row {i}; gaps must be at most {MAX_INTERARRIVAL_S:g} s")
-            raise ScenarioError(p, f"{column}[row {i + 1}]", written.iloc[i], why)
+            why = (f"arrival times must increase: not after {cells.iloc[i - 1]} on line {lines[i - 1]}"
+                   if step[i - 1] < 0.0 else f"{step[i - 1]:.10g} s after line {lines[i - 1]}; "
+                   f"gaps must be at most {MAX_INTERARRIVAL_S:g} s")
+            raise ScenarioError(p, f"{column}[line {lines[i]}]", cells.iloc[i], why)
         values, noun = step, "gaps"
     zero = np.flatnonzero(values == 0.0)  # Weibull's, gamma's, lognorm's likelihood is 0 or inf there
     if zero.size:
         i = int(zero[0]) + times
-        same = f"the same time as row {i}: " if times else ""
-        raise ScenarioError(p, f"{column}[row {i + 1}]", written.iloc[i],
+        same = f"the same time as line {lines[i - 1]}: " if times else ""
+        raise ScenarioError(p, f"{column}[line {lines[i]}]", cells.iloc[i],
                             f"{same}{zero.size} of {values.size} gaps are 0 (logged in the same second?): no "
                             "continuous distribution fits them; log the times more finely, or replay the "
                             "gaps as a trace (arrivals.trace_csv takes zeros)")
@@ -106,8 +105,9 @@ def _why_unusable(cell: str, value: float, *, times: bool, dated: bool) -> str:
     return f"inter-arrival times must be finite, > 0 and at most {MAX_INTERARRIVAL_S:g} s"
 
 
-def _read_cells(p: Path, column: str) -> Any:
-    """The cells of ``column`` in the CSV file ``p``, as written (a pandas Series of str)."""
+def _read_cells(p: Path, column: str) -> tuple[list[int], Any]:
+    """The cells of ``column`` in the CSV file ``p`` as a pandas Series of str (read as a run's
+    trace reader reads them, :func:`~cell.trace_file.column_cells`), and each one's file line."""
     import pandas as pd
 
     if not p.is_file():
@@ -125,14 +125,12 @@ def _read_cells(p: Path, column: str) -> Any:
     if not text.strip():
         raise ScenarioError(p, "(file)", str(p), "empty file")
     index = find_column(next(csv.reader([text.lstrip().splitlines()[0]], skipinitialspace=True)), column)
-    if isinstance(index, str):  # before pandas, which renames a second X to X.1 and miscounts ';' rows
+    if isinstance(index, str):  # the column the user named (--column) is not there
         raise ScenarioError(p, "--column", column, index)
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("error", pd.errors.ParserWarning)
-            frame = pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False, index_col=False)
-    except (ValueError, pd.errors.ParserWarning) as exc:  # pandas' parser errors are ValueErrors
-        why = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise ScenarioError(p, "(file)", str(p), f"not a readable CSV: {why}") from None
-    blank = frame.apply(lambda c: c.str.strip() == "").all(axis=1)  # a spreadsheet's empty rows: ',,'
-    return frame.loc[~blank].iloc[:, index].reset_index(drop=True)
+        cells = column_cells(io.StringIO(text, newline=""), column)
+    except csv.Error as exc:
+        cells = f"not a readable CSV: {' '.join(str(exc).split())[:120]}"
+    if isinstance(cells, str):
+        raise ScenarioError(p, "(file)", str(p), cells)
+    return cells[0], pd.Series(cells[1], dtype=str)

@@ -2,14 +2,19 @@
 
 Fits candidate scipy.stats distributions to observed inter-arrival times by
 maximum likelihood (:mod:`cell.analysis.fit`), prints them ranked, and writes
-the ``arrivals:`` block of the best one that never gives a negative time,
-with a histogram of the data and the fitted densities.  ``--times`` reads the
-column as arrival times and fits the gaps between them.
+the ``arrivals:`` block of the best one that never gives a negative time (or, when
+that one misses the data's mean or sd, the one nearest them: :func:`~cell.analysis.fit.choose`),
+with a histogram of the data and the fitted densities.  A fit that does not stand for the
+data (:func:`~cell.analysis.fit.caution`) is said in a warning and in the block, which
+then points to replaying the data as a trace.  ``--times`` reads the column as arrival
+times and fits the gaps between them.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -18,7 +23,11 @@ from cell.errors import ScenarioError
 HELP = "fit a distribution to observed inter-arrival times; write the arrivals block"
 DESCRIPTION = ("Fit scipy.stats distributions to observed inter-arrival times by maximum likelihood, "
                "rank them, and write the arrivals: block of the best one that never gives a negative "
-               "time, with a histogram of the data under the fitted densities. Zero gaps (two parts "
+               "time (or, if it misses the data's mean or sd, the one nearest them), with a histogram "
+               "of the data under the fitted densities. When the written fit's mean or sd is off the "
+               "data's, or the Kolmogorov-Smirnov test rejects it (p < 0.001), a warning and a comment "
+               "in the block say so, with the line that replays the data themselves as a trace "
+               "(arrivals.trace_csv). Zero gaps (two parts "
                "logged in the same second) are refused, counted: no continuous distribution fits them, "
                "and leaving them out would lengthen the mean; log the times more finely, or replay the "
                "gaps as a trace (arrivals.trace_csv takes zeros).")
@@ -58,11 +67,22 @@ def _destination(path: str | Path, option: str, taken: Sequence[Path]) -> Path:
     return p
 
 
+def _replay(trace: Path, out: Path | None, column: str, times: bool) -> str:
+    """How to replay the data themselves: the trace as it is, named from --out's directory,
+    when its column is a run's (``interarrival_s``, gaps)."""
+    if column != "interarrival_s" or times:
+        return "arrivals.trace_csv (a CSV of the gaps in a column named interarrival_s)"
+    path = os.path.relpath(trace.resolve(), out.resolve().parent) if out is not None else str(trace)
+    return f"arrivals: {{trace_csv: {path}}}"
+
+
 def main(args: argparse.Namespace) -> int:
     """Fit, print the table, write (or print) the arrivals block and the figure."""
     from cell.analysis.fit import (
         DEFAULT_FAMILIES,
         arrivals_yaml,
+        caution,
+        choose,
         draw,
         family_of,
         fit_trace,
@@ -96,15 +116,15 @@ def main(args: argparse.Namespace) -> int:
         fits = fit_trace(values, families, rank_by=args.rank_by)
     except ValueError as exc:
         raise ScenarioError(trace, args.column, count, str(exc)) from None
-    usable = [f for f in fits if f.nonnegative]
-    if not usable:
-        raise ScenarioError(trace, "--families", ",".join(families),
-                            "no fitted family keeps inter-arrival times non-negative")
-    chosen = usable[0]
-    block = arrivals_yaml(chosen, f"{trace}, column {args.column} ({count})")
-    table = format_table(fits)
-    if chosen is not fits[0]:
-        table += f"\nChosen: {chosen.family}, the best fit that allows no negative times."
+    try:
+        chosen, why = choose(fits, values)
+    except ValueError as exc:
+        raise ScenarioError(trace, "--families", ",".join(families), str(exc)) from None
+    warning = caution(chosen, values)
+    if warning:
+        warning += f". To run the data themselves, replay them: {_replay(trace, out, args.column, times)}"
+    block = arrivals_yaml(chosen, f"{trace}, column {args.column} ({count})", warning)
+    table = format_table(fits) + (f"\n{why}" if why else "")
     from cell.output import atomic_paths
 
     targets = [t for t in (figure, out) if t is not None]
@@ -120,4 +140,6 @@ def main(args: argparse.Namespace) -> int:
     print(block.rstrip("\n") if out is None else f"wrote {out}")
     if figure is not None:
         print(f"{comment}wrote {figure}")
+    if warning:
+        print(f"cell: warning: {warning}", file=sys.stderr)
     return 0
