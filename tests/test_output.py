@@ -35,7 +35,7 @@ from .outputs import (
 def test_written_whole_with_ordinary_permissions(tmp_path):
     target = tmp_path / "sub" / "a.csv"
     write_csv(pd.DataFrame({"x": [1.5, 2.0]}), target)
-    assert target.read_text() == "x\n1.5\n2\n"
+    assert target.read_text() == "x\n1.5\n2.0\n"
     assert stat.S_IMODE(target.stat().st_mode) == 0o666 & ~current_umask()
     assert [p.name for p in target.parent.iterdir()] == ["a.csv"]
 

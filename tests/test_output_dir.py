@@ -27,7 +27,7 @@ def test_whole_set_appears_with_ordinary_modes(tmp_path):
         with out.open("summary.csv") as stream:
             stream.write("s\n")
         assert not target.exists()  # nothing visible before the end
-    assert (target / "parts.csv").read_text() == "x\n1.5\n2\n"
+    assert (target / "parts.csv").read_text() == "x\n1.5\n2.0\n"
     assert sorted(p.name for p in target.iterdir()) == sorted(NAMES)
     assert siblings(target) == ["run"]
     umask = current_umask()

@@ -19,7 +19,7 @@ import shutil
 import stat
 import sys
 import tempfile
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from types import TracebackType
 from typing import IO, TYPE_CHECKING, Any
@@ -48,14 +48,25 @@ if TYPE_CHECKING:
     import pandas as pd
 
 #: Digits kept in CSV floats: ten significant, identical on every run.  So an instant past
-#: 1e7 s (a run of some 450,000 parts) keeps 0.01 s, past 1e8 s 0.1 s; and a whole number is
-#: written without a point (pandas reads a column of them as integers).
+#: 1e7 s (a run of some 450,000 parts) keeps 0.01 s, past 1e8 s 0.1 s.
 FLOAT_FORMAT = "%.10g"
+
+
+def float_text(value: float, fmt: str = FLOAT_FORMAT) -> str:
+    """A float as CSV text: ``fmt``, with ``.0`` after a whole number (``21.0``, not ``21``),
+    so that pandas reads a float column as floats whatever its values."""
+    text = fmt % value
+    return text if "." in text or "e" in text or "n" in text else text + ".0"  # n: inf, nan
+
+
+def float_formatter(fmt: str = FLOAT_FORMAT) -> Callable[[float], str]:
+    """:func:`float_text` with ``fmt``, as pandas' ``to_csv(float_format=...)`` takes it."""
+    return lambda value: float_text(value, fmt)
 
 _open: Any = open  # every file written goes through here (tests simulate a full disk with it)
 
-__all__ = ["FLOAT_FORMAT", "OutputDir", "atomic_path", "atomic_paths", "check_file", "write_csv",
-           "write_text"]
+__all__ = ["FLOAT_FORMAT", "OutputDir", "atomic_path", "atomic_paths", "check_file", "float_formatter",
+           "float_text", "write_csv", "write_text"]
 
 _renameat2: Any = None
 if sys.platform.startswith("linux"):
@@ -175,7 +186,8 @@ class OutputDir(contextlib.AbstractContextManager["OutputDir"]):
     def write_csv(self, name: str, frame: pd.DataFrame, float_format: str = FLOAT_FORMAT) -> None:
         """A DataFrame as CSV with a fixed float format (byte-identical reruns)."""
         with failing(f"{self.target}/{name}"), self.open(name, "w", newline="") as stream:
-            frame.to_csv(stream, index=False, float_format=float_format, lineterminator="\n")
+            frame.to_csv(stream, index=False, float_format=float_formatter(float_format),
+                         lineterminator="\n")
 
     def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> None:
@@ -255,4 +267,5 @@ def write_text(text: str, target: str | os.PathLike[str]) -> None:
 def write_csv(frame: pd.DataFrame, target: str | os.PathLike[str], float_format: str = FLOAT_FORMAT) -> None:
     """A DataFrame as CSV, atomically, with a fixed float format (byte-identical reruns)."""
     with atomic_path(target) as tmp, _open(tmp, "w", encoding="utf-8", newline="") as stream:
-        frame.to_csv(stream, index=False, float_format=float_format, lineterminator="\n")
+        frame.to_csv(stream, index=False, float_format=float_formatter(float_format),
+                         lineterminator="\n")

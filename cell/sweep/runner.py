@@ -43,7 +43,7 @@ import numpy as np
 
 from cell.cache import Identity, memo
 from cell.errors import CellError
-from cell.output import FLOAT_FORMAT, atomic_path, write_csv
+from cell.output import atomic_path, float_formatter, write_csv
 from cell.progress import Progress
 from cell.scenario import Scenario
 from cell.sweep.columns import Column, grid_columns, point_values
@@ -393,6 +393,6 @@ def _assemble(sweep: Sweep, task_dir: Path, tasks: Iterable[Task], target: Path)
     with atomic_path(target) as tmp, open(tmp, "w", encoding="utf-8", newline="") as stream:
         for i, frame in enumerate(frames):
             frame.reindex(columns=list(names)).to_csv(
-                stream, header=i == 0, index=False, float_format=FLOAT_FORMAT,
+                stream, header=i == 0, index=False, float_format=float_formatter(),
                 lineterminator="\n")
     return target
