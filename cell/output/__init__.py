@@ -59,8 +59,9 @@ def float_text(value: float, fmt: str = FLOAT_FORMAT) -> str:
     return text if "." in text or "e" in text or "n" in text else text + ".0"  # n: inf, nan
 
 
-def float_formatter(fmt: str = FLOAT_FORMAT) -> Callable[[float], str]:
-    """:func:`float_text` with ``fmt``, as pandas' ``to_csv(float_format=...)`` takes it."""
+def float_formatter(fmt: str = FLOAT_FORMAT) -> Callable[[Any], str]:
+    """:func:`float_text` with ``fmt``, as pandas' ``to_csv(float_format=...)`` takes it
+    (pandas calls it with floats only)."""
     return lambda value: float_text(value, fmt)
 
 _open: Any = open  # every file written goes through here (tests simulate a full disk with it)
