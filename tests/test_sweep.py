@@ -238,7 +238,8 @@ def test_a_fresh_run_of_an_edited_sweep_keeps_the_old_results(sweeps, tmp_path):
               replicate=sweeps.first_draw, progress=False)
     before = sorted((tmp_path / "o").rglob("*"))
     smaller = load_sweep(sweeps.write(tmp_path, replications=2))
-    with pytest.raises(CellError, match="holds the results of this sweep"):
+    with pytest.raises(CellError, match="holds this sweep's results at replications: 6: add "
+                                        "--resume to reuse those that fit replications: 2"):
         run_sweep(smaller, tmp_path / "o", workers=1, replicate=sweeps.first_draw,
                   progress=False)
     assert sorted((tmp_path / "o").rglob("*")) == before

@@ -13,6 +13,7 @@ from typing import Any
 
 from cell.errors import CellError
 from cell.output import write_text
+from cell.sweep.options import show
 from cell.sweep.spec import Sweep
 
 MANIFEST = "sweep.json"
@@ -21,6 +22,11 @@ TASK_DIR = "tasks"
 TASK_FILES = "task-*.csv"
 #: The lock a running sweep holds in its folder (:func:`lock`).
 LOCK = ".sweep.lock"
+#: The manifest's fingerprint of all but the replications (:meth:`Sweep.fingerprint`): a
+#: sweep that differs only in its count may reuse the folder's tasks (:func:`check_owner`).
+ANY_COUNT = "fingerprint_any_replications"
+#: The manifest's most replications of a point that the folder's tasks may hold.
+MOST = "replications_run_most"
 
 
 def check_out(out: str | Path) -> Path:
@@ -68,16 +74,25 @@ def _manifest(path: Path) -> Any:
 def check_owner(sweep: Sweep, out: Path, resume: bool) -> None:
     """Refuse, before any work, to run ``sweep`` into ``out`` if that would lose results:
     those of another sweep (or of this one before a file it reads changed, or written by
-    another version of cell), or this sweep's finished tasks without ``resume``."""
+    another version of cell), or this sweep's finished tasks without ``resume``.  Those of
+    this sweep at another whole number of replications (in the same batches) are this
+    sweep's: ``resume`` reuses the tasks that fit, unless :func:`_not_resizable` says why not."""
     manifest = out / MANIFEST
     found = _manifest(manifest) if manifest.is_file() else None
     tasks = len(finished_tasks(out))
     if not isinstance(found, dict) or not (tasks or (out / "replications.csv").exists()):
         return
+    flag = f"--out {out}" + (" (--resume)" if resume else "")
     if found.get("fingerprint") != sweep.fingerprint():
-        flag = f"--out {out}" + (" (--resume)" if resume else "")
-        raise CellError(f"{flag}: holds the results of {_whose(found, sweep)}: choose another "
-                        "--out or remove it")
+        if found.get(ANY_COUNT) != sweep.fingerprint(replications=False):
+            raise CellError(f"{flag}: holds the results of {_whose(found, sweep)}: choose "
+                            "another --out or remove it")
+        was = f"this sweep's results at replications: {_count(found.get('precision'), found)}"
+        if why := _not_resizable(found, sweep):
+            raise CellError(f"{flag}: holds {was}, and {why}; choose another --out or remove it")
+        if not resume:
+            raise CellError(f"--out {out}: holds {was}: add --resume to reuse those that fit "
+                            f"replications: {sweep.replications}, or remove the folder")
     if resume:
         return
     if (out / "replications.csv").exists():
@@ -85,6 +100,41 @@ def check_owner(sweep: Sweep, out: Path, resume: bool) -> None:
                         "--resume to reuse it (nothing runs again), or remove the folder")
     raise CellError(f"--out {out}: holds {tasks} finished task{'s' if tasks != 1 else ''} of "
                     "this sweep: add --resume to go on, or remove the folder")
+
+
+def _count(precision: object, found: dict[str, Any]) -> str:
+    """A manifest's ``replications`` as the sweep file gave it (a count, or a precision)."""
+    return show(precision) if isinstance(precision, dict) else str(found.get("replications"))
+
+
+def _not_resizable(found: dict[str, Any], sweep: Sweep) -> str | None:
+    """Why the finished tasks of a manifest's sweep, the same as ``sweep`` but for its
+    replications (:meth:`Sweep.fingerprint`), cannot be reused for ``sweep``; None if they
+    can: both fixed counts in the same batches, and no finished task cut short, which
+    would be overwritten by fewer replications (the cut falls on a task's end, or past
+    every replication this folder has run)."""
+    was, now = found.get("precision"), sweep.precision
+    if was is not None or now is not None:
+        now_text = show(now.as_dict()) if now else str(sweep.replications)
+        return (f"--resume reuses them for other replications only when both are a whole "
+                f"number (now: {now_text}; a precision's rounds cannot be resized)")
+    if found.get("batch") != sweep.batch:
+        return (f"they were run in batches of {found.get('batch')}, not {sweep.batch}: set "
+                f"batch: {found.get('batch')} to reuse them")
+    most, n, batch = _most(found), sweep.replications, sweep.batch
+    if n < most and n % batch:
+        first = n - n % batch
+        return (f"replications: {n} would cut the finished task of replications {first}-"
+                f"{min(first + batch, most) - 1} short (batch {batch}): choose a multiple of "
+                f"{batch}, or {most} or more")
+    return None
+
+
+def _most(found: dict[str, Any]) -> int:
+    """The most replications of a point whose tasks a fixed-count sweep's folder may hold
+    (after a --resume at fewer, those past the count are kept)."""
+    counts = [found.get(k) for k in (MOST, "replications")]
+    return max((c for c in counts if isinstance(c, int)), default=0)
 
 
 def _whose(found: dict[str, Any], sweep: Sweep) -> str:
@@ -167,15 +217,20 @@ def prepare(sweep: Sweep, out: Path, resume: bool) -> None:
     check_owner(sweep, out, resume)
     for leftover in task_dir.glob(".task-*.tmp") if task_dir.is_dir() else ():
         leftover.unlink(missing_ok=True)
+    found = _manifest(manifest) if resume and manifest.is_file() else None
+    most = sweep.replications
+    if isinstance(found, dict) and found.get(ANY_COUNT) == sweep.fingerprint(replications=False):
+        most = max(most, _most(found))  # the tasks past the count are kept, for a later one
     if not resume:  # nothing of this sweep's, nor of another's, is lost (check_owner)
         for stale in finished_tasks(out):
             stale.unlink()
         (out / "replications.csv").unlink(missing_ok=True)
     doc: dict[str, Any] = {"sweep": sweep.source, "name": sweep.name,
                            "fingerprint": sweep.fingerprint(),
+                           ANY_COUNT: sweep.fingerprint(replications=False),
                            "tasks": len(sweep.points) * -(-sweep.first_round // sweep.batch),
-                           "replications": sweep.replications, "seed": sweep.seed,
-                           "batch": sweep.batch}
+                           "replications": sweep.replications, MOST: most,
+                           "seed": sweep.seed, "batch": sweep.batch}
     if sweep.precision is not None:
         doc["precision"] = sweep.precision.as_dict()
     doc |= {"version": __version__, "inputs": inputs(sweep)}

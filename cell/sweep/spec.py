@@ -185,19 +185,24 @@ class Sweep:
     def total_replications(self) -> int:
         return len(self.points) * self.first_round
 
-    def fingerprint(self) -> str:
+    def fingerprint(self, replications: bool = True) -> str:
         """Hash of everything that decides the results (for ``--resume``): the settings,
         the content of every file the points name (:mod:`cell.sweep.inputs`) and the
-        version of cell."""
+        version of cell.  Without ``replications``: of all but the number of replications,
+        the batch and a precision, which replication r's results do not depend on (what a
+        sweep run again at another count shares with the first run:
+        :func:`cell.sweep.outdir.check_owner`)."""
         from cell import __version__
         from cell.sweep.inputs import digest, sweep_files
 
         doc: dict[str, Any] = {
             "base": self.base.to_dict(), "fixed": [list(kv) for kv in self.fixed],
             "points": [[p.policy, [list(kv) for kv in p.values]] for p in self.points],
-            "replications": self.replications, "seed": self.seed, "batch": self.batch,
+            "seed": self.seed,
             "files": sorted(str(digest(f)) for f in sweep_files(self)), "version": __version__}
-        if self.precision is not None:
+        if replications:
+            doc |= {"replications": self.replications, "batch": self.batch}
+        if replications and self.precision is not None:
             doc["precision"] = self.precision.as_dict()
         text = json.dumps(doc, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()
