@@ -31,6 +31,7 @@ from cell.reporting.headlines import (
 )
 from cell.sweep import Sweep, grid_columns
 from cell.sweep.columns import NAME_SUFFIX
+from cell.sweep.windows import AUTO
 
 #: Sentences listed per measure before the rest is left to differences.csv.
 MAX_SENTENCES = 12
@@ -132,6 +133,8 @@ def markdown(summary: pd.DataFrame, differences: pd.DataFrame, replications: pd.
     """The whole ``report.md``; ``caveat``, if given, is said first (e.g. that counts
     come from different windows)."""
     parts = _parts(sweep)
+    auto = _auto(sweep)
+    per_run = None if auto else parts  # a warm-up of auto: the window is not `parts` parts
     cols = display_columns(summary, sweep)
     policies = sweep.policies
     level = f"{sweep.confidence * 100:g} %"
@@ -153,13 +156,12 @@ def markdown(summary: pd.DataFrame, differences: pd.DataFrame, replications: pd.
     whole = {h.column for h in present  # counts: every run's value a whole number
              if np.all(np.mod(replications[h.column].dropna().to_numpy(float), 1) == 0)}
     for h in present:
-        lines += [f"## {h.title}" + (f", per {parts}-part run" if h.per_run and parts else ""),
-                  ""]
+        lines += [f"## {h.title}" + (_per_run(parts, auto) if h.per_run else ""), ""]
         lines += _table(summary[summary["measure"] == h.column], cols, policies,
                         h.column in whole)
         if f"fig_{h.column}.png" in figures:
             lines += ["", f"![{h.title}](fig_{h.column}.png)"]
-        lines += [""] + _sentences(h, differences, cols, parts, sweep.confidence)
+        lines += [""] + _sentences(h, differences, cols, per_run, sweep.confidence)
     lines += ["## Reading", ""]
     for text in reading(summary, differences, sweep, cols, present, whole):
         lines += [text, ""]
@@ -169,6 +171,24 @@ def markdown(summary: pd.DataFrame, differences: pd.DataFrame, replications: pd.
 def _parts(sweep: Sweep) -> int | None:
     parts = {p.scenario.run.parts for p in sweep.points}
     return parts.pop() if len(parts) == 1 else None
+
+
+def _auto(sweep: Sweep) -> str:
+    """``all`` or ``some`` if all or some points leave MSER-5 to choose their warm-up
+    (``run.warmup_parts: auto``), else ``""``."""
+    auto = [p.scenario.run.warmup_parts == AUTO for p in sweep.points]
+    return "all" if all(auto) else "some" if any(auto) else ""
+
+
+def _per_run(parts: int | None, auto: str) -> str:
+    """What a count's heading says it is per: ``, per 500-part run``; under a warm-up of
+    ``auto`` the window is the parts after the warm-up MSER-5 chose, run by run, so no
+    number of parts is named."""
+    if auto == "all":
+        return ", per run, after the warm-up MSER-5 chose for it"
+    if auto:
+        return ", per run, after its warm-up (chosen by MSER-5 where it is auto)"
+    return f", per {parts}-part run" if parts else ""
 
 
 def _replications(sweep: Sweep, parts: int | None) -> str:
