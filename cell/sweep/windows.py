@@ -110,7 +110,8 @@ def window_warning(sweep: Sweep) -> str | None:
 
     keys = [k for k in WINDOW_KEYS if any(s[0] == k for s in settings)]
     what = "; ".join(f"run.{k} {side(k, 1)} against {side(k, 2)}" for k in keys)
-    auto = (f" (auto: {AUTO_WHY}, so no two points share a window)") if any(AUTO in s[1:] for s in settings) else ""
+    auto = (f" (auto: {AUTO_WHY}, so no two points share a window)"
+            if any(AUTO in s[1:] for s in settings) else "")
     return (f"{len(apart)} of {len(pairs)} paired comparisons are between points that run "
             f"over different windows ({what}{auto}): their {WINDOW_MEASURES_TEXT} are not "
             "comparable and are left out of differences.csv; compare the rates, or give the "
