@@ -221,3 +221,24 @@ def test_compare_report_carries_the_window_caveat(tmp_path, capsys):
     counts = {"parts_delivered", "parts_missed", "spacing_outside_tol"}
     assert counts <= same and not counts & differ
     assert "parts_per_hr_wallclock" in differ & same
+
+
+def test_compare_warns_when_both_warmups_are_auto(tmp_path, capsys):
+    """auto against auto: MSER-5 cuts each run apart, so counts are over different windows;
+    the suggestion is a fixed warm-up (no number exists before the runs), and works."""
+    a = scenario(tmp_path, "one", run__parts=30, run__warmup_parts="auto")
+    b = scenario(tmp_path, "other", run__parts=30, run__warmup_parts="auto",
+                 controller__policy="non-adaptive")
+    out, warned = compare_run(capsys, a, b)
+    assert len(warned) == 1, warned
+    assert "one has run.warmup_parts auto, other auto (auto: MSER-5" in warned[0]
+    assert "(--set run.warmup_parts=N, N a fixed number of parts)" in warned[0]
+    rows = verdict_rows(out)
+    assert "not compared" in rows["Parts delivered"] and "auto against auto" in rows[
+        "Parts delivered"]
+    assert "not compared" not in rows["Parts per hour (wall clock)"]
+    compare_run(capsys, a, b, "--out", str(tmp_path / "cmp"))
+    measures = set(pd.read_csv(tmp_path / "cmp" / "differences.csv")["measure"])
+    assert "parts_per_hr_wallclock" in measures and "parts_delivered" not in measures
+    out, warned = compare_run(capsys, a, b, "--set", "run.warmup_parts=5")
+    assert warned == [] and "not compared" not in out

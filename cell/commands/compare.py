@@ -7,7 +7,8 @@ measure, which is better, by how much, and whether the interval excludes zero;
 ``--out DIR`` writes the report (as ``cell sweep --report``) and the
 replications, as a unit.  Counts (parts delivered, lost, ...) and extremes (closest
 spacing, fastest belt, ...) are per run, after the warm-up: if A and B differ in
-``run.parts`` or ``run.warmup_parts`` a warning says so, the verdict leaves them
+``run.parts`` or ``run.warmup_parts``, or either has ``run.warmup_parts: auto`` (MSER-5
+cuts each run where its own output settles), a warning says so, the verdict leaves them
 uncompared and ``differences.csv`` leaves them out (:mod:`cell.sweep.windows`);
 rates still compare.
 """
@@ -68,10 +69,12 @@ def labels(a: Scenario, b: Scenario, arg_a: str, arg_b: str) -> tuple[str, str]:
     return f"A: {a.name}", f"B: {b.name}"
 
 
-def _suggest(va: object, vb: object) -> object:
-    """A value valid for both (``--set`` sets it for both): the larger
-    number, or the fixed warm-up when the other is ``auto``."""
-    return max(v for v in (va, vb) if isinstance(v, int))
+def _suggest(va: object, vb: object) -> str:
+    """A value valid for both (``--set`` sets it for both): the larger number, the fixed
+    warm-up when the other is ``auto``, or ``N`` (said to be a fixed number) when both are
+    ``auto``: no number is known before the runs, MSER-5 choosing one per run."""
+    numbers = [v for v in (va, vb) if isinstance(v, int)]
+    return str(max(numbers)) if numbers else "N"
 
 
 def _sides(sweep: Sweep) -> tuple[tuple[str, Point], tuple[str, Point]]:
@@ -82,15 +85,19 @@ def _sides(sweep: Sweep) -> tuple[tuple[str, Point], tuple[str, Point]]:
 
 def window_warning(sweep: Sweep) -> str | None:
     """One line if A's and B's counts and extremes are over different windows, else None."""
-    from cell.sweep.windows import WINDOW_MEASURES_TEXT, windows_apart
+    from cell.sweep.windows import AUTO, AUTO_WHY, WINDOW_MEASURES_TEXT, windows_apart
 
     (la, a), (lb, b) = _sides(sweep)
-    differ = windows_apart(a.scenario, b.scenario)
+    differ = windows_apart(a.scenario, b.scenario, auto_apart=True)
     if not differ:
         return None
     said = {"parts": "runs {} parts", "warmup_parts": "has run.warmup_parts {}"}
     what = "; ".join(f"{la} {said[k].format(va)}, {lb} {vb}" for k, va, vb in differ)
+    if any(AUTO in (va, vb) for _, va, vb in differ):
+        what += f" (auto: {AUTO_WHY}, so {la}'s and {lb}'s windows differ in length)"
     sets = " ".join(f"--set run.{k}={_suggest(va, vb)}" for k, va, vb in differ)
+    if any(va == vb == AUTO for _, va, vb in differ):
+        sets += ", N a fixed number of parts"
     return (f"{what}: {WINDOW_MEASURES_TEXT} are not comparable; compare the rates, or give "
             f"both the same window ({sets})")
 
@@ -193,7 +200,7 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> s
     from cell.sweep.windows import window_kind, windows_apart
 
     (la, a), (lb, b) = _sides(sweep)
-    differ = windows_apart(a.scenario, b.scenario)
+    differ = windows_apart(a.scenario, b.scenario, auto_apart=True)
     parts = a.scenario.run.parts if a.scenario.run.parts == b.scenario.run.parts else None
     level = f"{sweep.confidence * 100:g} %"
     length = (f" of {parts} part{'s' if parts != 1 else ''}" if parts else

@@ -31,6 +31,7 @@ from cell.reporting.headlines import (
 )
 from cell.sweep import Sweep, grid_columns
 from cell.sweep.columns import NAME_SUFFIX
+from cell.sweep.windows import AUTO
 
 #: Sentences listed per measure before the rest is left to differences.csv.
 MAX_SENTENCES = 12
@@ -65,18 +66,21 @@ def where(row: Mapping[Any, Any], cols: Sequence[str]) -> str:
     return ", ".join(f"{c.removesuffix(NAME_SUFFIX)} = {show(row[c])}" for c in cols)
 
 
-def cell(s: Mapping[Any, Any], whole: bool = False) -> str:
+def cell(s: Mapping[Any, Any], whole: bool = False, runs: int | None = None) -> str:
     """A summary row as ``mean ± half [p2.5–p97.5]``, or what stands in for an interval;
-    ``whole``: the measure counts things, so single runs are shown as whole numbers."""
+    ``whole``: the measure counts things, so single runs are shown as whole numbers;
+    ``runs``: the point's replications, said (``from 2 of 3 runs``) when fewer gave a value."""
     n, mean = int(s["n"]), float(s["mean"])
     if n == 0:
         return "—"
+    few = runs is not None and n < runs
     if n == 1:
-        return f"{number(mean)} (one run)"
+        return f"{number(mean)} " + (f"(from 1 of {runs} runs)" if few else "(one run)")
+    of = f" (from {n} of {runs} runs)" if few else ""
     if float(s["sd"]) == 0.0:
-        return f"{number(mean)} (no variation)"
+        return f"{number(mean)} (no variation){of}"
     lo, hi = single_runs(s, whole)
-    return f"{plus_minus(mean, half_width(s))} [{lo}–{hi}]"
+    return f"{plus_minus(mean, half_width(s))} [{lo}–{hi}]{of}"
 
 
 def single_runs(s: Mapping[Any, Any], whole: bool = False) -> tuple[str, str]:
@@ -132,6 +136,8 @@ def markdown(summary: pd.DataFrame, differences: pd.DataFrame, replications: pd.
     """The whole ``report.md``; ``caveat``, if given, is said first (e.g. that counts
     come from different windows)."""
     parts = _parts(sweep)
+    auto = _auto(sweep)
+    per_run = None if auto else parts  # a warm-up of auto: the window is not `parts` parts
     cols = display_columns(summary, sweep)
     policies = sweep.policies
     level = f"{sweep.confidence * 100:g} %"
@@ -150,16 +156,16 @@ def markdown(summary: pd.DataFrame, differences: pd.DataFrame, replications: pd.
     lines += _variation(summary, sweep)
     lines += _precision(replications, summary, sweep, cols)
     present = [h for h in HEADLINES if h.column in set(summary["measure"])]
+    runs = [len(runs_of(replications, sweep, i)) for i in range(len(sweep.points))]
     whole = {h.column for h in present  # counts: every run's value a whole number
              if np.all(np.mod(replications[h.column].dropna().to_numpy(float), 1) == 0)}
     for h in present:
-        lines += [f"## {h.title}" + (f", per {parts}-part run" if h.per_run and parts else ""),
-                  ""]
+        lines += [f"## {h.title}" + (_per_run(parts, auto) if h.per_run else ""), ""]
         lines += _table(summary[summary["measure"] == h.column], cols, policies,
-                        h.column in whole)
+                        h.column in whole, runs)
         if f"fig_{h.column}.png" in figures:
             lines += ["", f"![{h.title}](fig_{h.column}.png)"]
-        lines += [""] + _sentences(h, differences, cols, parts, sweep.confidence)
+        lines += [""] + _sentences(h, differences, cols, per_run, sweep.confidence)
     lines += ["## Reading", ""]
     for text in reading(summary, differences, sweep, cols, present, whole):
         lines += [text, ""]
@@ -169,6 +175,24 @@ def markdown(summary: pd.DataFrame, differences: pd.DataFrame, replications: pd.
 def _parts(sweep: Sweep) -> int | None:
     parts = {p.scenario.run.parts for p in sweep.points}
     return parts.pop() if len(parts) == 1 else None
+
+
+def _auto(sweep: Sweep) -> str:
+    """``all`` or ``some`` if all or some points leave MSER-5 to choose their warm-up
+    (``run.warmup_parts: auto``), else ``""``."""
+    auto = [p.scenario.run.warmup_parts == AUTO for p in sweep.points]
+    return "all" if all(auto) else "some" if any(auto) else ""
+
+
+def _per_run(parts: int | None, auto: str) -> str:
+    """What a count's heading says it is per: ``, per 500-part run``; under a warm-up of
+    ``auto`` the window is the parts after the warm-up MSER-5 chose, run by run, so no
+    number of parts is named."""
+    if auto == "all":
+        return ", per run, after the warm-up MSER-5 chose for it"
+    if auto:
+        return ", per run, after its warm-up (chosen by MSER-5 where it is auto)"
+    return f", per {parts}-part run" if parts else ""
 
 
 def _replications(sweep: Sweep, parts: int | None) -> str:
@@ -223,10 +247,13 @@ def _precision(replications: pd.DataFrame, summary: pd.DataFrame, sweep: Sweep,
 
 
 def _table(rows: pd.DataFrame, cols: Sequence[str], policies: Sequence[str],
-           whole: bool = False) -> list[str]:
+           whole: bool = False, runs: Sequence[int] | None = None) -> list[str]:
+    """A measure's table: a row per grid combination, a column per policy; ``runs``: each
+    row's point's replications (``rows`` are in point order, as summary.csv)."""
     grid: dict[tuple[str, ...], dict[str, str]] = {}
-    for r in rows.to_dict("records"):
-        grid.setdefault(tuple(show(r[c]) for c in cols), {})[str(r["policy"])] = cell(r, whole)
+    for i, r in enumerate(rows.to_dict("records")):
+        grid.setdefault(tuple(show(r[c]) for c in cols), {})[str(r["policy"])] = \
+            cell(r, whole, runs[i] if runs is not None else None)
     head = [c.removesuffix(NAME_SUFFIX) for c in cols] + list(policies)
     out = table_head(head)
     for keys, cells in grid.items():
@@ -291,8 +318,8 @@ def _verdicts(h: Headline, differences: pd.DataFrame, cols: Sequence[str]) -> li
         if n > 1 and np.isfinite(mean).all():
             order = np.argsort(-np.abs(mean), kind="stable")
             big, small = recs[int(order[0])], recs[int(order[-1])]
-            text += (f"; largest {_signed(big)} (at {where(big, cols)}), smallest "
-                     f"{_signed(small)} (at {where(small, cols)})")
+            text += (f"; furthest from zero {_signed(big)} (at {where(big, cols)}), nearest "
+                     f"zero {_signed(small)} (at {where(small, cols)})")
         elif n == 1 and np.isfinite(mean).all():
             text += f" ({_signed(recs[0])})"
         out.append(text + ".")

@@ -339,7 +339,8 @@ def overload_warning(sweep: Sweep) -> str | None:
     if not over:
         return None
     worst = max(over, key=lambda p: p.utilisation)
-    where = ", ".join(f"{k} {show(v)}" for k, v in worst.values) or worst.policy
+    where = ", ".join(f"{k} {worst.name_of(k) or show(v)}" for k, v in worst.values) \
+        or worst.policy
     return overloaded(f"{len(over)} of {len(sweep.points)} points have utilisation 1 or more "
                       f"(up to {worst.utilisation:.3f}, at {where})")
 

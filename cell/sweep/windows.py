@@ -32,6 +32,9 @@ WINDOW_KEYS = ("parts", "warmup_parts")
 #: The warm-up MSER-5 chooses run by run (``run.warmup_parts: auto``).
 AUTO = "auto"
 
+#: Why ``auto`` on either side puts two runs' counts over different windows.
+AUTO_WHY = "MSER-5 cuts each run's warm-up where its own output settles"
+
 #: The words of a summary column's name that make it an extreme over the window.
 EXTREME_WORDS = frozenset({"min", "max"})
 
@@ -107,8 +110,8 @@ def window_warning(sweep: Sweep) -> str | None:
 
     keys = [k for k in WINDOW_KEYS if any(s[0] == k for s in settings)]
     what = "; ".join(f"run.{k} {side(k, 1)} against {side(k, 2)}" for k in keys)
-    auto = (" (auto: MSER-5 cuts each run's warm-up where its own output settles, so no two "
-            "points share a window)") if any(AUTO in s[1:] for s in settings) else ""
+    auto = (f" (auto: {AUTO_WHY}, so no two points share a window)"
+            if any(AUTO in s[1:] for s in settings) else "")
     return (f"{len(apart)} of {len(pairs)} paired comparisons are between points that run "
             f"over different windows ({what}{auto}): their {WINDOW_MEASURES_TEXT} are not "
             "comparable and are left out of differences.csv; compare the rates, or give the "
