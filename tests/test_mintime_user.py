@@ -70,13 +70,20 @@ def _dynamics(tmp_path, name, key, values):
     return str(tmp_path / name)
 
 
+def _needed(err):
+    """{joint number: torque} that a weak-drive line names."""
+    import re
+
+    return {int(j): float(v) for j, v in re.findall(r"\(joint (\d)\) (?:needs )?([\d.]+) N·m", err)}
+
+
 def test_a_drive_too_weak_for_the_arm_names_the_file_key_joint_and_torques(tmp_path, capsys):
     """The shoulder's stall torque below what holding the arm at rest takes: one line naming
     the dynamics file, its key and value, the joint and both torques; nothing written.  The
-    torque named is where the planner's own boundary lies: a little more passes that point."""
+    torque named is the most any point of either regime needs (R IV's, a little past its
+    start), whichever point the planner stopped at: a drive given that much plans."""
     out = tmp_path / "out"
-    for stall, regime, needed in (("0.5", "R2", "1.4"), ("1.39", "R2", "1.4"),
-                                  ("1.42", "R4", "1.62")):
+    for stall in ("0.5", "1.39", "1.42"):
         weak = _dynamics(tmp_path, "weak.yaml", "stall_torque_nm", f"[3.1, {stall}, 1.66, 1.14, 1.14]")
         for command in (["mintime"], ["run", "--set", "robot.timing=minimum-time"]):
             args = [command[0], "baseline", *command[1:], "--set", f"mintime.dynamics_file={weak}"]
@@ -84,11 +91,30 @@ def test_a_drive_too_weak_for_the_arm_names_the_file_key_joint_and_torques(tmp_p
             err = capsys.readouterr().err
             assert err.count("\n") == 1 and not out.exists()
             assert err.startswith(f"cell: error: {weak}: drives.stall_torque_nm = [3.1, {stall}, ")
-            assert (f"the shoulder (joint 2) needs {needed} N·m to hold the arm against gravity "
-                    f"at the start of {regime}, more than its stall torque {stall} N·m") in err
-    assert main(["mintime", "baseline", "--set", "mintime.dynamics_file=" + _dynamics(
-        tmp_path, "ok.yaml", "stall_torque_nm", "[3.1, 1.7, 1.66, 1.14, 1.14]"),
-        "--out", str(out)]) == 0
+            assert ("the shoulder (joint 2) needs 1.62 N·m to hold the arm against gravity "
+                    f"at s = 0.0466 of R4, more than its stall torque {stall} N·m") in err
+            assert _needed(err) == {2: 1.62}
+    enough = _dynamics(tmp_path, "ok.yaml", "stall_torque_nm", "[3.1, 1.62, 1.66, 1.14, 1.14]")
+    assert main(["mintime", "baseline", "--set", f"mintime.dynamics_file={enough}",
+                 "--out", str(out)]) == 0
+
+
+def test_every_weak_drive_is_named_with_the_torque_that_holds(tmp_path, capsys):
+    """Under a stronger gravity the shoulder and the elbow both fall short: both are named, each
+    with the most it needs anywhere; given exactly those torques, the planner plans."""
+    base = _dynamics(tmp_path, "g.yaml", "gravity_m_s2", "30.0")
+    assert main(["mintime", "baseline", "--set", f"mintime.dynamics_file={base}",
+                 "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    need = _needed(err)
+    assert sorted(need) == [2, 3] and need[2] > 3.4 and need[3] > 1.66
+    assert err.count("\n") == 1 and "the shoulder (joint 2) needs" in err and "; the elbow" in err
+    text = (tmp_path / "g.yaml").read_text()
+    assert "stall_torque_nm: [3.1, 3.40, 1.66," in text
+    text = text.replace("stall_torque_nm: [3.1, 3.40, 1.66,", f"stall_torque_nm: [3.1, {need[2]}, {need[3]},")
+    (tmp_path / "g.yaml").write_text(text)
+    assert main(["mintime", "baseline", "--set", f"mintime.dynamics_file={base}",
+                 "--out", str(tmp_path / "out")]) == 0
 
 
 def test_links_too_heavy_name_the_masses(tmp_path, capsys):
