@@ -189,13 +189,18 @@ def _solved_timing(s: Scenario) -> RobotTiming:
         raise planner_error(s, exc, "robot.timing = 'minimum-time'") from None
 
 
+#: The built-in dynamics file, against which a user's file is compared.
+BUILT_IN_DYNAMICS = "microbot_dynamics.yaml"
+
+
 def planner_error(s: Scenario, exc: NoMotionError, asked: str) -> CellError:
     """The planner's "no motion" as one line naming its cause: a drive too weak to hold the
     arm (the dynamics file, the key that made it so, the torques), no bound on the
     accelerations at all (``mintime.acceleration_bounds``), else the scenario and ``asked``, the
     key that asked for the planner, with the dynamic model planned with."""
-    from cell.dynamics import Drives, Links
-    from cell.mintime.regimes import WeakDriveError
+    from cell import catalog
+    from cell.dynamics_file import load_dynamics
+    from cell.mintime.regimes import WeakDriveError, model_value
 
     mt = s.mintime
     if not mt.acceleration_bounds and mt.dynamics_file is None:
@@ -205,11 +210,14 @@ def planner_error(s: Scenario, exc: NoMotionError, asked: str) -> CellError:
                              "acceleration (set either)")
     path = dynamics_path(s)
     if isinstance(exc, WeakDriveError) and path is not None:
-        model = planner_bounds(s).dynamics
-        key, value = "drives.stall_torque_nm", model.drives.stall_torque_nm
-        if value == Drives.stall_torque_nm and model.links.mass_kg != Links.mass_kg:
-            key, value = "links.mass_kg", model.links.mass_kg
-        return ScenarioError(path, key, value, f"{exc} (the dynamic model of {s.source})")
+        model, built_in = planner_bounds(s).dynamics, load_dynamics(catalog.path(BUILT_IN_DYNAMICS))
+        changed = exc.keys_changed(model, built_in)
+        key = changed[0] if changed else "drives.stall_torque_nm"
+        verb = "differs" if len(changed) == 2 else "differ"
+        also = (f"; {' and '.join(changed[1:])} {verb} from the built-in {BUILT_IN_DYNAMICS} too"
+                if len(changed) > 1 else "")
+        return ScenarioError(path, key, model_value(model, key),
+                             f"{exc} (the dynamic model of {catalog.shown(s.source)}{also})")
     model_used = f" (dynamic model {path})" if path is not None else ""
     return CellError(f"{s.source}: {asked}: {exc}{model_used}")
 

@@ -123,7 +123,44 @@ def test_links_too_heavy_name_the_masses(tmp_path, capsys):
                  "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
     assert f"{heavy}: links.mass_kg = [1.6, 0.9, 0.75, 0.3, 0.4]: the shoulder (joint 2)" in err
-    assert "more than its stall torque 3.4 N·m" in err and "baseline.yaml" in err
+    assert "more than its stall torque 3.4 N·m" in err and err.endswith("(the dynamic model of baseline)\n")
+
+
+@pytest.mark.parametrize(("text", "named"), [
+    ("gravity_m_s2: 30.0\n", "gravity_m_s2 = 30.0"),
+    ("links:\n  com_m: [[0, -0.03, 0], [1.0, 0, 0], [-0.0889, 0, 0], [0, 0, 0], [0, 0, 0.03]]\n",
+     "links.com_m = [[0.0, -0.03, 0.0], [1.0, 0.0, 0.0], "),
+])
+def test_a_weak_drive_is_blamed_on_the_key_that_differs_from_the_built_in_file(
+        tmp_path, capsys, text, named):
+    """Gravity or a centre of mass changed (a file of that key alone), the stall torques left
+    as they were: the line names the changed key, not the drives."""
+    mine = tmp_path / "mine.yaml"
+    mine.write_text(text)
+    assert main(["mintime", "baseline", "--set", f"mintime.dynamics_file={mine}",
+                 "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"cell: error: {mine}: {named}") and "differ" not in err
+    assert "to hold the arm against gravity" in err and "stall_torque" not in err
+
+
+def test_a_weak_drive_names_every_changed_key_but_not_a_stronger_drive(tmp_path, capsys):
+    """Heavier links under a stronger gravity, the shoulder's drive made stronger (still too
+    weak): the masses are named, gravity beside them, the stronger drive not at all."""
+    text = tmp_path / "m.yaml"
+    _dynamics(tmp_path, "m.yaml", "mass_kg", "[1.6, 0.9, 0.75, 0.30, 0.40]")
+    body = text.read_text()
+    for old, new in (("gravity_m_s2: 9.80665", "gravity_m_s2: 12.0"),
+                     ("stall_torque_nm: [3.1, 3.40,", "stall_torque_nm: [3.1, 3.6,")):
+        assert old in body
+        body = body.replace(old, new)
+    text.write_text(body)
+    assert main(["mintime", "baseline", "--set", f"mintime.dynamics_file={text}",
+                 "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"cell: error: {text}: links.mass_kg = [1.6, 0.9, ")
+    assert err.endswith("(the dynamic model of baseline; gravity_m_s2 differs from the built-in "
+                        "microbot_dynamics.yaml too)\n")
 
 
 def test_elapsed_time_is_the_planners_time_sum():

@@ -137,6 +137,31 @@ class WeakDriveError(NoMotionError):
         self.shortfalls = shortfalls
         super().__init__("; ".join(f.text(i == 0) for i, f in enumerate(shortfalls)))
 
+    def keys_changed(self, model: DynamicsModel, reference: DynamicsModel) -> list[str]:
+        """The keys of :data:`HOLDING_KEYS` in which ``model`` differs from ``reference``; the
+        stall torques only if lower at a joint that falls short (a stronger drive is no cause)."""
+        ours, theirs = model.drives.stall_torque_nm, reference.drives.stall_torque_nm
+        lower = any(ours[f.joint] < theirs[f.joint] for f in self.shortfalls)
+        return [k for k in HOLDING_KEYS if model_value(model, k) != model_value(reference, k)
+                and (k != "drives.stall_torque_nm" or lower)]
+
+
+#: A dynamics file's keys that holding the arm against gravity depends on, in the order blame
+#: is given.
+HOLDING_KEYS = ("drives.stall_torque_nm", "links.mass_kg", "links.com_m", "gravity_m_s2")
+
+
+def model_value(model: DynamicsModel, key: str) -> Any:
+    """The value of a dynamics file's dotted ``key`` in ``model``, tuples as the file's lists."""
+    value: Any = model
+    for part in key.split("."):
+        value = getattr(value, part)
+    return _listed(value)
+
+
+def _listed(value: Any) -> Any:
+    return [_listed(v) for v in value] if isinstance(value, tuple) else value
+
 
 def weak_drive(table: StepTable, model: DynamicsModel | None, geometry: CellGeometry,
                n_grid: int) -> WeakDriveError | None:
