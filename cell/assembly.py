@@ -29,7 +29,7 @@ from cell.kinematics import JOINT_NAMES, Arm, Hand, Placement
 from cell.motors import Motors, max_rates
 from cell.policies.base import CellConstants, Policy
 from cell.robot import RobotTiming, build_timing, timing_from_plain, timing_to_plain
-from cell.scenario import MAX_TIME_S, Scenario, default_scenario
+from cell.scenario import MAX_TIME_S, Scenario, default_scenario, load_scenario
 
 if TYPE_CHECKING:
     from cell.path import CellGeometry
@@ -189,10 +189,6 @@ def _solved_timing(s: Scenario) -> RobotTiming:
         raise planner_error(s, exc, "robot.timing = 'minimum-time'") from None
 
 
-#: The built-in dynamics file, against which a user's file is compared.
-BUILT_IN_DYNAMICS = "microbot_dynamics.yaml"
-
-
 def planner_error(s: Scenario, exc: NoMotionError, asked: str) -> CellError:
     """The planner's "no motion" as one line naming its cause: a drive too weak to hold the
     arm (the dynamics file, the key that made it so, the torques), no bound on the
@@ -200,23 +196,25 @@ def planner_error(s: Scenario, exc: NoMotionError, asked: str) -> CellError:
     key that asked for the planner, with the dynamic model planned with."""
     from cell import catalog
     from cell.dynamics_file import load_dynamics
-    from cell.mintime.regimes import WeakDriveError, model_value
+    from cell.mintime.regimes import WeakDriveError
 
     mt = s.mintime
     if not mt.acceleration_bounds and mt.dynamics_file is None:
-        return ScenarioError(s.source, "mintime.acceleration_bounds", False, "with "
-                             "mintime.dynamics_file empty too, nothing bounds the minimum-time "
-                             "planner's accelerations: the fastest motion would need infinite "
-                             "acceleration (set either)")
+        key, other = "mintime.acceleration_bounds", "mintime.dynamics_file empty"
+        try:  # the file itself names a dynamics file, emptied by --set: blame that key
+            if load_scenario(s.source).mintime.dynamics_file is not None:
+                key, other = "mintime.dynamics_file", "mintime.acceleration_bounds false"
+        except (CellError, OSError):
+            pass
+        return ScenarioError(s.source, key, s.get(key), f"with {other} too, nothing bounds the "
+                             "minimum-time planner's accelerations: the fastest motion would need "
+                             "infinite acceleration (set either)")
     path = dynamics_path(s)
     if isinstance(exc, WeakDriveError) and path is not None:
-        model, built_in = planner_bounds(s).dynamics, load_dynamics(catalog.path(BUILT_IN_DYNAMICS))
-        changed = exc.keys_changed(model, built_in)
-        key = changed[0] if changed else "drives.stall_torque_nm"
-        verb = "differs" if len(changed) == 2 else "differ"
-        also = (f"; {' and '.join(changed[1:])} {verb} from the built-in {BUILT_IN_DYNAMICS} too"
-                if len(changed) > 1 else "")
-        return ScenarioError(path, key, model_value(model, key),
+        built_in = "microbot_dynamics.yaml"  # against which the user's file is compared
+        key, value, also = exc.blame(planner_bounds(s).dynamics,
+                                     load_dynamics(catalog.path(built_in)), built_in)
+        return ScenarioError(path, key, value,
                              f"{exc} (the dynamic model of {catalog.shown(s.source)}{also})")
     model_used = f" (dynamic model {path})" if path is not None else ""
     return CellError(f"{s.source}: {asked}: {exc}{model_used}")

@@ -181,3 +181,23 @@ def test_elapsed_time_is_the_planners_time_sum():
     res = plan_regimes(geometry_of(KIN), motors_of(KIN), planner_bounds(KIN))
     for r in res.values():
         assert elapsed_s(r.profile.s, r.profile.sdot)[-1] == r.profile.time_s
+
+
+@pytest.mark.parametrize(("args", "line"), [
+    (["baseline", "--set", "mintime.dynamics_file=null"],
+     "baseline.yaml (--set): mintime.dynamics_file = None: with mintime.acceleration_bounds false"),
+    (["mintime_kinematic", "--set", "mintime.acceleration_bounds=false"],
+     "mintime_kinematic.yaml (--set): mintime.acceleration_bounds = False: with "
+     "mintime.dynamics_file empty"),
+    (["{own}"], "own.yaml: mintime.acceleration_bounds = False: with mintime.dynamics_file empty"),
+])
+def test_nothing_bounding_the_accelerations_blames_the_key_given(tmp_path, capsys, args, line):
+    """Neither a dynamics file nor acceleration bounds: the line names the key the command
+    line emptied, marked (--set); both in the file itself: the file's, unmarked."""
+    own = tmp_path / "own.yaml"
+    own.write_text("mintime:\n  dynamics_file: null\n")
+    args = [a.replace("{own}", str(own)) for a in args]
+    assert main(["mintime", *args, "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and line in err and "nothing bounds" in err
+    assert ("(--set)" in err) == ("--set" in args)

@@ -137,13 +137,20 @@ class WeakDriveError(NoMotionError):
         self.shortfalls = shortfalls
         super().__init__("; ".join(f.text(i == 0) for i, f in enumerate(shortfalls)))
 
-    def keys_changed(self, model: DynamicsModel, reference: DynamicsModel) -> list[str]:
-        """The keys of :data:`HOLDING_KEYS` in which ``model`` differs from ``reference``; the
-        stall torques only if lower at a joint that falls short (a stronger drive is no cause)."""
+    def blame(self, model: DynamicsModel, reference: DynamicsModel, name: str
+              ) -> tuple[str, Any, str]:
+        """(key, value, words to add) for a dynamics file: the first of :data:`HOLDING_KEYS`
+        in which ``model`` differs from ``reference`` (file ``name``), the others named in
+        the words; the stall torques only if lower at a joint that falls short (a stronger
+        drive is no cause), and by default."""
         ours, theirs = model.drives.stall_torque_nm, reference.drives.stall_torque_nm
         lower = any(ours[f.joint] < theirs[f.joint] for f in self.shortfalls)
-        return [k for k in HOLDING_KEYS if model_value(model, k) != model_value(reference, k)
-                and (k != "drives.stall_torque_nm" or lower)]
+        changed = [k for k in HOLDING_KEYS if model_value(model, k) != model_value(reference, k)
+                   and (k != "drives.stall_torque_nm" or lower)] or ["drives.stall_torque_nm"]
+        verb = "differs" if len(changed) == 2 else "differ"
+        also = f"; {' and '.join(changed[1:])} {verb} from the built-in {name} too" \
+            if len(changed) > 1 else ""
+        return changed[0], model_value(model, changed[0]), also
 
 
 #: A dynamics file's keys that holding the arm against gravity depends on, in the order blame
