@@ -46,7 +46,7 @@ def test_cell_run_and_cell_mintime_name_the_planners_bounds(tmp_path, capsys):
         out = capsys.readouterr().out.splitlines()
         lines[label] = [ln for ln in out if ln.startswith("minimum-time planner:")]
     dyn, = lines["dynamic"]
-    assert "dynamic model " in dyn and dyn.endswith("microbot_dynamics.yaml")
+    assert "dynamic model " in dyn and dyn.endswith("; dynamic model microbot_dynamics")
     assert "acceleration" not in dyn and "at the motors' peak rates" in dyn
     kin, = lines["kinematic"]
     assert "dynamic model" not in kin and "0.5 × the motors' peak rates" in kin
@@ -55,6 +55,12 @@ def test_cell_run_and_cell_mintime_name_the_planners_bounds(tmp_path, capsys):
     assert "planner" not in capsys.readouterr().out       # constant-rate timing plans nothing
     assert main(["mintime", "baseline", "--out", str(tmp_path / "m")]) == 0
     assert dyn in capsys.readouterr().out.splitlines()
+    # a file of the user's own is named as given
+    own = tmp_path / "own_dyn.yaml"
+    own.write_text("gravity_m_s2: 9.81\n")
+    assert main(["mintime", "baseline", "--set", f"mintime.dynamics_file={own}",
+                 "--out", str(tmp_path / "own")]) == 0
+    assert capsys.readouterr().out.splitlines()[0].endswith(f"; dynamic model {own}")
 
 
 def _dynamics(tmp_path, name, key, values):
