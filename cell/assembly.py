@@ -29,7 +29,7 @@ from cell.kinematics import JOINT_NAMES, Arm, Hand, Placement
 from cell.motors import Motors, max_rates
 from cell.policies.base import CellConstants, Policy
 from cell.robot import RobotTiming, build_timing, timing_from_plain, timing_to_plain
-from cell.scenario import MAX_TIME_S, Scenario, default_scenario
+from cell.scenario import MAX_TIME_S, Scenario, default_scenario, load_scenario
 
 if TYPE_CHECKING:
     from cell.path import CellGeometry
@@ -194,22 +194,28 @@ def planner_error(s: Scenario, exc: NoMotionError, asked: str) -> CellError:
     arm (the dynamics file, the key that made it so, the torques), no bound on the
     accelerations at all (``mintime.acceleration_bounds``), else the scenario and ``asked``, the
     key that asked for the planner, with the dynamic model planned with."""
-    from cell.dynamics import Drives, Links
+    from cell import catalog
+    from cell.dynamics_file import load_dynamics
     from cell.mintime.regimes import WeakDriveError
 
     mt = s.mintime
     if not mt.acceleration_bounds and mt.dynamics_file is None:
-        return ScenarioError(s.source, "mintime.acceleration_bounds", False, "with "
-                             "mintime.dynamics_file empty too, nothing bounds the minimum-time "
-                             "planner's accelerations: the fastest motion would need infinite "
-                             "acceleration (set either)")
+        key, other = "mintime.acceleration_bounds", "mintime.dynamics_file empty"
+        try:  # the file itself names a dynamics file, emptied by --set: blame that key
+            if load_scenario(s.source).mintime.dynamics_file is not None:
+                key, other = "mintime.dynamics_file", "mintime.acceleration_bounds false"
+        except (CellError, OSError):
+            pass
+        return ScenarioError(s.source, key, s.get(key), f"with {other} too, nothing bounds the "
+                             "minimum-time planner's accelerations: the fastest motion would need "
+                             "infinite acceleration (set either)")
     path = dynamics_path(s)
     if isinstance(exc, WeakDriveError) and path is not None:
-        model = planner_bounds(s).dynamics
-        key, value = "drives.stall_torque_nm", model.drives.stall_torque_nm
-        if value == Drives.stall_torque_nm and model.links.mass_kg != Links.mass_kg:
-            key, value = "links.mass_kg", model.links.mass_kg
-        return ScenarioError(path, key, value, f"{exc} (the dynamic model of {s.source})")
+        built_in = "microbot_dynamics.yaml"  # against which the user's file is compared
+        key, value, also = exc.blame(planner_bounds(s).dynamics,
+                                     load_dynamics(catalog.path(built_in)), built_in)
+        return ScenarioError(path, key, value,
+                             f"{exc} (the dynamic model of {catalog.shown(s.source)}{also})")
     model_used = f" (dynamic model {path})" if path is not None else ""
     return CellError(f"{s.source}: {asked}: {exc}{model_used}")
 

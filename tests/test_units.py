@@ -63,3 +63,24 @@ def test_cell_run_warns_of_a_trace_in_milliseconds_and_runs(tmp_path: Path, caps
     assert "cell: warning: utilisation 0.00081: a part every 22333.3 s on average (6.2 h)" in err
     assert "are the times in milliseconds? arrivals.trace_csv (msv.csv) is read in seconds" in err
     assert (tmp_path / "out" / "summary.csv").is_file()
+
+
+@pytest.mark.parametrize("cycle, said", [
+    ("22587", "controller.nominal_cycle_s = 22587 s (6.27 h) is 1000 times the arrivals' mean "
+              "(22.586 s): milliseconds for seconds, or the other way round? both are in seconds; "
+              "the controller aims at it, not at the arrivals (set it to null to follow them); "
+              "the input belt's length"),
+    ("30", "controller.nominal_cycle_s (30.0000 s) is +32.8% off the arrivals' mean (22.5860 s): "
+           "the controller aims at it, not at the arrivals; set it to null to follow them"),
+])
+def test_cell_run_says_a_nominal_cycle_off_the_arrivals_once(tmp_path: Path, capsys, cycle: str,
+                                                             said: str) -> None:
+    """A cycle in milliseconds: one line, the unit slip and what the controller does with it
+    (not a second line of +99904.5 %); a cycle merely off: the percentage line, as before."""
+    assert main(["run", "baseline", "--set", f"controller.nominal_cycle_s={cycle}",
+                 "--set", "run.parts=3", "--out", str(tmp_path / "out")]) == 0
+    captured = capsys.readouterr()
+    (line,) = [ln for ln in captured.err.splitlines() if "nominal_cycle_s" in ln]
+    assert line.startswith(f"cell: warning: {said}")
+    assert captured.err.count("cell: warning:") == 1
+    assert f"nominal cycle {float(cycle):.4f} s (controller.nominal_cycle_s)" in captured.out

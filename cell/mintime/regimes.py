@@ -13,6 +13,7 @@ through a cubic spline for q' and q''.  The bounds (:class:`PlannerBounds`):
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -100,35 +101,96 @@ def regime_rows(rp: RegimePath, motors: Motors, bounds: PlannerBounds, geometry:
     return s, q, PathRows.join(*parts), vmax
 
 
-class WeakDriveError(NoMotionError):
-    """No motion where a drive cannot hold the arm against gravity at rest: joint ``joint``
-    (0-4) needs ``needed_nm`` at ``s`` of ``regime``, more than its stall torque ``stall_nm``."""
+@dataclass(frozen=True)
+class Shortfall:
+    """Joint ``joint`` (0-4) needs ``needed_nm`` to hold the arm still at ``s`` of ``regime``,
+    more than its stall torque ``stall_nm`` (shown rounded up, so that the value shown holds)."""
 
-    def __init__(self, regime: str, s: float, joint: int, needed_nm: float, stall_nm: float):
-        self.regime, self.s, self.joint = regime, s, joint
-        self.needed_nm, self.stall_nm = needed_nm, stall_nm
+    regime: str
+    s: float
+    joint: int
+    needed_nm: float
+    stall_nm: float
+
+    def text(self, first: bool = True) -> str:
+        """The shortfall in words; after the first, shorter (the line stays readable)."""
+        s, name = self.s, f"the {JOINT_NAMES[self.joint]} (joint {self.joint + 1})"
+        needed, stall = f"{_rounded_up(self.needed_nm):.3g} N·m", f"{self.stall_nm:.3g} N·m"
+        if not first:
+            return f"{name} {needed} (s = {s:.4f} of {self.regime}), more than its {stall}"
         where = "at the start of" if s == 0 else "at the end of" if s == 1 else f"at s = {s:.4f} of"
-        super().__init__(f"the {JOINT_NAMES[joint]} (joint {joint + 1}) needs {needed_nm:.3g} N·m "
-                         f"to hold the arm against gravity {where} {regime}, more than its "
-                         f"stall torque {stall_nm:.3g} N·m")
+        return (f"{name} needs {needed} to hold the arm against gravity {where} {self.regime}, "
+                f"more than its stall torque {stall}")
 
 
-def weak_drive(rp: RegimePath, model: DynamicsModel | None, geometry: CellGeometry,
-               s: NDArray[np.float64], q: NDArray[np.float64]) -> WeakDriveError | None:
-    """The first grid point of ``rp`` where a drive's stall torque cannot hold the arm still
-    (gravity alone; the joint whose shortfall is largest there), or None."""
+def _rounded_up(x: float) -> float:
+    """``x`` rounded up at three significant digits: a stall torque set to it holds."""
+    scale = 10.0 ** (2 - math.floor(math.log10(x))) if x > 0 else 1.0
+    return math.ceil(x * scale) / scale
+
+
+class WeakDriveError(NoMotionError):
+    """No motion where a drive cannot hold the arm against gravity at rest: one
+    :class:`Shortfall` per joint that falls short, each at the point that needs the most."""
+
+    def __init__(self, shortfalls: tuple[Shortfall, ...]):
+        self.shortfalls = shortfalls
+        super().__init__("; ".join(f.text(i == 0) for i, f in enumerate(shortfalls)))
+
+    def blame(self, model: DynamicsModel, reference: DynamicsModel, name: str
+              ) -> tuple[str, Any, str]:
+        """(key, value, words to add) for a dynamics file: the first of :data:`HOLDING_KEYS`
+        in which ``model`` differs from ``reference`` (file ``name``), the others named in
+        the words; the stall torques only if lower at a joint that falls short (a stronger
+        drive is no cause), and by default."""
+        ours, theirs = model.drives.stall_torque_nm, reference.drives.stall_torque_nm
+        lower = any(ours[f.joint] < theirs[f.joint] for f in self.shortfalls)
+        changed = [k for k in HOLDING_KEYS if model_value(model, k) != model_value(reference, k)
+                   and (k != "drives.stall_torque_nm" or lower)] or ["drives.stall_torque_nm"]
+        verb = "differs" if len(changed) == 2 else "differ"
+        also = f"; {' and '.join(changed[1:])} {verb} from the built-in {name} too" \
+            if len(changed) > 1 else ""
+        return changed[0], model_value(model, changed[0]), also
+
+
+#: A dynamics file's keys that holding the arm against gravity depends on, in the order blame
+#: is given.
+HOLDING_KEYS = ("drives.stall_torque_nm", "links.mass_kg", "links.com_m", "gravity_m_s2")
+
+
+def model_value(model: DynamicsModel, key: str) -> Any:
+    """The value of a dynamics file's dotted ``key`` in ``model``, tuples as the file's lists."""
+    value: Any = model
+    for part in key.split("."):
+        value = getattr(value, part)
+    return _listed(value)
+
+
+def _listed(value: Any) -> Any:
+    return [_listed(v) for v in value] if isinstance(value, tuple) else value
+
+
+def weak_drive(table: StepTable, model: DynamicsModel | None, geometry: CellGeometry,
+               n_grid: int) -> WeakDriveError | None:
+    """The drives whose stall torque cannot hold the arm still (gravity alone) somewhere on
+    the free regimes' grids, or None.  Each joint is named with the most any grid point of any
+    regime needs: a stall torque raised to that holds the arm everywhere."""
     if model is None:
         return None
-    ch = chain(model, geometry.arm.l2, geometry.arm.l3, rp.load_oz, rp.tcp_in)
-    zero = np.zeros_like(q)
-    hold = np.abs(ch.rnea(q, zero, zero, friction=False, gravity=True))
     stall = np.asarray(model.drives.stall_torque_nm, float)
-    short = np.flatnonzero((hold > stall).any(axis=1))
-    if len(short) == 0:
-        return None
-    i = int(short[0])
-    j = int(np.argmax(hold[i] / stall))
-    return WeakDriveError(rp.regime, float(s[i]), j, float(hold[i, j]), float(stall[j]))
+    s = path_grid(n_grid)
+    worst: dict[int, Shortfall] = {}
+    for r in FREE_REGIMES:
+        rp = regime_path(table, r, geometry)
+        ch = chain(model, geometry.arm.l2, geometry.arm.l3, rp.load_oz, rp.tcp_in)
+        q = rp.spline()(s)
+        zero = np.zeros_like(q)
+        hold = np.abs(ch.rnea(q, zero, zero, friction=False, gravity=True))
+        for j in np.flatnonzero((hold > stall).any(axis=0)):
+            i = int(np.argmax(hold[:, j]))
+            if int(j) not in worst or hold[i, j] > worst[int(j)].needed_nm:
+                worst[int(j)] = Shortfall(r, float(s[i]), int(j), float(hold[i, j]), float(stall[j]))
+    return WeakDriveError(tuple(worst[j] for j in sorted(worst))) if worst else None
 
 
 @dataclass(frozen=True)
@@ -151,7 +213,7 @@ def plan_regimes(geometry: CellGeometry, motors: Motors, bounds: PlannerBounds,
         try:
             profile = plan(rows)
         except CellError as exc:
-            weak = weak_drive(rp, bounds.dynamics, geometry, s, q)
+            weak = weak_drive(table, bounds.dynamics, geometry, len(s))
             raise weak or NoMotionError(f"regime {r}: {exc}") from None
         out[r] = RegimeResult(r, q, profile, vmax)
     return out

@@ -12,6 +12,7 @@ import json
 import sys
 from pathlib import Path
 
+from cell import catalog
 from cell.assembly import (
     constants,
     dynamics_path,
@@ -40,7 +41,7 @@ def planner_line(s: Scenario) -> str:
     bounds = [f"joint velocities at {rates}"]
     path = dynamics_path(s)
     if path is not None:
-        bounds.append(f"dynamic model {shown_path(path)}")
+        bounds.append(f"dynamic model {shown_path(catalog.shown(path))}")  # a built-in by name
     if m.acceleration_bounds:
         bounds.append("assumed acceleration bounds "
                       f"[{', '.join(f'{v:g}' for v in m.qddot_max_rad_s2)}] rad/s²")

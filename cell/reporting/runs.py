@@ -55,16 +55,16 @@ def run_heading(cell: AssembledCell) -> str:
     return heading
 
 
-def warnings(k: CellConstants) -> list[str]:
+def warnings(k: CellConstants, nominal: bool = True) -> list[str]:
     """One line each: the cell cannot keep up on average; the nominal cycle is not the
-    arrivals' mean."""
+    arrivals' mean (unless ``nominal`` is false: a line about its unit says so instead)."""
     from cell.sweep.spec import nominal_gap, overloaded
 
     out = []
     if k.utilisation >= 1:
         out.append(overloaded(f"utilisation {k.utilisation:.3f}",
                               (k.fastest_cycle_s, k.mean_interarrival_s)))
-    if abs(nominal_gap(k)) > NOMINAL_MISMATCH:  # NaN: the cycle follows the arrivals
+    if nominal and abs(nominal_gap(k)) > NOMINAL_MISMATCH:  # NaN: the cycle follows the arrivals
         out.append(nominal_off(nominal_mismatch(k.cycle_nom, k.mean_interarrival_s)))
     return out
 

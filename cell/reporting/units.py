@@ -32,10 +32,18 @@ def _times(ratio: float) -> str:
     return f"{shown} times" if ratio >= 1 else f"1/{shown} of"
 
 
+def cycle_slip(cell: AssembledCell) -> bool:
+    """Whether the stated nominal cycle is more than :data:`CYCLE_RATIO` times off the
+    arrivals' mean (then :func:`unit_warnings` says too that the controller aims at it)."""
+    stated = cell.scenario.controller.nominal_cycle_s
+    return stated is not None and not 1 / CYCLE_RATIO <= stated / cell.k.mean_interarrival_s <= CYCLE_RATIO
+
+
 def unit_warnings(cell: AssembledCell) -> list[str]:
     """One line each: a utilisation below :data:`LOW_UTILISATION`; a stated nominal cycle
-    more than :data:`CYCLE_RATIO` times off the arrivals' mean.  The line about a long
-    cycle adds the input belt's length when that is derived from it."""
+    more than :data:`CYCLE_RATIO` times off the arrivals' mean (:func:`cycle_slip`; the line
+    says what ``cell.reporting.runs.warnings`` would, which then leaves it out).  The line
+    about a long cycle adds the input belt's length when that is derived from it."""
     s, k = cell.scenario, cell.k
     mean = k.mean_interarrival_s
     out: list[str] = []
@@ -49,10 +57,11 @@ def unit_warnings(cell: AssembledCell) -> list[str]:
                    f"are the times in milliseconds? {where} is read in seconds")
         long_cycle = k.nominal_from == "arrivals"
     stated = s.controller.nominal_cycle_s
-    if stated is not None and not 1 / CYCLE_RATIO <= stated / mean <= CYCLE_RATIO:
+    if stated is not None and cycle_slip(cell):
         out.append(f"controller.nominal_cycle_s = {stated:.6g} s{_duration(stated)} is "
                    f"{_times(stated / mean)} the arrivals' mean ({mean:.6g} s): milliseconds "
-                   "for seconds, or the other way round? both are in seconds")
+                   "for seconds, or the other way round? both are in seconds; the controller "
+                   "aims at it, not at the arrivals (set it to null to follow them)")
         long_cycle = long_cycle or stated > mean
     if long_cycle and s.belts.input_length_in is None:
         metres = k.input_length * 0.0254
