@@ -65,12 +65,12 @@ def check_options(args: argparse.Namespace, cycle_s: float) -> None:
 
 
 def notes(scenario: Scenario, first: int, parts: int) -> list[str]:
-    """``cell run``'s warnings (an overloaded cell), and a note if the parts shown go past
-    the scenario's ``run.parts`` (the run is simulated on to reach them)."""
+    """``cell run``'s warnings (:func:`~cell.reporting.units.run_warnings`), and a note if the
+    parts shown go past the scenario's ``run.parts`` (the run is simulated on to reach them)."""
     from cell.assembly import assemble
-    from cell.reporting.runs import warnings
+    from cell.reporting.units import run_warnings
 
-    out = [f"warning: {line}" for line in warnings(assemble(scenario).k)]
+    out = [f"warning: {line}" for line in run_warnings(assemble(scenario))]
     last, n = first + parts - 1, scenario.run.parts
     if last > n:
         out.append(f"note: --from-part {first} --parts {parts} shows parts up to {last:,}, past "

@@ -28,7 +28,7 @@ def main(args: argparse.Namespace) -> int:
     from cell.assembly import assemble
     from cell.figures import FILES, make_figures
     from cell.output import OutputDir
-    from cell.reporting.runs import warnings
+    from cell.reporting.units import run_warnings
 
     def warn(line: str) -> None:
         print(f"cell: warning: {line}", file=sys.stderr)
@@ -36,7 +36,7 @@ def main(args: argparse.Namespace) -> int:
     names = [f"{stem}.png" for stem in FILES.values()]
     OutputDir.check(args.out, names)  # before any work
     scenario = scenario_of(args)
-    for line in warnings(assemble(scenario).k):  # as cell run says them: overload, nominal cycle
+    for line in run_warnings(assemble(scenario)):  # as cell run says them
         warn(line)
     with OutputDir(args.out, names) as out:
         drawn = make_figures(scenario, out.stage, warn=warn,

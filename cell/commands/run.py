@@ -37,8 +37,8 @@ def main(args: argparse.Namespace) -> int:
     from cell.output import OutputDir
     from cell.progress import Progress
     from cell.records import BELT_COLUMNS, PART_COLUMNS, SUMMARY_COLUMNS
-    from cell.reporting.runs import format_summary, run_heading, thesis_figures, warnings
-    from cell.reporting.units import cycle_slip, unit_warnings
+    from cell.reporting.runs import format_summary, run_heading, thesis_figures
+    from cell.reporting.units import run_warnings
     from cell.scenario import inert_settings
     from cell.simulation import simulate
 
@@ -50,8 +50,7 @@ def main(args: argparse.Namespace) -> int:
     if timed:
         from cell.reporting.mintime import planner_line
         print(planner_line(scenario))
-    said = [*warnings(cell.k, nominal=not cycle_slip(cell)), *unit_warnings(cell)]  # one line a slip
-    for line in [*said, *(inert_settings(scenario) if timed else [])]:
+    for line in [*run_warnings(cell), *(inert_settings(scenario) if timed else [])]:
         print(f"cell: warning: {line}", file=sys.stderr)
     n = scenario.run.parts
     with OutputDir(args.out, RUN_FILES) as out, \

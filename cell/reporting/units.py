@@ -69,3 +69,12 @@ def unit_warnings(cell: AssembledCell) -> list[str]:
         out[-1] += (f"; the input belt's length, derived from the nominal cycle (belts.input_length_in "
                     f"left out), is {k.input_length:.6g} in ({shown})")
     return out
+
+
+def run_warnings(cell: AssembledCell) -> list[str]:
+    """What ``cell run``, ``cell animate`` and ``cell figures`` warn of before they run: an
+    overloaded cell, a nominal cycle off the arrivals, a unit slip (one line for a slip of
+    the nominal cycle, not that and its percentage)."""
+    from cell.reporting.runs import warnings
+
+    return [*warnings(cell.k, nominal=not cycle_slip(cell)), *unit_warnings(cell)]

@@ -70,3 +70,17 @@ def test_both_policies_show_a_fixed_robot_at_its_own_cycle(tmp_path: Path) -> No
     assert cli(["animate", "non_adaptive", "--set", "controller.ideal_cycle_s=21.0", "--policy",
                 "both", "--out", str(tmp_path / "b.gif"), "--parts", "1", "--speed", "200",
                 "--dpi", "20"]) == 0
+
+
+def test_a_nominal_cycle_in_ms_is_warned_of_as_cell_run_warns(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """One line for the slip (its unit), not that and a percentage, from animate as from run."""
+    common = ["--set", "controller.nominal_cycle_s=22587", "--set", "run.parts=2"]
+    assert cli(["run", "baseline", *common, "--out", str(tmp_path / "run")]) == 0
+    run = said(capsys)
+    assert len(run) == 1 and "ms" in run[0] and "%" not in run[0], run
+    from cell.commands.animate import notes
+    from cell.scenario import load_scenario
+
+    scenario = load_scenario("baseline", {"controller.nominal_cycle_s": 22587, "run.parts": 2})
+    assert [f"cell: {line}" for line in notes(scenario, 1, 1)] == run
