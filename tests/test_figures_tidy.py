@@ -54,3 +54,27 @@ def test_fig13_marks_too_few_draws_on_the_axis_and_says_so(tmp_path: Path):
     trace = load_scenario(tmp_path / "s.yaml")
     ax = fig13_figure(trace, draws(trace, 2)).axes[0]  # no pdf either: still a valid axis
     assert ax.get_ylim() == (0.0, 1.0)
+
+
+@pytest.mark.parametrize(("arrivals", "pdf", "cdf"), [
+    (None, "fig13_weibull_pdf", "fig14_weibull_cdf"),  # the thesis's
+    ("{distribution: weibull_min, mean_s: 20, cv: 0.5}", "fig13_weibull_pdf", "fig14_weibull_cdf"),
+    ("{distribution: gamma, mean_s: 20, cv: 0.5}", "fig13_gamma_pdf", "fig14_gamma_cdf"),
+    ("{distribution: lognorm, mean_s: 20, cv: 0.3}", "fig13_lognormal_pdf", "fig14_lognormal_cdf"),
+    ("{distribution: gengamma, params: {a: 2, c: 1.5, loc: 10, scale: 4}}", "fig13_gengamma_pdf",
+     "fig14_gengamma_cdf"),
+    ("{trace_csv: gaps.csv}", "fig13_trace_pdf", "fig14_trace_cdf")])
+def test_fig13_14_files_are_named_after_the_arrivals(tmp_path: Path, arrivals: str | None,
+                                                     pdf: str, cdf: str):
+    """Fig. 13/14 are written under the family's name, the thesis's for a Weibull, and a
+    figure folder holding either is one `cell figures` may replace."""
+    from cell.figures import FILES, NAMES, make_figures
+    from cell.output import OutputDir
+
+    (tmp_path / "gaps.csv").write_text("interarrival_s\n" + "\n".join(["18.5", "24", "21"] * 4))
+    (tmp_path / "s.yaml").write_text(f"arrivals: {arrivals}\n" if arrivals else "name: s\n")
+    s = load_scenario(tmp_path / "s.yaml")
+    out = tmp_path / "figs"
+    drawn = make_figures(s, out, parts=12, only=[12, 13, 14])
+    assert [p.name for p in drawn] == [f"{FILES[12]}.png", f"{pdf}.png", f"{cdf}.png"]
+    assert OutputDir.check(out, NAMES) == out.resolve()
