@@ -20,8 +20,8 @@ from cell.reporting.table_7_1 import (
     statistics,
     summary_column,
     table_7_1,
+    table_7_1_files,
     thesis_value,
-    write_table_7_1,
 )
 from cell.sweep import load_sweep, run_sweep
 
@@ -161,13 +161,21 @@ def test_reading_follows_the_direction_of_the_numbers():
     assert "+66.7%" in more  # actual cycle 50 s against 30 s
 
 
-def test_write_table_7_1_writes_both_files(sweeps, tmp_path):
-    sweep = load_sweep(sweeps.write(tmp_path))
+def test_the_report_writes_both_table_7_1_files(sweeps, tmp_path):
+    """A Table 7.1 sweep's report holds table_7_1.csv (the long form, read back whole) and
+    table_7_1.md, as :func:`table_7_1_files` makes them."""
+    from cell.reporting.experiment import plan_report, write_report
+
+    sweep = load_sweep(sweeps.write(tmp_path, set={"run.parts": 500}))  # laid out like Table 7.1
     frame = run_sweep(sweep, tmp_path / "o", workers=1, replicate=sweeps.bookkeeping,
                       progress=False).replications
-    paths = write_table_7_1(frame, sweep, tmp_path / "rep")
-    assert [p.name for p in paths] == ["table_7_1.csv", "table_7_1.md"]
-    back = pd.read_csv(paths[0])
+    paths = write_report(frame, sweep, plan_report(sweep, tmp_path / "rep"), "test")
+    csv, md = tmp_path / "rep" / "table_7_1.csv", tmp_path / "rep" / "table_7_1.md"
+    assert {csv, md} <= set(paths)
+    table, text = table_7_1_files(frame, sweep)
+    assert md.read_text(encoding="utf-8") == text
+    back = pd.read_csv(csv)
+    assert len(back) == len(table)
     assert list(back.columns) == COLUMNS
     assert back.loc[back["accounting"] == "wallclock", "thesis"].isna().all()
 

@@ -26,14 +26,14 @@ def main(args: argparse.Namespace) -> int:
     import sys
 
     from cell.assembly import assemble
-    from cell.figures import FILES, make_figures
+    from cell.figures import NAMES, make_figures
     from cell.output import OutputDir
     from cell.reporting.units import run_warnings
 
     def warn(line: str) -> None:
         print(f"cell: warning: {line}", file=sys.stderr)
 
-    names = [f"{stem}.png" for stem in FILES.values()]
+    names = list(NAMES)
     OutputDir.check(args.out, names)  # before any work
     scenario = scenario_of(args)
     for line in run_warnings(assemble(scenario)):  # as cell run says them

@@ -1,7 +1,8 @@
 """The thesis's figures, regenerated from this model: ``cell figures``.
 
 Writes ``figNN_<slug>.png`` for Fig. 8, 9, 12-30 of the thesis's list of
-illustrations, each titled with its number and caption.  Fig. 8-21 need only the
+illustrations, each titled with its number and caption (Fig. 13/14 of arrivals other
+than a Weibull named after them: :func:`file_stem`).  Fig. 8-21 need only the
 path and the motors; Fig. 22-30 run the simulation (adaptive, and non-adaptive at
 the scenario's own cycle for Fig. 23/24 and at the six robot cycles of Table 7.1
 for Fig. 25-30: those the robot cannot make are left out).
@@ -41,6 +42,20 @@ FILES: dict[int, str] = {
     29: "fig29_ip_20_5000",
     30: "fig30_ip_20_0907",
 }
+#: Every file a figure set may hold: Fig. 13/14 are named after the arrivals (:func:`file_stem`).
+NAMES: tuple[str, ...] = (*(f"{stem}.png" for n, stem in FILES.items() if n not in (13, 14)),
+                          "fig13_*_pdf.png", "fig14_*_cdf.png")
+
+
+def file_stem(number: int, scenario: Scenario) -> str:
+    """Figure ``number``'s file stem: :data:`FILES`'s, but Fig. 13/14 of arrivals that are not
+    the thesis's Weibull are named after their family (``fig13_gamma_pdf``) or the trace's."""
+    given = scenario.arrivals
+    if number not in (13, 14) or (given.trace_csv is None and given.distribution == "weibull_min"):
+        return FILES[number]
+    family = "trace" if given.trace_csv is not None else \
+        arrivals.FAMILY_NAMES.get(given.distribution, given.distribution).lower()
+    return f"fig{number}_{family}_{'pdf' if number == 13 else 'cdf'}"
 
 
 def make_figures(scenario: Scenario, out: str | Path, *, parts: int | None = None,
@@ -57,7 +72,7 @@ def make_figures(scenario: Scenario, out: str | Path, *, parts: int | None = Non
     if parts is not None:
         scenario = scenario.with_overrides({"run.parts": parts})
     wanted = set(FILES) if only is None else set(only)
-    path = {n: out / f"{FILES[n]}.png" for n in FILES}
+    path = {n: out / f"{file_stem(n, scenario)}.png" for n in FILES}
     written: list[Path] = []
 
     def done(p: Path) -> None:

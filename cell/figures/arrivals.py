@@ -76,14 +76,32 @@ def _grid(s: Scenario, x: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.linspace(lo - 0.5, hi + 0.5, 600)
 
 
+#: Fig. 13's histogram has this many bins, or one a draw if there are fewer draws.
+BINS = 30
+#: Fewer draws than this get no histogram in Fig. 13 (a bar or two would tower over the pdf):
+#: each draw is marked on the axis instead.
+MIN_HISTOGRAM_DRAWS = 5
+
+
+def _draws_drawn(ax: Any, s: Scenario, x: NDArray[np.float64]) -> float:
+    """Draw Fig. 13's draws: a histogram, or marks on the axis below
+    :data:`MIN_HISTOGRAM_DRAWS`; return the histogram's tallest bar (0 for marks)."""
+    label = f"the {_times(x.size)} of the run (seed {s.run.seed})"
+    if x.size < MIN_HISTOGRAM_DRAWS:
+        ax.plot(x, np.zeros_like(x), "|", ms=16, mew=2.2, color="#3182bd", clip_on=False,
+                label=f"{label}:\ntoo few for a histogram, each marked on the axis")
+        return 0.0
+    heights, _, _ = ax.hist(x, bins=min(BINS, x.size), density=True, color="#9ecae1",
+                            edgecolor="white", label=label)
+    return float(heights.max())
+
+
 def fig13_figure(s: Scenario, x: NDArray[np.float64]) -> Figure:
     """Fig. 13, the draws' histogram under the distribution's pdf (not saved)."""
     fig, ax = new_figure(13, caption(s, "pdf"))
     d = distribution(s)
     t = _grid(s, x)
-    heights, _, _ = ax.hist(x, bins=30, density=True, color="#9ecae1", edgecolor="white",
-            label=f"the {_times(x.size)} of the run (seed {s.run.seed})")
-    top = float(heights.max())
+    top = _draws_drawn(ax, s, x)
     if d is not None:
         ax.plot(t, d.pdf(t), color="black", label=f"pdf{_cited(s, '6.8')}")
         ax.axvline(d.mean(), color="#d62728", ls="--", lw=1.2, label=f"mean {d.mean():.4f} s")
@@ -93,7 +111,7 @@ def fig13_figure(s: Scenario, x: NDArray[np.float64]) -> Figure:
         top = max(top, float(d.pdf(t).max()))
     ax.set_xlabel("inter-arrival time T (s)")
     ax.set_ylabel("probability density (1/s)")
-    ax.set_ylim(0, 1.45 * top)
+    ax.set_ylim(0, 1.45 * top if top > 0 else 1.0)  # a trace's few draws: no density to show
     ax.legend(loc="upper left")
     ax.set_title(_params_note(s, x), loc="left", fontsize=8.5)
     return fig

@@ -68,11 +68,16 @@ def style() -> Iterator[None]:
 
 
 def new_figure(number: int, caption: str, *, nrows: int = 1, ncols: int = 1,
-               size: tuple[float, float] = (8.0, 4.8), **subplot_kw: Any) -> tuple[Figure, Any]:
-    """A figure titled "Figure N. caption" (the thesis's list of illustrations)."""
+               size: tuple[float, float] = (8.0, 4.8), sharex: bool = False, sharey: bool = False,
+               **subplot_kw: Any) -> tuple[Figure, Any]:
+    """A figure titled "Figure N. caption" (the thesis's list of illustrations).
+
+    ``sharex``/``sharey``: the panels share that axis (its limits, and the tick labels only
+    on the outer panels); ``subplot_kw`` goes to each panel (e.g. ``projection="3d"``)."""
     fig = Figure(figsize=size, layout="constrained")
     FigureCanvasAgg(fig)
-    axes = fig.subplots(nrows, ncols, squeeze=True, subplot_kw=subplot_kw or None)
+    axes = fig.subplots(nrows, ncols, sharex=sharex, sharey=sharey, squeeze=True,
+                        subplot_kw=subplot_kw or None)
     fig.suptitle(f"Figure {number}. {caption}")
     return fig, axes
 

@@ -1,7 +1,8 @@
-"""Table 7.1 beside the thesis: ``cell sweep ... --report DIR`` (thesis §7.2; docs/accounting.md).
+"""Table 7.1 beside the thesis (thesis §7.2; docs/accounting.md): part of a sweep's report.
 
-For a sweep laid out like Table 7.1 (see :func:`is_table_7_1`), beside the
-general report (:mod:`cell.reporting.experiment`), this writes
+For a sweep laid out like Table 7.1 (see :func:`is_table_7_1`), the report
+(:mod:`cell.reporting.experiment`, ``cell sweep ... --report DIR``) holds, beside its
+general files, the two that :func:`table_7_1_files` makes:
 
 - ``table_7_1.csv``: long form, one row per (policy, ideal cycle, accounting,
   measure): the published value, the mean over replications with its 95 %
@@ -25,7 +26,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -35,7 +35,6 @@ from cell import catalog
 from cell import thesis as published
 from cell.analysis.stats import summarise
 from cell.errors import CellError
-from cell.output import write_csv, write_text
 from cell.reporting.experiment_data import runs_of
 from cell.reporting.headlines import half_width, table_head, table_row
 from cell.reporting.table_7_1_reading import (
@@ -63,7 +62,7 @@ DECIMALS = {"actual_cycle_s": 2, "parts_missed": 1, "parts_per_hr": 1,
             "vavg_r4_in_s": 4, "ip": 4}
 __all__ = ["ACCOUNTINGS", "COLUMNS", "LABELS", "LAYOUTS", "MEASURES", "inside", "is_table_7_1",
            "markdown", "reading", "statistics", "summary_column", "table_7_1", "table_7_1_files",
-           "thesis_value", "write_table_7_1", "memoryless"]
+           "thesis_value", "memoryless"]
 
 
 def summary_column(accounting: str, measure: str, columns: Sequence[str]) -> str:
@@ -262,13 +261,3 @@ def table_7_1_files(replications: pd.DataFrame, sweep: Sweep) -> tuple[pd.DataFr
     """The long-form table and the markdown text, for ``table_7_1.csv`` and ``.md``."""
     table = table_7_1(replications, sweep)
     return table, markdown(table, sweep, replications)
-
-
-def write_table_7_1(replications: pd.DataFrame, sweep: Sweep, out: str | Path) -> list[Path]:
-    """Write ``table_7_1.csv`` and ``table_7_1.md`` into ``out``; return their paths."""
-    out = Path(out)
-    table, text = table_7_1_files(replications, sweep)
-    paths = [out / "table_7_1.csv", out / "table_7_1.md"]
-    write_csv(table, paths[0])
-    write_text(text, paths[1])
-    return paths

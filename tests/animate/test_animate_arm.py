@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cell.animation.scene import Scene, arm_pose, robot_state
+from cell.animation.robot import arm_pose, robot_state
+from cell.animation.scene import Scene
 from cell.figures.motion import timeline
 from cell.scenario import Scenario
 

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from cell.animation import simulate_scenes
-from cell.animation.scene import FALLING, Scene, build_scene, frame_times, parts_at, robot_state, window
+from cell.animation.robot import robot_state
+from cell.animation.scene import FALLING, Scene, build_scene, frame_times, parts_at, window
 from cell.scenario import Scenario
 
 FIRST, COUNT = 3000, 3

@@ -126,7 +126,7 @@ def test_a_frame_looks_the_robot_up_once_and_draws_the_held_part_between_the_fin
         scenes: list[Scene], monkeypatch: pytest.MonkeyPatch) -> None:
     """While a part is in the hand, one frame asks for the joints once, and the part (its
     number) is drawn midway between the finger tips drawn in the same frame."""
-    from cell.animation import render, scene
+    from cell.animation import render, robot
     from cell.animation.render import build_figure, draw_frame
 
     sc = scenes[0]
@@ -136,13 +136,13 @@ def test_a_frame_looks_the_robot_up_once_and_draws_the_held_part_between_the_fin
     assert parts_at(sc, t).where[i] == HAND
     panel = build_figure(scenes, dpi=20.0)[1][0]
     asked: list[object] = []
-    original = scene.robot_state
+    original = robot.robot_state
 
     def counted(*args: object) -> object:
         asked.append(args[1])
         return original(*args)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(scene, "robot_state", counted)
+    monkeypatch.setattr(robot, "robot_state", counted)
     monkeypatch.setattr(render, "robot_state", counted, raising=False)
     draw_frame(panel, t)
     assert asked == [t]
