@@ -311,6 +311,16 @@ def _syntax_error(src: _Source, path: KeyPath, exc: yaml.MarkedYAMLError) -> NoR
     src.fail(path, src.line_text(mark.line), f"invalid YAML at {where}: {problem or context}", "(syntax)")
 
 
+def _did_you_mean(path: str | Path) -> str:
+    """For a missing ``NAME`` beside which ``NAME.yaml`` (or ``.yml``) exists, a hint naming it."""
+    if Path(path).suffix.lower() in (".yaml", ".yml"):
+        return ""
+    for suffix in (".yaml", ".yml"):
+        if os.path.isfile(f"{path}{suffix}"):
+            return f"; did you mean {_oneline(f'{path}{suffix}')}?"
+    return ""
+
+
 def load_mapping(path: str | Path, what: str = "scenario") -> dict[Any, Any]:
     """The top-level mapping of the YAML file ``path`` (``{}`` if it holds no document).
 
@@ -325,8 +335,9 @@ def load_mapping(path: str | Path, what: str = "scenario") -> dict[Any, Any]:
         with open(path, "rb") as stream:
             data = stream.read(MAX_BYTES + 1)
     except OSError as exc:
-        reason = {FileNotFoundError: f"no such {what} file", IsADirectoryError: f"is a directory, not a "
-                  f"{what} file"}.get(type(exc)) or f"cannot read it: {(exc.strerror or str(exc)).lower()}"
+        reason = {FileNotFoundError: f"no such {what} file{_did_you_mean(path)}", IsADirectoryError:
+                  f"is a directory, not a {what} file"}.get(type(exc)) \
+            or f"cannot read it: {(exc.strerror or str(exc)).lower()}"
         raise ScenarioError(name, "(file)", name, reason) from None
     if len(data) > MAX_BYTES:
         raise ScenarioError(name, "(file)", name, f"larger than {MAX_BYTES >> 10} KiB: not a {what} file")

@@ -72,3 +72,16 @@ def test_a_dash_for_an_output_is_refused_instead_of_writing_a_file_named_dash(
     if what is not None:
         assert line == what.format("no cell command writes to standard output; name")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["trace.csv"]
+
+
+@pytest.mark.parametrize("command, suffix, what", [
+    ("run", ".yaml", "scenario"), ("run", ".yml", "scenario"), ("sweep", ".yaml", "sweep")])
+def test_a_name_without_its_suffix_suggests_the_file_beside_it(capsys, tmp_path, monkeypatch,
+                                                               command, suffix, what):
+    """``cell run slow_robot`` with slow_robot.yaml here: not a built-in name, but that file."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / f"slow_robot{suffix}").write_text("run: {parts: 3}\n")
+    line = refused(capsys, command, "slow_robot", "--out", "out")
+    assert line == (f"slow_robot: (file) = 'slow_robot': no such {what} file; "
+                    f"did you mean slow_robot{suffix}?")
+    assert refused(capsys, command, "slow_robots", "--out", "out").endswith(f"no such {what} file")
