@@ -228,6 +228,7 @@ class _Builder:
     def mapping(self, node: MappingNode) -> dict[Any, Any]:
         out: dict[Any, Any] = {}
         lines: dict[Any, int] = {}
+        self._refuse_unspaced(node)
         for key_node, value_node in node.value:
             key = self.build(key_node)
             if not isinstance(key, Hashable) or isinstance(key, list):
@@ -248,6 +249,18 @@ class _Builder:
             out[key] = self.build(value_node)
             self.path.pop()
         return out
+
+
+    def _refuse_unspaced(self, node: MappingNode) -> None:
+        """``{loc:3,scale:2}`` is YAML for the keys ``loc:3`` and ``scale:2`` without values:
+        refused, showing it with the spaces meant."""
+        if node.flow_style and any(
+                not k.style and ":" in k.value and v.tag == _NULL and not v.value and not v.style
+                for k, v in node.value):
+            text = self.src.text[node.start_mark.index:node.end_mark.index]
+            spaced = re.sub(r"([:,])(?=[^\s,:}\]])", r"\1 ", text)
+            self.src.fail(self.path, _oneline(text, 60),
+                          f"YAML needs a space after ':' ({_oneline(spaced, 80)})", "(syntax)")
 
 
 def _convert(tag: str, text: str) -> Any:
