@@ -7,16 +7,19 @@ an output that cannot be written (:class:`~cell.errors.CellError`), a usage
 error, memory running out, input nested past Python's recursion limit, and an
 operating-system refusal to write (permission, read-only file system, full
 disk, name too long) that got past the commands' own checks.  Ctrl-C is exit
-130; a reader that leaves (``cell run ... | head``) is ignored
+130, wherever it lands (also in an import, which may turn it into an ImportError); a
+reader that leaves (``cell run ... | head``) is ignored
 (:mod:`cell.output.streams`).  Anything else is a bug and keeps its traceback.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import errno
 import importlib
 import os
+import signal
 import sys
 import warnings
 from collections.abc import Sequence
@@ -33,6 +36,9 @@ COMMANDS = ("run", "sweep", "compare", "fit", "figures", "animate", "path", "min
 OUTPUT_ERRNOS = frozenset({errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOSPC, errno.EDQUOT,
                            errno.EFBIG, errno.ENAMETOOLONG, errno.ENOTDIR, errno.EISDIR,
                            errno.ELOOP, errno.EIO, errno.EXDEV})
+
+#: The exit code of an interrupted command: 128 + SIGINT, as a shell reports Ctrl-C.
+INTERRUPTED = 130
 
 #: What to make smaller when a command runs out of memory.
 MEMORY_HINTS = {
@@ -101,13 +107,54 @@ def _run(args: argparse.Namespace) -> int:
     return code
 
 
+def interrupted(exc: BaseException) -> bool:
+    """Whether ``exc`` is Ctrl-C or came of it: a KeyboardInterrupt, or an error raised while
+    one was handled (``ImportError: initialization failed`` of a module it cut short)."""
+    todo: list[BaseException | None] = [exc]
+    seen: set[int] = set()
+    while todo:
+        e = todo.pop()
+        if e is None or id(e) in seen:
+            continue
+        if isinstance(e, KeyboardInterrupt):
+            return True
+        seen.add(id(e))
+        todo += [e.__cause__, e.__context__]
+    return False
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one command; the exit code (0 done, 2 refused, 130 interrupted).  A reader of stdout
-    or stderr that leaves (``| head``) stops neither the command nor its error line's exit code."""
-    from cell.output.streams import reader_may_leave
+    or stderr that leaves (``| head``) stops neither the command nor its error line's exit code.
 
-    with reader_may_leave():
-        return _main(argv)
+    With ``argv`` None the process is the command's: interrupted, it ends at once with 130
+    (:func:`_exit_now`), whatever Ctrl-C met on its way."""
+    try:
+        from cell.output.streams import reader_may_leave
+
+        with reader_may_leave():
+            code = _main(argv)
+    except BaseException as exc:  # Ctrl-C while starting, or one that became another error
+        if not interrupted(exc):
+            raise
+        with contextlib.suppress(Exception):
+            print("cell: interrupted", file=sys.stderr)
+        code = INTERRUPTED
+    if code == INTERRUPTED and argv is None:
+        _exit_now(code)
+    return code
+
+
+def _exit_now(code: int) -> None:
+    """End the process with ``code``, ignoring another Ctrl-C on the way.  A normal exit could
+    still die by SIGINT: CPython does, if the KeyboardInterrupt went through an ``exec`` of a
+    string (a dataclass or namedtuple being made while a module was imported)."""
+    with contextlib.suppress(ValueError):  # not the main thread: nothing to ignore
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    os._exit(code)
 
 
 def _main(argv: Sequence[str] | None) -> int:
@@ -134,7 +181,7 @@ def _main(argv: Sequence[str] | None) -> int:
                      f"(Python's recursion limit, {sys.getrecursionlimit():,} levels)")
     except KeyboardInterrupt:
         print("cell: interrupted", file=sys.stderr)
-        return 130
+        return INTERRUPTED
     except OSError as exc:
         if exc.errno not in OUTPUT_ERRNOS:
             raise

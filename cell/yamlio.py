@@ -228,6 +228,7 @@ class _Builder:
     def mapping(self, node: MappingNode) -> dict[Any, Any]:
         out: dict[Any, Any] = {}
         lines: dict[Any, int] = {}
+        self._refuse_unspaced(node)
         for key_node, value_node in node.value:
             key = self.build(key_node)
             if not isinstance(key, Hashable) or isinstance(key, list):
@@ -248,6 +249,18 @@ class _Builder:
             out[key] = self.build(value_node)
             self.path.pop()
         return out
+
+
+    def _refuse_unspaced(self, node: MappingNode) -> None:
+        """``{loc:3,scale:2}`` is YAML for the keys ``loc:3`` and ``scale:2`` without values:
+        refused, showing it with the spaces meant."""
+        if node.flow_style and any(
+                not k.style and ":" in k.value and v.tag == _NULL and not v.value and not v.style
+                for k, v in node.value):
+            text = self.src.text[node.start_mark.index:node.end_mark.index]
+            spaced = re.sub(r"([:,])(?=[^\s,:}\]])", r"\1 ", text)
+            self.src.fail(self.path, _oneline(text, 60),
+                          f"YAML needs a space after ':' ({_oneline(spaced, 80)})", "(syntax)")
 
 
 def _convert(tag: str, text: str) -> Any:
@@ -311,6 +324,16 @@ def _syntax_error(src: _Source, path: KeyPath, exc: yaml.MarkedYAMLError) -> NoR
     src.fail(path, src.line_text(mark.line), f"invalid YAML at {where}: {problem or context}", "(syntax)")
 
 
+def _did_you_mean(path: str | Path) -> str:
+    """For a missing ``NAME`` beside which ``NAME.yaml`` (or ``.yml``) exists, a hint naming it."""
+    if Path(path).suffix.lower() in (".yaml", ".yml"):
+        return ""
+    for suffix in (".yaml", ".yml"):
+        if os.path.isfile(f"{path}{suffix}"):
+            return f"; did you mean {_oneline(f'{path}{suffix}')}?"
+    return ""
+
+
 def load_mapping(path: str | Path, what: str = "scenario") -> dict[Any, Any]:
     """The top-level mapping of the YAML file ``path`` (``{}`` if it holds no document).
 
@@ -325,8 +348,9 @@ def load_mapping(path: str | Path, what: str = "scenario") -> dict[Any, Any]:
         with open(path, "rb") as stream:
             data = stream.read(MAX_BYTES + 1)
     except OSError as exc:
-        reason = {FileNotFoundError: f"no such {what} file", IsADirectoryError: f"is a directory, not a "
-                  f"{what} file"}.get(type(exc)) or f"cannot read it: {(exc.strerror or str(exc)).lower()}"
+        reason = {FileNotFoundError: f"no such {what} file{_did_you_mean(path)}", IsADirectoryError:
+                  f"is a directory, not a {what} file"}.get(type(exc)) \
+            or f"cannot read it: {(exc.strerror or str(exc)).lower()}"
         raise ScenarioError(name, "(file)", name, reason) from None
     if len(data) > MAX_BYTES:
         raise ScenarioError(name, "(file)", name, f"larger than {MAX_BYTES >> 10} KiB: not a {what} file")

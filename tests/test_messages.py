@@ -52,10 +52,36 @@ def test_a_tab_in_the_indentation_is_called_a_tab(capsys, tmp_path: Path, text, 
     assert line.endswith(f": invalid YAML at {where}: a tab: YAML indents with spaces only")
 
 
-def test_path_refuses_a_dash_for_out_instead_of_writing_a_file_named_dash(capsys, tmp_path,
-                                                                         monkeypatch):
+@pytest.mark.parametrize("argv, what", [
+    (["path", "baseline", "--out", "-"], "--out -: {} a file"),
+    (["run", "baseline", "--out", "-"], "--out -: {} a directory"),
+    (["compare", "baseline", "non_adaptive", "--out", "-"], "--out -: {} a directory"),
+    (["fit", "trace.csv", "--out", "-"], "--out -: {} a file"),
+    (["fit", "trace.csv", "--out", "f.yaml", "--figure", "-"], None),  # the suffix, first
+    (["path", "baseline", "--out", "./-"], None),  # a file named '-', asked for: written
+])
+def test_a_dash_for_an_output_is_refused_instead_of_writing_a_file_named_dash(
+        capsys, tmp_path, monkeypatch, argv, what):
     """No command writes its output to stdout, so '-' is refused, not taken as a file name."""
     monkeypatch.chdir(tmp_path)
-    line = refused(capsys, "path", "baseline", "--out", "-")
-    assert line.startswith("--out -: cell path writes a CSV file, not standard output")
-    assert list(tmp_path.iterdir()) == []
+    (tmp_path / "trace.csv").write_text("interarrival_s\n" + "".join(f"{20 + i % 7}\n" for i in range(40)))
+    if "./-" in argv:
+        assert main(argv) == 0 and (tmp_path / "-").is_file()
+        return
+    line = refused(capsys, *argv)
+    if what is not None:
+        assert line == what.format("no cell command writes to standard output; name")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["trace.csv"]
+
+
+@pytest.mark.parametrize("command, suffix, what", [
+    ("run", ".yaml", "scenario"), ("run", ".yml", "scenario"), ("sweep", ".yaml", "sweep")])
+def test_a_name_without_its_suffix_suggests_the_file_beside_it(capsys, tmp_path, monkeypatch,
+                                                               command, suffix, what):
+    """``cell run slow_robot`` with slow_robot.yaml here: not a built-in name, but that file."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / f"slow_robot{suffix}").write_text("run: {parts: 3}\n")
+    line = refused(capsys, command, "slow_robot", "--out", "out")
+    assert line == (f"slow_robot: (file) = 'slow_robot': no such {what} file; "
+                    f"did you mean slow_robot{suffix}?")
+    assert refused(capsys, command, "slow_robots", "--out", "out").endswith(f"no such {what} file")

@@ -80,6 +80,11 @@ BAD = [
     ({"baseline": {"policy": "non-adaptive"}}, "baseline", "name the value of "
      "controller.ideal_cycle_s"),
     ({"baseline": [1, 2]}, "baseline", "must name a point"),
+    ({"replications": 20.0}, "replications = 20.0", "at least 1; write 20"),
+    ({"replications": 2.5}, "replications = 2.5", "at least 1"),
+    ({"replications": {"precision": 0.01, "measure": "parts_missed", "min": 5.0, "max": 50}},
+     "replications.min = 5.0", "at least 2; write 5"),
+    ({"seed": 7.0}, "seed = 7.0", "at least 0; write 7"),
 ]
 
 

@@ -263,3 +263,32 @@ def _only_scenario_errors(read):
         read()
     except ScenarioError as exc:
         assert "\n" not in str(exc) and len(str(exc)) < 400, str(exc)
+
+
+@pytest.mark.parametrize("text, spaced", [
+    ("{loc:3,scale:2}", "{loc: 3, scale: 2}"),
+    ("{loc:3, scale: 2}", "{loc: 3, scale: 2}"),
+    ("{shape:-1.5}", "{shape: -1.5}"),
+])
+def test_a_flow_mapping_without_spaces_after_colons_says_so(text, spaced, tmp_path):
+    """``{loc:3}`` is YAML for a key ``loc:3`` with no value: on the command line and in a
+    file, the error shows the mapping with the spaces meant."""
+    with pytest.raises(ScenarioError) as info:
+        parse_value(text, "--set arrivals.params")
+    assert str(info.value) == (f"--set arrivals.params: (value) = {text!r}: "
+                               f"YAML needs a space after ':' ({spaced})")
+    path = tmp_path / "s.yaml"
+    path.write_text(f"arrivals:\n  params: {text}\n")
+    with pytest.raises(ScenarioError) as info:
+        load_mapping(path)
+    assert info.value.key == "arrivals.params" and f"({spaced})" in str(info.value)
+
+
+@pytest.mark.parametrize("text, value", [
+    ('{"loc:3": 1}', {"loc:3": 1}),        # quoted: a key with a colon, as asked
+    ("{url: http://x}", {"url": "http://x"}),
+    ("{a}", {"a": None}),                   # a key without a value, but no colon in it
+    ("[loc:3]", ["loc:3"]),
+])
+def test_colons_yaml_reads_as_meant_are_left_alone(text, value):
+    assert parse_value(text) == value

@@ -63,7 +63,7 @@ def _destination(path: str | Path, option: str, taken: Sequence[Path]) -> Path:
            p.resolve() in {t.resolve() for t in taken} else "")
     if why:
         raise ScenarioError(p, option, str(p), why)
-    check_file(path)
+    check_file(path, option)  # refuses '-' too: no command writes to standard output
     return p
 
 

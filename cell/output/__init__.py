@@ -109,7 +109,7 @@ class OutputDir(contextlib.AbstractContextManager["OutputDir"]):
 
     def __init__(self, target: str | os.PathLike[str], names: Iterable[str], option: str = "--out"):
         self.target, self.names, self.option = _show(target), tuple(names), option
-        self.dir = absolute(target, "directory")
+        self.dir = absolute(target, "directory", option)
         self._recover()
         self.check(target, self.names, option)
         self._made: list[Path] = []
@@ -126,7 +126,7 @@ class OutputDir(contextlib.AbstractContextManager["OutputDir"]):
     @staticmethod
     def check(target: str | os.PathLike[str], names: Iterable[str], option: str = "--out") -> Path:
         """Refuse, changing nothing, a ``target`` this command could not write or must not replace."""
-        shown, path, names = _show(target), absolute(target, "directory"), tuple(names)
+        shown, path, names = _show(target), absolute(target, "directory", option), tuple(names)
         if path == Path.cwd() or path in Path.cwd().parents:
             raise CellError(f"{shown}: holds the current directory; choose another {option}")
         try:

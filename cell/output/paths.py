@@ -49,9 +49,13 @@ def alive(pid: int) -> bool:
     return True
 
 
-def absolute(target: str | os.PathLike[str], what: str) -> Path:
+def absolute(target: str | os.PathLike[str], what: str, option: str = "--out") -> Path:
+    """The absolute path of an output ``target`` (a file or directory: ``what``, given as
+    ``option``); '' and '-' refused (a '-' would be a file of that name, not standard output)."""
     if not os.fspath(target):
         raise CellError(f"'': an empty path; name a {what}")
+    if os.fspath(target) == "-":
+        raise CellError(f"{option} -: no cell command writes to standard output; name a {what}")
     return Path(os.path.realpath(os.path.abspath(target)))
 
 
@@ -138,9 +142,10 @@ def sync_tree(root: Path) -> None:
         fsync(Path(folder), directory=True)
 
 
-def check_file(target: str | os.PathLike[str]) -> Path:
-    """Refuse, changing nothing, a single-file ``target`` that cannot be written; its absolute path."""
-    shown, path = _show(target), absolute(target, "file")
+def check_file(target: str | os.PathLike[str], option: str = "--out") -> Path:
+    """Refuse, changing nothing, a single-file ``target`` (given as ``option``) that cannot be
+    written; its absolute path."""
+    shown, path = _show(target), absolute(target, "file", option)
     if os.path.isdir(path):
         raise CellError(f"{shown}: is a directory; name a file")
     check_parent(shown, path)

@@ -10,7 +10,9 @@ A point that does not vary a key holds its scenario's value there, so a plain
 ``groupby`` keeps every row.  Where the scenario leaves a setting empty and the
 run reports a summary column of the same name, the run's value is used: for
 ``controller.ideal_cycle_s`` the cycle the policy actually plans for
-(``ideal_cycle_s``; the nominal cycle for the adaptive policy).
+(``ideal_cycle_s``; the nominal cycle for the adaptive policy).  A file the point
+names (:data:`cell.scenario.PATH_KEYS`) is shown as the sweep file wrote it, not as
+the path it is read from.
 """
 
 from __future__ import annotations
@@ -20,9 +22,11 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from cell.scenario import PATH_KEYS
 from cell.sweep.spec import Point, Sweep
 
 NAME_SUFFIX = ".name"
+_PATH_COLUMNS = frozenset(".".join(k) for k in PATH_KEYS)
 _TOKEN = re.compile(r"\[(\d+)\]|([^.\[\]]+)")
 
 
@@ -96,6 +100,8 @@ def point_values(columns: Sequence[Column], point: Point,
             out[c.name] = point.name_of(c.key) or ""
             continue
         value = lookup(doc, c.name)  # the scenario's value, as validated
+        if c.name in _PATH_COLUMNS and c.key in given:  # as written, not resolved
+            value = flatten(c.key, given[c.key]).get(c.name, value)
         if value is None and c.key in given:  # a key that is not a scenario setting
             value = flatten(c.key, given[c.key]).get(c.name)
         if value is None and summary is not None and c.leaf in summary:

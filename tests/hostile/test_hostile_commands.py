@@ -81,6 +81,7 @@ def _targets(tmp: Path, kind: str) -> list[tuple[str, str, Path | str, str]]:
     folder.mkdir(exist_ok=True)
     cases: list[tuple[str, str, Path | str, str]] = [
         ("empty", "", "", "an empty path"),
+        ("a dash", "", "-", "no cell command writes to standard output"),
         ("under a file", "", blocker / name, "not a directory"),
         ("name too long", "", tmp / ("n" * 250 + (f".{suffix}" if suffix else "")), "file name too long"),
         ("path too long", "", tmp.joinpath(*["d" * 200] * 25) / name, "too long"),
