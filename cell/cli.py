@@ -19,7 +19,6 @@ import contextlib
 import errno
 import importlib
 import os
-import signal
 import sys
 import warnings
 from collections.abc import Sequence
@@ -27,6 +26,7 @@ from typing import Any, NoReturn
 
 from cell import __version__
 from cell.errors import CellError, ScenarioError, one_line, shown_path
+from cell.interrupts import exit_now
 
 #: Subcommands in the order ``cell --help`` lists them; each is cell.commands.<name>.
 COMMANDS = ("run", "sweep", "compare", "fit", "figures", "animate", "path", "mintime",
@@ -128,7 +128,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     or stderr that leaves (``| head``) stops neither the command nor its error line's exit code.
 
     With ``argv`` None the process is the command's: interrupted, it ends at once with 130
-    (:func:`_exit_now`), whatever Ctrl-C met on its way."""
+    (:func:`cell.interrupts.exit_now`), whatever Ctrl-C met on its way."""
     try:
         from cell.output.streams import reader_may_leave
 
@@ -141,20 +141,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             print("cell: interrupted", file=sys.stderr)
         code = INTERRUPTED
     if code == INTERRUPTED and argv is None:
-        _exit_now(code)
+        exit_now(code)
     return code
-
-
-def _exit_now(code: int) -> None:
-    """End the process with ``code``, ignoring another Ctrl-C on the way.  A normal exit could
-    still die by SIGINT: CPython does, if the KeyboardInterrupt went through an ``exec`` of a
-    string (a dataclass or namedtuple being made while a module was imported)."""
-    with contextlib.suppress(ValueError):  # not the main thread: nothing to ignore
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-    for stream in (sys.stdout, sys.stderr):
-        with contextlib.suppress(Exception):
-            stream.flush()
-    os._exit(code)
 
 
 def _main(argv: Sequence[str] | None) -> int:

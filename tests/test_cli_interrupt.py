@@ -90,7 +90,7 @@ def test_a_real_process_exits_130_with_one_line():
 
 def test_the_process_ends_now_only_when_it_is_the_commands(monkeypatch):
     ended = []
-    monkeypatch.setattr(cell.cli, "_exit_now", ended.append)
+    monkeypatch.setattr(cell.cli, "exit_now", ended.append)
     monkeypatch.setattr("cell.commands.scenarios.main", lambda args: exec("raise KeyboardInterrupt"))
     assert main(["scenarios"]) == INTERRUPTED and ended == []
     monkeypatch.setattr(sys, "argv", ["cell", "scenarios"])

@@ -56,6 +56,7 @@ def test_a_tab_in_the_indentation_is_called_a_tab(capsys, tmp_path: Path, text, 
     (["path", "baseline", "--out", "-"], "--out -: {} a file"),
     (["run", "baseline", "--out", "-"], "--out -: {} a directory"),
     (["compare", "baseline", "non_adaptive", "--out", "-"], "--out -: {} a directory"),
+    (["sweep", "table_7_1", "--out", "-"], "--out -: {} a directory"),
     (["fit", "trace.csv", "--out", "-"], "--out -: {} a file"),
     (["fit", "trace.csv", "--out", "f.yaml", "--figure", "-"], None),  # the suffix, first
     (["path", "baseline", "--out", "./-"], None),  # a file named '-', asked for: written

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import contextlib
 import os
 import shlex
 import signal
@@ -13,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from cell.commands import check_workers, workers_argument
+from cell.interrupts import exit_now
 
 HELP = "replicated sweep over scenario keys, with its report"
 DESCRIPTION = ("Run a grid of scenarios with replications (common random numbers); write "
@@ -75,19 +75,8 @@ def main(args: argparse.Namespace) -> int:
             for number, handler in previous.items():
                 signal.signal(number, signal.SIG_DFL if handler is None else handler)
     if stop.signum is not None:
-        _exit(code)
+        exit_now(code)
     return code
-
-
-def _exit(code: int) -> None:
-    """End a stopped sweep now, with ``code``.  Its workers are gone and its files whole;
-    a normal exit could still turn the code into a death by SIGINT (CPython does, if the
-    KeyboardInterrupt went through an ``exec`` of a string: a dataclass or namedtuple
-    being made while a module was imported)."""
-    for stream in (sys.stdout, sys.stderr):
-        with contextlib.suppress(Exception):
-            stream.flush()
-    os._exit(code)
 
 
 def _sweep(args: argparse.Namespace, stop: _Stop) -> int:

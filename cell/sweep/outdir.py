@@ -13,6 +13,7 @@ from typing import Any
 
 from cell.errors import CellError
 from cell.output import write_text
+from cell.output.paths import absolute
 from cell.sweep.options import show
 from cell.sweep.spec import Sweep
 
@@ -35,6 +36,7 @@ def check_out(out: str | Path) -> Path:
     one holding a ``replications.csv`` or task files but no ``sweep.json``."""
     if str(out) == "":
         raise CellError("--out '': an empty path; give a directory for the sweep's results")
+    absolute(out, "directory")  # '-' is refused as every command refuses it
     path = Path(out)
     for parent in (path, *path.parents):
         if parent.exists() and not parent.is_dir():
