@@ -16,7 +16,7 @@ from cell.reporting.experiment_plots import (
     layout,
     title,
 )
-from cell.reporting.experiment_text import show
+from cell.reporting.experiment_reading import show
 from cell.reporting.headlines import HEADLINES
 from cell.sweep import load_sweep, run_sweep
 

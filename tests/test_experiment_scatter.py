@@ -7,7 +7,8 @@ import pandas as pd
 import pytest
 
 from cell.analysis.stats import PAIRED_KEYS, summarise
-from cell.reporting.experiment_text import cell, reading
+from cell.reporting.experiment_reading import reading
+from cell.reporting.experiment_text import cell
 from cell.reporting.headlines import HEADLINES
 
 KEY = "belts.output_nominal_in_s"

@@ -28,7 +28,8 @@ import pandas as pd
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from cell.reporting.experiment_text import display_columns, show
+from cell.reporting.experiment_reading import show
+from cell.reporting.experiment_text import display_columns
 from cell.reporting.headlines import HEADLINES, Headline
 from cell.sweep import Sweep, grid_columns
 from cell.sweep.columns import NAME_SUFFIX
