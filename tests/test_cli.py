@@ -162,15 +162,16 @@ def test_schema_describes_every_section(capsys):
 
 def test_schema_help_is_plain_text_and_its_file_comes_with_the_line_that_uses_it(tmp_path, capsys):
     """``cell schema --help`` reads without the docstring's markup; ``--out`` names the first line
-    that the YAML language server reads, as the README's "Editors" gives it."""
+    that the YAML language server reads, as docs/usage.md's "Editors" gives it."""
     with pytest.raises(SystemExit):
         build_parser().parse_args(["schema", "--help"])
     assert "``" not in capsys.readouterr().out
     out = tmp_path / "scenario.schema.json"
     assert main(["schema", "--out", str(out)]) == 0
     assert "# yaml-language-server: $schema=scenario.schema.json" in capsys.readouterr().out.splitlines()
-    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text(encoding="utf-8")
-    assert "`# yaml-language-server: $schema=scenario.schema.json`" in readme
+    root = Path(__file__).resolve().parent.parent
+    usage = (root / "docs" / "usage.md").read_text(encoding="utf-8")   # the README points there
+    assert "`# yaml-language-server: $schema=scenario.schema.json`" in usage
 
 def test_a_built_in_file_is_named_in_reports_as_a_user_would_type_it(tmp_path):
     from cell import catalog
