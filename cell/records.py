@@ -6,7 +6,7 @@
 * :class:`BeltChange`: a row of ``belts.csv``, one per speed change of a belt.
 
 The fields, in order, *are* the columns; each field's docstring is its
-meaning (the README's column tables are checked against them).
+meaning (docs/usage.md's column tables are checked against them).
 """
 
 from __future__ import annotations

@@ -3,8 +3,8 @@
 Writes DIR/profile.csv (one row per grid point of each regime: regime, s, the
 time from the regime's start, the joint angles, ṡ and the velocity-limit curve)
 and DIR/summary.json (each regime's time and switching points, and the limits
-used) as one set: both appear together or neither does.  README.md describes
-every column and key.
+used) as one set: both appear together or neither does.  docs/usage.md
+("Minimum-time motion") describes every column and key.
 """
 
 from __future__ import annotations

@@ -146,7 +146,7 @@ def readme(c: dict) -> str:
         "  does not measure.",
         "",
         "`kinematic.json` and `dynamic.json` are `cell mintime`'s `summary.json` for each scenario",
-        "(times and switching points of R II and R IV, and the limits; the top README's",
+        "(times and switching points of R II and R IV, and the limits; docs/usage.md's",
         "minimum-time section describes each key); `cycles.json` holds the table above.",
         "",
         "## Table 7.1 under minimum-time timing",
