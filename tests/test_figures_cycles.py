@@ -17,7 +17,7 @@ from cell.policies.fixed import fixed_plan
 from cell.scenario import default_scenario
 from cell.thesis import TABLE_7_1_CYCLES
 
-#: Arrivals 3 % slower than the thesis's: the nominal cycle follows their mean (README), and R IV
+#: Arrivals 3 % slower than the thesis's: the nominal cycle follows their mean (docs/usage.md), and R IV
 #: shortened from it to 20.5 or 20.0907 s falls below what the base can do.
 SLOWER = {"arrivals": {"distribution": "gamma", "mean_s": 23.3, "cv": 0.3}, "run.parts": 30}
 

@@ -28,7 +28,7 @@ from cell.simulation import simulate
 OWN_CYCLE = {"controller": {"policy": "non-adaptive", "ideal_cycle_s": 21.0,
                             "nominal_cycle_s": 22.0},
              "arrivals": {"distribution": "gamma", "mean_s": 22.0, "cv": 0.3}, "run.parts": 40}
-#: Parts come faster than the robot's fastest cycle (README: overload).
+#: Parts come faster than the robot's fastest cycle (docs/usage.md: overload).
 OVERLOAD = "name: overload\narrivals: {distribution: weibull_min, mean_s: 16.0, cv: 0.05}\n"
 
 

@@ -27,7 +27,7 @@ def test_travel_is_the_area_under_the_speed_history() -> None:
 
 def test_the_input_length_is_two_nominal_cycles_of_belt(scenes: list[Scene],
                                                          scenario: Scenario) -> None:
-    """Baseline leaves it empty: 2 x 3.0 in/s x 22.5872 s = 135.52 in (README)."""
+    """Baseline leaves it empty: 2 x 3.0 in/s x 22.5872 s = 135.52 in (docs/assumptions.md)."""
     for sc in scenes:
         assert sc.data.input_length_in == pytest.approx(2 * 3.0 * 22.5872)
 
