@@ -115,9 +115,8 @@ def write_report(replications: pd.DataFrame, sweep: Sweep, target: Target,
     summary, differences = tables or (summary_table(replications, sweep),
                                       difference_table(replications, sweep))
     pngs = figures(summary, replications, sweep)
-    text = markdown(summary, differences, replications, sweep, command, list(pngs), caveat)
-    if target.table_7_1:
-        text = _link_table_7_1(text)
+    text = markdown(summary, differences, replications, sweep, command, list(pngs), caveat,
+                    target.table_7_1)
     written = []
     with OutputDir(target.directory, target.names, "--report") as out:
         out.write_text("report.md", text)
@@ -137,11 +136,3 @@ def write_report(replications: pd.DataFrame, sweep: Sweep, target: Target,
             written += list(TABLE_7_1_FILES)
     return [target.directory / name for name in written]
 
-
-def _link_table_7_1(text: str) -> str:
-    """``report.md`` with a paragraph pointing at Table 7.1's two files, before its
-    first section."""
-    link = ("Table 7.1 beside the thesis's: [`table_7_1.md`](table_7_1.md); its numbers: "
-            "[`table_7_1.csv`](table_7_1.csv).")
-    head, sep, rest = text.partition("\n## ")
-    return f"{head}\n{link}\n\n## {rest}" if sep else f"{text.rstrip()}\n\n{link}\n"

@@ -103,9 +103,10 @@ def sentence(h: Headline, d: Mapping[Any, Any], a: str, b: str, parts: int | Non
 
 def markdown(summary: pd.DataFrame, differences: pd.DataFrame, replications: pd.DataFrame,
              sweep: Sweep, command: str, figures: Sequence[str],
-             caveat: str | None = None) -> str:
+             caveat: str | None = None, table_7_1: bool = False) -> str:
     """The whole ``report.md``; ``caveat``, if given, is said first (e.g. that counts
-    come from different windows)."""
+    come from different windows); ``table_7_1``: the report holds Table 7.1's two files,
+    linked before the first section."""
     parts = _parts(sweep)
     auto = _auto(sweep)
     per_run = None if auto else parts  # a warm-up of auto: the window is not `parts` parts
@@ -125,6 +126,9 @@ def markdown(summary: pd.DataFrame, differences: pd.DataFrame, replications: pd.
     if caveat:
         lines += [f"**Caveat:** {caveat}.", ""]
     lines += _variation(summary, sweep)
+    if table_7_1:
+        lines += ["Table 7.1 beside the thesis's: [`table_7_1.md`](table_7_1.md); its numbers: "
+                  "[`table_7_1.csv`](table_7_1.csv).", ""]
     lines += _precision(replications, summary, sweep, cols)
     present = [h for h in HEADLINES if h.column in set(summary["measure"])]
     runs = [len(runs_of(replications, sweep, i)) for i in range(len(sweep.points))]
