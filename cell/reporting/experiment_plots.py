@@ -79,8 +79,7 @@ def layout(summary: pd.DataFrame, sweep: Sweep) -> Layout:
 def figures(summary: pd.DataFrame, replications: pd.DataFrame, sweep: Sweep) -> dict[str, bytes]:
     """``fig_<measure>.png`` -> PNG bytes, for each headline measure in the summary."""
     plan = layout(summary, sweep)
-    panels = list(dict.fromkeys(tuple(show(v) for v in r)
-                                for r in summary[list(plan.panels)].itertuples(index=False)))
+    panels = _combos(summary, plan.panels)
     if len(panels) > MAX_PANELS:
         return {}
     policies = sweep.policies
@@ -123,10 +122,7 @@ def draw(h: Headline, rows: pd.DataFrame, sweep: Sweep, plan: Layout,
         floor = mean.min() / 2
         rows = rows.assign(ci_low=rows["ci_low"].clip(lower=floor))
     for ax, combo in zip(axes, panels, strict=False):
-        sub = rows
-        for c, v in zip(plan.panels, combo, strict=True):
-            sub = sub[sub[c].map(show) == v]
-        _panel(ax, h, sub, sweep, plan, colours)
+        _panel(ax, h, _select(rows, plan.panels, combo), sweep, plan, colours)
         if log:
             ax.set_yscale("log")
         if plan.panels:
@@ -177,16 +173,24 @@ def _series(rows: pd.DataFrame, plan: Layout, policies: Sequence[str]
         if not own:
             out.append((policy, 0, policy, r))
             continue
-        combos = list(dict.fromkeys(tuple(show(v) for v in t)
-                                    for t in r[own].itertuples(index=False)))
-        for j, combo in enumerate(combos):
-            sub = r
-            for c, v in zip(own, combo, strict=True):
-                sub = sub[sub[c].map(show) == v]
+        for j, combo in enumerate(_combos(r, own)):
             label = f"{policy}: " + ", ".join(f"{c.removesuffix(NAME_SUFFIX)} = {v}"
                                                for c, v in zip(own, combo, strict=True))
-            out.append((policy, j, label, sub))
+            out.append((policy, j, label, _select(r, own, combo)))
     return out
+
+
+def _combos(rows: pd.DataFrame, cols: Sequence[str]) -> list[tuple[str, ...]]:
+    """The combinations of ``cols``' values in ``rows``, as shown, in order of appearance."""
+    return list(dict.fromkeys(tuple(show(v) for v in t)
+                              for t in rows[list(cols)].itertuples(index=False)))
+
+
+def _select(rows: pd.DataFrame, cols: Sequence[str], combo: Sequence[str]) -> pd.DataFrame:
+    """The rows whose ``cols`` show as ``combo``."""
+    for c, v in zip(cols, combo, strict=True):
+        rows = rows[rows[c].map(show) == v]
+    return rows
 
 
 def _panel(ax: Axes, h: Headline, rows: pd.DataFrame, sweep: Sweep, plan: Layout,
