@@ -37,6 +37,7 @@ from cell.analysis.stats import summarise
 from cell.errors import CellError
 from cell.reporting.experiment_data import runs_of
 from cell.reporting.headlines import half_width, table_head, table_row
+from cell.reporting.runs import is_thesis_cell
 from cell.reporting.table_7_1_reading import (
     ACCOUNTINGS,
     LABELS,
@@ -48,6 +49,7 @@ from cell.reporting.table_7_1_reading import (
     row_of,
     thesis_value,
 )
+from cell.scenario import load_scenario
 
 if TYPE_CHECKING:
     from cell.sweep import Point, Sweep
@@ -99,9 +101,6 @@ def is_table_7_1(sweep: Sweep) -> bool:
     varies at most the robot cycle, runs only policies the thesis published figures for, a
     fixed number of times, on the thesis's own cell (any robot timing:
     :func:`~cell.reporting.runs.is_thesis_cell`)."""
-    from cell.reporting.runs import is_thesis_cell
-    from cell.scenario import load_scenario
-
     if not (set(sweep.keys) <= {VARIED_KEY} and sweep.precision is None
             and all(p.policy in published.PUBLISHED for p in sweep.points)):
         return False
