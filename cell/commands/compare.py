@@ -88,7 +88,7 @@ def window_warning(sweep: Sweep) -> str | None:
     from cell.sweep.windows import AUTO, AUTO_WHY, WINDOW_MEASURES_TEXT, windows_apart
 
     (la, a), (lb, b) = _sides(sweep)
-    differ = windows_apart(a.scenario, b.scenario, auto_apart=True)
+    differ = windows_apart(a.scenario, b.scenario)
     if not differ:
         return None
     said = {"parts": "runs {} parts", "warmup_parts": "has run.warmup_parts {}"}
@@ -200,7 +200,7 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> s
     from cell.sweep.windows import window_kind, windows_apart
 
     (la, a), (lb, b) = _sides(sweep)
-    differ = windows_apart(a.scenario, b.scenario, auto_apart=True)
+    differ = windows_apart(a.scenario, b.scenario)
     parts = a.scenario.run.parts if a.scenario.run.parts == b.scenario.run.parts else None
     level = f"{sweep.confidence * 100:g} %"
     length = (f" of {parts} part{'s' if parts != 1 else ''}" if parts else

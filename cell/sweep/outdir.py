@@ -220,8 +220,8 @@ def prepare(sweep: Sweep, out: Path, resume: bool) -> None:
     for leftover in task_dir.glob(".task-*.tmp") if task_dir.is_dir() else ():
         leftover.unlink(missing_ok=True)
     found = _manifest(manifest) if resume and manifest.is_file() else None
-    most = sweep.replications
-    if isinstance(found, dict) and found.get(ANY_COUNT) == sweep.fingerprint(replications=False):
+    most, any_count = sweep.replications, sweep.fingerprint(replications=False)
+    if isinstance(found, dict) and found.get(ANY_COUNT) == any_count:
         most = max(most, _most(found))  # the tasks past the count are kept, for a later one
     if not resume:  # nothing of this sweep's, nor of another's, is lost (check_owner)
         for stale in finished_tasks(out):
@@ -229,7 +229,7 @@ def prepare(sweep: Sweep, out: Path, resume: bool) -> None:
         (out / "replications.csv").unlink(missing_ok=True)
     doc: dict[str, Any] = {"sweep": sweep.source, "name": sweep.name,
                            "fingerprint": sweep.fingerprint(),
-                           ANY_COUNT: sweep.fingerprint(replications=False),
+                           ANY_COUNT: any_count,
                            "tasks": len(sweep.points) * -(-sweep.first_round // sweep.batch),
                            "replications": sweep.replications, MOST: most,
                            "seed": sweep.seed, "batch": sweep.batch}

@@ -76,15 +76,14 @@ def window_kind(measure: str) -> str | None:
     return "an extreme" if measure in extreme_measures() else None
 
 
-def windows_apart(a: Scenario, b: Scenario, auto_apart: bool = False
-                  ) -> list[tuple[str, Any, Any]]:
+def windows_apart(a: Scenario, b: Scenario) -> list[tuple[str, Any, Any]]:
     """The window settings on which ``a`` and ``b`` differ: (key, a's value, b's value).
-    With ``auto_apart``, a warm-up of ``auto`` on either side differs even from ``auto``:
-    MSER-5 cuts each run where its own output settles, so two points (of different
-    policies or settings) count over windows of different lengths."""
+    A warm-up of ``auto`` on either side differs even from ``auto``: MSER-5 cuts each run
+    where its own output settles, so two points (of different policies or settings) count
+    over windows of different lengths."""
     def apart(key: str) -> bool:
         va, vb = getattr(a.run, key), getattr(b.run, key)
-        return va != vb or (auto_apart and key == "warmup_parts" and AUTO in (va, vb))
+        return va != vb or (key == "warmup_parts" and AUTO in (va, vb))
 
     return [(key, getattr(a.run, key), getattr(b.run, key)) for key in WINDOW_KEYS if apart(key)]
 
@@ -92,8 +91,7 @@ def windows_apart(a: Scenario, b: Scenario, auto_apart: bool = False
 def pair_apart(sweep: Sweep, pair: Pair) -> list[tuple[str, Any, Any]]:
     """:func:`windows_apart` of a pair's point and the point it is compared with (a
     warm-up of ``auto`` differs between them)."""
-    return windows_apart(sweep.points[pair.point].scenario, sweep.points[pair.versus].scenario,
-                         auto_apart=True)
+    return windows_apart(sweep.points[pair.point].scenario, sweep.points[pair.versus].scenario)
 
 
 def window_warning(sweep: Sweep) -> str | None:
