@@ -105,6 +105,20 @@ class SimResult:
             rows = self._rows or []
         return pd.DataFrame(rows, columns=PART_COLUMNS)
 
+    def belt_histories(self) -> dict[str, np.ndarray]:
+        """Each belt's speed changes as (m, 2) rows (from_s, speed_in_s), in time order: the
+        flat arrays the run kept, with no object made per change (a long run has millions)."""
+        log = self._belt_log
+        if log is None:
+            return {name: np.empty((0, 2)) for name in _BELTS}
+        which, rows = np.frombuffer(log.belt, dtype=np.int8), np.column_stack(
+            [np.frombuffer(log.t), np.frombuffer(log.v)]).reshape(-1, 2)
+        out = {}
+        for b, name in enumerate(_BELTS):
+            own = rows[which == b]
+            out[name] = own[np.argsort(own[:, 0], kind="stable")]
+        return out
+
     @property
     def belts(self) -> dict[str, list[tuple[float, float]]]:
         """(instant, speed) of every speed change of the ``input`` and ``output`` belts."""

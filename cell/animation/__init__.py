@@ -95,24 +95,11 @@ def simulated(scenario: Scenario, progress: bool = False) -> Any:
             if bar.enabled and record.part % step == 0:
                 bar.update(step)
 
-        changes: dict[str, tuple[array[float], array[float]]] = {
-            "input": (array("d"), array("d")), "output": (array("d"), array("d"))}
-
-        def changed(change: Any) -> None:
-            at, speed = changes[change.belt]
-            at.append(change.from_s)
-            speed.append(change.speed_in_s)
-
-        result = simulate(scenario, keep_parts=False, on_part=keep, keep_belts=False,
-                          on_belt=changed)
+        result = simulate(scenario, keep_parts=False, on_part=keep)
         bar.update(n - bar.n)
     parts = pd.DataFrame({f: np.frombuffer(columns[f]) for f in FRAME_FIELDS})
     parts = parts.astype({"part": np.int64, "picked": bool})
-    belts = {}
-    for belt, (at, speed) in changes.items():  # each belt's in time order, as the run's are
-        rows = np.column_stack([np.frombuffer(at), np.frombuffer(speed)]).reshape(-1, 2)
-        belts[belt] = rows[np.argsort(rows[:, 0], kind="stable")]
-    return SimpleNamespace(parts=parts, belts=belts, summary=result.summary)
+    return SimpleNamespace(parts=parts, belts=result.belt_histories(), summary=result.summary)
 
 
 def simulate_scenes(scenario: Scenario, policies: list[str], first: int, count: int,
