@@ -25,6 +25,7 @@ from cell.figures.style import (
     new_figure,
     save,
 )
+from cell.reporting.table_7_1 import fixed_cycle
 from cell.scenario import Scenario
 from cell.thesis import TABLE_7_1_CYCLES
 
@@ -56,13 +57,6 @@ class Runs:
     def own(self) -> Run:
         """The non-adaptive run at the scenario's own cycle."""
         return self.non_adaptive[self.own_cycle_s]
-
-
-def fixed_cycle(s: Scenario) -> float:
-    """The non-adaptive robot's cycle in ``s``, as ``cell run`` runs it: ``controller.ideal_cycle_s``,
-    else the nominal cycle (Fig. 23/24 draw it)."""
-    c = s.controller.ideal_cycle_s
-    return float(c) if c is not None else nominal_cycle(s)
 
 
 def missed_cycles(s: Scenario, cycles: tuple[float, ...] = TABLE_7_1_CYCLES

@@ -52,7 +52,8 @@ from cell.reporting.table_7_1_reading import (
 from cell.scenario import load_scenario
 
 if TYPE_CHECKING:
-    from cell.sweep import Point, Sweep
+    from cell.scenario import Scenario
+    from cell.sweep import Sweep
 
 COLUMNS = ["policy", "ideal_cycle_s", "accounting", "measure", "thesis",
            "mean", "ci_low", "ci_high", "run_p2_5", "run_p97_5"]
@@ -87,13 +88,14 @@ def summary_column(accounting: str, measure: str, columns: Sequence[str]) -> str
                     f"({accounting} accounting)")
 
 
-def ideal_cycle(point: Point) -> float:
-    """A point's robot cycle: ``controller.ideal_cycle_s``, else the nominal cycle
+def fixed_cycle(s: Scenario) -> float:
+    """The non-adaptive robot's cycle in ``s``, as ``cell run`` runs it (a Table 7.1 row's,
+    Fig. 23/24's): ``controller.ideal_cycle_s``, else the nominal cycle
     (:func:`cell.assembly.nominal_cycle`: the arrivals' mean when the scenario sets none)."""
     from cell.assembly import nominal_cycle
 
-    c = point.scenario.controller
-    return float(c.ideal_cycle_s if c.ideal_cycle_s is not None else nominal_cycle(point.scenario))
+    c = s.controller.ideal_cycle_s
+    return float(c) if c is not None else nominal_cycle(s)
 
 
 def is_table_7_1(sweep: Sweep) -> bool:
@@ -127,7 +129,7 @@ def table_7_1(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     for i in order:
         p = sweep.points[i]
         runs = runs_of(replications, sweep, i)
-        cycle = ideal_cycle(p)
+        cycle = fixed_cycle(p.scenario)
         for accounting in ACCOUNTINGS:
             for measure in MEASURES:
                 column = summary_column(accounting, measure, list(replications.columns))
