@@ -9,33 +9,49 @@ from __future__ import annotations
 import csv
 from collections.abc import Iterable, Sequence
 
+Records = list[tuple[int, list[str]]]
+
 
 def column_cells(stream: Iterable[str], column: str) -> tuple[list[int], list[str]] | str:
     """The cells of ``column`` in a CSV text, spaces around them dropped ('' in a short row),
     each with the file line its row starts on (the header's line is 1 if nothing precedes it,
-    as a spreadsheet numbers its rows); or why they cannot be read (:func:`find_column`, a row
-    with more fields than the header, a blank line between readings).  Blank lines, and a
-    spreadsheet's rows of empty cells (',,'), are skipped before the header and after the last
-    reading; one between readings is a missing reading, and skipping it would shift every later
-    gap.  csv.Error on a malformed quote."""
+    as a spreadsheet numbers its rows); or why they cannot be read (:func:`records`,
+    :func:`find_column`, :func:`cells_of`).  OSError or UnicodeDecodeError as ``stream`` raises."""
+    rows = records(stream)
+    if isinstance(rows, str):
+        return rows
+    index = find_column(rows[0][1], column)
+    return index if isinstance(index, str) else cells_of(rows, index)
+
+
+def records(stream: Iterable[str]) -> Records | str:
+    """The non-blank rows of a CSV text (the header first), each with the file line it starts on;
+    or why they cannot be read (a malformed quote, no rows, a blank line between readings).
+    Blank lines, and a spreadsheet's rows of empty cells (',,'), are skipped before the header
+    and after the last reading; one between readings is a missing reading, and skipping it would
+    shift every later gap."""
     reader = csv.reader(stream, strict=True, skipinitialspace=True)
-    records: list[tuple[int, list[str]]] = []
+    rows: Records = []
     start, blank = 1, 0
-    for row in reader:
-        if any(c.strip() for c in row):
-            if blank:
-                return (f"line {blank} is blank and readings follow it: a missing reading (skipping "
-                        "it would shift every later gap): remove the line or fill it")
-            records.append((start, row))
-        elif records and not blank:
-            blank = start
-        start = reader.line_num + 1
-    if not records:
-        return "not a readable CSV: No columns to parse from file"
-    (_, header), data = records[0], records[1:]
-    index = find_column(header, column)
-    if isinstance(index, str):
-        return index
+    try:
+        for row in reader:
+            if any(c.strip() for c in row):
+                if blank:
+                    return (f"line {blank} is blank and readings follow it: a missing reading (skipping "
+                            "it would shift every later gap): remove the line or fill it")
+                rows.append((start, row))
+            elif rows and not blank:
+                blank = start
+            start = reader.line_num + 1
+    except csv.Error as exc:
+        return f"not a readable CSV: {' '.join(str(exc).split())[:120]}"
+    return rows or "not a readable CSV: No columns to parse from file"
+
+
+def cells_of(rows: Records, index: int) -> tuple[list[int], list[str]] | str:
+    """The file lines and cells of column ``index`` in the readings of ``rows`` (:func:`records`),
+    or why they cannot be read (a row with more fields than the header)."""
+    (_, header), data = rows[0], rows[1:]
     ragged = next(((line, row) for line, row in data if len(row) > len(header)), None)
     if ragged is not None:
         return (f"not a readable CSV: line {ragged[0]} has {len(ragged[1])} fields, "

@@ -250,7 +250,6 @@ class _Builder:
             self.path.pop()
         return out
 
-
     def _refuse_unspaced(self, node: MappingNode) -> None:
         """``{loc:3,scale:2}`` is YAML for the keys ``loc:3`` and ``scale:2`` without values:
         refused, showing it with the spaces meant."""

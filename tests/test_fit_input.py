@@ -52,6 +52,17 @@ def test_rows_of_empty_cells_are_skipped_as_the_trace_reader_skips_them(tmp_path
     assert fitted(capsys, str(excel)) == fitted(capsys, str(plain))
 
 
+def test_rows_of_empty_cells_before_the_header_are_skipped_by_both_readers(tmp_path: Path, capsys):
+    """Empty rows (',,') above the header: a run reads the times under it, and so does
+    ``cell fit``, which takes the same row for the header (it took the first line)."""
+    x = gaps()
+    rows = "".join(f"{i},{float(v)!r}\n" for i, v in enumerate(x, 1))
+    plain = write(tmp_path / "plain.csv", "part,interarrival_s\n" + rows)
+    padded = write(tmp_path / "padded.csv", ",\n , \npart,interarrival_s\n" + rows)
+    assert read_trace(padded).tolist() == x.tolist()
+    assert fitted(capsys, str(padded)) == fitted(capsys, str(plain))
+
+
 @pytest.mark.parametrize("rows", [
     "".join(f"{i};{v:.3f}\n" for i, v in enumerate(gaps(), 1)),
     "".join(f"{i};{v:.3f}\n".replace(".", ",") for i, v in enumerate(gaps(), 1)),

@@ -12,6 +12,7 @@ column holds arrival times, and the gaps between them are fitted.
 from __future__ import annotations
 
 import math
+import textwrap
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -330,8 +331,6 @@ def _yaml_float(v: float, digits: int = 7) -> str:
 def arrivals_yaml(fit: Fit, source: str, caution: str = "") -> str:
     """The scenario's ``arrivals:`` block for ``fit``, with comments naming ``source`` and
     saying ``caution`` (wrapped) when there is one."""
-    import textwrap
-
     source = " ".join(source.split())  # one comment line, whatever the name holds
     params = ", ".join(f"{k}: {_yaml_float(v, _digits(k, fit.params, 7))}" for k, v in fit.params.items())
     warned = "".join(f"# {line}\n" for line in textwrap.wrap(f"CAUTION: {' '.join(caution.split())}", 98)) \

@@ -6,7 +6,6 @@ column (and the file's line) and the value as written; :mod:`cell.analysis.fit` 
 
 from __future__ import annotations
 
-import csv
 import io
 import math
 import re
@@ -19,7 +18,7 @@ from numpy.typing import NDArray
 from cell.analysis.fit import MIN_VALUES
 from cell.arrivals import MAX_INTERARRIVAL_S
 from cell.errors import ScenarioError
-from cell.trace_file import column_cells, find_column
+from cell.trace_file import cells_of, find_column, records
 
 
 def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool = False,
@@ -107,7 +106,8 @@ def _why_unusable(cell: str, value: float, *, times: bool, dated: bool) -> str:
 
 def _read_cells(p: Path, column: str) -> tuple[list[int], Any]:
     """The cells of ``column`` in the CSV file ``p`` as a pandas Series of str (read as a run's
-    trace reader reads them, :func:`~cell.trace_file.column_cells`), and each one's file line."""
+    trace reader reads them, :func:`~cell.trace_file.column_cells`: the same header, rows and
+    lines), and each one's file line."""
     import pandas as pd
 
     if not p.is_file():
@@ -124,13 +124,13 @@ def _read_cells(p: Path, column: str) -> tuple[list[int], Any]:
                             f"not UTF-8 text (byte {exc.start}); save the CSV as UTF-8") from None
     if not text.strip():
         raise ScenarioError(p, "(file)", str(p), "empty file")
-    index = find_column(next(csv.reader([text.lstrip().splitlines()[0]], skipinitialspace=True)), column)
+    rows = records(io.StringIO(text, newline=""))
+    if isinstance(rows, str):
+        raise ScenarioError(p, "(file)", str(p), rows)
+    index = find_column(rows[0][1], column)
     if isinstance(index, str):  # the column the user named (--column) is not there
         raise ScenarioError(p, "--column", column, index)
-    try:
-        cells = column_cells(io.StringIO(text, newline=""), column)
-    except csv.Error as exc:
-        cells = f"not a readable CSV: {' '.join(str(exc).split())[:120]}"
+    cells = cells_of(rows, index)
     if isinstance(cells, str):
         raise ScenarioError(p, "(file)", str(p), cells)
     return cells[0], pd.Series(cells[1], dtype=str)

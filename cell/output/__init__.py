@@ -269,4 +269,4 @@ def write_csv(frame: pd.DataFrame, target: str | os.PathLike[str], float_format:
     """A DataFrame as CSV, atomically, with a fixed float format (byte-identical reruns)."""
     with atomic_path(target) as tmp, _open(tmp, "w", encoding="utf-8", newline="") as stream:
         frame.to_csv(stream, index=False, float_format=float_formatter(float_format),
-                         lineterminator="\n")
+                     lineterminator="\n")

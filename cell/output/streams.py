@@ -68,4 +68,3 @@ def reader_may_leave() -> Iterator[None]:
             sys.stdout = saved[0]
         if sys.stderr is err:
             sys.stderr = saved[1]
-
