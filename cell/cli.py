@@ -9,7 +9,7 @@ operating-system refusal to write (permission, read-only file system, full
 disk, name too long) that got past the commands' own checks.  Ctrl-C is exit
 130, wherever it lands (also in an import, which may turn it into an ImportError); a
 reader that leaves (``cell run ... | head``) is ignored
-(:mod:`cell.output.streams`).  Anything else is a bug and keeps its traceback.
+(:mod:`cell.streams`).  Anything else is a bug and keeps its traceback.
 """
 
 from __future__ import annotations
@@ -130,7 +130,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     With ``argv`` None the process is the command's: interrupted, it ends at once with 130
     (:func:`cell.interrupts.exit_now`), whatever Ctrl-C met on its way."""
     try:
-        from cell.output.streams import reader_may_leave
+        from cell.streams import reader_may_leave
 
         with reader_may_leave():
             code = _main(argv)

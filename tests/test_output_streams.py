@@ -8,7 +8,7 @@ import sys
 import pandas as pd
 import pytest
 
-from cell.output.streams import Guarded, reader_may_leave
+from cell.streams import Guarded, reader_may_leave
 
 
 def _with_closed_reader(args, tmp_path, unbuffered, closed="stdout"):
