@@ -61,11 +61,11 @@ def error_from_validation(exc: ValidationError, raw: Any, file: object,
     elif kind == "value_error":
         why = str(ctx.get("error", err["msg"]))
     else:
-        why = _PHRASES.get(kind, err["msg"][0].lower() + err["msg"][1:]) + _instead(kind, value)
+        why = _PHRASES.get(kind, err["msg"][0].lower() + err["msg"][1:]) + write_instead(kind, value)
     return ScenarioError(file, key or "(top level)", value, why)
 
 
-def _instead(kind: str, value: Any) -> str:
+def write_instead(kind: str, value: Any) -> str:
     """What to write where a value was plainly meant but has the wrong type: a count written
     as a float (1e3), text that YAML read as a number (``name: 2026``).  Counts stay strict, as
     every int setting is: a float is not silently taken for one."""

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 from cell.errors import ScenarioError
 from cell.records import RunSummary
 from cell.scenario import known_key
-from cell.settings import _instead
+from cell.settings import write_instead
 
 if TYPE_CHECKING:
     from cell.sweep.spec import Point, Sweep
@@ -87,7 +87,7 @@ def whole(raw: Mapping[str, Any], key: str, default: Any, lo: int, file: object,
     (``20.0``) is refused too, as a scenario's counts are, but told to write ``20``."""
     value = raw.get(key, default)
     if isinstance(value, bool) or not isinstance(value, int) or value < lo:
-        hint = _instead("int_from_float", value) if isinstance(value, float) and value >= lo else ""
+        hint = write_instead("int_from_float", value) if isinstance(value, float) and value >= lo else ""
         raise ScenarioError(file, shown or key, value, f"must be a whole number of at least {lo}{hint}")
     return value
 
