@@ -35,7 +35,7 @@ def records(stream: Iterable[str]) -> Records | str:
     start, blank = 1, 0
     try:
         for row in reader:
-            if any(c.strip() for c in row):
+            if "".join(row).strip():  # some cell not blank (one join, no generator per row)
                 if blank:
                     return (f"line {blank} is blank and readings follow it: a missing reading (skipping "
                             "it would shift every later gap): remove the line or fill it")

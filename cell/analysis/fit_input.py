@@ -22,7 +22,7 @@ from cell.trace_file import cells_of, find_column, records
 
 
 def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool = False,
-                sorted_ok: bool = False) -> NDArray[np.float64]:
+                sorted_ok: bool = False, most: float = MAX_INTERARRIVAL_S) -> NDArray[np.float64]:
     """The inter-arrival gaps in a CSV column: at least :data:`MIN_VALUES`, finite, > 0, not all equal
     (zero gaps, from a log stamped to the second, are refused, counted: see ``cell fit --help``).
 
@@ -31,7 +31,8 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
     returned.  Without it, a column of :data:`MIN_VALUES` or more values that never
     decreases is refused as arrival times (n iid gaps come
     in increasing order with probability 1/n!, < 1e-18 at n = 20), unless
-    ``sorted_ok`` says they are gaps in sorted order.  Any problem raises
+    ``sorted_ok`` says they are gaps in sorted order.  Gaps must be at most ``most`` seconds
+    (a scenario's longest inter-arrival time by default).  Any problem raises
     :class:`~cell.errors.ScenarioError` naming the file, the key (``(file)``,
     ``--column``, ``COLUMN`` or ``COLUMN[line N]``, N the file's line, the header's 1, as a
     spreadsheet numbers its rows) and the value as written.
@@ -54,20 +55,20 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
         raise ScenarioError(p, column, seen,
                             "the column never decreases, so it looks like arrival times, not gaps: "
                             "use --times to fit their differences (or --gaps if these are sorted gaps)")
-    bad = np.flatnonzero(~finite if times else ~finite | (values < 0.0) | (values > MAX_INTERARRIVAL_S))
+    bad = np.flatnonzero(~finite if times else ~finite | (values < 0.0) | (values > most))
     if bad.size:
         i = int(bad[0])
         raise ScenarioError(p, f"{column}[line {lines[i]}]", cells.iloc[i],
-                            _why_unusable(cells.iloc[i], values[i], times=times, dated=dated))
+                            _why_unusable(cells.iloc[i], values[i], times=times, dated=dated, most=most))
     noun = "values"
     if times:
         step = np.diff(values)
-        back = np.flatnonzero(~(step > 0.0) | (step > MAX_INTERARRIVAL_S))
+        back = np.flatnonzero(~(step > 0.0) | (step > most))
         if back.size and step[back[0]] != 0.0:  # a first repeated time is said below
             i = int(back[0]) + 1
             why = (f"arrival times must increase: not after {cells.iloc[i - 1]} on line {lines[i - 1]}"
                    if step[i - 1] < 0.0 else f"{step[i - 1]:.10g} s after line {lines[i - 1]}; "
-                   f"gaps must be at most {MAX_INTERARRIVAL_S:g} s")
+                   f"gaps must be at most {most:g} s")
             raise ScenarioError(p, f"{column}[line {lines[i]}]", cells.iloc[i], why)
         values, noun = step, "gaps"
     zero = np.flatnonzero(values == 0.0)  # Weibull's, gamma's, lognorm's likelihood is 0 or inf there
@@ -88,7 +89,12 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
     return values
 
 
-def _why_unusable(cell: str, value: float, *, times: bool, dated: bool) -> str:
+#: An ISO 8601 date, or date and time (what ``--times`` reads as a time stamp).
+ISO_STAMP = re.compile(r"\d{4}-\d{2}-\d{2}([T ]\d{1,2}:\d{2}(:\d{2}([.,]\d+)?)?)?(Z|[+-]\d{2}:?\d{2})?")
+
+
+def _why_unusable(cell: str, value: float, *, times: bool, dated: bool,
+                  most: float = MAX_INTERARRIVAL_S) -> str:
     """Why a cell of the column cannot be used (``value`` as read, NaN if not a number)."""
     if cell == "":
         return "missing value"
@@ -97,17 +103,29 @@ def _why_unusable(cell: str, value: float, *, times: bool, dated: bool) -> str:
     if math.isnan(value) and cell.lower() != "nan":
         if re.fullmatch(r"[+-]?\d*,\d+", cell):
             return "not a number: write a decimal point, not a comma"
-        return ("not a number of seconds nor an ISO date-time (YYYY-MM-DD hh:mm:ss)" if times
-                else "not a number")
+        if times:
+            return "not a number of seconds nor an ISO date-time (YYYY-MM-DD hh:mm:ss)"
+        if ISO_STAMP.fullmatch(cell):
+            return "not a number; looks like timestamps: use --times to fit the gaps between them"
+        return "not a number"
     if times:
         return "arrival times must be finite"
-    return f"inter-arrival times must be finite, > 0 and at most {MAX_INTERARRIVAL_S:g} s"
+    if math.isinf(most):
+        return "times must be finite and > 0"
+    return f"inter-arrival times must be finite, > 0 and at most {most:g} s"
 
 
 def _read_cells(p: Path, column: str) -> tuple[list[int], Any]:
     """The cells of ``column`` in the CSV file ``p`` as a pandas Series of str (read as a run's
     trace reader reads them, :func:`~cell.trace_file.column_cells`: the same header, rows and
     lines), and each one's file line."""
+    lines, (cells,) = _read_columns(p, [(column, "--column")])
+    return lines, cells
+
+
+def _read_columns(p: Path, columns: list[tuple[str, str]]) -> tuple[list[int], list[Any]]:
+    """The file lines of the readings of the CSV file ``p``, and the cells of each of
+    ``columns`` (a name and the option that named it) as pandas Series of str."""
     import pandas as pd
 
     if not p.is_file():
@@ -127,10 +145,60 @@ def _read_cells(p: Path, column: str) -> tuple[list[int], Any]:
     rows = records(io.StringIO(text, newline=""))
     if isinstance(rows, str):
         raise ScenarioError(p, "(file)", str(p), rows)
-    index = find_column(rows[0][1], column)
-    if isinstance(index, str):  # the column the user named (--column) is not there
-        raise ScenarioError(p, "--column", column, index)
-    cells = cells_of(rows, index)
-    if isinstance(cells, str):
-        raise ScenarioError(p, "(file)", str(p), cells)
-    return cells[0], pd.Series(cells[1], dtype=str)
+    lines: list[int] = []
+    found = []
+    for column, option in columns:
+        index = find_column(rows[0][1], column)
+        if isinstance(index, str):  # the column the user named (--column) is not there
+            raise ScenarioError(p, option, column, index)
+        cells = cells_of(rows, index)
+        if isinstance(cells, str):
+            raise ScenarioError(p, "(file)", str(p), cells)
+        lines = cells[0]
+        found.append(pd.Series(cells[1], dtype=str))
+    return lines, found
+
+
+#: How a censoring column says a time is censored (the item was still working) or observed.
+CENSORED_WORDS = frozenset({"1", "true", "yes", "y", "t"})
+OBSERVED_WORDS = frozenset({"0", "false", "no", "n", "f"})
+
+
+def read_lifetimes(path: str | Path, column: str, censor_column: str | None = None) -> tuple[
+        NDArray[np.float64], NDArray[np.bool_]]:
+    """Times to failure or repair (finite, > 0, at least :data:`MIN_VALUES`, of which at least
+    two observed and not all equal) in ``column`` of a CSV, and which are right-censored: True
+    where ``censor_column`` says 1, true or yes (the item was still working then), False for
+    0, false or no (it failed, or the repair ended, then); all False without the column.
+    Sorted times are accepted (life data often come sorted).  Problems as :func:`read_column`."""
+    p = Path(path)
+    named = [(column, "--column")] + ([(censor_column, "--censored")] if censor_column else [])
+    lines, found = _read_columns(p, named)
+    cells = found[0]
+    import pandas as pd
+
+    values = pd.to_numeric(cells, errors="coerce").to_numpy(dtype=float)
+    bad = np.flatnonzero(~np.isfinite(values) | ~(values > 0.0))
+    if bad.size:
+        i = int(bad[0])
+        raise ScenarioError(p, f"{column}[line {lines[i]}]", cells.iloc[i],
+                            _why_unusable(cells.iloc[i], values[i], times=False, dated=False,
+                                          most=math.inf))
+    censored = np.zeros(values.size, dtype=bool)
+    if censor_column:
+        flags = found[1].str.lower()
+        known = flags.isin(CENSORED_WORDS | OBSERVED_WORDS).to_numpy()
+        if not known.all():
+            i = int(np.flatnonzero(~known)[0])
+            raise ScenarioError(p, f"{censor_column}[line {lines[i]}]", found[1].iloc[i],
+                                "not a censoring flag: 1, true or yes (censored: still working then), "
+                                "0, false or no (observed)")
+        censored = flags.isin(CENSORED_WORDS).to_numpy()
+    observed = values[~censored]
+    if values.size < MIN_VALUES:
+        raise ScenarioError(p, column, f"{values.size} values",
+                            f"needs at least {MIN_VALUES} values to fit a distribution")
+    if observed.size < 2 or np.ptp(observed) == 0.0:
+        raise ScenarioError(p, censor_column or column, f"{observed.size} observed of {values.size}",
+                            "needs at least two observed (uncensored) times, not all equal, to fit")
+    return values, censored
