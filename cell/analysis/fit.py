@@ -242,21 +242,24 @@ def fit_each(families: Sequence[str], fit_one: Callable[[str], Fit],
     when no family could be fitted."""
     for family in families:
         family_of(family)  # an unknown name is an error, not a failed fit
-    fits = []
+    fits, missed = [], []
     for family in families:
         try:
             with time_limit(budget_s):
                 fit = fit_one(family)
         except OutOfTime:
-            warnings.warn(f"{family} left out: its fit took more than the {budget_s:g} s budget "
-                          "(--budget S allows more)", RuntimeWarning, stacklevel=2)
+            missed.append(f"{family}: its fit took more than the {budget_s:g} s budget "
+                          "(--budget S allows more)")
             continue
         except (RuntimeError, FloatingPointError, ValueError, ZeroDivisionError, OverflowError) as exc:
-            warnings.warn(f"{family} left out: {exc}", RuntimeWarning, stacklevel=2)
+            missed.append(f"{family}: {exc}")
             continue
         fits.append(fit)
     if not fits:
-        raise ValueError("no family could be fitted")
+        raise ValueError("no family could be fitted: " + "; ".join(missed))
+    for why in missed:
+        family, _, reason = why.partition(": ")
+        warnings.warn(f"{family} left out: {reason}", RuntimeWarning, stacklevel=2)
     return fits
 
 

@@ -143,7 +143,7 @@ def choose(fits: Sequence[Fit], values: ArrayLike,
     usable = [f for f in fits if not why_not[id(f)]]
     if not usable:
         raise ValueError("no fitted family gives times a scenario accepts: " +
-                         "; ".join(f"{f.family} {why_not[id(f)]}" for f in fits))
+                         "; ".join(f"{f.family}: {why_not[id(f)]}" for f in fits))
     moments = [_moments(f, x) for f in usable]
     first = moments[0]
     best = 0 if not (first.mean_off or first.sd_off) else \
@@ -169,7 +169,7 @@ def first_accepted(fits: Sequence[Fit], refused: Callable[[Fit], str] = unusable
     ahead = next((i for i, why in enumerate(why_not) if not why), None)
     if ahead is None:
         raise ValueError("no fitted family gives times a scenario accepts: " +
-                         "; ".join(f"{f.family} {why}" for f, why in zip(fits, why_not)))
+                         "; ".join(f"{f.family}: {why}" for f, why in zip(fits, why_not)))
     if ahead == 0:
         return fits[0], ""
     passed = "; ".join(f"{f.family} {why}" for f, why in zip(fits[:ahead], why_not))

@@ -42,11 +42,11 @@ def _curves(ax: Any, fits: Sequence[Fit], best: Fit | None, grid: NDArray[np.flo
                 label=f"{f.family}{' (chosen)' if bold else ''}: D = {f.statistic:.4f}, AIC = {f.aic:.1f}")
 
 
-def draw(values: ArrayLike, fits: Sequence[Fit], out_png: str | Path, *, best: Fit | None = None,
-         xlabel: str = "inter-arrival time (s)") -> None:
+def figure(values: ArrayLike, fits: Sequence[Fit], *, best: Fit | None = None,
+           xlabel: str = "inter-arrival time (s)") -> Any:
     """Histogram of ``values`` (a density over all of them, 1/s) under each fitted pdf, on
     :func:`body_range`; the values beyond it counted in the title; ``best`` (default the first
-    fit) drawn bold; written as PNG to ``out_png``."""
+    fit) drawn bold (not saved)."""
     x = np.asarray(values, dtype=float).ravel()
     best = best if best is not None else (fits[0] if fits else None)
     fig, ax = _canvas()
@@ -66,7 +66,13 @@ def draw(values: ArrayLike, fits: Sequence[Fit], out_png: str | Path, *, best: F
     ax.set_xlabel(xlabel)
     ax.set_ylabel("density (1/s)")
     ax.legend(fontsize="small")
-    fig.savefig(out_png, format="png", dpi=100)
+    return fig
+
+
+def draw(values: ArrayLike, fits: Sequence[Fit], out_png: str | Path, *, best: Fit | None = None,
+         xlabel: str = "inter-arrival time (s)") -> None:
+    """:func:`figure`, written as PNG to ``out_png``."""
+    figure(values, fits, best=best, xlabel=xlabel).savefig(out_png, format="png", dpi=100)
 
 
 def draw_censored(values: ArrayLike, censored: ArrayLike, fits: Sequence[Fit], out_png: str | Path, *,
