@@ -154,7 +154,7 @@ def _read(args: argparse.Namespace, trace: Path, lifetimes: bool) -> Data:
 
     if lifetimes and not args.times:
         values, censored = read_lifetimes(trace, args.column, args.censored)
-        cut = f", {int(censored.sum())} right-censored ({args.censored})" if args.censored else ""
+        cut = f", {int(censored.sum())} of them right-censored by {args.censored}" if args.censored else ""
         count = f"{values.size} times{cut}"
         return Data(values, censored if censored.any() else None, count, _subsampled(values.size, "times"))
     values = read_column(trace, args.column, times=args.times, sorted_ok=args.gaps or lifetimes,
