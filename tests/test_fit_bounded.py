@@ -149,7 +149,8 @@ def test_a_family_without_a_finite_mean_is_refused_and_nothing_written(small: Pa
     with pytest.raises(ScenarioError) as err:
         cmd_fit(parse(str(small), "--families", family, "--out", str(out)))
     assert (err.value.key, err.value.why) == ("--families", f"no fitted family gives times a scenario "
-                                                            f"accepts: {family}: {why}")
+                                                            f"accepts (non-negative, with a finite positive "
+                                                            f"mean): {family}: {why}")
     assert sorted(p.name for p in small.parent.iterdir()) == ["gaps.csv"]
 
 
@@ -166,8 +167,9 @@ def test_truncpareto_on_a_small_sample_is_refused_by_the_scenario_check(small: P
     digits the block rounds away, and a scenario holding the block refuses it."""
     with pytest.raises(ScenarioError) as err:
         cmd_fit(parse(str(small), "--families", "truncpareto"))
-    assert err.value.why == ("no fitted family gives times a scenario accepts: truncpareto: arrivals.params "
-                             "refused: inter-arrival times must be non-negative with a finite, positive mean")
+    assert err.value.why == ("no fitted family gives times a scenario accepts (non-negative, with a finite "
+                             "positive mean): truncpareto: arrivals.params refused: inter-arrival times must "
+                             "be non-negative with a finite, positive mean")
 
 
 def test_every_candidate_is_validated_as_a_scenario_before_one_is_written(small: Path, monkeypatch, capsys):

@@ -142,7 +142,8 @@ def choose(fits: Sequence[Fit], values: ArrayLike,
     why_not = {id(f): refused(f) for f in fits}
     usable = [f for f in fits if not why_not[id(f)]]
     if not usable:
-        raise ValueError("no fitted family gives times a scenario accepts: " +
+        raise ValueError("no fitted family gives times a scenario accepts (non-negative, with a finite "
+                         "positive mean): " +
                          "; ".join(f"{f.family}: {why_not[id(f)]}" for f in fits))
     moments = [_moments(f, x) for f in usable]
     first = moments[0]
@@ -168,7 +169,8 @@ def first_accepted(fits: Sequence[Fit], refused: Callable[[Fit], str] = unusable
     why_not = [refused(f) for f in fits]
     ahead = next((i for i, why in enumerate(why_not) if not why), None)
     if ahead is None:
-        raise ValueError("no fitted family gives times a scenario accepts: " +
+        raise ValueError("no fitted family gives times a scenario accepts (non-negative, with a finite "
+                         "positive mean): " +
                          "; ".join(f"{f.family}: {why}" for f, why in zip(fits, why_not)))
     if ahead == 0:
         return fits[0], ""
