@@ -44,10 +44,7 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
     values = pd.to_numeric(cells, errors="coerce").to_numpy(dtype=float)
     dated = times and bool(np.isnan(values).all())
     if dated:  # arrival times as date-times (ISO 8601, e.g. 2026-03-02 08:15:04.5): seconds
-        stamps = pd.to_datetime(cells, format="ISO8601", errors="coerce", utc=True)
-        dated = bool(stamps.notna().any())
-        if dated:
-            values = (stamps - stamps.min()).dt.total_seconds().to_numpy(dtype=float)
+        values, dated = _stamps_as_seconds(cells, values)
     finite = np.isfinite(values)
     if not (times or sorted_ok) and values.size >= MIN_VALUES and finite.all() \
             and np.all(np.diff(values) >= 0.0) and np.ptp(values) > 0.0:
@@ -91,6 +88,17 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
 
 #: An ISO 8601 date, or date and time (what ``--times`` reads as a time stamp).
 ISO_STAMP = re.compile(r"\d{4}-\d{2}-\d{2}([T ]\d{1,2}:\d{2}(:\d{2}([.,]\d+)?)?)?(Z|[+-]\d{2}:?\d{2})?")
+
+
+def _stamps_as_seconds(cells: Any, values: NDArray[np.float64]) -> tuple[NDArray[np.float64], bool]:
+    """ISO 8601 date-times as seconds from the earliest, and True; ``values`` and False if
+    none of the cells is one."""
+    import pandas as pd
+
+    stamps = pd.to_datetime(cells, format="ISO8601", errors="coerce", utc=True)
+    if not stamps.notna().any():
+        return values, False
+    return (stamps - stamps.min()).dt.total_seconds().to_numpy(dtype=float), True
 
 
 def _why_unusable(cell: str, value: float, *, times: bool, dated: bool,
