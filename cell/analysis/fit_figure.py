@@ -95,5 +95,5 @@ def draw_censored(values: ArrayLike, censored: ArrayLike, fits: Sequence[Fit], o
     ax.set_ylim(0.0, 1.02)
     ax.set_xlabel(xlabel)
     ax.set_ylabel("cumulative probability")
-    ax.legend(fontsize="small", loc="lower right")
+    ax.legend(fontsize="small", loc="upper left")
     fig.savefig(out_png, format="png", dpi=100)
