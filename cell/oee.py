@@ -1,0 +1,98 @@
+"""The run's time accounted for: each piece of equipment's states, the robot's shares of
+them, and OEE = availability × performance × quality (Nakajima; SPEC §10; docs/model.md,
+"When equipment fails").
+
+* availability: the time the cell was not down (the robot or a belt failed; the sensor's
+  failures do not stop it) over the run less its planned maintenance;
+* performance: the robot's fastest cycle × parts delivered over that up time;
+* quality: parts set down within the spacing tolerance over parts delivered.
+
+Time measures cover the whole run (a warm-up in parts is not cut from them).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from cell.records import LIMIT_BIT, RunSummary, StateSpan
+from cell.timeline import ROBOT_STATES, fractions, states
+
+_EMPTY = np.empty(0)
+
+
+def _spans(stops: list[tuple[str, str, float, float, Any]], keep: Callable[[str, str], bool]
+           ) -> tuple[np.ndarray, np.ndarray]:
+    chosen = [(a, b) for name, cause, a, b, _ in stops if keep(name, cause)]
+    if not chosen:
+        return _EMPTY, _EMPTY
+    arr = np.asarray(chosen, dtype=float)
+    return arr[:, 0], arr[:, 1]
+
+
+def timelines(column: Callable[[str], np.ndarray], downtime: Any, end_s: float
+              ) -> dict[str, list[tuple[str, float, float]]]:
+    """Each piece of equipment's (state, from, to) over [0, end_s]; ``column`` gives the run
+    log's per-part values (every part, warm-up included)."""
+    stops = downtime.all_stops(end_s) if downtime is not None else []
+    arrival, at_bot = column("arrival"), column("at_bot")
+    if downtime is not None:
+        motion = np.frombuffer(downtime.robot.motion, dtype=float).reshape(-1, 2)
+        since = downtime.robot._moving_since
+        if since == since:
+            motion = np.vstack([motion, [[since, end_s]]])
+        busy = (motion[:, 0], motion[:, 1])
+    else:
+        picked = column("picked") != 0
+        busy = (at_bot[picked], at_bot[picked] + column("cycle")[picked])
+    out = {"robot": states(end_s, [
+        ("down", *_spans(stops, lambda n, c: n == "robot" and c != "maintenance")),
+        ("maintenance", *_spans(stops, lambda n, c: n == "robot" and c == "maintenance")),
+        ("busy", *busy), ("waiting", arrival, at_bot)], "idle")}
+    for belt in ("input_belt", "output_belt"):
+        out[belt] = states(end_s, [("down", *_spans(stops, lambda n, c, b=belt: n == b))],
+                           "running")
+    if downtime is not None and downtime.spec.sensor is not None:
+        out["sensor"] = states(end_s, [("down", *_spans(stops, lambda n, c: n == "sensor"))],
+                               "up")
+    return out
+
+
+def state_spans(lines: dict[str, list[tuple[str, float, float]]]) -> list[StateSpan]:
+    """states.csv's rows, equipment by equipment."""
+    return [StateSpan(name, state, a, b) for name, rows in lines.items() for state, a, b in rows]
+
+
+def measure(r: RunSummary, column: Callable[[str], np.ndarray], downtime: Any,
+            fastest_cycle_s: float, end_s: float) -> dict[str, list[tuple[str, float, float]]]:
+    """Fill the summary's time shares, OEE and reliability figures; the timelines."""
+    lines = timelines(column, downtime, end_s)
+    share = fractions(lines["robot"], end_s, ROBOT_STATES)
+    r.robot_busy_fraction, r.robot_waiting_fraction = share["busy"], share["waiting"]
+    r.robot_idle_fraction, r.robot_down_fraction = share["idle"], share["down"]
+    r.robot_maintenance_fraction = share["maintenance"]
+    stops = downtime.all_stops(end_s) if downtime is not None else []
+    cell = states(end_s, [
+        ("maintenance", *_spans(stops, lambda n, c: n == "robot" and c == "maintenance")),
+        ("down", *_spans(stops, lambda n, c: n != "sensor" and c != "maintenance"))], "up")
+    cell_share = fractions(cell, end_s, ("maintenance", "down", "up"))
+    planned = 1.0 - cell_share["maintenance"]
+    up_s = cell_share["up"] * end_s
+    r.availability = cell_share["up"] / planned if planned > 0 else math.nan
+    r.performance = fastest_cycle_s * r.parts_delivered / up_s if up_s > 0 else math.nan
+    good = r.parts_delivered - r.spacing_outside_tol
+    r.quality = good / r.parts_delivered if r.parts_delivered else math.nan
+    r.oee = r.availability * r.performance * r.quality
+    r.service_level = r.parts_delivered / r.parts_arrived if r.parts_arrived else math.nan
+    limits = column("limits").astype(np.int_)[r.warmup_parts:]
+    r.parts_lost_downtime = int(np.count_nonzero(limits & LIMIT_BIT["lost_downtime"]))
+    r.parts_scrapped = int(np.count_nonzero(limits & LIMIT_BIT["scrapped"]))
+    failures = sum(1 for name, cause, *_ in stops if name == "robot" and cause != "maintenance")
+    r.robot_failures = failures
+    robot_up_s = end_s * (1.0 - share["down"] - share["maintenance"])
+    r.mtbf_observed_s = robot_up_s / failures if failures else math.nan
+    r.mttr_observed_s = share["down"] * end_s / failures if failures else math.nan
+    return lines
