@@ -387,7 +387,9 @@ def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, 
         sim_end_s=end_s)
     for name, counted in LIMIT_COUNTS.items():
         setattr(r, counted.field, count(name))
-    acct.finish(r, w, log.column("r4", w)[picked], t[1:])
+    # every handed-on part's next inter-arrival time (all of T_2 … T_{n+1} unless the run
+    # stopped with parts in the cell)
+    acct.finish(r, w, log.column("r4", w)[picked], t[log.column("part").astype(np.int_)])
     r.parts_per_hr_wallclock = float(accounting.parts_per_hr(r.actual_cycle_wallclock_s))
     r.parts_per_hr_thesis = float(accounting.parts_per_hr(r.actual_cycle_thesis_s))
     r.vavg_r4_in_s = k.timing.r4.length_in / r.r4_s if r.r4_s == r.r4_s else math.nan

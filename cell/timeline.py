@@ -15,6 +15,8 @@ from collections.abc import Iterator, Sequence
 import numpy as np
 
 ROBOT_STATES = ("down", "maintenance", "busy", "waiting", "idle")
+#: Instants closer than this are one instant (the rounding of summed leg times).
+GRAIN_S = 1e-6
 
 
 def union(starts: np.ndarray, ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -49,6 +51,12 @@ def states(horizon: float, layers: Sequence[tuple[str, np.ndarray, np.ndarray]],
     cuts = np.unique(np.concatenate([[0.0, horizon], *[np.concatenate([s, e])
                                                         for _, s, e in merged]]))
     cuts = cuts[(cuts >= 0.0) & (cuts <= horizon)]
+    if cuts.size > 1:  # instants a rounding apart are one (a leg's end and the next's start)
+        apart = np.concatenate([[True], np.diff(cuts) > GRAIN_S])
+        apart[-1] = True
+        cuts = cuts[apart]
+        if cuts.size > 2 and cuts[-1] - cuts[-2] <= GRAIN_S:
+            cuts = np.delete(cuts, -2)
     if cuts.size < 2:
         return []
     mid = 0.5 * (cuts[:-1] + cuts[1:])
