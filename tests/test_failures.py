@@ -73,17 +73,17 @@ def test_operating_clock_availability_follows_the_share_of_time_worked():
                    "clock": "operating"}}
     predicted, observed = [], []
     for seed in range(6):
-        s = load_scenario("baseline", {"run.hours": 4.0, "failures": f, "run.seed": seed})
+        s = load_scenario("non_adaptive", {"run.hours": 4.0, "failures": f, "run.seed": seed})
         r = simulate(s, keep_parts=False, keep_belts=False).summary
         up = 1.0 - r.robot_down_fraction
         b = r.robot_busy_fraction / up  # the share of up time the robot works
-        assert 0.5 < b < 1.0
+        assert 0.5 < b < 0.8  # the fixed cycle waits for a third of its parts
         predicted.append((mtbf_op / b) / (mtbf_op / b + mttr))
         observed.append(up)
     lo, hi = ci([o - p for o, p in zip(observed, predicted)])
     assert lo <= 0.0 <= hi, (lo, hi)
     # and the calendar reading would be wrong: the robot does not fail while it stands
-    assert np.mean(observed) > mtbf_op / (mtbf_op + mttr) + 0.01
+    assert np.mean(observed) > mtbf_op / (mtbf_op + mttr) + 0.03
 
 
 def test_two_machines_one_crew_match_the_machine_repairman_model():
