@@ -345,7 +345,7 @@ class Downtime:
             if spec is None:
                 continue
             down, up = hooks[name]
-            e = Equipment(self, name, spec, self.seed, down, up,  # type: ignore[arg-type]
+            e = Equipment(self, name, spec, self.seed, down, up,
                           MOVING_NOT if name == "robot" else 0)
             self.equipment.append(e)
 

@@ -33,6 +33,10 @@ def _spans(stops: list[tuple[str, str, float, float, Any]], keep: Callable[[str,
     return arr[:, 0], arr[:, 1]
 
 
+def _named(equipment: str) -> Callable[[str, str], bool]:
+    return lambda name, cause: name == equipment
+
+
 def timelines(column: Callable[[str], np.ndarray], downtime: Any, end_s: float
               ) -> dict[str, list[tuple[str, float, float]]]:
     """Each piece of equipment's (state, from, to) over [0, end_s]; ``column`` gives the run
@@ -53,8 +57,7 @@ def timelines(column: Callable[[str], np.ndarray], downtime: Any, end_s: float
         ("maintenance", *_spans(stops, lambda n, c: n == "robot" and c == "maintenance")),
         ("busy", *busy), ("waiting", arrival, at_bot)], "idle")}
     for belt in ("input_belt", "output_belt"):
-        out[belt] = states(end_s, [("down", *_spans(stops, lambda n, c, b=belt: n == b))],
-                           "running")
+        out[belt] = states(end_s, [("down", *_spans(stops, _named(belt)))], "running")
     if downtime is not None and downtime.spec.sensor is not None:
         out["sensor"] = states(end_s, [("down", *_spans(stops, lambda n, c: n == "sensor"))],
                                "up")
