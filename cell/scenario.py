@@ -249,6 +249,11 @@ def _cross_checks(s: Scenario, file: object) -> None:
     from cell.arrivals import check_arrivals
 
     check_arrivals(s.arrivals, s.base_dir, file)
+    _length_and_failures(s, file)
+
+
+def _length_and_failures(s: Scenario, file: object) -> None:
+    """``run.hours`` against ``run.parts``, and the ``failures:`` section's times."""
     if s.run.hours is not None or s.failures is not None:
         from cell.failure_spec import check_failures
         from cell.horizon import check_hours
