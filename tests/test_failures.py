@@ -229,3 +229,24 @@ def test_the_sensor_down_leaves_the_controller_without_look_ahead():
     # no look-ahead: the adaptive controller runs its nominal cycle and never steers the
     # input belt for a next part (no ceiling hit, no R IV at its peak)
     assert r.limit_input_ceiling == 0 and r.limit_r4_peak == 0
+
+
+@pytest.mark.parametrize("name", ["baseline", "non_adaptive"])
+def test_the_shares_summed_without_failures_are_the_timelines(name, monkeypatch):
+    import cell.oee as oee
+    import cell.simulation as sim
+
+    seen: dict = {}
+    measure = oee.measure
+
+    def grab(*args):  # noqa: ANN002, ANN202
+        seen["args"] = args
+        return measure(*args)
+
+    monkeypatch.setattr(sim.oee, "measure", grab)
+    simulate(load_scenario(name, {"run.parts": 400}), keep_parts=False, keep_belts=False)
+    _, column, _, _, end = seen["args"]
+    fast = oee.fast_shares(column, end)
+    full = oee.fractions(oee.timelines(column, None, end)["robot"], end, oee.ROBOT_STATES)
+    assert fast == pytest.approx(full, abs=1e-12)
+    assert sum(fast.values()) == pytest.approx(1.0)
