@@ -289,8 +289,12 @@ class RobotStops:
 class Downtime:
     """A run's failures: every piece of equipment's clock and repairs, and their log."""
 
-    def __init__(self, env: simpy.Environment, failures: Any, seed: Any):
+    def __init__(self, env: simpy.Environment, failures: Any, seed: Any,
+                 robot_exposure: Exposure | None = None):
         self.env, self.spec, self.seed = env, failures, seed
+        self.robot_exposure = robot_exposure
+        """What the robot's failure clock counts down instead of its drawn time to failure
+        (a wear model's exposure); None: ``failures.robot.time_to_failure``."""
         self.crews = simpy.Resource(env, failures.repair.crews) if failures.repair else None
         self.stops: list[tuple[str, str, float, float, Any]] = []
         """(equipment, cause, from_s, to_s, part) of every stop, as each ends."""
@@ -347,6 +351,8 @@ class Downtime:
             down, up = hooks[name]
             e = Equipment(self, name, spec, self.seed, down, up,
                           MOVING_NOT if name == "robot" else 0)
+            if name == "robot" and self.robot_exposure is not None:
+                e.exposure = self.robot_exposure
             self.equipment.append(e)
 
     def start(self) -> None:

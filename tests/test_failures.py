@@ -250,3 +250,43 @@ def test_the_shares_summed_without_failures_are_the_timelines(name, monkeypatch)
     full = oee.fractions(oee.timelines(column, None, end)["robot"], end, oee.ROBOT_STATES)
     assert fast == pytest.approx(full, abs=1e-12)
     assert sum(fast.values()) == pytest.approx(1.0)
+
+
+class RIVWear:
+    """A wear model's shape: one motor worn only in R IV, failing after 100 s of it."""
+
+    cause = "wear"
+
+    def thresholds(self) -> list[float]:
+        return [100.0]
+
+    def renew(self, component: int) -> float:
+        return 100.0
+
+    def rates(self, leg: int) -> tuple[float, ...]:
+        return (1.0,) if leg == 5 else (0.0,)
+
+    def cycle(self, legs_s) -> None:  # noqa: ANN001
+        self.cycles = getattr(self, "cycles", 0) + 1
+
+
+def test_a_wear_exposure_drives_the_robots_failure_clock(monkeypatch):
+    import functools
+
+    import cell.simulation as sim
+    from cell.failures import Downtime
+
+    wear = RIVWear()
+    monkeypatch.setattr(sim, "Downtime", functools.partial(Downtime, robot_exposure=wear))
+    f = {"robot": {"time_to_failure": expon(1.0),
+                   "time_to_repair": {"distribution": "uniform", "params": {"loc": 60.0,
+                                                                            "scale": 1e-6}}}}
+    res = simulate(load_scenario("non_adaptive", {"run.parts": 60, "failures": f}))
+    first = res.stops()[0]
+    assert first.cause == "wear" and first.to_s - first.from_s == pytest.approx(60.0, abs=1e-5)
+    # R IV motion before the failure adds up to the budget: the clock ran in R IV only
+    parts = res.parts[res.parts.picked]
+    end = parts.at_bot_s + parts.motion_cycle_s
+    r4 = (np.minimum(end, first.from_s) - np.minimum(end - parts.r4_s, first.from_s)).clip(0)
+    assert r4.sum() == pytest.approx(100.0, abs=1e-6)
+    assert wear.cycles == len(parts)
