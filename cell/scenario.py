@@ -45,7 +45,7 @@ from cell.sections import (  # noqa: F401 - the schema, re-exported
     RobotSettings,
     RunSettings,
 )
-from cell.settings import Section, error_from_validation, model_at
+from cell.settings import Section, error_from_validation, model_at, unwrap_optional
 
 
 # --------------------------------------------------------------------------- scenario
@@ -172,7 +172,7 @@ def known_key(dotted: str) -> bool:
         field = model.model_fields.get(part)
         if field is None:
             return False
-        annotation = field.annotation
+        annotation = unwrap_optional(field.annotation)
         if isinstance(annotation, type) and issubclass(annotation, BaseModel):
             model = annotation
             continue

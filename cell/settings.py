@@ -92,7 +92,7 @@ def model_at(root: type[BaseModel], loc: list[Any]) -> type[BaseModel] | None:
     model: Any = root
     for p in loc:
         field = model.model_fields.get(p) if isinstance(p, str) else None
-        annotation = _unwrap_optional(field.annotation) if field is not None else None
+        annotation = unwrap_optional(field.annotation) if field is not None else None
         if field is None or not (isinstance(annotation, type)
                                  and issubclass(annotation, BaseModel)):
             return None
@@ -100,7 +100,7 @@ def model_at(root: type[BaseModel], loc: list[Any]) -> type[BaseModel] | None:
     return model
 
 
-def _unwrap_optional(annotation: Any) -> Any:
+def unwrap_optional(annotation: Any) -> Any:
     """``Model | None`` (an optional section, such as ``failures``) as ``Model``."""
     args = getattr(annotation, "__args__", None)
     if args and len(args) == 2 and type(None) in args and getattr(annotation, "__origin__", None) \
