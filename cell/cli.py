@@ -26,7 +26,7 @@ from typing import Any, NoReturn
 
 from cell import __version__
 from cell.errors import CellError, ScenarioError, one_line, shown_path
-from cell.interrupts import exit_now
+from cell.interrupts import exit_now, interrupted
 
 #: Subcommands in the order ``cell --help`` lists them; each is cell.commands.<name>.
 COMMANDS = ("run", "sweep", "compare", "fit", "figures", "animate", "path", "mintime",
@@ -105,22 +105,6 @@ def _run(args: argparse.Namespace) -> int:
     for text in dict.fromkeys(f"{w.message} ({w.category.__name__})" for w in caught):
         print(f"cell: warning: {one_line(text, 300)}", file=sys.stderr)
     return code
-
-
-def interrupted(exc: BaseException) -> bool:
-    """Whether ``exc`` is Ctrl-C or came of it: a KeyboardInterrupt, or an error raised while
-    one was handled (``ImportError: initialization failed`` of a module it cut short)."""
-    todo: list[BaseException | None] = [exc]
-    seen: set[int] = set()
-    while todo:
-        e = todo.pop()
-        if e is None or id(e) in seen:
-            continue
-        if isinstance(e, KeyboardInterrupt):
-            return True
-        seen.add(id(e))
-        todo += [e.__cause__, e.__context__]
-    return False
 
 
 def main(argv: Sequence[str] | None = None) -> int:
