@@ -33,8 +33,9 @@ class PluginError(CellError):
 
     def __init__(self, name: str, what: str, exc: BaseException):
         where = ""
-        if isinstance(exc, (ImportError, SyntaxError)) and getattr(exc, "name", None):
-            where = f" (module {exc.name})"
+        module = getattr(exc, "name", None) if isinstance(exc, ImportError) else None
+        if module:
+            where = f" (module {module})"
         super().__init__(f"policy {name!r} {what}{where}: {type(exc).__name__}: "
                          f"{one_line(str(exc) or '(no message)', 200)}")
 
@@ -45,10 +46,9 @@ def _plugins() -> dict[str, Any]:
         from importlib.metadata import entry_points
 
         try:
-            found = entry_points(group=ENTRY_POINT_GROUP)
+            _entry_points = {ep.name: ep for ep in entry_points(group=ENTRY_POINT_GROUP)}
         except Exception:  # noqa: BLE001 - a broken installed distribution: no plug-ins
-            found = ()
-        _entry_points = {ep.name: ep for ep in found}
+            _entry_points = {}
     return _entry_points
 
 

@@ -61,8 +61,8 @@ Replicate = Callable[[Scenario, np.random.SeedSequence], Mapping[str, Any]]
 
 #: Float digits in the per-task files: enough to round-trip exactly.
 TASK_FLOAT_FORMAT = "%.17g"
-#: How long to try reaching a dask scheduler.
-CONNECT_TIMEOUT = "20s"
+#: Seconds a dask client gets to close (a scheduler gone away does not answer).
+CLOSE_TIMEOUT_S = 5
 #: Tasks in flight on a dask cluster at once (local workers: twice their number).
 CLUSTER_WINDOW = 1024
 
@@ -163,20 +163,13 @@ def _open_executor(workers: int, scheduler: str | None, say: bool = True
                    ) -> tuple[cf.Executor | None, Any]:
     """The executor for the tasks (None: run in this process) and a client to close;
     ``say``: tell stderr while a scheduler is being reached."""
-    if scheduler:
-        try:
-            import distributed
-        except ImportError:
-            raise CellError("--scheduler needs dask.distributed: "
-                            "pip install 'cell[dist]'") from None
+    if scheduler is not None:
+        from cell.sweep.cluster import CONNECT_TIMEOUT_S, connect
+
         if say:
             print(f"connecting to the dask scheduler at {scheduler} (giving up after "
-                  f"{CONNECT_TIMEOUT})", file=sys.stderr)
-        try:
-            client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT)
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise CellError(f"--scheduler {scheduler}: cannot reach the dask scheduler "
-                            f"({exc})") from None
+                  f"{CONNECT_TIMEOUT_S:g} s)", file=sys.stderr)
+        client = connect(scheduler)
         return client.get_executor(pure=False), client
     if workers <= 1:
         return None, None
@@ -278,7 +271,7 @@ def _close(executor: cf.Executor | None, client: Any, wait: bool) -> None:
     elif executor is not None:
         executor.shutdown(wait=wait)
     if client is not None:
-        client.close()
+        client.close(timeout=CLOSE_TIMEOUT_S)
 
 
 #: At most this many local worker processes per core.
@@ -349,8 +342,13 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
                 ranges = {p: (counts[p], counts[p] + k) for p, k in more.items() if k}
                 bar.grow(sum(more.values()))
         _close(executor, client, wait=True)
-    except BaseException:
+    except BaseException as exc:
         _close(executor, client, wait=False)
+        if scheduler:
+            from cell.sweep.cluster import lost
+
+            if (gone := lost(scheduler, exc, out)) is not None:
+                raise gone from None
         raise
     # The files the rounds wrote, point by point: a round's tasks start where it does
     # (``min`` need not be a multiple of ``batch``), not where cutting from 0 would.
