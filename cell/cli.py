@@ -24,6 +24,11 @@ import warnings
 from collections.abc import Sequence
 from typing import Any, NoReturn
 
+try:  # imported now: when the open files run out, importing it would fail too
+    import resource
+except ImportError:  # pragma: no cover - not on Windows
+    resource = None  # type: ignore[assignment]
+
 from cell import __version__
 from cell.errors import CellError, ScenarioError, one_line, shown_path
 from cell.interrupts import exit_now, interrupted
@@ -96,6 +101,15 @@ def _memory() -> str:
     return f" (this machine has {total / 2**30:.0f} GiB)"
 
 
+def _open_files() -> str:
+    """The open-file limit, and what to do about it, as the error says it."""
+    try:
+        soft = resource.getrlimit(resource.RLIMIT_NOFILE)[0]  # type: ignore[union-attr]
+    except (AttributeError, OSError, ValueError):  # not on this system
+        return ""
+    return f" (this process may open {soft}: raise it with ulimit -n, or use fewer --workers)"
+
+
 def _run(args: argparse.Namespace) -> int:
     """The command; a warning that a finished command met is one line each (a refused one's are
     dropped: its error says what went wrong)."""
@@ -114,10 +128,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     With ``argv`` None the process is the command's: interrupted, it ends at once with 130
     (:func:`cell.interrupts.exit_now`), whatever Ctrl-C met on its way."""
     try:
-        from cell.streams import reader_may_leave
+        from cell.streams import reader_may_leave, standard_streams
 
-        with reader_may_leave():
-            code = _main(argv)
+        standard_streams()
+        mpl = _matplotlib_home()
+        try:
+            with reader_may_leave():
+                code = _where() or _main(argv)
+        finally:
+            if mpl is not None:
+                import shutil
+
+                shutil.rmtree(mpl, ignore_errors=True)
     except BaseException as exc:  # Ctrl-C while starting, or one that became another error
         if not interrupted(exc):
             raise
@@ -127,6 +149,53 @@ def main(argv: Sequence[str] | None = None) -> int:
     if code == INTERRUPTED and argv is None:
         exit_now(code)
     return code
+
+
+def _usable(path: str) -> bool:
+    """Whether ``path`` is, or could be made as, a folder one can write in (nothing made)."""
+    path = os.path.abspath(path)
+    while not os.path.lexists(path):
+        parent = os.path.dirname(path)
+        if parent == path:
+            return False
+        path = parent
+    return os.path.isdir(path) and os.access(path, os.W_OK | os.X_OK)
+
+
+def _matplotlib_home() -> str | None:
+    """A temporary folder for matplotlib's configuration and cache, made (and put in
+    ``MPLCONFIGDIR``) only when the one it would use cannot be written (a read-only or
+    file-valued ``HOME``, a bad ``MPLCONFIGDIR``): matplotlib would otherwise warn on stderr
+    and leave its own temporary folder behind.  The caller removes it at the end."""
+    given = os.environ.get("MPLCONFIGDIR")
+    if given:
+        wanted = given
+    else:
+        base = os.environ.get("XDG_CONFIG_HOME", "")
+        if not os.path.isabs(base):
+            base = os.path.join(os.path.expanduser("~"), ".config")
+        wanted = os.path.join(base, "matplotlib")
+    if os.path.isabs(wanted) and _usable(wanted):
+        return None
+    import tempfile
+
+    try:
+        made = tempfile.mkdtemp(prefix="cell-matplotlib-")
+    except OSError:
+        return None
+    os.environ["MPLCONFIGDIR"] = made
+    return made
+
+
+def _where() -> int:
+    """0 if the working directory exists; else the error line's exit code (every relative path,
+    and much of what the libraries do, needs it)."""
+    try:
+        os.getcwd()
+    except OSError as exc:
+        return _fail(f"the working directory is gone ({(exc.strerror or str(exc)).lower()}): "
+                     "cd into one that exists")
+    return 0
 
 
 def _main(argv: Sequence[str] | None) -> int:
@@ -155,6 +224,8 @@ def _main(argv: Sequence[str] | None) -> int:
         print("cell: interrupted", file=sys.stderr)
         return INTERRUPTED
     except OSError as exc:
+        if exc.errno in (errno.EMFILE, errno.ENFILE):
+            return _fail(f"cell {args.command}: too many open files{_open_files()}")
         if exc.errno not in OUTPUT_ERRNOS:
             raise
         reason = (exc.strerror or os.strerror(exc.errno or 0)).lower()

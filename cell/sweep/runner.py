@@ -28,6 +28,7 @@ for any n > replication.  ``--workers 1`` runs in this process.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import functools
 import os
 import signal
@@ -47,7 +48,7 @@ from cell.output import atomic_path, float_formatter, write_csv
 from cell.progress import Progress
 from cell.scenario import Scenario
 from cell.sweep.columns import Column, grid_columns, point_values
-from cell.sweep.outdir import TASK_DIR, check_out, prepare
+from cell.sweep.outdir import MANIFEST, TASK_DIR, check_out, finished_tasks, prepare
 from cell.sweep.spec import Sweep, Task, overload_warning
 from cell.sweep.windows import window_warning
 
@@ -303,6 +304,7 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     values: dict[int, list[float]] = {p: [] for p in counts}
     run = reused = 0
     rounds: list[dict[int, tuple[int, int]]] = []  # each round's replications, by point
+    fresh = not (out / MANIFEST).exists()
     try:
         prepare(sweep, out, resume)
         bar = Progress(sweep.total_replications, sweep.name, "replications", file=sys.stderr,
@@ -344,6 +346,8 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
         _close(executor, client, wait=True)
     except BaseException as exc:
         _close(executor, client, wait=False)
+        if fresh:
+            _unmade(out)
         if scheduler:
             from cell.sweep.cluster import lost
 
@@ -355,6 +359,17 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     tasks = (t for p in counts for r in rounds if p in r for t in sweep.iter_tasks({p: r[p]}))
     path = _assemble(sweep, task_dir, tasks, out / "replications.csv")
     return Outcome(path, run, reused, counts)
+
+
+def _unmade(out: Path) -> None:
+    """A sweep that failed or stopped before any task finished leaves nothing behind: the
+    manifest it wrote and its empty task folder are removed (and the folder itself by
+    :func:`cell.sweep.outdir.lock`, if it made it)."""
+    if finished_tasks(out):
+        return
+    (out / MANIFEST).unlink(missing_ok=True)
+    with contextlib.suppress(OSError):
+        (out / TASK_DIR).rmdir()
 
 
 def _finished(sweep: Sweep, task_dir: Path, task: Task) -> pd.DataFrame:
