@@ -31,7 +31,7 @@ except ImportError:  # pragma: no cover - not on Windows
 
 from cell import __version__
 from cell.errors import CellError, ScenarioError, one_line, shown_path
-from cell.interrupts import exit_now, interrupted
+from cell.interrupts import Stops, exit_now, interrupted, stopped_by
 
 #: Subcommands in the order ``cell --help`` lists them; each is cell.commands.<name>.
 COMMANDS = ("run", "sweep", "compare", "fit", "figures", "animate", "path", "mintime",
@@ -44,6 +44,11 @@ OUTPUT_ERRNOS = frozenset({errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOSPC,
 
 #: The exit code of an interrupted command: 128 + SIGINT, as a shell reports Ctrl-C.
 INTERRUPTED = 130
+#: And of a killed one: 128 + SIGTERM.
+TERMINATED = 143
+
+#: The stop signals of the command running in this process (see :class:`Stops`).
+_stops = Stops()
 
 #: What to make smaller when a command runs out of memory.
 MEMORY_HINTS = {
@@ -83,6 +88,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _fail(message: str) -> int:
+    if _stops.settled():  # the error came of a stop (ffmpeg, stopped first, failed)
+        raise KeyboardInterrupt
     print(f"cell: error: {one_line(message, 1000)}", file=sys.stderr)
     return 2
 
@@ -104,7 +111,7 @@ def _memory() -> str:
 def _open_files() -> str:
     """The open-file limit, and what to do about it, as the error says it."""
     try:
-        soft = resource.getrlimit(resource.RLIMIT_NOFILE)[0]  # type: ignore[union-attr]
+        soft = resource.getrlimit(resource.RLIMIT_NOFILE)[0]
     except (AttributeError, OSError, ValueError):  # not on this system
         return ""
     return f" (this process may open {soft}: raise it with ulimit -n, or use fewer --workers)"
@@ -122,32 +129,43 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run one command; the exit code (0 done, 2 refused, 130 interrupted).  A reader of stdout
-    or stderr that leaves (``| head``) stops neither the command nor its error line's exit code.
+    """Run one command; the exit code (0 done, 2 refused, 130 interrupted, 143 terminated).  A
+    reader of stdout or stderr that leaves (``| head``) stops neither the command nor its error
+    line's exit code.
 
-    With ``argv`` None the process is the command's: interrupted, it ends at once with 130
-    (:func:`cell.interrupts.exit_now`), whatever Ctrl-C met on its way."""
+    With ``argv`` None the process is the command's: stopped, it ends at once with its code
+    (:func:`cell.interrupts.exit_now`), whatever Ctrl-C or kill met on its way."""
+    global _stops
+    _stops = stops = Stops().install()
+    mpl = None
     try:
         from cell.streams import reader_may_leave, standard_streams
 
         standard_streams()
         mpl = _matplotlib_home()
-        try:
-            with reader_may_leave():
-                code = _where() or _main(argv)
-        finally:
-            if mpl is not None:
-                import shutil
-
-                shutil.rmtree(mpl, ignore_errors=True)
-    except BaseException as exc:  # Ctrl-C while starting, or one that became another error
-        if not interrupted(exc):
+        with reader_may_leave():
+            code = _where() or _main(argv)
+        if stops.settled():  # stopped while it finished: said so, its outputs whole
+            code = _said_stopped(None, stops.signum)
+    except BaseException as exc:  # a stop, or one that became another error on its way
+        if not (interrupted(exc) or stops.settled()):
             raise
-        with contextlib.suppress(Exception):
-            print("cell: interrupted", file=sys.stderr)
-        code = INTERRUPTED
-    if code == INTERRUPTED and argv is None:
+        code = _said_stopped(exc, stops.signum)
+    finally:
+        stops.restore()
+        if mpl is not None:
+            import shutil
+
+            shutil.rmtree(mpl, ignore_errors=True)
+    if code in (INTERRUPTED, TERMINATED) and argv is None:
         exit_now(code)
+    return code
+
+
+def _said_stopped(exc: BaseException | None, signum: int | None) -> int:
+    code, line = stopped_by(exc, signum)
+    with contextlib.suppress(Exception):
+        print(line, file=sys.stderr)
     return code
 
 
@@ -220,9 +238,6 @@ def _main(argv: Sequence[str] | None) -> int:
     except RecursionError:
         return _fail(f"cell {args.command}: input nested too deeply to process "
                      f"(Python's recursion limit, {sys.getrecursionlimit():,} levels)")
-    except KeyboardInterrupt:
-        print("cell: interrupted", file=sys.stderr)
-        return INTERRUPTED
     except OSError as exc:
         if exc.errno in (errno.EMFILE, errno.ENFILE):
             return _fail(f"cell {args.command}: too many open files{_open_files()}")
