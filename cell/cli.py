@@ -169,6 +169,36 @@ def _said_stopped(exc: BaseException | None, signum: int | None) -> int:
     return code
 
 
+#: Output options, checked before any work (:func:`_check_targets`).
+TARGETS = ("out", "report", "figure")
+#: The kernel's own file systems: nothing of a command's goes there.
+SYSTEM_DIRS = ("/proc", "/sys")
+
+
+def _check_targets(args: argparse.Namespace) -> None:
+    """Every output a command was given, refused before any work if it cannot be right: an
+    empty path, one under /proc or /sys, a sweep's ``--report`` inside its results folder."""
+    given = {name: getattr(args, name, None) for name in TARGETS}
+    for name, value in given.items():
+        if value is None:
+            continue
+        text = os.fspath(value)
+        if not text.strip():
+            raise CellError(f"--{name} {text!r}: an empty path: name a file or folder")
+        real = os.path.realpath(text)
+        for system in SYSTEM_DIRS:
+            if real == system or real.startswith(system + os.sep):
+                raise CellError(f"--{name} {shown_path(text)}: under {system}, the kernel's "
+                                "own file system: choose another place")
+    out, report = given["out"], given["report"]
+    if out is not None and report is not None and args.command == "sweep":
+        o, r = os.path.realpath(out), os.path.realpath(report)
+        if r == o or r.startswith(o.rstrip(os.sep) + os.sep):
+            raise CellError(f"--report {shown_path(report)}: inside the results folder "
+                            f"--out {shown_path(out)}, whose files are the sweep's: "
+                            "choose another place")
+
+
 def _usable(path: str) -> bool:
     """Whether ``path`` is, or could be made as, a folder one can write in (nothing made)."""
     path = os.path.abspath(path)
@@ -225,6 +255,7 @@ def _main(argv: Sequence[str] | None) -> int:
     except SystemExit as exc:  # --help, --version: printed, done
         return exc.code if isinstance(exc.code, int) else 0
     try:
+        _check_targets(args)
         return _run(args)
     except ScenarioError as exc:  # found after loading (assembling the cell): still --set's
         sets = [pair.partition("=")[0].strip() for pair in getattr(args, "sets", None) or ()]
