@@ -376,12 +376,18 @@ class AssembledCell:
 
 
 def make_policy(s: Scenario, k: CellConstants) -> Policy:
+    """The scenario's policy, its every plan checked (:mod:`cell.policies.check`)."""
+    from cell.policies.check import check_policy
+
+    name = s.controller.policy
+    cls = registry.load(name, s.source)
     try:
-        cls = registry.get(s.controller.policy)
-    except KeyError:
-        raise ScenarioError(s.source, "controller.policy", s.controller.policy,
-                            "must be one of " + ", ".join(registry.names())) from None
-    return cls(k, s.controller, s.source)
+        policy = cls(k, s.controller, s.source)
+    except CellError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a plug-in's failure, named
+        raise registry.PluginError(name, "could not be built", exc) from exc
+    return check_policy(policy, name, k)
 
 
 def assemble(s: Scenario) -> AssembledCell:

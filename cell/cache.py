@@ -178,10 +178,18 @@ _MAGIC = b"cell-cache 1\n"
 
 
 def cache_dir() -> Path | None:
-    """``$XDG_CACHE_HOME/cell`` (default ``~/.cache/cell``); None if ``CELL_NO_CACHE`` is set."""
+    """``$XDG_CACHE_HOME/cell`` (default ``~/.cache/cell``); None if ``CELL_NO_CACHE`` is set
+    or there is no absolute place for it.  A relative ``XDG_CACHE_HOME`` is ignored (as the
+    XDG specification asks), and a relative home gives no disk cache: neither may leave a
+    cache folder in the working directory."""
     if os.environ.get(NO_CACHE_ENV, "") not in ("", "0"):
         return None
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    base = os.environ.get("XDG_CACHE_HOME", "")
+    if not os.path.isabs(base):
+        home = os.path.expanduser("~")
+        if not os.path.isabs(home):
+            return None
+        base = os.path.join(home, ".cache")
     return Path(base) / "cell"
 
 

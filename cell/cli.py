@@ -24,9 +24,14 @@ import warnings
 from collections.abc import Sequence
 from typing import Any, NoReturn
 
+try:  # imported now: when the open files run out, importing it would fail too
+    import resource
+except ImportError:  # pragma: no cover - not on Windows
+    resource = None  # type: ignore[assignment]
+
 from cell import __version__
 from cell.errors import CellError, ScenarioError, one_line, shown_path
-from cell.interrupts import exit_now
+from cell.interrupts import Stops, exit_now, interrupted, stopped_by
 
 #: Subcommands in the order ``cell --help`` lists them; each is cell.commands.<name>.
 COMMANDS = ("run", "sweep", "compare", "fit", "figures", "animate", "path", "mintime",
@@ -39,6 +44,11 @@ OUTPUT_ERRNOS = frozenset({errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOSPC,
 
 #: The exit code of an interrupted command: 128 + SIGINT, as a shell reports Ctrl-C.
 INTERRUPTED = 130
+#: And of a killed one: 128 + SIGTERM.
+TERMINATED = 143
+
+#: The stop signals of the command running in this process (see :class:`Stops`).
+_stops = Stops()
 
 #: What to make smaller when a command runs out of memory.
 MEMORY_HINTS = {
@@ -78,6 +88,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _fail(message: str) -> int:
+    if _stops.settled():  # the error came of a stop (ffmpeg, stopped first, failed)
+        raise KeyboardInterrupt
     print(f"cell: error: {one_line(message, 1000)}", file=sys.stderr)
     return 2
 
@@ -96,6 +108,15 @@ def _memory() -> str:
     return f" (this machine has {total / 2**30:.0f} GiB)"
 
 
+def _open_files() -> str:
+    """The open-file limit, and what to do about it, as the error says it."""
+    try:
+        soft = resource.getrlimit(resource.RLIMIT_NOFILE)[0]
+    except (AttributeError, OSError, ValueError):  # not on this system
+        return ""
+    return f" (this process may open {soft}: raise it with ulimit -n, or use fewer --workers)"
+
+
 def _run(args: argparse.Namespace) -> int:
     """The command; a warning that a finished command met is one line each (a refused one's are
     dropped: its error says what went wrong)."""
@@ -107,42 +128,122 @@ def _run(args: argparse.Namespace) -> int:
     return code
 
 
-def interrupted(exc: BaseException) -> bool:
-    """Whether ``exc`` is Ctrl-C or came of it: a KeyboardInterrupt, or an error raised while
-    one was handled (``ImportError: initialization failed`` of a module it cut short)."""
-    todo: list[BaseException | None] = [exc]
-    seen: set[int] = set()
-    while todo:
-        e = todo.pop()
-        if e is None or id(e) in seen:
-            continue
-        if isinstance(e, KeyboardInterrupt):
-            return True
-        seen.add(id(e))
-        todo += [e.__cause__, e.__context__]
-    return False
-
-
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run one command; the exit code (0 done, 2 refused, 130 interrupted).  A reader of stdout
-    or stderr that leaves (``| head``) stops neither the command nor its error line's exit code.
+    """Run one command; the exit code (0 done, 2 refused, 130 interrupted, 143 terminated).  A
+    reader of stdout or stderr that leaves (``| head``) stops neither the command nor its error
+    line's exit code.
 
-    With ``argv`` None the process is the command's: interrupted, it ends at once with 130
-    (:func:`cell.interrupts.exit_now`), whatever Ctrl-C met on its way."""
+    With ``argv`` None the process is the command's: stopped, it ends at once with its code
+    (:func:`cell.interrupts.exit_now`), whatever Ctrl-C or kill met on its way."""
+    global _stops
+    _stops = stops = Stops().install()
+    mpl = None
     try:
-        from cell.streams import reader_may_leave
+        from cell.streams import reader_may_leave, standard_streams
 
+        standard_streams()
+        mpl = _matplotlib_home()
         with reader_may_leave():
-            code = _main(argv)
-    except BaseException as exc:  # Ctrl-C while starting, or one that became another error
-        if not interrupted(exc):
+            code = _where() or _main(argv)
+        if stops.settled():  # stopped while it finished: said so, its outputs whole
+            code = _said_stopped(None, stops.signum)
+    except BaseException as exc:  # a stop, or one that became another error on its way
+        if not (interrupted(exc) or stops.settled()):
             raise
-        with contextlib.suppress(Exception):
-            print("cell: interrupted", file=sys.stderr)
-        code = INTERRUPTED
-    if code == INTERRUPTED and argv is None:
+        code = _said_stopped(exc, stops.signum)
+    finally:
+        stops.restore()
+        if mpl is not None:
+            import shutil
+
+            shutil.rmtree(mpl, ignore_errors=True)
+    if code in (INTERRUPTED, TERMINATED) and argv is None:
         exit_now(code)
     return code
+
+
+def _said_stopped(exc: BaseException | None, signum: int | None) -> int:
+    code, line = stopped_by(exc, signum)
+    with contextlib.suppress(Exception):
+        print(line, file=sys.stderr)
+    return code
+
+
+#: Output options, checked before any work (:func:`_check_targets`).
+TARGETS = ("out", "report", "figure")
+#: The kernel's own file systems: nothing of a command's goes there.
+SYSTEM_DIRS = ("/proc", "/sys")
+
+
+def _check_targets(args: argparse.Namespace) -> None:
+    """Every output a command was given, refused before any work if it cannot be right: an
+    empty path, one under /proc or /sys, a sweep's ``--report`` inside its results folder."""
+    given = {name: getattr(args, name, None) for name in TARGETS}
+    for name, value in given.items():
+        if value is None:
+            continue
+        text = os.fspath(value)
+        if not text.strip():
+            raise CellError(f"--{name} {text!r}: an empty path: name a file or folder")
+        real = os.path.realpath(text)
+        for system in SYSTEM_DIRS:
+            if real == system or real.startswith(system + os.sep):
+                raise CellError(f"--{name} {shown_path(text)}: under {system}, the kernel's "
+                                "own file system: choose another place")
+    out, report = given["out"], given["report"]
+    if out is not None and report is not None and args.command == "sweep":
+        o, r = os.path.realpath(out), os.path.realpath(report)
+        if r == o or r.startswith(o.rstrip(os.sep) + os.sep):
+            raise CellError(f"--report {shown_path(report)}: inside the results folder "
+                            f"--out {shown_path(out)}, whose files are the sweep's: "
+                            "choose another place")
+
+
+def _usable(path: str) -> bool:
+    """Whether ``path`` is, or could be made as, a folder one can write in (nothing made)."""
+    path = os.path.abspath(path)
+    while not os.path.lexists(path):
+        parent = os.path.dirname(path)
+        if parent == path:
+            return False
+        path = parent
+    return os.path.isdir(path) and os.access(path, os.W_OK | os.X_OK)
+
+
+def _matplotlib_home() -> str | None:
+    """A temporary folder for matplotlib's configuration and cache, made (and put in
+    ``MPLCONFIGDIR``) only when the one it would use cannot be written (a read-only or
+    file-valued ``HOME``, a bad ``MPLCONFIGDIR``): matplotlib would otherwise warn on stderr
+    and leave its own temporary folder behind.  The caller removes it at the end."""
+    given = os.environ.get("MPLCONFIGDIR")
+    if given:
+        wanted = given
+    else:
+        base = os.environ.get("XDG_CONFIG_HOME", "")
+        if not os.path.isabs(base):
+            base = os.path.join(os.path.expanduser("~"), ".config")
+        wanted = os.path.join(base, "matplotlib")
+    if os.path.isabs(wanted) and _usable(wanted):
+        return None
+    import tempfile
+
+    try:
+        made = tempfile.mkdtemp(prefix="cell-matplotlib-")
+    except OSError:
+        return None
+    os.environ["MPLCONFIGDIR"] = made
+    return made
+
+
+def _where() -> int:
+    """0 if the working directory exists; else the error line's exit code (every relative path,
+    and much of what the libraries do, needs it)."""
+    try:
+        os.getcwd()
+    except OSError as exc:
+        return _fail(f"the working directory is gone ({(exc.strerror or str(exc)).lower()}): "
+                     "cd into one that exists")
+    return 0
 
 
 def _main(argv: Sequence[str] | None) -> int:
@@ -154,6 +255,7 @@ def _main(argv: Sequence[str] | None) -> int:
     except SystemExit as exc:  # --help, --version: printed, done
         return exc.code if isinstance(exc.code, int) else 0
     try:
+        _check_targets(args)
         return _run(args)
     except ScenarioError as exc:  # found after loading (assembling the cell): still --set's
         sets = [pair.partition("=")[0].strip() for pair in getattr(args, "sets", None) or ()]
@@ -167,10 +269,9 @@ def _main(argv: Sequence[str] | None) -> int:
     except RecursionError:
         return _fail(f"cell {args.command}: input nested too deeply to process "
                      f"(Python's recursion limit, {sys.getrecursionlimit():,} levels)")
-    except KeyboardInterrupt:
-        print("cell: interrupted", file=sys.stderr)
-        return INTERRUPTED
     except OSError as exc:
+        if exc.errno in (errno.EMFILE, errno.ENFILE):
+            return _fail(f"cell {args.command}: too many open files{_open_files()}")
         if exc.errno not in OUTPUT_ERRNOS:
             raise
         reason = (exc.strerror or os.strerror(exc.errno or 0)).lower()

@@ -14,6 +14,9 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
+from cell.errors import CellError, ScenarioError, one_line
+from cell.interrupts import interrupted
+
 #: Built-in policies: name -> "module:Class", imported on first use.
 BUILT_IN: dict[str, str] = {
     "non-adaptive": "cell.policies.fixed:FixedCycle",
@@ -25,12 +28,27 @@ _registered: dict[str, Any] = {}
 _entry_points: dict[str, Any] | None = None
 
 
+class PluginError(CellError):
+    """A policy that cannot be loaded or built: one line naming it and its error."""
+
+    def __init__(self, name: str, what: str, exc: BaseException):
+        where = ""
+        module = getattr(exc, "name", None) if isinstance(exc, ImportError) else None
+        if module:
+            where = f" (module {module})"
+        super().__init__(f"policy {name!r} {what}{where}: {type(exc).__name__}: "
+                         f"{one_line(str(exc) or '(no message)', 200)}")
+
+
 def _plugins() -> dict[str, Any]:
     global _entry_points
     if _entry_points is None:
         from importlib.metadata import entry_points
 
-        _entry_points = {ep.name: ep for ep in entry_points(group=ENTRY_POINT_GROUP)}
+        try:
+            _entry_points = {ep.name: ep for ep in entry_points(group=ENTRY_POINT_GROUP)}
+        except Exception:  # noqa: BLE001 - a broken installed distribution: no plug-ins
+            _entry_points = {}
     return _entry_points
 
 
@@ -71,3 +89,24 @@ def get(name: str) -> Any:
     if name in _plugins():
         return _plugins()[name].load()
     raise KeyError(name)
+
+
+def load(name: str, source: object = None) -> Any:
+    """:func:`get`, every failure one line: a name that is not known is the scenario's
+    ``controller.policy`` error (``source``, the scenario's file); a plug-in that cannot be
+    imported, raises while it is, or is not a policy class, a :class:`PluginError`."""
+    try:
+        cls = get(name)
+    except KeyError:
+        raise ScenarioError(source, "controller.policy", name,
+                            "must be one of " + ", ".join(names())) from None
+    except CellError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a plug-in's own failure, named
+        if interrupted(exc):  # an import that Ctrl-C cut short
+            raise
+        raise PluginError(name, "could not be loaded", exc) from exc
+    if not callable(cls):
+        raise PluginError(name, "is not a policy class",
+                          TypeError(f"{type(cls).__name__} object is not callable"))
+    return cls

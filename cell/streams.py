@@ -31,7 +31,7 @@ class Guarded:
         if not self.gone:
             try:
                 return self.stream.write(text)
-            except BrokenPipeError:
+            except (OSError, ValueError):  # the reader left, the device is full, closed
                 self._silence()
         return len(text)
 
@@ -39,7 +39,7 @@ class Guarded:
         if not self.gone:
             try:
                 self.stream.flush()
-            except BrokenPipeError:
+            except (OSError, ValueError):
                 self._silence()
 
     def _silence(self) -> None:
@@ -51,6 +51,34 @@ class Guarded:
                 os.dup2(devnull, self.stream.fileno())
             finally:
                 os.close(devnull)
+
+
+def _null_stream(fd: int) -> TextIO:
+    """A text stream on descriptor ``fd`` (the null device put there), or on the null device."""
+    try:
+        return open(fd, "w", closefd=False, errors="backslashreplace")  # noqa: SIM115
+    except OSError:
+        return open(os.devnull, "w")  # noqa: SIM115
+
+
+def standard_streams() -> None:
+    """Standard input, output and error open whatever the caller closed (``cell run >&-``):
+    a closed descriptor 0, 1 or 2 gets the null device, so no file the command opens takes
+    its number (and receives what is printed), and ``sys.stdout``/``sys.stderr``, which
+    Python leaves None then, a stream on it.  Called first thing, before any file is open."""
+    for fd in (0, 1, 2):
+        try:
+            os.fstat(fd)
+        except OSError:
+            with contextlib.suppress(OSError):
+                got = os.open(os.devnull, os.O_RDWR)
+                if got != fd:
+                    os.dup2(got, fd)
+                    os.close(got)
+    if sys.stdout is None:
+        sys.stdout = _null_stream(1)
+    if sys.stderr is None:
+        sys.stderr = _null_stream(2)
 
 
 @contextlib.contextmanager

@@ -46,6 +46,24 @@ LIMITS = {"parts": (1, 10_000), "from_part": (1, 10_000_000), "speed": (0.01, 1e
 MAX_FRAMES = 100_000
 
 
+#: The largest frame drawn (pixels): about 5 s a frame on a slow machine (a quarter of a second
+#: a megapixel, measured), so a long animation is not minutes a frame.
+MAX_FRAME_PIXELS = 20_000_000
+
+
+def check_frame_size(dpi: float, columns: int) -> None:
+    """Refuse a ``--dpi`` whose frames would be too large to draw in reasonable time."""
+    from cell.animation.render import frame_pixels
+    from cell.errors import CellError
+
+    pixels = frame_pixels(columns, dpi)
+    if pixels > MAX_FRAME_PIXELS:
+        most = dpi * (MAX_FRAME_PIXELS / pixels) ** 0.5
+        raise CellError(f"--dpi {dpi:g}: frames of {pixels / 1e6:.0f} megapixels, more than "
+                        f"{MAX_FRAME_PIXELS / 1e6:.0f} (each would take many seconds to draw); "
+                        f"use --dpi {int(most)} or less")
+
+
 def check_options(args: argparse.Namespace, cycle_s: float) -> None:
     """Every option within its bounds, and a frame count that can be drawn, or one line."""
     import math
@@ -57,6 +75,7 @@ def check_options(args: argparse.Namespace, cycle_s: float) -> None:
         if not (math.isfinite(value) and lo <= value <= hi):
             option = "--" + key.replace("_", "-")
             raise CellError(f"{option} {value:g}: must be between {lo:g} and {hi:g}")
+    check_frame_size(args.dpi, 2 if args.policy == "both" else 1)
     frames = (args.parts + 1) * cycle_s / args.speed * args.fps
     if frames > MAX_FRAMES:
         raise CellError(f"--parts {args.parts} --speed {args.speed:g} --fps {args.fps}: about "

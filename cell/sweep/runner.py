@@ -28,6 +28,7 @@ for any n > replication.  ``--workers 1`` runs in this process.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import functools
 import os
 import signal
@@ -47,7 +48,7 @@ from cell.output import atomic_path, float_formatter, write_csv
 from cell.progress import Progress
 from cell.scenario import Scenario
 from cell.sweep.columns import Column, grid_columns, point_values
-from cell.sweep.outdir import TASK_DIR, check_out, prepare
+from cell.sweep.outdir import MANIFEST, TASK_DIR, check_out, finished_tasks, prepare
 from cell.sweep.spec import Sweep, Task, overload_warning
 from cell.sweep.windows import window_warning
 
@@ -61,8 +62,8 @@ Replicate = Callable[[Scenario, np.random.SeedSequence], Mapping[str, Any]]
 
 #: Float digits in the per-task files: enough to round-trip exactly.
 TASK_FLOAT_FORMAT = "%.17g"
-#: How long to try reaching a dask scheduler.
-CONNECT_TIMEOUT = "20s"
+#: Seconds a dask client gets to close (a scheduler gone away does not answer).
+CLOSE_TIMEOUT_S = 5
 #: Tasks in flight on a dask cluster at once (local workers: twice their number).
 CLUSTER_WINDOW = 1024
 
@@ -163,20 +164,13 @@ def _open_executor(workers: int, scheduler: str | None, say: bool = True
                    ) -> tuple[cf.Executor | None, Any]:
     """The executor for the tasks (None: run in this process) and a client to close;
     ``say``: tell stderr while a scheduler is being reached."""
-    if scheduler:
-        try:
-            import distributed
-        except ImportError:
-            raise CellError("--scheduler needs dask.distributed: "
-                            "pip install 'cell[dist]'") from None
+    if scheduler is not None:
+        from cell.sweep.cluster import CONNECT_TIMEOUT_S, connect
+
         if say:
             print(f"connecting to the dask scheduler at {scheduler} (giving up after "
-                  f"{CONNECT_TIMEOUT})", file=sys.stderr)
-        try:
-            client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT)
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise CellError(f"--scheduler {scheduler}: cannot reach the dask scheduler "
-                            f"({exc})") from None
+                  f"{CONNECT_TIMEOUT_S:g} s)", file=sys.stderr)
+        client = connect(scheduler)
         return client.get_executor(pure=False), client
     if workers <= 1:
         return None, None
@@ -278,7 +272,7 @@ def _close(executor: cf.Executor | None, client: Any, wait: bool) -> None:
     elif executor is not None:
         executor.shutdown(wait=wait)
     if client is not None:
-        client.close()
+        client.close(timeout=CLOSE_TIMEOUT_S)
 
 
 #: At most this many local worker processes per core.
@@ -310,6 +304,7 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     values: dict[int, list[float]] = {p: [] for p in counts}
     run = reused = 0
     rounds: list[dict[int, tuple[int, int]]] = []  # each round's replications, by point
+    fresh = not (out / MANIFEST).exists()
     try:
         prepare(sweep, out, resume)
         bar = Progress(sweep.total_replications, sweep.name, "replications", file=sys.stderr,
@@ -349,14 +344,32 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
                 ranges = {p: (counts[p], counts[p] + k) for p, k in more.items() if k}
                 bar.grow(sum(more.values()))
         _close(executor, client, wait=True)
-    except BaseException:
+    except BaseException as exc:
         _close(executor, client, wait=False)
+        if fresh:
+            _unmade(out)
+        if scheduler:
+            from cell.sweep.cluster import lost
+
+            if (gone := lost(scheduler, exc, out)) is not None:
+                raise gone from None
         raise
     # The files the rounds wrote, point by point: a round's tasks start where it does
     # (``min`` need not be a multiple of ``batch``), not where cutting from 0 would.
     tasks = (t for p in counts for r in rounds if p in r for t in sweep.iter_tasks({p: r[p]}))
     path = _assemble(sweep, task_dir, tasks, out / "replications.csv")
     return Outcome(path, run, reused, counts)
+
+
+def _unmade(out: Path) -> None:
+    """A sweep that failed or stopped before any task finished leaves nothing behind: the
+    manifest it wrote and its empty task folder are removed (and the folder itself by
+    :func:`cell.sweep.outdir.lock`, if it made it)."""
+    if finished_tasks(out):
+        return
+    (out / MANIFEST).unlink(missing_ok=True)
+    with contextlib.suppress(OSError):
+        (out / TASK_DIR).rmdir()
 
 
 def _finished(sweep: Sweep, task_dir: Path, task: Task) -> pd.DataFrame:

@@ -64,6 +64,7 @@ from cell.sweep.options import (
     summary_measures,
     whole,
 )
+from cell.sweep.policy_names import check_policy_names
 
 if TYPE_CHECKING:
     from cell.policies.base import CellConstants
@@ -266,6 +267,7 @@ def load_sweep(path: str | Path) -> Sweep:
 
     shared, names = grid(raw["grid"], path, "grid") if "grid" in raw else ({}, {})
     policies_raw = raw.get("policies", [base.controller.policy])
+    check_policy_names(policies_raw, path)  # cell.sweep.policy_names
     per_policy: dict[str, dict[str, list[Any]]] | None = None
     named_by_policy: dict[str, dict[str, list[str]]] = {}
     if isinstance(policies_raw, list) and policies_raw:
@@ -392,3 +394,4 @@ def comparison(a: Scenario, b: Scenario, labels: tuple[str, str], replications: 
                  (pa, pb), replications, seed, min(batch, replications),
                  baseline=Baseline(b.controller.policy, (("scenario", lb),),
                                    text=f"{lb} ({b.controller.policy})"))
+

@@ -1,0 +1,97 @@
+"""SIGINT and SIGTERM at any moment of a command: ``cell: interrupted`` (130) or
+``cell: terminated`` (143), its temporary folders removed, finished outputs intact.
+
+Each test waits for a readiness marker on disk (a temporary folder, a finished task) before
+it sends the signal: no fixed delays.  (A signal in the interpreter's own start, before any
+of cell's code runs, gets Python's default; from ``cell.cli.main`` on, these hold.)
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from cell import catalog
+
+BASELINE = str(catalog.path("baseline"))
+NON_ADAPTIVE = str(catalog.path("non_adaptive"))
+LINES = {signal.SIGINT: (130, "cell: interrupted"), signal.SIGTERM: (143, "cell: terminated")}
+
+
+def _start(args, tmp_path: Path) -> subprocess.Popen:
+    tmp = tmp_path / "tmp"
+    tmp.mkdir(exist_ok=True)
+    env = {**os.environ, "TMPDIR": str(tmp), "XDG_CACHE_HOME": str(tmp_path / ".cache")}
+    return subprocess.Popen([sys.executable, "-m", "cell", *args], cwd=tmp_path, env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+
+
+def _wait_for(proc: subprocess.Popen, ready, what: str, limit_s: float = 120) -> None:
+    end = time.monotonic() + limit_s
+    while not ready():
+        if proc.poll() is not None:
+            pytest.fail(f"ended ({proc.returncode}) before {what}: {proc.stderr.read()}")
+        if time.monotonic() > end:
+            proc.kill()
+            pytest.fail(f"no {what} within {limit_s} s")
+        time.sleep(0.01)
+
+
+def _stop(proc: subprocess.Popen, number: int) -> list[str]:
+    proc.send_signal(number)
+    err = proc.stderr.read()
+    code = proc.wait(timeout=60)
+    expected_code, line = LINES[number]
+    assert code == expected_code, err
+    lines = [x for x in err.splitlines() if "%)" not in x and not x.startswith("cell: warning")]
+    assert lines[-1] == line or lines[-1].startswith("cell sweep: stopped"), err
+    return lines
+
+
+def _left(folder: Path) -> list[str]:
+    """What is in ``folder`` beside the cache the test gave the command."""
+    return sorted(name for name in os.listdir(folder) if name != ".cache")
+
+
+def _glob(folder: Path, pattern: str) -> list[Path]:
+    return list(folder.glob(pattern)) if folder.is_dir() else []
+
+
+@pytest.mark.parametrize("number", [signal.SIGTERM])
+def test_compare_stopped_removes_its_temporary_folder(tmp_path, number):
+    out = tmp_path / "cmp"
+    proc = _start(["compare", BASELINE, NON_ADAPTIVE, "--set", "run.parts=200",
+                   "--replications", "3000", "--workers", "1", "--out", str(out)], tmp_path)
+    _wait_for(proc, lambda: _glob(tmp_path / "tmp", "cell-compare-*/**/sweep.json"),
+              "compare's temporary folder")
+    assert _stop(proc, number) == [LINES[number][1]]
+    assert list((tmp_path / "tmp").iterdir()) == []
+    assert not out.exists()
+
+
+def test_run_terminated_leaves_no_output_and_no_staging(tmp_path):
+    out = tmp_path / "run"
+    proc = _start(["run", BASELINE, "--set", "run.parts=2000000", "--out", str(out)], tmp_path)
+    _wait_for(proc, lambda: _glob(tmp_path, ".run.cell-tmp-*/parts.csv"), "the run's staging")
+    assert _stop(proc, signal.SIGTERM)[-1] == "cell: terminated"
+    assert _left(tmp_path) == ["tmp"] and list((tmp_path / "tmp").iterdir()) == []
+
+
+def test_sweep_terminated_keeps_finished_tasks_and_resumes(tmp_path):
+    sweep = tmp_path / "sweep.yaml"
+    sweep.write_text(f"base: {BASELINE}\ngrid: {{run.parts: [2000, 2001, 2002, 2003, 2004, "
+                     "2005, 2006, 2007]}\nreplications: 3\nseed: 1\n")
+    out = tmp_path / "out"
+    proc = _start(["sweep", str(sweep), "--out", str(out), "--workers", "1"], tmp_path)
+    _wait_for(proc, lambda: _glob(out, "tasks/task-*.csv"), "a finished task")
+    lines = _stop(proc, signal.SIGTERM)
+    assert "--resume" in lines[-1]
+    kept = {p.name: p.read_bytes() for p in _glob(out, "tasks/task-*.csv")}
+    assert kept and not (out / "replications.csv").exists()
+    assert _glob(out, "tasks/.task-*.tmp") == []
