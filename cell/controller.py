@@ -100,15 +100,17 @@ class Controller:
                 missed(part)
                 continue
             view.part, view.now = part.part - 1, now
-            (r1_pre, r1_post, r2, r3_pre, r3_post, r4, input_speed, input_after_lo, input_next,
-             output_to_g, to_g, cycle, limits, steers_belts) = plan_for(view)
-            if steers_belts:
-                replan_in(now + r1_pre, input_after_lo, now + cycle, input_next)
+            plan = plan_for(view)
+            r1_pre, r3_pre, r3_post, to_g, cycle = \
+                plan.r1_pre, plan.r3_pre, plan.r3_post, plan.to_g, plan.cycle
+            output_to_g, r2, r4, limits = plan.output_to_g, plan.r2, plan.r4, plan.limits
+            if plan.steers_belts:
+                replan_in(now + r1_pre, plan.input_after_lo, now + cycle, plan.input_next)
                 replan_out(now, output_to_g, now + to_g, u_nom)
-            r1, r3 = r1_pre + r1_post, r3_pre + r3_post
+            r1, r3 = r1_pre + plan.r1_post, r3_pre + r3_post
             part.picked = True
             part.motion_cycle_s = cycle
-            part.input_speed_in_s, part.output_speed_in_s = input_speed, output_to_g
+            part.input_speed_in_s, part.output_speed_in_s = plan.input_speed, output_to_g
             part.r1_s, part.r2_s, part.r3_s, part.r4_s = r1, r2, r3, r4
             part.v_r1_in_s, part.v_r2_in_s = l1 / r1, l2 / r2
             part.v_r3_in_s, part.v_r4_in_s = l3 / r3, l4 / r4

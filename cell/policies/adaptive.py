@@ -46,8 +46,6 @@ from cell.records import (
     RunSummary,
 )
 
-_new_tuple = tuple.__new__
-
 
 def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
                   gap_in: float | None, lag: float | None = None) -> Plan:
@@ -129,9 +127,9 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
         elif u > k.output_max:
             u = k.output_max
             flags |= OUTPUT_CEILING
-    # Plan(...) without its Python-level __new__ (once a part): every field, in order
-    return _new_tuple(Plan, (r1a, r1b, r2, r3a, r3b, r4, v, w, v_next, u, r1a + r1b + r2, cycle,
-                             flags, True))
+    return Plan(r1_pre=r1a, r1_post=r1b, r2=r2, r3_pre=r3a, r3_post=r3b, r4=r4,
+                input_speed=v, input_after_lo=w, input_next=v_next, output_to_g=u,
+                to_g=r1a + r1b + r2, cycle=cycle, limits=flags)
 
 
 class Adaptive(Policy):

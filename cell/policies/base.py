@@ -15,7 +15,7 @@ from abc import ABC, abstractmethod
 from array import array
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, ClassVar, NamedTuple, Protocol
+from typing import Any, ClassVar, Protocol
 
 import numpy as np
 
@@ -83,8 +83,14 @@ class CellConstants:
         return self.fastest_cycle_s / self.mean_interarrival_s
 
 
-class Plan(NamedTuple):
-    """One transfer cycle: regime times (s), belt speeds (in/s) and what went wrong."""
+@dataclass(slots=True, kw_only=True)
+class Plan:
+    """One transfer cycle: regime times (s), belt speeds (in/s) and what went wrong.
+
+    A named record: built with keywords and read by name, never by position (a slotted
+    dataclass, as quick to build and read as the tuple it replaces).  A policy may hand
+    the same plan out for every part (the fixed cycle does), so nobody changes one.
+    """
 
     r1_pre: float
     r1_post: float
@@ -108,6 +114,9 @@ class Plan(NamedTuple):
     """The limits hit (bits of :data:`cell.records.LIMIT_BIT`)."""
     steers_belts: bool = True
     """Whether the belt speeds above are commands (False: the belts are left alone)."""
+    output_floor_at: float = math.inf
+    """The spacing contract (docs/model.md): seconds from the start of this cycle at which
+    the output belt drops to its floor until the next part's plan (inf: not planned)."""
 
 
 class CellView(Protocol):
