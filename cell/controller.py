@@ -9,6 +9,7 @@ policy's; nothing here knows which policy runs.
 
 from __future__ import annotations
 
+import math
 from typing import Any, Protocol
 
 import simpy
@@ -17,6 +18,9 @@ from cell.conveyors import EPS_S, InputConveyor, OutputConveyor
 from cell.policies.base import CellConstants, Policy
 from cell.records import LET_GO, PartRecord
 from cell.robot import Robot
+from cell.sensor import Sensor
+
+INF = math.inf
 
 
 class RunLog(Protocol):
@@ -43,6 +47,9 @@ class View:
         """Index of the part at B."""
         self.now = 0.0
         """The instant it reached B (the simulation's clock)."""
+        self.sensor_up = True
+        """False while the look-ahead sensor is down (a failure): it then reports nothing,
+        the ideal look-ahead included, and ``next_part`` is None."""
 
     def input_speed(self) -> float:
         return self._input_speed(self.now + EPS_S)
@@ -52,8 +59,15 @@ class View:
         last = self.output.last_td_x
         return None if last is None else self._output_travel(self.now) - last
 
+    def since_touchdown(self) -> float | None:
+        """Seconds since the last part was set down (None if none yet)."""
+        return None if self.output.last_td_x is None else self.now - self.output.last_td_s
+
     def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
-        """(a, b) of the first part after this one that can still be caught."""
+        """(a, b) of the first part after this one that can still be caught: the ideal
+        look-ahead, which reads the feeder's schedule (``sensor.lookahead: ideal``)."""
+        if not self.sensor_up:
+            return None
         now, fed_s, length = self.now, self.fed_s, self._length
         x_now = None
         for j in range(self.part + 1, self.n):
@@ -66,6 +80,31 @@ class View:
             if x_fed is None:  # dropped between now and LO (or held back): not on the belt yet
                 x_fed = x_now + v * (max(f, now) - now)
             d = x_fed + length - (x_now + v * lag)
+            if d > 0:
+                return (lag, d)
+        return None
+
+
+class SensorView(View):
+    """The view with a physical look-ahead (``sensor.lookahead: sensor``): the next part is
+    the first the sensor has reported that can still be caught, where the report puts it;
+    the feeder's schedule is not given to it, so no arrival the sensor has not seen is read."""
+
+    def __init__(self, k: CellConstants, sensor: Sensor, n_parts: int,
+                 conveyor: InputConveyor, output: OutputConveyor):
+        super().__init__(k, [], n_parts, conveyor, output)
+        self.sensor = sensor
+
+    def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
+        """(lag, b) of the first reported part after this one still short of B at LO (its
+        reported distance less the belt's travel since the report); None if none."""
+        sensor, now = self.sensor, self.now
+        sensor.update(now, self.part)
+        if not self.sensor_up:
+            return None
+        ahead = self._input_travel(now) + v * lag  # the belt's travel at LO
+        for _, distance, x_told in sensor.reports:
+            d = distance - (ahead - x_told)
             if d > 0:
                 return (lag, d)
         return None
@@ -85,6 +124,8 @@ class Controller:
         returns, without the property call)."""
         env, robot, view, plan_for = self.env, self.robot, self.view, self.policy.plan
         replan_in, replan_out, u_nom = self.conveyor.replan, self.output.replan, self.k.u_nom
+        output_floor, u_min = self.output.belt.then, self.k.output_min
+        aim = self.k.lookahead_margin_s  # step 6.3 from when the next part is aimed at B
         get, flag, missed, order = self.conveyor.at_bot.get, self.log.flag, self.log.missed, \
             robot.order
         t = self.k.timing
@@ -105,8 +146,10 @@ class Controller:
                 plan.r1_pre, plan.r3_pre, plan.r3_post, plan.to_g, plan.cycle
             output_to_g, r2, r4, limits = plan.output_to_g, plan.r2, plan.r4, plan.limits
             if plan.steers_belts:
-                replan_in(now + r1_pre, plan.input_after_lo, now + cycle, plan.input_next)
+                replan_in(now + r1_pre, plan.input_after_lo, now + cycle + aim, plan.input_next)
                 replan_out(now, output_to_g, now + to_g, u_nom)
+                if plan.output_floor_at < INF:  # the spacing contract: the belt's floor after TD
+                    output_floor(now + plan.output_floor_at, u_min)
             r1, r3 = r1_pre + plan.r1_post, r3_pre + r3_post
             part.picked = True
             part.motion_cycle_s = cycle

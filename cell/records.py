@@ -30,10 +30,13 @@ LIMITS = (
     "let_go",           # reached B while the robot was busy: fell off at F (§6.3)
     "spacing_off",      # set down outside the spacing tolerance (§4.3 f)
     "held_at_feeder",   # dropped later than it came: the belt had not cleared a part's size
+    "spacing_wait",     # spacing off: the robot waited longer than the output floor allows
+    "spacing_unforeseen",  # spacing off: a wait the look-ahead did not foresee (belt slowed late)
 )
 LIMIT_BIT = {name: 1 << i for i, name in enumerate(LIMITS)}
 (INPUT_FLOOR, INPUT_CEILING, INPUT_TRACKING, OUTPUT_FLOOR, OUTPUT_CEILING, R2_PEAK, R4_PEAK,
- LET_GO, SPACING_OFF, HELD_AT_FEEDER) = (1 << i for i in range(len(LIMITS)))
+ LET_GO, SPACING_OFF, HELD_AT_FEEDER, SPACING_WAIT, SPACING_UNFORESEEN) = \
+    (1 << i for i in range(len(LIMITS)))
 
 
 class LimitCount(NamedTuple):
@@ -58,6 +61,10 @@ LIMIT_COUNTS: dict[str, LimitCount] = {
     "output_floor": LimitCount("limit_output_floor", "output belt at its floor"),
     "output_ceiling": LimitCount("limit_output_ceiling", "output belt at its ceiling"),
     "held_at_feeder": LimitCount("parts_held", "held at the feeder (belt not clear)"),
+    "spacing_wait": LimitCount("limit_spacing_wait",
+                               "spacing off: a wait longer than the output floor allows"),
+    "spacing_unforeseen": LimitCount("limit_spacing_unforeseen",
+                                     "spacing off: a wait the look-ahead did not foresee"),
 }
 
 
@@ -233,6 +240,15 @@ class RunSummary:
     """The calibrated slack of the thesis's bookkeeping (non-adaptive), s."""
     sim_end_s: float = NAN
     """Simulated time when the run ended."""
+    limit_spacing_wait: int = 0
+    """Parts set down off spacing because the robot waited so long that even the output belt
+    at its floor from the last touch-down could not have kept 45 in (spacing contract)."""
+    limit_spacing_unforeseen: int = 0
+    """Parts set down off spacing after a wait the look-ahead did not foresee (a part let go,
+    missed by the sensor or misjudged): the output belt was slowed too late."""
+    parts_bound: int = 0
+    """The most parts any controller could deliver from the same arrivals with the same robot
+    and belts (a bound: each part's window at B, picks a fastest cycle apart; cell.bound)."""
 
     def __getitem__(self, name: str) -> Any:
         return getattr(self, name)

@@ -36,7 +36,8 @@ import simpy
 from cell import accounting
 from cell.arrivals import interarrival_times
 from cell.assembly import AssembledCell, assemble
-from cell.controller import Controller, View
+from cell.bound import parts_bound
+from cell.controller import Controller, SensorView, View
 from cell.conveyors import InputConveyor, OutputConveyor
 from cell.feeder import Feeder
 from cell.policies.base import Accounting
@@ -53,6 +54,7 @@ from cell.records import (
 )
 from cell.robot import Robot
 from cell.scenario import Scenario
+from cell.sensor import Sensor, sensor_position
 
 PartSink = Callable[[PartRecord], Any]
 BeltSink = Callable[[BeltChange], Any]
@@ -289,17 +291,29 @@ def simulate(scenario: Scenario | AssembledCell,
     robot = Robot(env, output.placed)
     feeder = Feeder(env, t_list, conveyor, n, k.part_size, log.flag)
     conveyor.feeder = feeder
-    view = View(k, feeder.fed_s, n, conveyor, output)
+    view = _view(cell, seed, feeder, conveyor, output)
     Controller(env, k, policy, view, conveyor, output, robot, log)
     env.run()
     conveyor.belt.close()
-    output.belt.close()
+    output.belt.close(until=env.now)  # a floor planned after the last touch-down never ran
 
     summary = _summary(cell, log, acct, t_all, n, env.now)
     summary.seed = _seed_value(seed)
     summary.input_speed_max_in_s = conveyor.belt.max_speed_in_s
     summary.input_speed_min_in_s = conveyor.belt.min_speed_in_s
+    summary.parts_bound = parts_bound(k, feeder.fed_s[summary.warmup_parts:n])
     return SimResult(summary, rows, belts if keep_belts else None)
+
+
+def _view(cell: AssembledCell, seed: Any, feeder: Feeder, conveyor: InputConveyor,
+          output: OutputConveyor) -> View:
+    """What the controller sees: the feeder's schedule (``sensor.lookahead: ideal``), or only
+    what a physical sensor has reported (``sensor``)."""
+    s, k, n = cell.scenario, cell.k, cell.scenario.run.parts
+    if s.sensor.lookahead == "ideal":
+        return View(k, feeder.fed_s, n, conveyor, output)
+    position = sensor_position(s.sensor, k.input_length, s.source)
+    return SensorView(k, Sensor(s.sensor, position, conveyor, n, seed), n, conveyor, output)
 
 
 def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, n: int,

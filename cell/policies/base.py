@@ -62,6 +62,9 @@ class CellConstants:
     a belt left slower than this would lengthen the next cycle (docs/model.md)."""
     mean_interarrival_s: float = float("nan")
     """Mean inter-arrival time of the arrivals (the distribution's or the trace's)."""
+    lookahead_margin_s: float = 0.0
+    """The adaptive controller aims the next part at B this long after the robot is back
+    (``sensor.margin_s``; 0 with the ideal look-ahead, as the thesis)."""
     nominal_from: str = "scenario"
     """Where ``cycle_nom`` came from: ``scenario`` (``controller.nominal_cycle_s``),
     ``arrivals`` (their mean) or ``fastest`` (the arrivals are faster than the robot)."""
@@ -76,6 +79,14 @@ class CellConstants:
         """The robot's fastest cycle: R II and R IV at the motors' peak, belts at nominal."""
         t = self.timing
         return self.r1_nom + t.r2_min_s + self.r3_pre_nom + self.r3_post_nom + t.r4_min_s
+
+    @property
+    def floor_gap_in(self) -> float:
+        """The spacing contract's threshold: the most the last part set down may have travelled
+        when the next part reaches B for 45 in to be kept with the output belt at its floor
+        until G (R I + R II at their nominal sum) and at nominal from G to TD."""
+        return self.spacing - self.u_nom * self.r3_pre_nom - \
+            self.output_min * (self.r1_nom + self.r2_nom) - 1e-6
 
     @property
     def utilisation(self) -> float:
@@ -133,6 +144,9 @@ class CellView(Protocol):
 
     def output_gap(self) -> float | None:
         """How far the last part set down has travelled on the output belt (None: none yet)."""
+
+    def since_touchdown(self) -> float | None:
+        """Seconds since the last part was set down (None: none yet)."""
 
 
 class Policy(ABC):
