@@ -126,6 +126,7 @@ class Controller:
         replan_in, replan_out, u_nom = self.conveyor.replan, self.output.replan, self.k.u_nom
         output_floor, u_min = self.output.belt.then, self.k.output_min
         aim = self.k.lookahead_margin_s  # step 6.3 from when the next part is aimed at B
+        floor_after_td = math.nan  # the last planned TD (the spacing contract; nan: none)
         get, flag, missed, order = self.conveyor.at_bot.get, self.log.flag, self.log.missed, \
             robot.order
         t = self.k.timing
@@ -139,6 +140,8 @@ class Controller:
                 part.missed = True
                 flag(part, LET_GO)
                 missed(part)
+                if floor_after_td == floor_after_td:  # a wait now foreseen: the output belt's
+                    replan_out(max(now, floor_after_td), u_min)  # floor from TD (or now)
                 continue
             view.part, view.now = part.part - 1, now
             plan = plan_for(view)
@@ -150,6 +153,7 @@ class Controller:
                 replan_out(now, output_to_g, now + to_g, u_nom)
                 if plan.output_floor_at < INF:  # the spacing contract: the belt's floor after TD
                     output_floor(now + plan.output_floor_at, u_min)
+                    floor_after_td = now + to_g + r3_pre
             r1, r3 = r1_pre + plan.r1_post, r3_pre + r3_post
             part.picked = True
             part.motion_cycle_s = cycle
