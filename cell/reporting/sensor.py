@@ -85,9 +85,11 @@ def table(reps: pd.DataFrame, drop_point_in: float) -> pd.DataFrame:
                 "delivered_vs_fixed_ci_high": diff["ci_high"]}
             rows.append(row)
     t = pd.DataFrame(rows)
-    ref = t[t["sensor"] == "reference"].set_index("arrivals")["delivered_vs_fixed"]
-    t["advantage_kept"] = [r.delivered_vs_fixed / ref[r.arrivals] if r.policy == "adaptive"
-                           and ref[r.arrivals] > 0 else math.nan for r in t.itertuples()]
+    ref: dict[str, float] = dict(zip(t[t["sensor"] == "reference"]["arrivals"],
+                                     t[t["sensor"] == "reference"]["delivered_vs_fixed"]))
+    t["advantage_kept"] = [a / ref[str(where)] if policy == "adaptive" and ref[str(where)] > 0
+                           else math.nan for a, where, policy in
+                           zip(t["delivered_vs_fixed"], t["arrivals"], t["policy"])]
     return t
 
 
