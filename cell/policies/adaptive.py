@@ -123,26 +123,33 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
     if v_next > t.input_track_max_in_s:
         v_next = t.input_track_max_in_s
         flags |= INPUT_TRACKING
-    # 5.0: output belt until G, between the 44.75 and 45.25 in limits.
-    u = k.u_nom
     ttsot = r1a + r1b + r2
-    if gap_in is not None:
-        rest = gap_in + k.u_nom * r3a
-        lo = (k.spacing - k.tol - rest) / ttsot
-        hi = (k.spacing + k.tol - rest) / ttsot
-        u = 0.5 * (lo + hi)
-        if u < k.output_min:
-            u = k.output_min
-            flags |= OUTPUT_FLOOR
-            if rest + u * ttsot > k.spacing + k.tol:  # off: name the cause
-                flags |= spacing_cause(k, idle_s, ttsot, r3a)
-        elif u > k.output_max:
-            u = k.output_max
-            flags |= OUTPUT_CEILING
+    u, out_flags = (k.u_nom, 0) if gap_in is None else output_speed(k, gap_in, ttsot, r3a, idle_s)
+    flags |= out_flags
     return Plan(r1_pre=r1a, r1_post=r1b, r2=r2, r3_pre=r3a, r3_post=r3b, r4=r4,
                 input_speed=v, input_after_lo=w, input_next=v_next, output_to_g=u,
                 to_g=ttsot, cycle=cycle, limits=flags,
                 output_floor_at=floor_at(k, nxt, w, v_next, cycle, ttsot + r3a))
+
+
+def output_speed(k: CellConstants, gap_in: float, ttsot: float, r3a: float,
+                 idle_s: float | None) -> tuple[float, int]:
+    """Step 5.0: the output belt until G, the average of the speeds that set the part down
+    44.75 and 45.25 in behind the last, within the belt's floor and ceiling; the limits hit
+    (and, spacing off at the floor, its cause)."""
+    rest = gap_in + k.u_nom * r3a
+    lo = (k.spacing - k.tol - rest) / ttsot
+    hi = (k.spacing + k.tol - rest) / ttsot
+    u = 0.5 * (lo + hi)
+    if u < k.output_min:
+        u = k.output_min
+        flags = OUTPUT_FLOOR
+        if rest + u * ttsot > k.spacing + k.tol:  # off: name the cause
+            flags |= spacing_cause(k, idle_s, ttsot, r3a)
+        return u, flags
+    if u > k.output_max:
+        return k.output_max, OUTPUT_CEILING
+    return u, 0
 
 
 def floor_at(k: CellConstants, nxt: tuple[float, float] | None, w: float, v_next: float,
