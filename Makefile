@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-stamp
 WORKERS ?= 2
 
-.PHONY: all venv test sweep sweep-mintime whatif stress figures animation bench lint clean
+.PHONY: all venv test sweep sweep-mintime whatif stress sensor figures animation bench lint clean
 
 all: test
 
@@ -38,6 +38,11 @@ stress: $(STAMP)
 	rm -rf build/stress
 	$(PY) -m cell sweep scenarios/stress.yaml --out build/stress --workers $(WORKERS)
 	MPLBACKEND=Agg $(PY) -m cell.reporting.stress build/stress/replications.csv reports/stress
+
+sensor: $(STAMP)
+	rm -rf build/sensor
+	$(PY) -m cell sweep scenarios/sensor.yaml --out build/sensor --workers $(WORKERS)
+	MPLBACKEND=Agg $(PY) -m cell.reporting.sensor build/sensor/replications.csv reports/sensor
 
 figures: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m cell figures --out reports/figures

@@ -317,7 +317,19 @@ def constants(s: Scenario, timing: RobotTiming) -> CellConstants:
         r3_post_nom=r3b, r4_nom=r4, r2_nom=r2, r1_nom=r1a + r1b,
         input_min=b.input_min_in_s, output_min=b.output_min_in_s, part_size=s.part.size_in,
         input_absorb=_absorbable(t, b.input_nominal_in_s, r1a + r1b + (r2 - t.r2_min_s)),
-        mean_interarrival_s=mean, nominal_from=source)
+        mean_interarrival_s=mean, nominal_from=source,
+        lookahead_margin_s=lookahead_margin(s))
+
+
+def lookahead_margin(s: Scenario) -> float:
+    """``sensor.margin_s``, or its default: 0 for the ideal look-ahead; three standard
+    deviations of a sensor's error, in time at the nominal input speed."""
+    m = s.sensor
+    if m.margin_s is not None:
+        return float(m.margin_s)
+    if m.lookahead == "ideal":
+        return 0.0
+    return 3.0 * m.noise_sd_in / s.belts.input_nominal_in_s
 
 
 def _absorbable(t: RobotTiming, v_nom: float, r1_most_s: float) -> float:
@@ -399,4 +411,7 @@ def assemble(s: Scenario) -> AssembledCell:
         load_dynamics(unused)
     timing = robot_timing(s)
     k = constants(s, timing)
+    from cell.sensor import sensor_position
+
+    sensor_position(s.sensor, k.input_length, s.source)  # a sensor beyond the feeder: refused
     return AssembledCell(s, timing, k, make_policy(s, k))

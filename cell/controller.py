@@ -9,6 +9,7 @@ policy's; nothing here knows which policy runs.
 
 from __future__ import annotations
 
+import math
 from typing import Any, Protocol
 
 import simpy
@@ -17,6 +18,9 @@ from cell.conveyors import EPS_S, InputConveyor, OutputConveyor
 from cell.policies.base import CellConstants, Policy
 from cell.records import PartRecord
 from cell.robot import Robot
+from cell.sensor import Sensor
+
+INF = math.inf
 
 
 class RunLog(Protocol):
@@ -44,8 +48,8 @@ class View:
         self.now = 0.0
         """The instant it reached B (the simulation's clock)."""
         self.sensor_up = True
-        """False while the look-ahead sensor is down (a failure): :meth:`next_part` then
-        reports nothing, for an ideal look-ahead as well."""
+        """False while the look-ahead sensor is down (a failure): it then reports nothing,
+        the ideal look-ahead included, and ``next_part`` is None."""
 
     def input_speed(self) -> float:
         return self._input_speed(self.now + EPS_S)
@@ -55,9 +59,13 @@ class View:
         last = self.output.last_td_x
         return None if last is None else self._output_travel(self.now) - last
 
+    def since_touchdown(self) -> float | None:
+        """Seconds since the last part was set down (None if none yet)."""
+        return None if self.output.last_td_x is None else self.now - self.output.last_td_s
+
     def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
-        """(a, b) of the first part after this one that can still be caught (None: none
-        is coming, or the sensor is down)."""
+        """(a, b) of the first part after this one that can still be caught: the ideal
+        look-ahead, which reads the feeder's schedule (``sensor.lookahead: ideal``)."""
         if not self.sensor_up:
             return None
         now, fed_s, length = self.now, self.fed_s, self._length
@@ -77,6 +85,31 @@ class View:
         return None
 
 
+class SensorView(View):
+    """The view with a physical look-ahead (``sensor.lookahead: sensor``): the next part is
+    the first the sensor has reported that can still be caught, where the report puts it;
+    the feeder's schedule is not given to it, so no arrival the sensor has not seen is read."""
+
+    def __init__(self, k: CellConstants, sensor: Sensor, n_parts: int,
+                 conveyor: InputConveyor, output: OutputConveyor):
+        super().__init__(k, [], n_parts, conveyor, output)
+        self.sensor = sensor
+
+    def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
+        """(lag, b) of the first reported part after this one still short of B at LO (its
+        reported distance less the belt's travel since the report); None if none."""
+        sensor, now = self.sensor, self.now
+        sensor.update(now, self.part)
+        if not self.sensor_up:
+            return None
+        ahead = self._input_travel(now) + v * lag  # the belt's travel at LO
+        for _, distance, x_told in sensor.reports:
+            d = distance - (ahead - x_told)
+            if d > 0:
+                return (lag, d)
+        return None
+
+
 class Controller:
     """Decides each part's cycle when it reaches B (SimPy process)."""
 
@@ -91,6 +124,9 @@ class Controller:
         returns, without the property call)."""
         env, robot, view, plan_for = self.env, self.robot, self.view, self.policy.plan
         replan_in, replan_out, u_nom = self.conveyor.replan, self.output.replan, self.k.u_nom
+        output_floor, u_min = self.output.belt.then, self.k.output_min
+        aim = self.k.lookahead_margin_s  # step 6.3 from when the next part is aimed at B
+        floor_after_td = math.nan  # the last planned TD (the spacing contract; nan: none)
         get, flag, missed, order = self.conveyor.at_bot.get, self.log.flag, self.log.missed, \
             robot.order
         t = self.k.timing
@@ -104,17 +140,24 @@ class Controller:
                 part.missed = True
                 flag(part, robot.loss(now))  # let go, or lost to downtime
                 missed(part)
+                if floor_after_td == floor_after_td:  # a wait now foreseen: the output belt's
+                    replan_out(max(now, floor_after_td), u_min)  # floor from TD (or now)
                 continue
             view.part, view.now = part.part - 1, now
-            (r1_pre, r1_post, r2, r3_pre, r3_post, r4, input_speed, input_after_lo, input_next,
-             output_to_g, to_g, cycle, limits, steers_belts) = plan_for(view)
-            if steers_belts:
-                replan_in(now + r1_pre, input_after_lo, now + cycle, input_next)
+            plan = plan_for(view)
+            r1_pre, r3_pre, r3_post, to_g, cycle = \
+                plan.r1_pre, plan.r3_pre, plan.r3_post, plan.to_g, plan.cycle
+            output_to_g, r2, r4, limits = plan.output_to_g, plan.r2, plan.r4, plan.limits
+            if plan.steers_belts:
+                replan_in(now + r1_pre, plan.input_after_lo, now + cycle + aim, plan.input_next)
                 replan_out(now, output_to_g, now + to_g, u_nom)
-            r1, r3 = r1_pre + r1_post, r3_pre + r3_post
+                if plan.output_floor_at < INF:  # the spacing contract: the belt's floor after TD
+                    output_floor(now + plan.output_floor_at, u_min)
+                    floor_after_td = now + to_g + r3_pre
+            r1, r3 = r1_pre + plan.r1_post, r3_pre + r3_post
             part.picked = True
             part.motion_cycle_s = cycle
-            part.input_speed_in_s, part.output_speed_in_s = input_speed, output_to_g
+            part.input_speed_in_s, part.output_speed_in_s = plan.input_speed, output_to_g
             part.r1_s, part.r2_s, part.r3_s, part.r4_s = r1, r2, r3, r4
             part.v_r1_in_s, part.v_r2_in_s = l1 / r1, l2 / r2
             part.v_r3_in_s, part.v_r4_in_s = l3 / r3, l4 / r4

@@ -13,7 +13,7 @@ taken it first), and the output conveyor's when a part is set down.
 from __future__ import annotations
 
 import math
-from bisect import bisect_right
+from bisect import bisect_left, bisect_right
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -127,6 +127,13 @@ class Belt:
         if t2 is not None:
             self._run_from(t2, v2)
 
+    def then(self, t: float, v: float) -> None:
+        """And from instant t, after every change planned, run at v (a third change)."""
+        if not v > 0 or not t > self._t[-1]:
+            raise ValueError(f"a belt's further change must come after its last and be "
+                             f"positive, got {t!r}, {v!r}")
+        self._run_from(t, v)
+
     def _run_from(self, t: float, v: float) -> None:
         """Run at v from instant t on (at or before the last change: that change's speed is v)."""
         ts, xs, vs = self._t, self._x, self._v
@@ -195,8 +202,13 @@ class Belt:
         for tp, vp in ahead:
             self._run_from(tp, vp)
 
-    def close(self) -> None:
-        """Hand every change still held (planned ones included) to ``on_change``."""
+    def close(self, until: float | None = None) -> None:
+        """Hand every change still held (planned ones included) to ``on_change``; with
+        ``until`` (the end of the run), those planned to start then or later, which never
+        took effect, are dropped instead."""
+        if until is not None:
+            keep = max(bisect_left(self._t, until - EPS_S), 1)
+            del self._t[keep:], self._x[keep:], self._v[keep:]
         self._settle(len(self._t))
         del self._t[:], self._x[:], self._v[:]
 

@@ -32,10 +32,13 @@ LIMITS = (
     "held_at_feeder",   # dropped later than it came: the belt had not cleared a part's size
     "lost_downtime",    # reached B (or was being picked) while the robot was stopped: rode off
     "scrapped",         # in the hand when the robot failed, scrapped (failures.robot.part_in_hand)
+    "spacing_wait",     # spacing off: the robot waited longer than the output floor allows
+    "spacing_unforeseen",  # spacing off: a wait the look-ahead did not foresee (belt slowed late)
 )
 LIMIT_BIT = {name: 1 << i for i, name in enumerate(LIMITS)}
 (INPUT_FLOOR, INPUT_CEILING, INPUT_TRACKING, OUTPUT_FLOOR, OUTPUT_CEILING, R2_PEAK, R4_PEAK,
- LET_GO, SPACING_OFF, HELD_AT_FEEDER, LOST_DOWNTIME, SCRAPPED) = (1 << i for i in range(len(LIMITS)))
+ LET_GO, SPACING_OFF, HELD_AT_FEEDER, LOST_DOWNTIME, SCRAPPED, SPACING_WAIT, SPACING_UNFORESEEN) = \
+    (1 << i for i in range(len(LIMITS)))
 
 
 class LimitCount(NamedTuple):
@@ -60,6 +63,10 @@ LIMIT_COUNTS: dict[str, LimitCount] = {
     "output_floor": LimitCount("limit_output_floor", "output belt at its floor"),
     "output_ceiling": LimitCount("limit_output_ceiling", "output belt at its ceiling"),
     "held_at_feeder": LimitCount("parts_held", "held at the feeder (belt not clear)"),
+    "spacing_wait": LimitCount("limit_spacing_wait",
+                               "spacing off: a wait longer than the output floor allows"),
+    "spacing_unforeseen": LimitCount("limit_spacing_unforeseen",
+                                     "spacing off: a wait the look-ahead did not foresee"),
 }
 
 
@@ -267,6 +274,15 @@ class RunSummary:
     """The robot's time up (not down, not in maintenance) per failure."""
     mttr_observed_s: float = NAN
     """The robot's time down per failure (the wait for a crew included)."""
+    limit_spacing_wait: int = 0
+    """Parts set down off spacing because the robot waited so long that even the output belt
+    at its floor from the last touch-down could not have kept 45 in (spacing contract)."""
+    limit_spacing_unforeseen: int = 0
+    """Parts set down off spacing after a wait the look-ahead did not foresee (a part let go,
+    missed by the sensor or misjudged): the output belt was slowed too late."""
+    parts_bound: int = 0
+    """The most parts any controller could deliver from the same arrivals with the same robot
+    and belts (a bound: each part's window at B, picks a fastest cycle apart; cell.bound)."""
 
     def __getitem__(self, name: str) -> Any:
         return getattr(self, name)

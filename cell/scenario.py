@@ -44,6 +44,7 @@ from cell.sections import (  # noqa: F401 - the schema, re-exported
     PathSettings,
     RobotSettings,
     RunSettings,
+    SensorSettings,
 )
 from cell.settings import Section, error_from_validation, model_at, unwrap_optional
 
@@ -67,6 +68,7 @@ class Scenario(Section):
     mintime: MinTimeSettings = MinTimeSettings()
     failures: FailureSettings | None = None
     """Breakdowns and repairs (docs/model.md, "When equipment fails"); absent: none."""
+    sensor: SensorSettings = SensorSettings()
 
     _source: str = PrivateAttr(default="<defaults>")
 

@@ -333,3 +333,27 @@ class FailureSettings(Section):
     repair: RepairSettings | None = None
     """Absent: every failure is repaired at once (as many crews as failures)."""
     maintenance: MaintenanceSettings | None = None
+# --------------------------------------------------------------------------- sensor
+class SensorSettings(Section):
+    """What the adaptive controller knows of the next part (docs/model.md, "The look-ahead")."""
+
+    lookahead: Literal["ideal", "sensor"] = "ideal"
+    """``ideal``: the thesis's assumption (§5.3 step 1.0), the next part's arrival known when
+    the transfer starts, even before the feeder drops it (an idealisation); ``sensor``: a
+    physical sensor that reports parts as they pass it, with the error, delay and misses
+    below.  Left out: ``ideal``, so the thesis's results reproduce (docs/model.md)."""
+    position_in: float | None = _num(None, ge=0.0, le=MAX_LENGTH_IN)
+    """How far before B the sensor sees a part (in).  Empty: at the feeder's drop point
+    (``belts.input_length_in``); it cannot be further up than that, nor behind B."""
+    noise_sd_in: float = _num(0.0, ge=0.0, le=MAX_LENGTH_IN)
+    """Standard deviation of the error on the position it reports (in, normal)."""
+    latency_s: float = _num(0.0, ge=0.0, le=MAX_TIME_S)
+    """How long after a part passes it the report reaches the controller (s): a known, fixed
+    delay, which the controller dates the report back by; a part is seen that much later."""
+    miss_probability: float = _num(0.0, ge=0.0, le=1.0)
+    """The chance that a part passes unreported (each part drawn on its own)."""
+    margin_s: float | None = _num(None, ge=0.0, le=MAX_TIME_S)
+    """How long after the robot is back the adaptive controller aims the next part at B, so
+    that a part the sensor misjudges is not let go for arriving a moment early (s).  Empty:
+    0 with the ideal look-ahead (the thesis's exact aim); with a sensor, three standard
+    deviations of its error, in time at the nominal input speed."""

@@ -35,7 +35,8 @@ import simpy
 
 from cell import accounting, oee
 from cell.assembly import AssembledCell, assemble
-from cell.controller import Controller, View
+from cell.bound import parts_bound
+from cell.controller import Controller, SensorView, View
 from cell.conveyors import InputConveyor, OutputConveyor
 from cell.failures import Downtime
 from cell.feeder import Feeder
@@ -56,6 +57,7 @@ from cell.records import (
 )
 from cell.robot import Robot
 from cell.scenario import Scenario
+from cell.sensor import Sensor, sensor_position
 
 PartSink = Callable[[PartRecord], Any]
 BeltSink = Callable[[BeltChange], Any]
@@ -325,7 +327,7 @@ def simulate(scenario: Scenario | AssembledCell,
     robot = Robot(env, output.placed, None if downtime is None else downtime.robot.cycle)
     feeder = Feeder(env, t_list, conveyor, n, k.part_size, log.flag)
     conveyor.feeder = feeder
-    view = View(k, feeder.fed_s, n, conveyor, output)
+    view = _view(cell, seed, n, feeder, conveyor, output)
     Controller(env, k, policy, view, conveyor, output, robot, log)
     if downtime is None and horizon is None:
         env.run()
@@ -335,16 +337,28 @@ def simulate(scenario: Scenario | AssembledCell,
             downtime.start()
         run_until_done(env, log, n, horizon, output)
     conveyor.belt.close()
-    output.belt.close()
+    output.belt.close(until=env.now)  # a floor planned after the last touch-down never ran
 
     summary = _summary(cell, log, acct, t_all, n, env.now)
     lines = oee.measure(summary, log.column, downtime, k.fastest_cycle_s, env.now)
     summary.seed = _seed_value(seed)
     summary.input_speed_max_in_s = conveyor.belt.max_speed_in_s
     summary.input_speed_min_in_s = conveyor.belt.min_speed_in_s
+    summary.parts_bound = parts_bound(k, feeder.fed_s[summary.warmup_parts:n])
     result = SimResult(summary, rows, belts if keep_belts else None)
     result.downtime, result.timelines = downtime, lines
     return result
+
+
+def _view(cell: AssembledCell, seed: Any, n: int, feeder: Feeder, conveyor: InputConveyor,
+          output: OutputConveyor) -> View:
+    """What the controller sees: the feeder's schedule (``sensor.lookahead: ideal``), or only
+    what a physical sensor has reported (``sensor``)."""
+    s, k = cell.scenario, cell.k
+    if s.sensor.lookahead == "ideal":
+        return View(k, feeder.fed_s, n, conveyor, output)
+    position = sensor_position(s.sensor, k.input_length, s.source)
+    return SensorView(k, Sensor(s.sensor, position, conveyor, n, seed), n, conveyor, output)
 
 
 def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, n: int,

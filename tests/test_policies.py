@@ -162,8 +162,10 @@ class AlwaysNominal(Policy):
 
     def plan(self, view):
         k = self.k
-        return Plan(k.r1_pre_nom, k.r1_post_nom, k.r2_nom, k.r3_pre_nom, k.r3_post_nom, k.r4_nom,
-                    k.v_nom, k.v_nom, k.v_nom, k.u_nom, k.r1_nom + k.r2_nom, k.cycle_nom,
+        return Plan(r1_pre=k.r1_pre_nom, r1_post=k.r1_post_nom, r2=k.r2_nom,
+                    r3_pre=k.r3_pre_nom, r3_post=k.r3_post_nom, r4=k.r4_nom,
+                    input_speed=k.v_nom, input_after_lo=k.v_nom, input_next=k.v_nom,
+                    output_to_g=k.u_nom, to_g=k.r1_nom + k.r2_nom, cycle=k.cycle_nom,
                     steers_belts=False)
 
 

@@ -98,7 +98,29 @@ def spacings_off() -> tuple[int, int]:
 
 C = 22.5872
 #: (a regular expression capturing one number in the README, the value it must show)
+def sensor_advantage(arrivals: str, sensor: str) -> float:
+    t = pd.read_csv(REPORTS / "sensor" / "sensor.csv")
+    return float(t[(t["arrivals"] == arrivals) & (t["sensor"] == sensor)]["delivered_vs_fixed"].iloc[0])
+
+
+def sensor_over(arrivals: str) -> str:
+    ideal, ref = sensor_advantage(arrivals, "ideal"), sensor_advantage(arrivals, "reference")
+    return f"{(ideal - ref) / ref:.0%}".rstrip("%")
+
+
 CHECKS: list[tuple[str, Callable[[], str]]] = [
+    (r"drop\s+point:\s+([\d.]+)\s+against\s+[\d.]+\s+parts\s+per\s+500\s+on\s+the\s+thesis",
+     lambda: f"{sensor_advantage('thesis', 'ideal'):.1f}"),
+    (r"drop\s+point:\s+[\d.]+\s+against\s+([\d.]+)\s+parts\s+per\s+500\s+on\s+the\s+thesis",
+     lambda: f"{sensor_advantage('thesis', 'reference'):.1f}"),
+    (r"on\s+the\s+thesis\s+arrivals\s+\(the\s+ideal\s+look-ahead\s+overstates\s+it\s+by\s+(\d+)%",
+     lambda: sensor_over("thesis")),
+    (r"and\s+([\d.]+)\s+against\s+[\d.]+\s+parts\s+per\s+500\s+on\s+the\s+spread",
+     lambda: f"{sensor_advantage('spread', 'ideal'):.1f}"),
+    (r"and\s+[\d.]+\s+against\s+([\d.]+)\s+parts\s+per\s+500\s+on\s+the\s+spread",
+     lambda: f"{sensor_advantage('spread', 'reference'):.1f}"),
+    (r"on\s+the\s+spread\s+arrivals\s+\(the\s+ideal\s+look-ahead\s+overstates\s+it\s+by\s+(\d+)%",
+     lambda: sensor_over("spread")),
     (r"range of 95 % of single runs \((\d+) of 18\)", lambda: f"{inside_count()}"),
     (r"Vavg R IV matches to ([\d.]+) in/s", lambda: f"{vavg_gap():.5f}".rstrip("0")),
     (r"loses ([\d.]+) parts of 500 on average \(the thesis: 206\)",

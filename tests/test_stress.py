@@ -29,7 +29,9 @@ def synthetic(rng: np.random.Generator, advantage: float, n: int = 12) -> pd.Dat
                          "fastest_cycle_s": 18.0841, "utilisation": 18.0841 / 19.8925,
                          "spacing_outside_tol": 0.0, "limit_input_floor": 1.0,
                          "limit_r4_peak": 2.0, "limit_r2_peak": 0.0, "limit_input_ceiling": 0.0,
-                         "limit_output_floor": 0.0, "parts_held": 0.0})
+                         "limit_output_floor": 0.0, "parts_held": 0.0, "parts_bound": 500.0,
+                         "limit_output_ceiling": 0.0, "limit_spacing_wait": 0.0,
+                         "limit_spacing_unforeseen": 0.0})
     return pd.DataFrame(rows)
 
 
@@ -89,3 +91,26 @@ def test_written_as_a_set(tmp_path):
     out = write(path, tmp_path / "stress")
     assert sorted(p.name for p in out.iterdir()) == ["README.md", "stress.csv", "stress.png"]
     assert (out / "stress.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_the_spacing_promise_is_read_with_its_causes():
+    """A point (load 1.1, cv 0.5) where the adaptive robot sets 2 % of its parts off spacing,
+    all after unforeseen waits: the reading names it, its share and the cause counted."""
+    reps = synthetic(np.random.default_rng(2), 9.0)
+    ad = reps["policy"] == "adaptive"
+    reps.loc[ad, "spacing_outside_tol"] = 0.02 * reps.loc[ad, "parts_delivered"]
+    reps.loc[ad, "limit_spacing_unforeseen"] = reps.loc[ad, "spacing_outside_tol"]
+    text = " ".join(reading(table(reps)))
+    assert "(more than 1 % at 1: gamma cv 0.5 load 1.10: 2.00 %" in text
+    assert f"{reps.loc[ad, 'limit_spacing_unforeseen'].mean():.2f} a wait not foreseen" in text
+    fine = synthetic(np.random.default_rng(2), 9.0)
+    assert "the promise of at most 1 % holds at every one of them" in " ".join(reading(table(fine)))
+
+
+def test_the_bound_is_read_as_a_share():
+    reps = synthetic(np.random.default_rng(4), 9.0)
+    t = table(reps)
+    share = t.set_index("policy")["delivered_vs_bound"]
+    for policy in ("adaptive", "non-adaptive"):
+        runs = reps[reps.policy == policy]
+        assert share[policy] == pytest.approx(runs["parts_delivered"].sum() / 500.0 / len(runs))

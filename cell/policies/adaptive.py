@@ -43,14 +43,19 @@ from cell.records import (
     OUTPUT_FLOOR,
     R2_PEAK,
     R4_PEAK,
+    SPACING_UNFORESEEN,
+    SPACING_WAIT,
     RunSummary,
 )
 
-_new_tuple = tuple.__new__
+#: The spacing contract plans the output belt's floor this long after the instant the next
+#: part is expected at B (a decision on time replans first, so nothing changes then).
+FLOOR_MARGIN_S = 1.0
 
 
 def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
-                  gap_in: float | None, lag: float | None = None) -> Plan:
+                  gap_in: float | None, lag: float | None = None,
+                  idle_s: float | None = None) -> Plan:
     """Thesis §5.3 steps 2.0-6.3 for one part (pure), within the belts' and motors' limits.
 
     ``v``: input belt speed now (R I tracks it).  ``nxt = (a, b)``: the next part
@@ -59,14 +64,16 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
     on the belt, a = time until the feeder drops it and b = the belt's length);
     None if no part is coming.  ``gap_in``: how far the last part set down has
     travelled on the output belt (None before the first).  ``lag``: B → LO at v,
-    if the caller has it already.
+    if the caller has it already.  ``idle_s``: seconds since that part was set down
+    (to name the cause when the spacing cannot be kept).
 
     Departures from the thesis (docs/model.md), none of which binds on its arrivals:
     step 3.2 slows the input belt no further than its floor, taking time off R II
     (down to its fastest) before that, and a part still too early is let go (it
     reaches B while the robot is busy); step 6.3 also raises a belt left
     slower than R II can absorb (``k.input_absorb``), so a slowed belt never lengthens
-    the next cycle; step 5.0 keeps the output belt within its floor and ceiling.
+    the next cycle; step 5.0 keeps the output belt within its floor and ceiling, and the
+    spacing contract steers it after TD as well (:func:`floor_at`).
     """
     t = k.timing
     flags = 0
@@ -80,16 +87,17 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
     r3a, r3b, r4 = k.r3_pre_nom, k.r3_post_nom, k.r4_nom
     cycle = r1a + r1b + r2 + r3a + r3b + r4
     w = v
+    m = k.lookahead_margin_s  # the next part aimed at B this long after the robot is back
     if nxt is not None:
         a, b = nxt
         eta = a + b / v                       # 3.0: next arrival at the current speed
-        if eta > cycle:                       # 3.1: late; speed the belt up after the lag
-            w = b / (cycle - a) if cycle > a else math.inf
+        if eta > cycle + m:                       # 3.1: late; speed the belt up after the lag
+            w = b / (cycle + m - a) if cycle + m > a else math.inf
             if w > k.input_max:
                 w = k.input_max
                 flags |= INPUT_CEILING
-        elif eta < cycle:                     # 3.2: early; R IV first, then the belt
-            need = cycle - eta
+        elif eta < cycle + m:                     # 3.2: early; R IV first, then the belt
+            need = cycle + m - eta
             if r4 - need >= t.r4_min_s:
                 r4 -= need
                 cycle -= need
@@ -97,14 +105,14 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
                 cycle -= r4 - t.r4_min_s
                 r4 = t.r4_min_s
                 flags |= R4_PEAK
-                w = b / (cycle - a)
+                w = b / (cycle + m - a)
                 if w < k.input_min:           # departure: the belt's floor, R II first
-                    over = cycle - (a + b / k.input_min)  # the cycle past the floor's arrival
+                    over = cycle + m - (a + b / k.input_min)  # the cycle past the floor's arrival
                     spare = min(r2 - t.r2_min_s, over)
                     if spare > 0:
                         r2 -= spare
                         cycle -= spare
-                        w = b / (cycle - a)
+                        w = b / (cycle + m - a)
                     if w < k.input_min:  # also by a rounding once R II took it all up
                         w = k.input_min
                         if spare < over:  # R II could not: the next part comes early
@@ -115,23 +123,66 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
     if v_next > t.input_track_max_in_s:
         v_next = t.input_track_max_in_s
         flags |= INPUT_TRACKING
-    # 5.0: output belt until G, between the 44.75 and 45.25 in limits.
-    u = k.u_nom
-    if gap_in is not None:
-        ttsot = r1a + r1b + r2
-        rest = gap_in + k.u_nom * r3a
-        lo = (k.spacing - k.tol - rest) / ttsot
-        hi = (k.spacing + k.tol - rest) / ttsot
-        u = 0.5 * (lo + hi)
-        if u < k.output_min:
-            u = k.output_min
-            flags |= OUTPUT_FLOOR
-        elif u > k.output_max:
-            u = k.output_max
-            flags |= OUTPUT_CEILING
-    # Plan(...) without its Python-level __new__ (once a part): every field, in order
-    return _new_tuple(Plan, (r1a, r1b, r2, r3a, r3b, r4, v, w, v_next, u, r1a + r1b + r2, cycle,
-                             flags, True))
+    ttsot = r1a + r1b + r2
+    u, out_flags = (k.u_nom, 0) if gap_in is None else output_speed(k, gap_in, ttsot, r3a, idle_s)
+    flags |= out_flags
+    return Plan(r1_pre=r1a, r1_post=r1b, r2=r2, r3_pre=r3a, r3_post=r3b, r4=r4,
+                input_speed=v, input_after_lo=w, input_next=v_next, output_to_g=u,
+                to_g=ttsot, cycle=cycle, limits=flags,
+                output_floor_at=floor_at(k, nxt, w, v_next, cycle, ttsot + r3a))
+
+
+def output_speed(k: CellConstants, gap_in: float, ttsot: float, r3a: float,
+                 idle_s: float | None) -> tuple[float, int]:
+    """Step 5.0: the output belt until G, the average of the speeds that set the part down
+    44.75 and 45.25 in behind the last, within the belt's floor and ceiling; the limits hit
+    (and, spacing off at the floor, its cause)."""
+    rest = gap_in + k.u_nom * r3a
+    lo = (k.spacing - k.tol - rest) / ttsot
+    hi = (k.spacing + k.tol - rest) / ttsot
+    u = 0.5 * (lo + hi)
+    if u < k.output_min:
+        u = k.output_min
+        flags = OUTPUT_FLOOR
+        if rest + u * ttsot > k.spacing + k.tol:  # off: name the cause
+            flags |= spacing_cause(k, idle_s, ttsot, r3a)
+        return u, flags
+    if u > k.output_max:
+        return k.output_max, OUTPUT_CEILING
+    return u, 0
+
+
+def floor_at(k: CellConstants, nxt: tuple[float, float] | None, w: float, v_next: float,
+             cycle: float, td: float) -> float:
+    """The spacing contract (docs/model.md): when, in seconds from the start of this cycle,
+    the output belt is to drop to its floor after this part's touch-down ``td``.
+
+    The next part is expected at B at ``t_e`` (the look-ahead's part at the planned input
+    speeds: ``w`` until the cycle ends, ``v_next`` after; the robot back at ``cycle``).  If
+    the belt at nominal until a margin after ``t_e`` still leaves room for 45 in, the floor
+    is planned for then: a decision on time replans first, and nothing changes.  A wait
+    foreseen too long for that, or no part in sight, slows the belt at TD, so that the
+    gap grows as slowly as the belt allows until the next part is planned.
+    """
+    if nxt is None:
+        return td
+    a, b = nxt
+    switch = cycle + k.lookahead_margin_s  # step 6.3's change of the input belt
+    run = switch - a
+    eta = a + b / w if b <= w * run else (switch if switch > a else a) + \
+        (b - (w * run if run > 0 else 0.0)) / v_next
+    t_e = (eta if eta > cycle else cycle) + FLOOR_MARGIN_S
+    return t_e if k.u_nom * (t_e - td) <= k.floor_gap_in else td
+
+
+def spacing_cause(k: CellConstants, idle_s: float | None, ttsot: float, r3a: float) -> int:
+    """Why a part is set down off spacing with the output belt at its floor: the wait since
+    the last touch-down was too long even for the floor from then (``spacing_wait``), or
+    the belt was slowed too late, the look-ahead not having foreseen the wait."""
+    if idle_s is None:
+        return 0
+    shortest = k.output_min * (idle_s + ttsot) + k.u_nom * r3a
+    return SPACING_WAIT if shortest > k.spacing + k.tol else SPACING_UNFORESEEN
 
 
 class Adaptive(Policy):
@@ -152,7 +203,8 @@ class Adaptive(Policy):
     def plan(self, view: CellView) -> Plan:
         v = view.input_speed()
         lag = self._lag(v)
-        return adaptive_plan(self.k, v, view.next_part(lag, v), view.output_gap(), lag)
+        return adaptive_plan(self.k, v, view.next_part(lag, v), view.output_gap(), lag,
+                             view.since_touchdown())
 
     def accounting(self) -> MotionTimeAccounting:
         return AdaptiveAccounting(self)

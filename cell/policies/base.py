@@ -15,7 +15,7 @@ from abc import ABC, abstractmethod
 from array import array
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, ClassVar, NamedTuple, Protocol
+from typing import Any, ClassVar, Protocol
 
 import numpy as np
 
@@ -62,6 +62,9 @@ class CellConstants:
     a belt left slower than this would lengthen the next cycle (docs/model.md)."""
     mean_interarrival_s: float = float("nan")
     """Mean inter-arrival time of the arrivals (the distribution's or the trace's)."""
+    lookahead_margin_s: float = 0.0
+    """The adaptive controller aims the next part at B this long after the robot is back
+    (``sensor.margin_s``; 0 with the ideal look-ahead, as the thesis)."""
     nominal_from: str = "scenario"
     """Where ``cycle_nom`` came from: ``scenario`` (``controller.nominal_cycle_s``),
     ``arrivals`` (their mean) or ``fastest`` (the arrivals are faster than the robot)."""
@@ -78,13 +81,27 @@ class CellConstants:
         return self.r1_nom + t.r2_min_s + self.r3_pre_nom + self.r3_post_nom + t.r4_min_s
 
     @property
+    def floor_gap_in(self) -> float:
+        """The spacing contract's threshold: the most the last part set down may have travelled
+        when the next part reaches B for 45 in to be kept with the output belt at its floor
+        until G (R I + R II at their nominal sum) and at nominal from G to TD."""
+        return self.spacing - self.u_nom * self.r3_pre_nom - \
+            self.output_min * (self.r1_nom + self.r2_nom) - 1e-6
+
+    @property
     def utilisation(self) -> float:
         """Fastest cycle over mean inter-arrival time: 1 or more, the cell cannot keep up."""
         return self.fastest_cycle_s / self.mean_interarrival_s
 
 
-class Plan(NamedTuple):
-    """One transfer cycle: regime times (s), belt speeds (in/s) and what went wrong."""
+@dataclass(slots=True, kw_only=True)
+class Plan:
+    """One transfer cycle: regime times (s), belt speeds (in/s) and what went wrong.
+
+    A named record: built with keywords and read by name, never by position (a slotted
+    dataclass, as quick to build and read as the tuple it replaces).  A policy may hand
+    the same plan out for every part (the fixed cycle does), so nobody changes one.
+    """
 
     r1_pre: float
     r1_post: float
@@ -108,6 +125,9 @@ class Plan(NamedTuple):
     """The limits hit (bits of :data:`cell.records.LIMIT_BIT`)."""
     steers_belts: bool = True
     """Whether the belt speeds above are commands (False: the belts are left alone)."""
+    output_floor_at: float = math.inf
+    """The spacing contract (docs/model.md): seconds from the start of this cycle at which
+    the output belt drops to its floor until the next part's plan (inf: not planned)."""
 
 
 class CellView(Protocol):
@@ -124,6 +144,9 @@ class CellView(Protocol):
 
     def output_gap(self) -> float | None:
         """How far the last part set down has travelled on the output belt (None: none yet)."""
+
+    def since_touchdown(self) -> float | None:
+        """Seconds since the last part was set down (None: none yet)."""
 
 
 class Policy(ABC):

@@ -35,10 +35,11 @@ def fixed_plan(k: CellConstants, ideal_cycle_s: float, file: object = None) -> P
                             f"{k.shortest_cycle_s:.4f} s")
     r4 = max(r4, t.r4_min_s)
     to_g = k.r1_pre_nom + k.r1_post_nom + k.r2_nom
-    return Plan(k.r1_pre_nom, k.r1_post_nom, k.r2_nom, k.r3_pre_nom, k.r3_post_nom, r4,
-                k.v_nom, k.v_nom, k.v_nom, k.u_nom, to_g,
-                to_g + k.r3_pre_nom + k.r3_post_nom + r4, R4_PEAK if r4 <= t.r4_min_s else 0,
-                steers_belts=False)
+    return Plan(r1_pre=k.r1_pre_nom, r1_post=k.r1_post_nom, r2=k.r2_nom, r3_pre=k.r3_pre_nom,
+                r3_post=k.r3_post_nom, r4=r4, input_speed=k.v_nom, input_after_lo=k.v_nom,
+                input_next=k.v_nom, output_to_g=k.u_nom, to_g=to_g,
+                cycle=to_g + k.r3_pre_nom + k.r3_post_nom + r4,
+                limits=R4_PEAK if r4 <= t.r4_min_s else 0, steers_belts=False)
 
 
 class FixedCycle(Policy):
