@@ -115,7 +115,7 @@ def test_built_in_files_are_listed_by_what_they_are_for(capsys):
     assert main(["scenarios"]) == 0
     listed = capsys.readouterr().out
     headings = [line for line in listed.splitlines() if not line.startswith(" ")]
-    assert [h.split()[0] for h in headings] == ["scenario", "sweep", "dynamics"]
+    assert [h.split()[0] for h in headings] == ["scenario", "sweep", "dynamics", "study"]
     section = {h.split()[0]: [] for h in headings}
     current = None
     for line in listed.splitlines():
@@ -136,6 +136,10 @@ def test_built_in_files_are_listed_by_what_they_are_for(capsys):
         load_sweep(name)
     for name in section["dynamics"]:
         load_dynamics(catalog.path(name))
+    from cell.study import load_study
+
+    for name in section["study"]:
+        load_study(catalog.path(name))
 
 
 @pytest.mark.parametrize("command,name,found", [
