@@ -189,7 +189,7 @@ def worker(source: str, out: str) -> int:
     from cell.study import load_study
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
-    study = load_study(source)
+    study = load_study(source, corners=False)
     o = optuna.load_study(study_name=study.name, storage=storage_url(Path(out)))
     return work(study, o)
 

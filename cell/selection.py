@@ -70,13 +70,47 @@ def table(sel: Selection, labels: Sequence[str], measure: str) -> list[str]:
 
 def sentence(sel: Selection, labels: Sequence[str], measure: str) -> str:
     """The selection in words."""
-    alike = [labels[i] for i in sel.alike()]
+    left = [labels[i] for i in sel.survivors if i != sel.best]
+    near = [labels[i] for i in sel.within_delta() if i not in sel.survivors]
     text = (f"KN (Kim & Nelson 2001) chose **{labels[sel.best]}** on {measure}, with probability "
             f"of correct selection at least {sel.pcs:g} when the best is better by δ = "
-            f"{sel.delta:g} or more")
-    if alike:
-        text += ("; it cannot be told apart, within δ or the replications allowed, from "
-                 + ", ".join(alike))
-    else:
-        text += "; every other candidate was eliminated"
-    return text + "."
+            f"{sel.delta:g} or more.")
+    if left:
+        text += (" The replications allowed did not tell it apart from " + ", ".join(left) + ".")
+    if near:
+        text += (" Within δ of it (a difference the study calls too small to matter, so not "
+                 "told apart from it): " + ", ".join(near) + ".")
+    if not left and not near:
+        text += " Every other candidate was eliminated, and is more than δ from it."
+    return text
+
+
+def select_sweep(sweep: Any, replications: Any, measure: str, delta: float, pcs: float,
+                 goal: str | None = None, max_n: int = 1000) -> tuple[Selection, list[str]]:
+    """KN over a sweep's points on ``measure``: the replications ``replications.csv`` holds
+    are the first stage (their fewest per point is n0) and the start of every point's
+    sequence; more run on the sweep's own streams.  Returns the selection and the points'
+    labels."""
+    from cell.errors import CellError
+    from cell.study import measures_of
+
+    goal = goal or GOALS.get(measure)
+    if goal is None:
+        raise CellError(f"--select-best {measure}: say whether more or less is better "
+                        "(--goal maximize or --goal minimize)")
+    known: dict[int, list[float]] = {}
+    labels: list[str] = []
+    for i, p in enumerate(sweep.points):
+        rows = replications[(replications["policy"] == p.policy) & (replications["point"] == p.index)]
+        rows = rows.sort_values("replication")
+        if measure in rows.columns:
+            known[i] = [float(v) for v in rows[measure]]
+        else:
+            known[i] = [measures_of(r)[measure] for r in rows.to_dict("records")]
+        labels.append(", ".join([p.policy] + [f"{k} {p.name_of(k) or v}" for k, v in p.values]))
+    n0 = min(len(v) for v in known.values())
+    if n0 < 2:
+        raise CellError(f"--select-best {measure}: KN needs at least 2 replications of every point")
+    sel = select_scenarios([p.scenario for p in sweep.points], measure, goal == "maximize", delta,
+                           pcs, n0, max(max_n, n0), sweep.stream, known)
+    return sel, labels

@@ -94,7 +94,7 @@ def _cached(source: str) -> Study:
 
     if source not in _STUDIES:
         _STUDIES.clear()
-        _STUDIES[source] = load_study(source)
+        _STUDIES[source] = load_study(source, corners=False)
     return _STUDIES[source]
 
 

@@ -43,7 +43,10 @@ def reading(study: Study, sobol: Any, morris: Any, points: Any, policies: Sequen
         adv = points[ADVANTAGE]
         worst = points.loc[adv.idxmin()]
         keys = [c for c in points.columns if c not in ("design", ADVANTAGE) and "/" not in c]
-        at = ", ".join(f"{k} = {worst[k]:.4g}" for k in keys)
+        base = {p.key: study_value(study, p.key) for p in study.params}
+        at = ", ".join(f"{k} = {worst[k]:.4g}" for k in keys
+                       if worst[k] == worst[k] and abs(worst[k] - base[k]) > 1e-9 * max(1, abs(base[k])))
+        at = f"{worst['design']} point {int(adv.idxmin())}: " + (at or "the base values")
         n_bad = int((adv <= 0).sum())
         if n_bad == 0:
             out.append(f"- **The thesis's conclusion** (the adaptive robot delivers more parts "
@@ -60,6 +63,15 @@ def reading(study: Study, sobol: Any, morris: Any, points: Any, policies: Sequen
             out.append("- The advantage's size depends most on " + ", ".join(
                 f"`{k}` (ST {st:.2f} ± {h:.2f})" for k, st, h in mv) + ".")
     return out
+
+
+def study_value(study: Study, key: str) -> float:
+    """A key's value in the study's base scenario (with ``set``)."""
+    import re
+
+    m = re.match(r"^(.*)\[(\d+)\]$", key)
+    s = study.scenario({})
+    return float(s.get(m[1])[int(m[2])]) if m else float(s.get(key))
 
 
 def figure(sobol: Any, path: Any) -> None:

@@ -186,8 +186,10 @@ class Study:
         return [self.scenario({}).controller.policy]
 
 
-def load_study(path: str | Path) -> Study:
-    """Read and check a study file; every problem is one :class:`ScenarioError`."""
+def load_study(path: str | Path, corners: bool = True) -> Study:
+    """Read and check a study file; every problem is one :class:`ScenarioError`.
+    ``corners``: also build each key's scenario at both ends of its range (a worker
+    reading a file its command checked already skips it)."""
     from cell import catalog
     from cell.yamlio import load_mapping
 
@@ -210,7 +212,8 @@ def load_study(path: str | Path) -> Study:
         raise ScenarioError(path, "vary", settings.vary, "name at least one key to vary")
     params = tuple(_param(path, base, key, spec) for key, spec in settings.vary.items())
     study = Study(path, settings, base, params, ())
-    _check_corners(study)
+    if corners:
+        _check_corners(study)
     measures = summary_measures()
     constraints = tuple(_constraint(path, i, text, measures)
                         for i, text in enumerate(settings.constraints))
@@ -302,15 +305,15 @@ def _refuse_unset(study: Study, where: str, measure: str) -> None:
 
 
 def _check_corners(study: Study) -> None:
-    """Build the scenario at every key's low and high end (and each choice), the others
-    at their low end, so a bad range is refused before any work, naming its key."""
+    """Build the scenario at every key's low and high end (and each choice), one key at a
+    time, so a bad range is refused before any work, naming its key.  (A point where several
+    keys combine into a cell that cannot work is a refused trial of ``cell optimize``.)"""
     from cell.assembly import assemble
 
-    lows = {p.key: (p.choices[0] if p.is_choice else _value(p, p.low)) for p in study.params}
     for p in study.params:
         for v in (p.choices if p.is_choice else (_value(p, p.low), _value(p, p.high))):
             try:
-                assemble(study.scenario({**lows, p.key: v}))
+                assemble(study.scenario({p.key: v}))
             except ScenarioError as exc:
                 raise ScenarioError(study.source, f"vary.{p.key}", v, f"at this value "
                                     f"{exc.key} = {exc.value}: {exc.why}") from None

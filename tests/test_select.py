@@ -40,7 +40,7 @@ def _macro_pcs(means: np.ndarray, rho: float, n_max: int, seed: int) -> tuple[fl
 @pytest.mark.parametrize("rho", [0.0, 0.6])
 def test_kn_picks_the_best_in_the_slippage_configuration(rho: float) -> None:
     means = np.array([DELTA] + [0.0] * (K - 1))
-    share, unfinished = _macro_pcs(means, rho, n_max=600, seed=23 + int(10 * rho))
+    share, unfinished = _macro_pcs(means, rho, n_max=400, seed=23 + int(10 * rho))
     assert unfinished == 0
     assert share >= PCS, share
 
