@@ -42,7 +42,7 @@ def fingerprint(study: Study) -> str:
     return hashlib.sha256(json.dumps(doc, sort_keys=True, default=str).encode()).hexdigest()
 
 
-def directions(study: Study) -> list[str]:
+def directions(study: Study) -> list[Any]:
     return [o.goal for o in study.settings.objectives]
 
 
@@ -52,7 +52,7 @@ def _sampler(study: Study, number: int) -> Any:
     seed = int(np.random.SeedSequence([study.settings.seed, number]).generate_state(1)[0])
     # Optuna 5 reads the constraints a trial sets itself (Trial.set_constraint); before it,
     # a constraints_func gave them
-    given = {} if _SET_CONSTRAINT else {"constraints_func": _constraints}
+    given: dict[str, Any] = {} if _SET_CONSTRAINT else {"constraints_func": _constraints}
     if len(study.settings.objectives) > 1:
         return optuna.samplers.NSGAIISampler(seed=seed, **given)
     return optuna.samplers.TPESampler(seed=seed, n_startup_trials=min(10, max(2, study.settings.trials // 4)),

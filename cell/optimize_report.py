@@ -68,9 +68,15 @@ def candidates(study: Study, frame: Any) -> list[int]:
     m, up = selection_measure(study)
     feasible = frame[frame["feasible"]]
     order = feasible.sort_values([m, "trial"], ascending=[not up, True])
-    front = [i for i in order.index if frame.loc[i, "on_front"]]
-    rest = [i for i in order.index if i not in front]
-    picked = (front + rest)[:sel.candidates]
+    keys = [p.key for p in study.params]
+    seen: set[tuple[str, ...]] = set()
+    picked = []
+    for i in [i for i in order.index if frame.loc[i, "on_front"]] + \
+            [i for i in order.index if not frame.loc[i, "on_front"]]:
+        point = tuple(str(frame.loc[i, k]) for k in keys)  # a point the search tried twice: once
+        if point not in seen and len(picked) < sel.candidates:
+            seen.add(point)
+            picked.append(i)
     return picked if len(picked) >= 2 else []
 
 
@@ -164,6 +170,23 @@ def importances(study: Study, o: Any) -> dict[str, float]:
         return {}
 
 
+def answer(study: Study, front: Any) -> str:
+    """The front (or the best) in one sentence."""
+    keys = [p.key for p in study.params]
+    if not len(front):
+        return "No trial met the constraints: widen the ranges or relax the constraints."
+    distinct = front.drop_duplicates(subset=keys)
+    points = "; ".join(", ".join(f"{k} = {_show(r[k])}" for k in keys) + f" (trial {int(r['trial'])})"
+                       for _, r in distinct.sort_values(keys).iterrows())
+    cons = " and ".join(str(c) for c in study.constraints) or "no constraint"
+    if len(study.settings.objectives) > 1 and len(distinct) == 1:
+        return (f"One point is best in every objective at once, so there is no trade-off to choose "
+                f"along: {points}, with {cons} kept on the means.")
+    if len(study.settings.objectives) > 1:
+        return f"The trade-off ({len(distinct)} points, {cons} kept on the means): {points}."
+    return f"The best feasible point ({cons} kept on the means): {points}."
+
+
 def importance_measure(study: Study) -> tuple[str, bool]:
     """The measure the keys' importance is for: the selection's, else the first objective."""
     try:
@@ -195,7 +218,7 @@ def markdown(study: Study, frame: Any, picked: list[int], sel: Selection | None,
         lines.append(f"| {p.key} | {rng} |")
     front = frame[frame["on_front"]] if len(frame) else frame
     title = "Pareto front" if len(s.objectives) > 1 else "Best feasible trial"
-    lines += ["", f"## {title}", ""]
+    lines += ["", "## Answer", "", answer(study, front), "", f"## {title}", ""]
     if not len(front):
         lines.append("No trial met the constraints.")
     else:

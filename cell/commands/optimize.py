@@ -6,8 +6,12 @@ import argparse
 import shlex
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from cell.commands import check_workers, workers_argument
+
+if TYPE_CHECKING:
+    from cell.study import Study
 
 HELP = "search scenario keys for the best setting (Optuna), then select it (KN)"
 DESCRIPTION = ("Search a study file's keys with Optuna (TPE for one objective, NSGA-II for "
@@ -68,7 +72,7 @@ def main(args: argparse.Namespace) -> int:
     return 0
 
 
-def write_results(study, o, out: Path, command: str) -> list[Path]:  # type: ignore[no-untyped-def]
+def write_results(study: Study, o: Any, out: Path, command: str) -> list[Path]:
     from cell.optimize import SELECT_OFFSET
     from cell.optimize_report import (
         candidates,

@@ -55,7 +55,8 @@ def _sizes(study: Any, source: Path) -> dict[str, int]:
                             ("sobol", s, {"samples", "keys"})):
         for k, v in d.items():
             if k not in known:
-                raise ScenarioError(source, f"{where}.{k}", v, f"unknown key (known: {', '.join(sorted(known))})")
+                raise ScenarioError(source, f"{where}.{k}", v,
+                                    f"unknown key (known: {', '.join(sorted(known))})")
             if not isinstance(v, int) or isinstance(v, bool) or v < 2:
                 raise ScenarioError(source, f"{where}.{k}", v, "must be a whole number, at least 2")
     samples = s.get("samples", 64)
@@ -112,6 +113,9 @@ def run(study: Any, workers: int, sizes: dict[str, int]) -> dict[str, Any]:
     names = [f"{p}/{m}" if m != "advantage" else m for p, m in cols]
     points = pd.concat([_points("morris", md, ym, names), _points("sobol", sd, ys, names)],
                        ignore_index=True)
+    for p in study.params:  # a whole-number key as the runs had it
+        if p.whole and p.key in points.columns:
+            points[p.key] = points[p.key].round()
     sizes.update(morris=len(md.points), sobol=len(sd.points))
     return {"morris": pd.DataFrame(mrows), "sobol": pd.DataFrame(srows), "points": points,
             "policies": policies}
