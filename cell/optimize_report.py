@@ -70,7 +70,7 @@ def candidates(study: Study, frame: Any) -> list[int]:
     order = feasible.sort_values([m, "trial"], ascending=[not up, True])
     keys = [p.key for p in study.params]
     seen: set[tuple[str, ...]] = set()
-    picked = []
+    picked: list[int] = []
     for i in [i for i in order.index if frame.loc[i, "on_front"]] + \
             [i for i in order.index if not frame.loc[i, "on_front"]]:
         point = tuple(str(frame.loc[i, k]) for k in keys)  # a point the search tried twice: once
@@ -225,7 +225,8 @@ def markdown(study: Study, frame: Any, picked: list[int], sel: Selection | None,
         ms = measured(study)
         keys = [p.key for p in study.params]
         lines += ["| trial | " + " | ".join(keys + ms) + " |", "|---" * (1 + len(keys) + len(ms)) + "|"]
-        for _, r in front.sort_values([study.settings.objectives[0].measure, "trial"]).iterrows():
+        shown = front.drop_duplicates(subset=keys)  # a point the search tried twice: once
+        for _, r in shown.sort_values([study.settings.objectives[0].measure, "trial"]).iterrows():
             cells = [_show(r[k]) for k in keys] + [f"{r[m]:.4g} ± {r[m + '_ci95']:.2g}" for m in ms]
             lines.append(f"| {int(r['trial'])} | " + " | ".join(cells) + " |")
     lines += ["", "![history](history.png) ![front](front.png)", "", "## Importance", ""]

@@ -108,15 +108,14 @@ def evaluate(study: Study, design: Design, policies: Sequence[str], measures: Se
     jobs = [(str(study.source.resolve()), design.keys, tuple(float(v) for v in x),
              tuple(policies), tuple(measures), study.settings.replications) for x in design.points]
     rows: list[list[float]] = []
+    _STUDIES.clear()
+    _STUDIES[str(study.source.resolve())] = study  # forked workers start with it too
     if workers <= 1:
-        _STUDIES[str(study.source.resolve())] = study
         for job in jobs:
             rows.append(_point(job))
             progress.update()
     else:
-        import multiprocessing
-
-        with cf.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+        with cf.ProcessPoolExecutor(workers) as pool:  # as a sweep's workers: forked on Linux
             for row in pool.map(_point, jobs, chunksize=max(1, len(jobs) // (8 * workers))):
                 rows.append(row)
                 progress.update()

@@ -12,8 +12,11 @@ from cell.sensitivity import ADVANTAGE
 from cell.study import Study
 
 FILES = ("morris.csv", "sobol.csv", "points.csv", "sensitivity.png", "report.md")
-#: A key "moves" a measure when its total index's lower 95 % bound is above this.
+#: A key "moves" a measure when its total index's lower 95 % bound is above this ...
 MOVES = 0.05
+#: ... and the measure itself spreads over the points by more than this share of its mean
+#: (below it, the indices apportion a variance too small to matter to anyone).
+MATERIAL = 0.005
 HEADLINE = {"parts_missed": "parts lost", "spacing_outside_pct": "spacing off",
             "parts_per_hr_wallclock": "throughput", ADVANTAGE: "the adaptive robot's advantage"}
 
@@ -25,13 +28,16 @@ def movers(sobol: Any, policy: str, measure: str) -> list[tuple[str, float, floa
     return [(r.key, float(r.ST), float(r.ST_ci95)) for r in f.itertuples()]
 
 
-def _span(points: Any, policy: str, m: str) -> str:
-    """A measure's range over the points, in words."""
+def _span(points: Any, policy: str, m: str) -> tuple[str, bool]:
+    """A measure's range over the points, in words, and whether that range is material."""
     col = f"{policy}/{m}" if m != ADVANTAGE else m
     if col not in points.columns:
-        return ""
+        return "", True
     lo, hi = float(points[col].min()), float(points[col].max())
-    return f"{lo:.5g} at every point" if lo == hi else f"{lo:.5g} to {hi:.5g} over the points"
+    if lo == hi:
+        return f"{lo:.5g} at every point", False
+    share = (hi - lo) / max(abs(float(points[col].mean())), 1e-300)
+    return f"{lo:.5g} to {hi:.5g} over the points, a spread of {100 * share:.2g} %", share > MATERIAL
 
 
 def reading(study: Study, sobol: Any, morris: Any, points: Any, policies: Sequence[str]) -> list[str]:
@@ -42,8 +48,14 @@ def reading(study: Study, sobol: Any, morris: Any, points: Any, policies: Sequen
             if m == ADVANTAGE or not ((sobol["policy"] == policy) & (sobol["measure"] == m)).any():
                 continue
             mv = movers(sobol, policy, m)
-            span = _span(points, policy, m)
-            if mv:
+            span, material = _span(points, policy, m)
+            if not material and "every point" in span:
+                out.append(f"- **{words}, {policy}** ({span}): no assumption moves it at all.")
+            elif not material:
+                out.append(f"- **{words}, {policy}** ({span}): practically the same whatever the "
+                           f"assumptions (a spread under {100 * MATERIAL:g} % of its mean); the "
+                           "indices below share out a variance too small to matter.")
+            elif mv:
                 named = ", ".join(f"`{k}` (ST {st:.2f} ± {h:.2f})" for k, st, h in mv)
                 out.append(f"- **{words}, {policy}** ({span}): moved by {named}.")
             else:

@@ -80,3 +80,28 @@ def test_eta_closed_form() -> None:
     assert h_squared(2, 0.05, 2) == pytest.approx(99.0)
     with pytest.raises(ValueError):
         eta(1, 0.05, 10)
+
+
+def test_sweep_select_best_continues_the_sweeps_streams(tmp_path, capsys) -> None:
+    """The fixed-cycle robot loses fewer parts at a shorter cycle (Table 7.1): KN over a
+    sweep's two cycles picks the shorter; without --delta nothing runs."""
+    from pathlib import Path
+
+    import pandas as pd
+
+    from cell.cli import main
+
+    base = Path(__file__).resolve().parents[1] / "scenarios" / "baseline.yaml"
+    sweep = tmp_path / "s.yaml"
+    sweep.write_text(f"base: {base}\nset: {{run.parts: 60}}\npolicies: [non-adaptive]\n"
+                     "grid: {controller.ideal_cycle_s: [20.1, 22.5872]}\nreplications: 3\nseed: 2\n")
+    out = tmp_path / "out"
+    assert main(["sweep", str(sweep), "--out", str(out), "--select-best", "parts_missed"]) == 2
+    assert "--delta" in capsys.readouterr().err and not out.exists()
+    assert main(["sweep", str(sweep), "--out", str(out), "--workers", "1",
+                 "--select-best", "parts_missed", "--delta", "1"]) == 0
+    sel = pd.read_csv(out / "selection.csv")
+    chosen = sel[sel["verdict"] == "chosen"]
+    assert len(chosen) == 1 and "20.1" in chosen["point"].iloc[0]
+    assert (sel["replications"] >= 3).all()
+    assert "KN (Kim & Nelson 2001) chose" in capsys.readouterr().out

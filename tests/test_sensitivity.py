@@ -45,3 +45,27 @@ def test_a_measure_no_key_moves_has_zero_indices() -> None:
 def test_a_choice_cannot_be_analysed() -> None:
     with pytest.raises(ValueError, match="range"):
         sobol_design([Param("controller.policy", choices=("adaptive",))], 8, seed=1)
+
+
+def test_the_results_do_not_depend_on_the_number_of_workers(tmp_path) -> None:
+    """The same points, run here and in two worker processes: the same numbers, in order."""
+    from pathlib import Path
+
+    from cell.progress import Progress
+    from cell.sensitivity import evaluate
+    from cell.study import load_study
+
+    base = Path(__file__).resolve().parents[1] / "scenarios" / "baseline.yaml"
+    path = tmp_path / "s.yaml"
+    path.write_text(f"base: {base}\nset: {{run.parts: 30}}\npolicies: [adaptive, non-adaptive]\n"
+                    "measures: [parts_missed, parts_per_hr_wallclock]\nreplications: 2\n"
+                    "vary: {belts.input_nominal_in_s: [2.0, 3.0], belts.input_length_in: [110, 160]}\n")
+    study = load_study(path)
+    d = sobol_design(list(study.params), 2, seed=3)
+    quiet = Progress(len(d.points), "t", "points", enabled=False)
+    one = evaluate(study, d, ["adaptive", "non-adaptive"], ["parts_missed", "parts_per_hr_wallclock"],
+                   1, quiet)
+    two = evaluate(study, d, ["adaptive", "non-adaptive"], ["parts_missed", "parts_per_hr_wallclock"],
+                   2, quiet)
+    assert one.shape == (len(d.points), 5) and np.array_equal(one, two)
+    assert (one[:, 4] > 0).all()  # the adaptive robot's advantage, column 'advantage'
