@@ -211,6 +211,10 @@ def markdown(study: Study, frame: Any, picked: list[int], sel: Selection | None,
              "by their keys, not their draws; each measure's mean has a 95 % t-interval.",
              "- Constraints (on the means): " + (", ".join(str(c) for c in study.constraints) or "none")
              + f"; {int(frame['feasible'].sum()) if len(frame) else 0} of {len(frame)} trials feasible.",
+             f"- What that buys: {len(frame) * s.replications:,} runs in the search; a "
+             f"constraint's mean is known to the ± beside it (a trial near a bound may be on "
+             "either side of it: KN's re-runs and more replications settle that), and the search "
+             "resolves a key to its step, not finer.",
              "", "## Varied keys", "", "| key | range |", "|---|---|"]
     for p in study.params:
         rng = ", ".join(map(str, p.choices)) if p.is_choice else \

@@ -12,7 +12,7 @@ import pytest
 from cell.cli import build_parser, main
 
 SUBCOMMANDS = ["path", "run", "sweep", "compare", "figures", "mintime", "bench", "fit",
-               "animate", "scenarios", "schema", "docs"]
+               "animate", "scenarios", "schema", "docs", "optimize", "sensitivity"]
 
 
 def test_help_lists_the_subcommands():
@@ -35,7 +35,8 @@ def test_parser_knows_every_subcommand():
         argv = {"path": ["x", "--out", "y"], "run": ["x", "--out", "y"],
                 "mintime": ["x", "--out", "y"], "sweep": ["x", "--out", "y"],
                 "fit": ["x"], "animate": ["x", "--out", "y.gif"],
-                "compare": ["a", "b"]}.get(name, [])
+                "compare": ["a", "b"], "optimize": ["x", "--out", "y"],
+                "sensitivity": ["x", "--out", "y"]}.get(name, [])
         assert parser.parse_args([name, *argv]).command == name
 
 
