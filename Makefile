@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-stamp
 WORKERS ?= 2
 
-.PHONY: all venv test sweep sweep-mintime whatif stress sensor figures animation bench lint clean
+.PHONY: all venv test sweep sweep-mintime whatif stress sensor figures animation bench lint clean optimize sensitivity
 
 all: test
 
@@ -53,6 +53,16 @@ animation: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) -m cell bench --out reports/bench.json
+
+# The worked example of README (cell optimize) and the assumptions' sensitivity (cell sensitivity).
+optimize: $(STAMP)
+	rm -rf build/optimize
+	MPLBACKEND=Agg $(PY) -m cell optimize scenarios/optimize.yaml --out build/optimize
+	rm -rf reports/optimize && mkdir -p reports/optimize
+	cp build/optimize/*.csv build/optimize/*.png build/optimize/report.md reports/optimize/
+
+sensitivity: $(STAMP)
+	MPLBACKEND=Agg $(PY) -m cell sensitivity scenarios/assumptions.yaml --out reports/sensitivity --workers $(WORKERS)
 
 lint: $(STAMP)
 	$(PY) -m ruff check cell tests

@@ -41,11 +41,13 @@ def resolve(name_or_path: str | Path, beside: Path | None = None) -> Path:
 #: Keys only a sweep file has, and keys only a dynamics file has.
 SWEEP_ONLY = frozenset({"base", "grid", "policies", "replications", "baseline", "batch", "set"})
 DYNAMICS_ONLY = frozenset({"links", "drives", "gravity_m_s2"})
+STUDY_ONLY = frozenset({"vary", "objectives", "constraints", "trials", "morris", "sobol"})
 
 #: What each kind of file is for, for messages.
 USE = {"scenario": "run it with `cell run`, `cell compare` or `cell animate`",
        "sweep": "run it with `cell sweep`",
-       "dynamics": "name it in a scenario's mintime.dynamics_file"}
+       "dynamics": "name it in a scenario's mintime.dynamics_file",
+       "study": "run it with `cell optimize` or `cell sensitivity`"}
 
 
 def kind(raw: object) -> str:
@@ -53,6 +55,8 @@ def kind(raw: object) -> str:
     keys = set(raw) if isinstance(raw, dict) else set()
     if keys & DYNAMICS_ONLY:
         return "dynamics"
+    if keys & STUDY_ONLY:
+        return "study"
     if keys & SWEEP_ONLY:
         return "sweep"
     return "scenario"

@@ -34,8 +34,8 @@ from cell.errors import CellError, ScenarioError, one_line, shown_path
 from cell.interrupts import Stops, exit_now, interrupted, stopped_by
 
 #: Subcommands in the order ``cell --help`` lists them; each is cell.commands.<name>.
-COMMANDS = ("run", "sweep", "compare", "fit", "figures", "animate", "path", "mintime",
-            "scenarios", "schema", "docs", "bench")
+COMMANDS = ("run", "sweep", "compare", "optimize", "sensitivity", "fit", "figures", "animate",
+            "path", "mintime", "scenarios", "schema", "docs", "bench")
 
 #: Errors of the operating system that a command's output can meet however well it checks.
 OUTPUT_ERRNOS = frozenset({errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOSPC, errno.EDQUOT,

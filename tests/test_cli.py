@@ -12,7 +12,7 @@ import pytest
 from cell.cli import build_parser, main
 
 SUBCOMMANDS = ["path", "run", "sweep", "compare", "figures", "mintime", "bench", "fit",
-               "animate", "scenarios", "schema", "docs"]
+               "animate", "scenarios", "schema", "docs", "optimize", "sensitivity"]
 
 
 def test_help_lists_the_subcommands():
@@ -35,7 +35,8 @@ def test_parser_knows_every_subcommand():
         argv = {"path": ["x", "--out", "y"], "run": ["x", "--out", "y"],
                 "mintime": ["x", "--out", "y"], "sweep": ["x", "--out", "y"],
                 "fit": ["x"], "animate": ["x", "--out", "y.gif"],
-                "compare": ["a", "b"]}.get(name, [])
+                "compare": ["a", "b"], "optimize": ["x", "--out", "y"],
+                "sensitivity": ["x", "--out", "y"]}.get(name, [])
         assert parser.parse_args([name, *argv]).command == name
 
 
@@ -115,7 +116,7 @@ def test_built_in_files_are_listed_by_what_they_are_for(capsys):
     assert main(["scenarios"]) == 0
     listed = capsys.readouterr().out
     headings = [line for line in listed.splitlines() if not line.startswith(" ")]
-    assert [h.split()[0] for h in headings] == ["scenario", "sweep", "dynamics"]
+    assert [h.split()[0] for h in headings] == ["scenario", "sweep", "dynamics", "study"]
     section = {h.split()[0]: [] for h in headings}
     current = None
     for line in listed.splitlines():
@@ -136,6 +137,10 @@ def test_built_in_files_are_listed_by_what_they_are_for(capsys):
         load_sweep(name)
     for name in section["dynamics"]:
         load_dynamics(catalog.path(name))
+    from cell.study import load_study
+
+    for name in section["study"]:
+        load_study(catalog.path(name))
 
 
 @pytest.mark.parametrize("command,name,found", [

@@ -31,6 +31,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--report", default=None, metavar="DIR",
                    help="also write the report into DIR, as a unit (into DIR/NAME/ if DIR "
                         "holds other files)")
+    p.add_argument("--select-best", default=None, metavar="MEASURE",
+                   help="then choose the best point on MEASURE by Kim & Nelson's KN, running more "
+                        "replications where needed; writes selection.csv into --out")
+    p.add_argument("--delta", type=float, default=None,
+                   help="with --select-best: the indifference zone, in MEASURE's units (required)")
+    p.add_argument("--pcs", type=float, default=0.95,
+                   help="with --select-best: the probability of correct selection (default 0.95)")
+    p.add_argument("--goal", choices=("maximize", "minimize"), default=None,
+                   help="with --select-best: whether more is better (default: by the measure)")
 
 
 class _Stop:
@@ -85,6 +94,7 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
     from cell.sweep.outdir import check_out, check_owner, lock
 
     out = check_out(args.out)  # before the sweep file's points are built and checked
+    _check_select(args)
     check_workers(args.workers, args.scheduler)
     sweep = load_sweep(args.sweep)
     check_owner(sweep, out, args.resume)  # no results of another sweep, nor this one's, lost
@@ -129,7 +139,42 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
             next((Path(p) for p in written if Path(p).name == "report.md"), None)
         if shown is not None:
             print(f"\n{headline(shown.read_text(encoding='utf-8'))}\n(all of it: {shown})")
+    if args.select_best:
+        _select_best(args, sweep, outcome, out)
     return 0
+
+
+def _check_select(args: argparse.Namespace) -> None:
+    """Refuse a --select-best without its --delta, or a --pcs out of range, before any work."""
+    from cell.errors import CellError
+    from cell.study import summary_measures
+
+    if args.select_best is None:
+        return
+    if args.select_best not in summary_measures():
+        raise CellError(f"--select-best {args.select_best}: no run reports it (a measure of the "
+                        "run summary: parts_missed, parts_per_hr_wallclock, ...)")
+    if args.delta is None or not args.delta > 0:
+        raise CellError(f"--delta {args.delta}: --select-best needs the indifference zone, a "
+                        "number above 0 in the measure's units")
+    if not 0.5 < args.pcs < 1:
+        raise CellError(f"--pcs {args.pcs}: a probability between 0.5 and 1")
+
+
+def _select_best(args: argparse.Namespace, sweep: Any, outcome: Any, out: Path) -> None:
+    """``--select-best``: KN over the sweep's points, continued on the sweep's own streams."""
+    import pandas as pd
+
+    from cell.output import write_csv
+    from cell.selection import select_sweep, sentence, table, verdicts
+
+    sel, labels = select_sweep(sweep, outcome.replications, args.select_best, args.delta,
+                               args.pcs, args.goal)
+    write_csv(pd.DataFrame({"point": labels, "mean": sel.means, "replications": sel.counts,
+                            "verdict": verdicts(sel)}), out / "selection.csv")
+    print("\n" + sentence(sel, labels, args.select_best) + "\n")
+    print("\n".join(table(sel, labels, args.select_best)))
+    print(f"wrote {out / 'selection.csv'}")
 
 
 def headline(markdown: str, tables: int = 3) -> str:
