@@ -43,6 +43,7 @@ from cell.sections import (  # noqa: F401 - the schema, re-exported
     PathSettings,
     RobotSettings,
     RunSettings,
+    WearSettings,
 )
 from cell.settings import Section, error_from_validation, model_at
 
@@ -64,6 +65,7 @@ class Scenario(Section):
     controller: ControllerSettings = ControllerSettings()
     run: RunSettings = RunSettings()
     mintime: MinTimeSettings = MinTimeSettings()
+    wear: WearSettings = WearSettings()
 
     _source: str = PrivateAttr(default="<defaults>")
 

@@ -73,6 +73,11 @@ class SimResult:
     first asked for.
     """
 
+    wear: dict[str, float] | None = None
+    """With ``wear.enabled``: the run's wear measures (:meth:`cell.wear.WearLog.row`)."""
+    wear_stops: list[tuple[float, float, int]] = []
+    """With ``wear.enabled``: each stop for a worn motor (from_s, to_s, joint)."""
+
     def __init__(self, summary: RunSummary, rows: list[tuple[Any, ...]] | None = None,
                  belt_log: BeltLog | None = None):
         self.summary = summary
@@ -291,6 +296,11 @@ def simulate(scenario: Scenario | AssembledCell,
     conveyor.feeder = feeder
     view = View(k, feeder.fed_s, n, conveyor, output)
     Controller(env, k, policy, view, conveyor, output, robot, log)
+    wear = None
+    if s.wear.enabled:  # the motors wear by each cycle run (cell.wear); off, nothing changes
+        from cell.wear import attach
+
+        wear = attach(cell.table, cell.timing, s.wear, robot, seed)
     env.run()
     conveyor.belt.close()
     output.belt.close()
@@ -299,7 +309,11 @@ def simulate(scenario: Scenario | AssembledCell,
     summary.seed = _seed_value(seed)
     summary.input_speed_max_in_s = conveyor.belt.max_speed_in_s
     summary.input_speed_min_in_s = conveyor.belt.min_speed_in_s
-    return SimResult(summary, rows, belts if keep_belts else None)
+    result = SimResult(summary, rows, belts if keep_belts else None)
+    if wear is not None:
+        result.wear = wear.row(env.now)
+        result.wear_stops = wear.stops
+    return result
 
 
 def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, n: int,
