@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-stamp
 WORKERS ?= 2
 
-.PHONY: all venv test sweep sweep-mintime whatif stress figures animation bench lint clean
+.PHONY: all venv test sweep sweep-mintime whatif stress figures animation bench lint clean reliability
 
 all: test
 
@@ -38,6 +38,11 @@ stress: $(STAMP)
 	rm -rf build/stress
 	$(PY) -m cell sweep scenarios/stress.yaml --out build/stress --workers $(WORKERS)
 	MPLBACKEND=Agg $(PY) -m cell.reporting.stress build/stress/replications.csv reports/stress
+
+# The reliability study (issue 21): both policies with motor wear, a year of two shifts a run.
+reliability: $(STAMP)
+	rm -rf build/reliability
+	MPLBACKEND=Agg $(PY) -m cell.reporting.reliability scenarios/reliability.yaml build/reliability reports/reliability
 
 figures: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m cell figures --out reports/figures

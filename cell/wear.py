@@ -27,7 +27,7 @@ out (:class:`WearClock`), which is replaced, its exposure starting again from ze
 from __future__ import annotations
 
 import math
-from bisect import bisect_right
+from bisect import bisect_left, bisect_right
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol
@@ -116,7 +116,7 @@ class SegmentWear:
     exposure is A_i u^(1−p) + B_i, A_i and B_i kept here for every i.
     """
 
-    __slots__ = ("timing", "_ub", "_a", "_b", "_q", "_seen")
+    __slots__ = ("timing", "_ub", "_a", "_b", "_q", "_seen", "_tbreak", "_tfix", "_lfree")
 
     def __init__(self, timing: Segment, lengths_in: ArrayLike, min_times_s: ArrayLike,
                  steps: ArrayLike, rated_steps_s: ArrayLike, model: WearModel):
@@ -144,6 +144,11 @@ class SegmentWear:
         lim_b = np.vstack([np.cumsum(limited[::-1], axis=0)[::-1], np.zeros((1, 5))])
         self._a: list[tuple[float, ...]] = [tuple(row) for row in free_a.tolist()]
         self._b: list[tuple[float, ...]] = [tuple(row) for row in (lim_b + fixed).tolist()]
+        # the timing's own breakpoints, in the same order: a stretch's time finds its
+        # interval in one bisection (cell.motors.Segment.velocity's)
+        if not np.array_equal(np.asarray(timing._ub), np.asarray(self._ub)):
+            raise ValueError("the stretch's moves are not the timing segment's")
+        self._tbreak, self._tfix, self._lfree = timing._tbreak, timing._tfix, timing._lfree
 
     def at_velocity(self, v: float) -> list[float]:
         """Exposure per joint (5 floats) of the stretch run at velocity v (inf: every move at
@@ -156,13 +161,19 @@ class SegmentWear:
         return [a * x + b for a, b in zip(self._a[i], self._b[i])]
 
     def at_time(self, time_s: float) -> list[float]:
-        """Exposure per joint of the stretch taking ``time_s`` (at least its motor floor); the
-        last answer is kept, since most stretches take the same time cycle after cycle."""
+        """Exposure per joint of the stretch taking ``time_s`` (its motor floor at least): the
+        interval of u found as :meth:`cell.motors.Segment.velocity` finds it, u = 1/v there.
+        The last answer is kept, since most stretches take the same time cycle after cycle."""
         seen = self._seen
         if seen[0] == time_s:
             return seen[1]
-        timing = self.timing
-        out = self.at_velocity(timing.velocity(max(time_s, timing.floor_s)))
+        j = bisect_left(self._tbreak, time_s)
+        lfree = self._lfree[j]
+        if lfree <= 0:
+            out = list(self._b[j])
+        else:
+            x = ((time_s - self._tfix[j]) / lfree) ** self._q
+            out = [a * x + b for a, b in zip(self._a[j], self._b[j])]
         self._seen = (time_s, out)
         return out
 
@@ -201,8 +212,8 @@ class CycleWear:
         last = self._last
         if last is not None and last[0] == key:
             return last[1]
-        out = [sum(col) for col in zip(*[w.at_time(t) for w, t in
-                                         zip(self.stretches, key, strict=True)])]
+        e = [w.at_time(t) for w, t in zip(self.stretches, key, strict=True)]
+        out = [a + b + c + d + f + g for a, b, c, d, f, g in zip(*e)]
         self._last = (key, out)
         return out
 
@@ -217,28 +228,40 @@ class WearClock:
 
     def __init__(self, wear: CycleWear, rng: np.random.Generator):
         self.wear, self.rng = wear, rng
-        self.exposure = [0.0] * 5
-        """Each motor's exposure since it was last replaced."""
         self.total = [0.0] * 5
         """Each motor's exposure over the whole run (for its life at this duty)."""
+        self.since = [0.0] * 5
+        """Each motor's total exposure when it was fitted."""
         self.threshold: list[float] = draw_thresholds(rng, 5, wear.model).tolist()
+        """The exposure since fitting at which each motor wears out."""
+        self._due = list(self.threshold)
+        self._first = min(self._due)
+
+    @property
+    def exposure(self) -> list[float]:
+        """Each motor's exposure since it was fitted."""
+        return [t - s for t, s in zip(self.total, self.since)]
 
     def cycle(self, times_s: Sequence[float]) -> int:
         """Add a cycle's exposure: the motor that wore out in it, or -1."""
         e = self.wear.of_times(times_s)
-        before = self.exposure
-        self.exposure = now = [x + y for x, y in zip(before, e)]
-        self.total = [x + y for x, y in zip(self.total, e)]
-        over = [j for j in range(5) if now[j] >= self.threshold[j]]
+        before = self.total
+        self.total = now = [x + y for x, y in zip(before, e)]
+        if max(now) < self._first:
+            return -1
+        due = self._due
+        over = [j for j in range(5) if now[j] >= due[j]]
         if not over:
             return -1
         # the motor whose threshold the cycle reached first (the smallest share of the cycle)
-        return min(over, key=lambda j: (self.threshold[j] - before[j]) / e[j] if e[j] else 0.0)
+        return min(over, key=lambda j: (due[j] - before[j]) / e[j] if e[j] else 0.0)
 
     def replace(self, joint: int) -> None:
         """A new motor at ``joint``: exposure 0, a new threshold."""
-        self.exposure[joint] = 0.0
+        self.since[joint] = self.total[joint]
         self.threshold[joint] = float(draw_thresholds(self.rng, 1, self.wear.model)[0])
+        self._due[joint] = self.since[joint] + self.threshold[joint]
+        self._first = min(self._due)
 
 
 # --------------------------------------------------------------------------- in a run
