@@ -342,3 +342,37 @@ def attach(table: StepTable, timing: RobotTiming, settings: WearSettingsLike, ro
 
     robot.order = order
     return log
+
+
+class WearExposure:
+    """The robot's failure clock counting motor wear (:class:`cell.failures.Exposure`):
+    five budgets, one a motor (the exposure at which it wears out), each used at its
+    exposure per second of the leg the robot is in, told of each cycle's leg times as it
+    starts.  Within a leg the rate is the leg's mean, so a motor wears out at the leg's
+    end exposure exactly and in between by linear interpolation."""
+
+    cause = "wear"
+
+    def __init__(self, wear: CycleWear, rng: np.random.Generator):
+        self.wear, self.rng = wear, rng
+        self._rates: list[list[float]] = [[0.0] * 5 for _ in STRETCHES]
+        self.total = [0.0] * 5
+        """Each motor's exposure over the run's cycles (for its life at this duty)."""
+
+    def thresholds(self) -> list[float]:
+        return draw_thresholds(self.rng, 5, self.wear.model).tolist()
+
+    def renew(self, component: int) -> float:
+        return float(draw_thresholds(self.rng, 1, self.wear.model)[0])
+
+    def rates(self, leg: int) -> Sequence[float]:
+        return self._rates[leg] if leg >= 0 else (0.0,) * 5
+
+    def cycle(self, legs_s: Sequence[float]) -> None:
+        rates = self._rates
+        total = self.total
+        for i, (w, t) in enumerate(zip(self.wear.stretches, legs_s, strict=True)):
+            e = w.at_time(t)
+            rates[i] = [x / t for x in e] if t > 0 else [0.0] * 5
+            total = [a + b for a, b in zip(total, e)]
+        self.total = total

@@ -129,8 +129,9 @@ def headline(t: pd.DataFrame) -> str:
     at = f" (it flips at p ≈ {flip:.2f})" if flip is not None else ""
     return (f"The thesis's reliability argument holds {where}{at}: at p = "
             f"{worst['wear_exponent']:g} the fixed robot at its shortest cycle "
-            f"({worst['shortest_cycle_s']:.4f} s) has {100 * (1 - worst['mtbf_ratio']):.0f} % "
-            f"shorter mean time between wear stops than the adaptive robot, "
+            f"({worst['shortest_cycle_s']:.4f} s) has {abs(100 * (1 - worst['mtbf_ratio'])):.0f} % "
+            f"{'shorter' if worst['mtbf_ratio'] < 1 else 'longer'} mean time between wear stops "
+            "than the adaptive robot, "
             f"{worst['down_fixed_h']:.1f} against {worst['down_adaptive_h']:.1f} h of downtime "
             f"a year, while delivering {worst['parts_fixed_per_h']:.1f} against "
             f"{worst['parts_adaptive_per_h']:.1f} parts/h.")
