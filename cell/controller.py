@@ -15,7 +15,7 @@ import simpy
 
 from cell.conveyors import EPS_S, InputConveyor, OutputConveyor
 from cell.policies.base import CellConstants, Policy
-from cell.records import LET_GO, PartRecord
+from cell.records import PartRecord
 from cell.robot import Robot
 
 
@@ -43,6 +43,9 @@ class View:
         """Index of the part at B."""
         self.now = 0.0
         """The instant it reached B (the simulation's clock)."""
+        self.sensor_up = True
+        """False while the look-ahead sensor is down (a failure): :meth:`next_part` then
+        reports nothing, for an ideal look-ahead as well."""
 
     def input_speed(self) -> float:
         return self._input_speed(self.now + EPS_S)
@@ -53,7 +56,10 @@ class View:
         return None if last is None else self._output_travel(self.now) - last
 
     def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
-        """(a, b) of the first part after this one that can still be caught."""
+        """(a, b) of the first part after this one that can still be caught (None: none
+        is coming, or the sensor is down)."""
+        if not self.sensor_up:
+            return None
         now, fed_s, length = self.now, self.fed_s, self._length
         x_now = None
         for j in range(self.part + 1, self.n):
@@ -96,7 +102,7 @@ class Controller:
             now = env._now
             if not robot.free_at_s <= now + EPS_S:  # the robot is not back: the part rides on
                 part.missed = True
-                flag(part, LET_GO)
+                flag(part, robot.loss(now))  # let go, or lost to downtime
                 missed(part)
                 continue
             view.part, view.now = part.part - 1, now

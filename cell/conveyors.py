@@ -45,7 +45,7 @@ class Belt:
     writer) and dropped, so a long run keeps a few entries, not its history.
     """
 
-    __slots__ = ("_t", "_x", "_v", "on_change", "max_speed_in_s", "min_speed_in_s")
+    __slots__ = ("_t", "_x", "_v", "on_change", "max_speed_in_s", "min_speed_in_s", "_halted")
 
     def __init__(self, speed_in_s: float,
                  on_change: Callable[[float, float], Any] | None = None):
@@ -61,6 +61,8 @@ class Belt:
         """The fastest of the settled speeds (of all of them once closed)."""
         self.min_speed_in_s = speed_in_s
         """The slowest of them."""
+        self._halted: tuple[float, list[tuple[float, float]]] | None = None
+        """While stopped by a failure: the speed it ran at and the changes planned after."""
 
     @property
     def held(self) -> int:
@@ -153,6 +155,46 @@ class Belt:
             for i in range(n):
                 told(ts[i], vs[i])
 
+    @property
+    def stopped(self) -> bool:
+        """Whether the belt stands (a failure, :meth:`stop`) until :meth:`restart`."""
+        return self._halted is not None
+
+    def stop(self, t: float) -> None:
+        """Stand from instant t (now) on: speed 0, parts stay where they are; what was
+        planned after t is kept for :meth:`restart` (docs/model.md, "When equipment fails")."""
+        ts, vs = self._t, self._v
+        k = bisect_right(ts, t)
+        later = list(zip(ts[k:], vs[k:]))
+        running = vs[k - 1] if k > 0 else vs[0]
+        del ts[k:], self._x[k:], vs[k:]
+        self._run_from(t, 0.0)
+        self._halted = (running, later)
+
+    def plan_stopped(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
+        """:meth:`plan` while stopped: the plan takes effect from the restart on."""
+        assert self._halted is not None
+        running, later = self._halted
+        later = [(t, v) for t, v in later if t < t1 - EPS_S] + [(t1, v1)]
+        if t2 is not None:
+            later.append((t2, v2))
+        self._halted = (running, later)
+
+    def restart(self, t: float) -> None:
+        """Run again from instant t (now), at the speed the plan has for t."""
+        assert self._halted is not None
+        v, later = self._halted
+        self._halted = None
+        ahead = []
+        for tp, vp in later:
+            if tp <= t:
+                v = vp
+            else:
+                ahead.append((tp, vp))
+        self._run_from(t, v)
+        for tp, vp in ahead:
+            self._run_from(tp, vp)
+
     def close(self) -> None:
         """Hand every change still held (planned ones included) to ``on_change``."""
         self._settle(len(self._t))
@@ -174,7 +216,7 @@ class InputConveyor:
     """
 
     def __init__(self, env: simpy.Environment, speed_in_s: float, length_in: float,
-                 on_change: Callable[[float, float], Any] | None = None):
+                 on_change: Callable[[float, float], Any] | None = None, stoppable: bool = False):
         self.env = env
         self.belt = Belt(speed_in_s, on_change)
         self.length_in = length_in
@@ -189,7 +231,9 @@ class InputConveyor:
         """When the part on its way to B gets there (-inf: none is)."""
         self.feeder: Any = None
         """The feeder, told of a replan while it holds a part back."""
-        self.process = env.process(self.run())
+        self.timing = False
+        """True while :meth:`run_stoppable` waits for a part to reach B (a stop re-times it)."""
+        self.process = env.process(self.run_stoppable() if stoppable else self.run())
 
     def drop(self, part: Any, x: float) -> None:
         """The feeder puts a part (its record) on the belt now, the belt's travel being x."""
@@ -221,6 +265,37 @@ class InputConveyor:
             # the controller takes the part (and replans) before this process resumes
             yield hand_over(part, delay)
             del x_fed[i]
+
+    def run_stoppable(self):  # noqa: ANN201 (SimPy generator)
+        """:meth:`run` for a belt that can stop: the part's arrival at B is timed again
+        (the process interrupted) whenever the belt stops or starts."""
+        env, get, hand_over, belt = self.env, self.loaded.get, self.at_bot.put_after, self.belt
+        while True:
+            part = yield get()
+            i = part.part - 1
+            target = self.x_fed[i] + self.length_in
+            while True:
+                self.timing = True
+                try:
+                    if belt.stopped:
+                        yield env.event()  # until the restart interrupts
+                    delay = belt.time_at(target) - env.now
+                    self.due_s = env.now + max(delay, 0.0)
+                    if delay > 0.0:
+                        yield env.timeout(delay)
+                    break
+                except simpy.Interrupt:
+                    continue
+                finally:
+                    self.timing = False
+            part.at_bot_s = self.due_s = env.now
+            yield hand_over(part, 0.0)
+            del self.x_fed[i]
+
+    def retime(self) -> None:
+        """The belt stopped or started: time the part on its way to B again."""
+        if self.timing:
+            self.process.interrupt()
 
 
 class OutputConveyor:

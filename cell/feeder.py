@@ -6,7 +6,8 @@ the input conveyor when its time comes.  Parts are solid: a part is dropped
 only once the belt has carried the previous one at least a part's size away
 (centre to centre); until then the feeder holds it back, like an escapement,
 and the hold is recorded (``feed_delay_s``).  On the thesis's arrivals (at least
-17.6 s apart) no part is ever held.
+17.6 s apart) no part is ever held.  While the input belt is stopped by a failure it
+carries nothing clear, so the feeder holds every part that comes until it runs again.
 """
 
 from __future__ import annotations
@@ -70,6 +71,8 @@ class Feeder:
                 self.holding = True
                 while x < clear_at - CLEAR_TOL_IN:
                     try:
+                        if belt.stopped:  # a failure: wait for the restart to interrupt
+                            yield env.event()
                         yield timeout(max(belt.time_at(clear_at) - env.now, EPS_S))
                     except simpy.Interrupt:  # the belt was replanned: time the wait again
                         pass

@@ -30,10 +30,12 @@ LIMITS = (
     "let_go",           # reached B while the robot was busy: fell off at F (§6.3)
     "spacing_off",      # set down outside the spacing tolerance (§4.3 f)
     "held_at_feeder",   # dropped later than it came: the belt had not cleared a part's size
+    "lost_downtime",    # reached B (or was being picked) while the robot was stopped: rode off
+    "scrapped",         # in the hand when the robot failed, scrapped (failures.robot.part_in_hand)
 )
 LIMIT_BIT = {name: 1 << i for i, name in enumerate(LIMITS)}
 (INPUT_FLOOR, INPUT_CEILING, INPUT_TRACKING, OUTPUT_FLOOR, OUTPUT_CEILING, R2_PEAK, R4_PEAK,
- LET_GO, SPACING_OFF, HELD_AT_FEEDER) = (1 << i for i in range(len(LIMITS)))
+ LET_GO, SPACING_OFF, HELD_AT_FEEDER, LOST_DOWNTIME, SCRAPPED) = (1 << i for i in range(len(LIMITS)))
 
 
 class LimitCount(NamedTuple):
@@ -233,6 +235,38 @@ class RunSummary:
     """The calibrated slack of the thesis's bookkeeping (non-adaptive), s."""
     sim_end_s: float = NAN
     """Simulated time when the run ended."""
+    robot_busy_fraction: float = NAN
+    """Share of the run the robot was in motion (``utilisation`` is a load, not this)."""
+    robot_waiting_fraction: float = NAN
+    """Share of the run the robot was up and still with a part on its way to B."""
+    robot_idle_fraction: float = NAN
+    """Share of the run the robot was up and still with nothing on the input belt."""
+    robot_down_fraction: float = NAN
+    """Share of the run the robot was down (failed: waiting for a crew or under repair)."""
+    robot_maintenance_fraction: float = NAN
+    """Share of the run the robot was in planned maintenance."""
+    availability: float = NAN
+    """OEE's A: time the cell was not down (robot or belts) over the time not planned off
+    (the run less planned maintenance)."""
+    performance: float = NAN
+    """OEE's P: the robot's fastest cycle × parts delivered / the cell's run time."""
+    quality: float = NAN
+    """OEE's Q: parts set down within the spacing tolerance / parts delivered."""
+    oee: float = NAN
+    """availability × performance × quality."""
+    service_level: float = NAN
+    """Parts delivered / parts arrived."""
+    parts_lost_downtime: int = 0
+    """Parts that rode off because the robot was stopped (down or in maintenance), or was
+    still making up a cycle a stop had held (counted in ``parts_missed`` too)."""
+    parts_scrapped: int = 0
+    """Parts in the hand when the robot failed, scrapped (failures.robot.part_in_hand)."""
+    robot_failures: int = 0
+    """Times the robot failed (planned stops not counted)."""
+    mtbf_observed_s: float = NAN
+    """The robot's time up (not down, not in maintenance) per failure."""
+    mttr_observed_s: float = NAN
+    """The robot's time down per failure (the wait for a crew included)."""
 
     def __getitem__(self, name: str) -> Any:
         return getattr(self, name)
@@ -253,6 +287,37 @@ class BeltChange:
     """The speed from then on (in/s)."""
 
 
+@dataclass(slots=True, frozen=True)
+class StateSpan:
+    """A piece of equipment in one state over an interval (a row of ``states.csv``)."""
+
+    equipment: str
+    """``robot``, ``input_belt``, ``output_belt`` or ``sensor``."""
+    state: str
+    """robot: busy / waiting / idle / down / maintenance; belts: running / stopped / down;
+    sensor: up / down."""
+    from_s: float
+    """When the state began."""
+    to_s: float
+    """When it ended (the run's end for the last)."""
+
+
+@dataclass(slots=True, frozen=True)
+class Stop:
+    """A failure or a planned stop (a row of ``failures.csv``)."""
+
+    equipment: str
+    """The piece of equipment that stopped."""
+    cause: str
+    """``failure`` (a drawn time to failure), ``wear`` (a worn motor) or ``maintenance``."""
+    from_s: float
+    """When it stopped."""
+    to_s: float
+    """When it ran again (repair done, crew wait included); the run's end if still down."""
+    part: Any
+    """The part the robot held or was picking when it failed (empty otherwise)."""
+
+
 def columns(record_type: type) -> list[str]:
     """The CSV columns of a record type: its fields, in order."""
     return [f.name for f in fields(record_type)]
@@ -261,3 +326,5 @@ def columns(record_type: type) -> list[str]:
 PART_COLUMNS = columns(PartRecord)
 SUMMARY_COLUMNS = columns(RunSummary)
 BELT_COLUMNS = columns(BeltChange)
+STATE_COLUMNS = columns(StateSpan)
+STOP_COLUMNS = columns(Stop)

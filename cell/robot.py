@@ -26,6 +26,7 @@ import simpy
 
 from cell.mailbox import Mailbox
 from cell.motors import Segment
+from cell.records import LET_GO
 
 if TYPE_CHECKING:
     from cell.steptable import StepTable
@@ -155,7 +156,7 @@ class Robot:
     no order comes before ``free_at_s``.
     """
 
-    def __init__(self, env: simpy.Environment, output: Mailbox):
+    def __init__(self, env: simpy.Environment, output: Mailbox, cycle: Any = None):
         self.env = env
         self.orders: Mailbox = Mailbox(env)
         """Cycles to run, from the controller: (part, B → LO, B → TD) tuples."""
@@ -163,7 +164,15 @@ class Robot:
         """Where parts are set down (the output conveyor's mailbox)."""
         self.free_at_s = 0.0
         """When the robot is (or will be) back at B, ready for a part."""
-        self.process = env.process(self.run())
+        self.cycle = cycle
+        """With failures (:mod:`cell.failures`): runs each order's legs one by one, so that a
+        stop can interrupt them; None: the fast path, one event an order."""
+        self.process = env.process(self.run() if cycle is None else self.run_stoppable())
+
+    def loss(self, now: float) -> int:
+        """The limit bit of a part that reaches B while the robot is not back: let go
+        (with failures: lost to downtime, if a stop kept the robot away)."""
+        return LET_GO
 
     def order(self, part: Any, to_lo_s: float, to_td_s: float, cycle_s: float) -> None:
         """Start a cycle now (the robot must be free): lift-off ``to_lo_s``, touch-down
@@ -177,3 +186,9 @@ class Robot:
             part, to_lo_s, to_td_s = yield get()
             part.pick_s = env._now + to_lo_s
             set_down(part, to_td_s)  # touch-down: B + (B → TD), as a timeout would fall
+
+    def run_stoppable(self):  # noqa: ANN201 (SimPy generator)
+        get, cycle = self.orders.get, self.cycle
+        while True:
+            order = yield get()
+            yield from cycle(*order)

@@ -33,6 +33,7 @@ from cell.sections import (  # noqa: F401 - the schema, re-exported
     ArrivalSettings,
     BeltSettings,
     ControllerSettings,
+    FailureSettings,
     HandSettings,
     JointLimitSettings,
     LayoutSettings,
@@ -45,7 +46,7 @@ from cell.sections import (  # noqa: F401 - the schema, re-exported
     RunSettings,
     WearSettings,
 )
-from cell.settings import Section, error_from_validation, model_at
+from cell.settings import Section, error_from_validation, model_at, unwrap_optional
 
 
 # --------------------------------------------------------------------------- scenario
@@ -66,6 +67,8 @@ class Scenario(Section):
     run: RunSettings = RunSettings()
     mintime: MinTimeSettings = MinTimeSettings()
     wear: WearSettings = WearSettings()
+    failures: FailureSettings | None = None
+    """Breakdowns and repairs (docs/model.md, "When equipment fails"); absent: none."""
 
     _source: str = PrivateAttr(default="<defaults>")
 
@@ -86,8 +89,14 @@ class Scenario(Section):
         return obj
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain YAML-able data (tuples as lists)."""
-        return _plain(self.model_dump())
+        """Plain YAML-able data (tuples as lists); ``failures`` and ``run.hours`` only when
+        given (so a scenario without them reads as it did before they existed)."""
+        d = _plain(self.model_dump())
+        if d.get("failures") is None:
+            d.pop("failures", None)
+        if d["run"].get("hours") is None:
+            d["run"].pop("hours", None)
+        return d
 
     def with_overrides(self, overrides: Mapping[str, Any], file: object = None,
                        paths_from: Path | None = None) -> Scenario:
@@ -165,7 +174,7 @@ def known_key(dotted: str) -> bool:
         field = model.model_fields.get(part)
         if field is None:
             return False
-        annotation = field.annotation
+        annotation = unwrap_optional(field.annotation)
         if isinstance(annotation, type) and issubclass(annotation, BaseModel):
             model = annotation
             continue
@@ -242,6 +251,21 @@ def _cross_checks(s: Scenario, file: object) -> None:
     from cell.arrivals import check_arrivals
 
     check_arrivals(s.arrivals, s.base_dir, file)
+    _length_and_failures(s, file)
+
+
+def _length_and_failures(s: Scenario, file: object) -> None:
+    """``run.hours`` against ``run.parts``, and the ``failures:`` section's times."""
+    if s.run.hours is not None or s.failures is not None:
+        from cell.failure_spec import check_failures
+        from cell.horizon import check_hours
+
+        check_hours(s, _DEFAULTS.run.parts, file)
+        check_failures(s.failures, file)
+    if s.wear.enabled and s.failures is not None and s.failures.robot is None:
+        raise ScenarioError(file, "wear.enabled", True,
+                            "with a failures: section, wear needs failures.robot (its "
+                            "time_to_repair is a worn motor's replacement)")
 
 
 # --------------------------------------------------------------------------- files

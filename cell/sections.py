@@ -24,6 +24,7 @@ MAX_PARTS = 10_000_000
 MAX_MOVES = 10_000
 MAX_GRID_POINTS = 100_000
 MAX_SEED = 2**128
+MAX_HOURS = 1e5
 
 
 def _num(default: Any = None, *, gt: float | None = None, ge: float | None = None,
@@ -251,6 +252,10 @@ class RunSettings(Section):
     delivery intervals).  The thesis's terminating 500-part runs keep 0."""
     seed: int = Field(1984, strict=True, ge=0, lt=MAX_SEED)
     """Root of every random stream (numpy SeedSequence)."""
+    hours: float | None = _num(None, gt=0.0, le=MAX_HOURS)
+    """The run's length in hours instead of parts: the parts that come in that time, the run
+    stopped at its end (parts still in the cell then are counted as such).  Give run.hours
+    or run.parts, not both."""
 
 
 class MinTimeSettings(Section):
@@ -292,3 +297,62 @@ class WearSettings(Section):
     """β, the Weibull shape in the exposure: above 1, the motor wears out."""
     repair_h: float = _num(4.0, ge=0.0, le=MAX_TIME_S / 3600.0)
     """Hours the robot is down while a worn motor is replaced."""
+
+
+# --------------------------------------------------------------------------- failures
+class TimeDistribution(Section):
+    """A time (s) as a scipy.stats distribution, named and parametrised as ``arrivals`` is."""
+
+    distribution: str = "expon"
+    """Any continuous distribution in scipy.stats, by name."""
+    params: dict[str, Annotated[float, Field(strict=True, allow_inf_nan=False)]] = Field(
+        default_factory=dict)
+    """Its parameters by scipy's names (``scale``, ``loc``, shapes), in seconds."""
+
+
+class EquipmentFailures(Section):
+    """How one piece of equipment fails and is repaired (docs/model.md, "When equipment fails")."""
+
+    time_to_failure: TimeDistribution
+    """Time from a repair to the next failure, counted on ``clock``."""
+    time_to_repair: TimeDistribution
+    """Time a repair takes once a crew is on it."""
+    clock: Literal["operating", "calendar"] = "operating"
+    """``operating``: the failure clock runs only while the equipment works (the robot in
+    motion); ``calendar``: whenever it is up."""
+
+
+class RobotFailures(EquipmentFailures):
+    """The arm's failures; a failure stops it mid-move."""
+
+    part_in_hand: Literal["finish", "scrap"] = "finish"
+    """What becomes of a part held when the arm fails: set down after the repair, or scrapped."""
+
+
+class RepairSettings(Section):
+    """The repair crews: a failure waits for a free one (machine-repairman)."""
+
+    crews: int = Field(1, strict=True, ge=1, le=1000)
+    """Crews working at once."""
+
+
+class MaintenanceSettings(Section):
+    """Planned stops of the robot, each started once the robot is back at B."""
+
+    every_h: float = _num(..., gt=0.0, le=MAX_HOURS)
+    """Hours between the starts of planned stops (from the start of the run)."""
+    duration_min: float = _num(..., gt=0.0, le=MAX_HOURS * 60)
+    """Minutes each stop lasts."""
+
+
+class FailureSettings(Section):
+    """Breakdowns, repairs and planned stops; absent: nothing ever stops."""
+
+    robot: RobotFailures | None = None
+    input_belt: EquipmentFailures | None = None
+    output_belt: EquipmentFailures | None = None
+    sensor: EquipmentFailures | None = None
+    """The look-ahead: while it is down the controller reads no next part."""
+    repair: RepairSettings | None = None
+    """Absent: every failure is repaired at once (as many crews as failures)."""
+    maintenance: MaintenanceSettings | None = None

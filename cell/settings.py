@@ -92,11 +92,23 @@ def model_at(root: type[BaseModel], loc: list[Any]) -> type[BaseModel] | None:
     model: Any = root
     for p in loc:
         field = model.model_fields.get(p) if isinstance(p, str) else None
-        if field is None or not (isinstance(field.annotation, type)
-                                 and issubclass(field.annotation, BaseModel)):
+        annotation = unwrap_optional(field.annotation) if field is not None else None
+        if field is None or not (isinstance(annotation, type)
+                                 and issubclass(annotation, BaseModel)):
             return None
-        model = field.annotation
+        model = annotation
     return model
+
+
+def unwrap_optional(annotation: Any) -> Any:
+    """``Model | None`` (an optional section, such as ``failures``) as ``Model``."""
+    args = getattr(annotation, "__args__", None)
+    if args and len(args) == 2 and type(None) in args and getattr(annotation, "__origin__", None) \
+            is not dict:
+        other = args[0] if args[1] is type(None) else args[1]
+        if isinstance(other, type) and issubclass(other, BaseModel):
+            return other
+    return annotation
 
 
 def _fields_at(root: type[BaseModel], loc: list[Any]) -> list[str]:

@@ -33,12 +33,13 @@ from typing import Any
 import numpy as np
 import simpy
 
-from cell import accounting
-from cell.arrivals import interarrival_times
+from cell import accounting, oee, wear_clock
 from cell.assembly import AssembledCell, assemble
 from cell.controller import Controller, View
 from cell.conveyors import InputConveyor, OutputConveyor
+from cell.failures import Downtime
 from cell.feeder import Feeder
+from cell.horizon import run_arrivals, run_until_done
 from cell.policies.base import Accounting
 from cell.records import (
     LIMIT_BIT,
@@ -49,6 +50,8 @@ from cell.records import (
     BeltChange,
     PartRecord,
     RunSummary,
+    StateSpan,
+    Stop,
     limit_names,
 )
 from cell.robot import Robot
@@ -61,7 +64,7 @@ _row = attrgetter(*PART_COLUMNS)
 _BELTS = ("input", "output")
 #: What the run's log keeps of each part for the summary (flags and picked as floats).
 PER_PART = ("touchdown", "picked", "r4", "output_speed", "interval", "spacing", "limits",
-            "feed_delay")
+            "feed_delay", "part", "arrival", "at_bot", "cycle")
 _PACK_PER_PART = struct.Struct(f"={len(PER_PART)}d").pack
 
 
@@ -72,17 +75,27 @@ class SimResult:
     stops tracking), belt changes as flat arrays; the record objects are made when
     first asked for.
     """
-
-    wear: dict[str, float] | None = None
-    """With ``wear.enabled``: the run's wear measures (:meth:`cell.wear.WearLog.row`)."""
-    wear_stops: list[tuple[float, float, int]] = []
-    """With ``wear.enabled``: each stop for a worn motor (from_s, to_s, joint)."""
+    wear: wear_clock.WearResult | None = None  # with wear.enabled: its measures and stops
 
     def __init__(self, summary: RunSummary, rows: list[tuple[Any, ...]] | None = None,
                  belt_log: BeltLog | None = None):
         self.summary = summary
         self._rows = rows
         self._belt_log = belt_log
+        self.downtime: Downtime | None = None
+        """The run's failures (None without a ``failures:`` section)."""
+        self.timelines: dict[str, list[tuple[str, float, float]]] = {}
+        """Each piece of equipment's (state, from_s, to_s) over the run."""
+
+    def state_spans(self) -> list[StateSpan]:
+        """states.csv's rows."""
+        return oee.state_spans(self.timelines)
+
+    def stops(self) -> list[Stop]:
+        """failures.csv's rows: every failure and planned stop, in order of start."""
+        if self.downtime is None:
+            return []
+        return [Stop(*row) for row in self.downtime.all_stops(self.summary.sim_end_s)]
 
     @functools.cached_property
     def records(self) -> list[PartRecord] | None:
@@ -224,7 +237,7 @@ class RunLog:
                     flags |= SPACING_OFF
                 p.limits = (names_of(flags) or limit_names(flags)) if flags else ""
                 note(pack(p.touchdown_s, p.picked, p.r4_s, p.output_speed_in_s, d, sp, flags,
-                          p.feed_delay_s))
+                          p.feed_delay_s, i, p.arrival_s, p.at_bot_s, p.motion_cycle_s))
                 if keep is not None:
                     keep(_row(p))
                 if sink is not None:
@@ -234,7 +247,25 @@ class RunLog:
                     following = i
                     return
                 p = waiting.pop(i)
+
+        def skip_to(i: int) -> None:  # the parts before i will never be done (:meth:`flush`)
+            nonlocal following
+            following = i
+        self._skip_to = skip_to
         return done
+
+    @property
+    def handed_on(self) -> int:
+        """Parts completed and handed on so far."""
+        return len(self.per_part) // (8 * len(PER_PART))
+
+    def flush(self) -> None:
+        """The run stopped with parts still in the cell: hand on those done after them."""
+        waiting = self.waiting
+        while waiting:
+            first = min(waiting)
+            self._skip_to(first)
+            self.delivered_part(waiting.pop(first))
 
     def column(self, name: str, start: int = 0) -> np.ndarray:
         """One of :data:`PER_PART`'s values of every part from ``start`` on (a copy)."""
@@ -267,7 +298,7 @@ def simulate(scenario: Scenario | AssembledCell,
              seed: int | np.random.SeedSequence | None = None, *, keep_parts: bool = True,
              on_part: PartSink | None = None, on_belt: BeltSink | None = None,
              keep_belts: bool = True) -> SimResult:
-    """Run ``run.parts`` parts through the cell under its policy.
+    """Run ``run.parts`` parts (or ``run.hours`` of parts) through the cell under its policy.
 
     ``seed``: int or SeedSequence; None means ``run.seed``.  Policies given the
     same seed see the same inter-arrival times (common random numbers).
@@ -278,9 +309,8 @@ def simulate(scenario: Scenario | AssembledCell,
     cell = scenario if isinstance(scenario, AssembledCell) else assemble(scenario)
     s, k, policy = cell.scenario, cell.k, cell.policy
     seed = s.run.seed if seed is None else seed
-    n = s.run.parts
     # T_1 .. T_{n+1}: the last is only the last part's "next arrival".
-    t_all = interarrival_times(s.arrivals, n + 1, seed, s.base_dir)
+    t_all, n, horizon = run_arrivals(s, seed)
     t_list: list[float] = t_all.tolist()
 
     rows: list[tuple[Any, ...]] | None = [] if keep_parts else None
@@ -289,30 +319,35 @@ def simulate(scenario: Scenario | AssembledCell,
     acct = policy.accounting()
     env = simpy.Environment()
     log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows)
-    conveyor = InputConveyor(env, k.v_nom, k.input_length, belts.told(0))
+    downtime = None if s.failures is None else Downtime(  # wear counted by the robot's clock
+        env, s.failures, seed, wear_clock.for_failures(cell, seed))
+    conveyor = InputConveyor(env, k.v_nom, k.input_length, belts.told(0),
+                             stoppable=downtime is not None)
     output = OutputConveyor(env, k.u_nom, log.delivered_part, belts.told(1))
-    robot = Robot(env, output.placed)
+    robot = Robot(env, output.placed, None if downtime is None else downtime.robot.cycle)
     feeder = Feeder(env, t_list, conveyor, n, k.part_size, log.flag)
     conveyor.feeder = feeder
     view = View(k, feeder.fed_s, n, conveyor, output)
     Controller(env, k, policy, view, conveyor, output, robot, log)
-    wear = None
-    if s.wear.enabled:  # the motors wear by each cycle run (cell.wear); off, nothing changes
-        from cell.wear import attach
-
-        wear = attach(cell.table, cell.timing, s.wear, robot, seed)
-    env.run()
+    wear = wear_clock.alone(cell, robot, seed, downtime)  # wear: without failures (or None)
+    if downtime is None and horizon is None:
+        env.run()
+    else:
+        if downtime is not None:
+            downtime.attach(robot, conveyor, output, feeder, view, log)
+            downtime.start()
+        run_until_done(env, log, n, horizon, output)
     conveyor.belt.close()
     output.belt.close()
 
     summary = _summary(cell, log, acct, t_all, n, env.now)
+    lines = oee.measure(summary, log.column, downtime, k.fastest_cycle_s, env.now)
     summary.seed = _seed_value(seed)
     summary.input_speed_max_in_s = conveyor.belt.max_speed_in_s
     summary.input_speed_min_in_s = conveyor.belt.min_speed_in_s
     result = SimResult(summary, rows, belts if keep_belts else None)
-    if wear is not None:
-        result.wear = wear.row(env.now)
-        result.wear_stops = wear.stops
+    result.downtime, result.timelines = downtime, lines
+    result.wear = wear_clock.measures(wear, downtime, env.now)
     return result
 
 
@@ -324,7 +359,8 @@ def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, 
     td = log.column("touchdown", w)
     picked = log.column("picked", w) != 0
     vout = log.column("output_speed", w)[picked]
-    ip_wall = t[w + 1:] / log.column("interval", w)  # each part's IP, as its record has it
+    # each part's IP, as its record has it (T_{i+1} over its interval)
+    ip_wall = t[log.column("part", w).astype(np.int_)] / log.column("interval", w)
     sp = log.column("spacing", w)
     sp = sp[np.isfinite(sp)]
     limits = log.column("limits", w).astype(np.int_)
@@ -340,7 +376,7 @@ def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, 
     r = RunSummary(
         scenario=s.name, policy=cell.policy.name, ideal_cycle_s=cell.policy.ideal_cycle_s,
         parts_arrived=n - w, parts_delivered=d, parts_missed=missed,
-        parts_in_cell=n - w - d - missed,
+        parts_in_cell=n - w - d - missed - count("scrapped"),
         actual_cycle_wallclock_s=float((done[-1] - done[0]) / (d - 1)) if d > 1 else math.nan,
         ip_wallclock=float(np.nanmean(ip_wall)) if np.isfinite(ip_wall).any() else math.nan,
         spacing_min_in=float(sp.min()) if sp.size else math.nan,
@@ -355,7 +391,9 @@ def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, 
         sim_end_s=end_s)
     for name, counted in LIMIT_COUNTS.items():
         setattr(r, counted.field, count(name))
-    acct.finish(r, w, log.column("r4", w)[picked], t[1:])
+    # every handed-on part's next inter-arrival time (all of T_2 … T_{n+1} unless the run
+    # stopped with parts in the cell)
+    acct.finish(r, w, log.column("r4", w)[picked], t[log.column("part").astype(np.int_)])
     r.parts_per_hr_wallclock = float(accounting.parts_per_hr(r.actual_cycle_wallclock_s))
     r.parts_per_hr_thesis = float(accounting.parts_per_hr(r.actual_cycle_thesis_s))
     r.vavg_r4_in_s = k.timing.r4.length_in / r.r4_s if r.r4_s == r.r4_s else math.nan

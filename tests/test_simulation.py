@@ -15,7 +15,7 @@ from cell.assembly import assemble
 from cell.cli import main
 from cell.records import PART_COLUMNS, SUMMARY_COLUMNS, PartRecord
 from cell.scenario import default_scenario, load_scenario
-from cell.simulation import RunLog, simulate
+from cell.simulation import PER_PART, RunLog, simulate
 
 BASELINE = catalog.path("baseline")
 NON_ADAPTIVE = catalog.path("non_adaptive")
@@ -392,4 +392,4 @@ def test_the_run_log_hands_parts_on_in_part_order_whatever_order_they_finish(fin
         while ready + 1 in done:
             ready += 1
         assert handed == list(range(1, ready + 1))
-    assert len(log.per_part) == 8 * 8 * 8  # eight doubles a part, each part once
+    assert len(log.per_part) == 8 * 8 * len(PER_PART)  # PER_PART's doubles a part, each once

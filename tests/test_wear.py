@@ -132,9 +132,9 @@ def test_a_worn_motor_stops_the_robot_for_its_repair(policy: str) -> None:
         "wear.rated_life_h": 0.5, "wear.repair_h": 0.1})
     worn = simulate(s)
     clean = simulate(s.with_overrides({"wear.enabled": False}))
-    assert worn.wear is not None and worn.wear["wear_failures"] == len(worn.wear_stops) > 2
+    assert worn.wear is not None and worn.wear["wear_failures"] == len(worn.wear.stops) > 2
     picks = np.array([r.pick_s for r in worn.records if r.picked])
-    for start, end, joint in worn.wear_stops:
+    for start, end, joint in worn.wear.stops:
         assert end - start == pytest.approx(360.0) and 0 <= joint < 5
         assert not np.any((picks > start + 1e-9) & (picks < end - 1e-9))
     w, c = worn.summary, clean.summary
@@ -147,3 +147,32 @@ def test_a_worn_motor_stops_the_robot_for_its_repair(policy: str) -> None:
 def test_bad_wear_values_name_the_key(key: str, value: float) -> None:
     with pytest.raises(ScenarioError, match=key.replace(".", r"\.")):
         default_scenario().with_overrides({key: value})
+
+
+def test_with_failures_the_robot_clock_counts_wear_and_logs_it() -> None:
+    """wear: with failures.robot: the failures' robot clock counts the motors' exposure
+    instead of its drawn time to failure; failures.csv's stops say ``wear``, each repaired for
+    the drawn time to repair, and the run's wear measures count them."""
+    s = default_scenario().with_overrides({
+        "run.parts": 800, "wear.enabled": True, "wear.rated_life_h": 0.5,
+        "failures": {"robot": {"time_to_failure": {"distribution": "expon",
+                                                   "params": {"scale": 1e9}},
+                               "time_to_repair": {"distribution": "uniform",
+                                                  "params": {"loc": 100.0, "scale": 100.0}}}}})
+    run = simulate(s, keep_parts=False, keep_belts=False)
+    stops = [x for x in run.stops() if x.equipment == "robot"]
+    assert len(stops) > 2 and {x.cause for x in stops} == {"wear"}
+    assert all(100.0 - 1e-9 <= x.to_s - x.from_s <= 200.0 + 1e-9 for x in stops[:-1])
+    assert run.wear is not None and run.wear["wear_failures"] == len(stops)
+    assert run.wear["wear_availability"] == pytest.approx(
+        run.wear["wear_mtbf_h"] / (run.wear["wear_mtbf_h"] + 150.0 / 3600.0))
+
+
+def test_wear_with_failures_but_no_robot_entry_is_refused() -> None:
+    with pytest.raises(ScenarioError, match=r"wear\.enabled.*failures\.robot"):
+        default_scenario().with_overrides({
+            "wear.enabled": True,
+            "failures": {"sensor": {"time_to_failure": {"distribution": "expon",
+                                                        "params": {"scale": 100.0}},
+                                    "time_to_repair": {"distribution": "expon",
+                                                       "params": {"scale": 10.0}}}}})

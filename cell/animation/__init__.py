@@ -106,10 +106,11 @@ def simulated(scenario: Scenario, progress: bool = False) -> Any:
 def run_stops(result: Any) -> tuple[tuple[str, str, float, float], ...]:
     """(equipment, cause, from_s, to_s) of every stop of a run: its failures and planned
     stops (``failures:``), and the robot's stops for a worn motor (``wear:``)."""
-    rows = [("robot", "wear", a, b) for a, b, _ in getattr(result, "wear_stops", [])]
-    stops = getattr(result, "stops", None)
-    if callable(stops):
-        rows += [(s.equipment, s.cause, s.from_s, s.to_s) for s in stops()]
+    if getattr(result, "downtime", None) is not None:  # failures.csv's rows, wear's included
+        rows = [(s.equipment, s.cause, s.from_s, s.to_s) for s in result.stops()]
+    else:
+        wear = getattr(result, "wear", None)
+        rows = [("robot", "wear", a, b) for a, b, _ in (wear.stops if wear else [])]
     return tuple(sorted(rows, key=lambda r: (r[2], r[0])))
 
 

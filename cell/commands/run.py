@@ -26,6 +26,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 #: The files of a run, written as one set.
 RUN_FILES = ("parts.csv", "summary.csv", "belts.csv")
+#: Written as well when the scenario has a ``failures:`` section.
+FAILURE_FILES = ("states.csv", "failures.csv")
 #: Runs of at least this many parts show their progress on stderr (a bar on a terminal,
 #: a line every tenth of the run in a log).
 PROGRESS_FROM_PARTS = 50_000
@@ -42,7 +44,7 @@ def main(args: argparse.Namespace) -> int:
     from cell.scenario import inert_settings
     from cell.simulation import simulate
 
-    OutputDir.check(args.out, RUN_FILES)  # before any work
+    OutputDir.check(args.out, RUN_FILES + FAILURE_FILES)  # before any work
     scenario = scenario_of(args)
     cell = assemble(scenario)  # every error is raised before anything is written
     print(run_heading(cell))
@@ -53,7 +55,7 @@ def main(args: argparse.Namespace) -> int:
     for line in [*run_warnings(cell), *(inert_settings(scenario) if timed else [])]:
         print(f"cell: warning: {line}", file=sys.stderr)
     n = scenario.run.parts
-    with OutputDir(args.out, RUN_FILES) as out, \
+    with OutputDir(args.out, RUN_FILES + FAILURE_FILES) as out, \
             Progress(n, "cell run", "parts", enabled=n >= PROGRESS_FROM_PARTS) as progress:
         with out.open("parts.csv", newline="") as pf, out.open("belts.csv", newline="") as bf:
             parts, belts = RowWriter(pf, PART_COLUMNS), RowWriter(bf, BELT_COLUMNS)
@@ -73,7 +75,33 @@ def main(args: argparse.Namespace) -> int:
             progress.update(n - progress.n)
         with out.open("summary.csv", newline="") as sf:
             RowWriter(sf, SUMMARY_COLUMNS).record(result.summary)
+        if scenario.failures is not None:
+            _write_failures(out, result)
     print(format_summary(result.summary, thesis_figures(scenario)))
+    r = result.summary
+    print(f"robot busy (in motion) {r.robot_busy_fraction:.3f} of the run, beside its load "
+          f"(utilisation) {r.utilisation:.3f}")
     shown = out.target
-    print(f"wrote {shown}/parts.csv, summary.csv and belts.csv")
+    if scenario.failures is None:
+        print(f"wrote {shown}/parts.csv, summary.csv and belts.csv")
+        return 0
+    print(f"availability {r.availability:.4f}, performance {r.performance:.4f}, quality "
+          f"{r.quality:.4f}: OEE {r.oee:.4f}; robot failures {r.robot_failures}, parts lost to "
+          f"downtime {r.parts_lost_downtime}, scrapped {r.parts_scrapped}")
+    print(f"wrote {shown}/parts.csv, summary.csv, belts.csv, states.csv and failures.csv")
     return 0
+
+
+def _write_failures(out: Any, result: Any) -> None:
+    """states.csv and failures.csv of a run with failures."""
+    from cell.csvfile import RowWriter
+    from cell.records import STATE_COLUMNS, STOP_COLUMNS
+
+    with out.open("states.csv", newline="") as f:
+        write = RowWriter(f, STATE_COLUMNS).record
+        for span in result.state_spans():
+            write(span)
+    with out.open("failures.csv", newline="") as f:
+        write = RowWriter(f, STOP_COLUMNS).record
+        for stop in result.stops():
+            write(stop)

@@ -48,7 +48,7 @@ def wear_summary(scenario: Any, seed: np.random.SeedSequence) -> Mapping[str, An
     from cell.sweep.runner import _assembled
 
     result = simulate(_assembled(scenario), seed=seed, keep_parts=False, keep_belts=False)
-    return {**result.summary.as_dict(), **(result.wear or {})}
+    return {**result.summary.as_dict(), **(result.wear.measures if result.wear else {})}
 
 
 def table(reps: pd.DataFrame) -> pd.DataFrame:

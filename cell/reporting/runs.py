@@ -36,7 +36,8 @@ def run_heading(cell: AssembledCell) -> str:
     source = {"scenario": "controller.nominal_cycle_s",
               "arrivals": "the arrivals' mean",
               "fastest": "the robot's fastest cycle: the arrivals come faster"}[k.nominal_from]
-    heading = (f"cell run: {s.name} ({cell.policy.name}), {s.run.parts} parts, seed {s.run.seed}\n"
+    length = f"{s.run.parts} parts" if s.run.hours is None else f"{s.run.hours:g} hours"
+    heading = (f"cell run: {s.name} ({cell.policy.name}), {length}, seed {s.run.seed}\n"
                f"nominal cycle {k.cycle_nom:.4f} s ({source}); mean inter-arrival "
                f"{k.mean_interarrival_s:.4f} s; the robot's fastest cycle {k.fastest_cycle_s:.4f} "
                f"s: utilisation {k.utilisation:.3f}")

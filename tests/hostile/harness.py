@@ -85,7 +85,9 @@ MAY_BE_UNDEFINED = {"ip_wallclock", "ip_thesis", "cycle_vs_nominal_pct", "ip_the
                     "cycle_vs_nominal_memoryless_pct", "thesis_slack_s", "actual_cycle_wallclock_s",
                     "parts_per_hr_wallclock", "spacing_min_in", "spacing_max_in", "vavg_r4_in_s",
                     "r4_s", "output_speed_min_in_s", "output_speed_max_in_s",
-                    "actual_cycle_thesis_s", "parts_per_hr_thesis"}
+                    "actual_cycle_thesis_s", "parts_per_hr_thesis",
+                    # no robot failure (MTBF, MTTR), no part delivered (P, Q and OEE)
+                    "mtbf_observed_s", "mttr_observed_s", "performance", "quality", "oee"}
 #: No quantity of this model comes near this (times up to 1e6 s a part, 1e7 parts).
 SANE = 1e14
 

@@ -1,0 +1,68 @@
+"""The ``failures:`` section and ``run.hours`` given bad values: one line naming the file, the
+key and the value, exit 2, nothing written (from ``--set`` and from a scenario file)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from .harness import cli, refused
+
+R = "{distribution: expon, params: {scale: 600}}"
+
+
+def robot(ttf: str, extra: str = "") -> str:
+    return f"{{robot: {{time_to_failure: {ttf}, time_to_repair: {R}}}{extra}}}"
+
+
+#: (id, the failures value, words the refusal must hold)
+CASES = [
+    ("zero mean time to failure", robot("{distribution: expon, params: {scale: 0}}"),
+     ("failures.robot.time_to_failure.params", "scale", "zero or negative")),
+    ("negative scale", robot("{distribution: expon, params: {scale: -600}}"),
+     ("failures.robot.time_to_failure.params", "-600")),
+    ("negative mean", robot("{distribution: norm, params: {loc: -600, scale: 10}}"),
+     ("failures.robot.time_to_failure.params", "non-negative")),
+    ("no finite mean", robot("{distribution: pareto, params: {b: 0.8}}"),
+     ("failures.robot.time_to_failure.params", "no finite mean")),
+    ("no finite mean repair",
+     f"{{input_belt: {{time_to_failure: {R}, time_to_repair: {{distribution: levy, params: {{}}}}}}}}",
+     ("failures.input_belt.time_to_repair.params", "no finite mean")),
+    ("no such distribution", robot("{distribution: gauss, params: {}}"),
+     ("failures.robot.time_to_failure.distribution", "gauss")),
+    ("zero crews", robot(R, ", repair: {crews: 0}"), ("failures.repair.crews", "0", "at least 1")),
+    ("unknown equipment", f"{{conveyor: {{time_to_failure: {R}, time_to_repair: {R}}}}}",
+     ("failures.conveyor", "unknown key", "robot, input_belt")),
+    ("maintenance longer than its interval",
+     robot(R, ", maintenance: {every_h: 1, duration_min: 90}"),
+     ("failures.maintenance.duration_min", "90", "shorter than its interval")),
+    ("unknown clock", f"{{robot: {{time_to_failure: {R}, time_to_repair: {R}, clock: wall}}}}",
+     ("failures.robot.clock", "wall")),
+    ("part in hand", f"{{robot: {{time_to_failure: {R}, time_to_repair: {R}, part_in_hand: drop}}}}",
+     ("failures.robot.part_in_hand", "drop")),
+    ("repair missing", f"{{robot: {{time_to_failure: {R}}}}}", ("failures.robot.time_to_repair",)),
+]
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
+def test_a_bad_failures_section_is_refused_in_one_line(tmp_path: Path, case: tuple) -> None:
+    _, value, words = case
+    out = tmp_path / "out"
+    refused(cli("run", "baseline", "--set", "run.parts=5", "--set", f"failures={value}",
+                "--out", out), "baseline.yaml", *words, nothing_in=out)
+    scenario = tmp_path / "bad.yaml"
+    scenario.write_text(f"run: {{parts: 5}}\nfailures: {value}\n", encoding="utf-8")
+    refused(cli("run", scenario, "--out", out), str(scenario), *words, nothing_in=out)
+
+
+def test_hours_and_parts_together_are_refused(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    refused(cli("run", "baseline", "--set", "run.hours=2", "--set", "run.parts=30", "--out", out),
+            "run.hours", "not both", nothing_in=out)
+
+
+def test_hours_in_which_no_part_comes_are_refused(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    refused(cli("run", "baseline", "--set", "run.hours=0.001", "--out", out),
+            "run.hours", "no part comes", nothing_in=out)
