@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-stamp
 WORKERS ?= 2
 
-.PHONY: all venv test sweep sweep-mintime whatif stress sensor figures animation bench lint clean optimize sensitivity
+.PHONY: all venv test sweep sweep-mintime whatif stress sensor reliability figures animation bench lint clean optimize sensitivity
 
 all: test
 
@@ -43,6 +43,11 @@ sensor: $(STAMP)
 	rm -rf build/sensor
 	$(PY) -m cell sweep scenarios/sensor.yaml --out build/sensor --workers $(WORKERS)
 	MPLBACKEND=Agg $(PY) -m cell.reporting.sensor build/sensor/replications.csv reports/sensor
+
+# The reliability study (issue 21): both policies with motor wear, a year of two shifts a run.
+reliability: $(STAMP)
+	rm -rf build/reliability
+	MPLBACKEND=Agg $(PY) -m cell.reporting.reliability scenarios/reliability.yaml build/reliability reports/reliability
 
 figures: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m cell figures --out reports/figures

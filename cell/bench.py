@@ -12,6 +12,9 @@ merged in by ``cell bench``):
   SimPy's own speed that the model's Python leaves;
 * the hand-off floor: the five processes passing parts along through the cell's
   own hand-offs with no model work (microseconds a part), what the model adds to;
+* a year of two shifts (637,000 parts, 4,000 h) of the adaptive robot with motor wear on
+  (``wear.enabled``, scenarios/reliability.yaml's setting), parts per second: the long run
+  the reliability study makes, one run;
 * whole processes: ``cell run baseline`` from a cold start (median of several,
   the disk cache warm as after any first run), ``cell sweep`` of Table 7.1 on two
   workers (700,000 parts), and the peak memory of ``cell run`` of 1,000,000 parts.
@@ -50,6 +53,17 @@ def parts_per_second(scenario: Scenario, repeats: int = 5) -> float:
     """Best-of-``repeats`` simulated parts per second (after one warm-up run)."""
     _streamed(scenario.with_overrides({"run.parts": 50}))  # solves and caches the path
     return scenario.run.parts / best_seconds(lambda: _streamed(scenario), repeats)
+
+
+#: A year of two shifts: 250 days × 16 h at the arrivals' mean of 22.586 s a part.
+YEAR_PARTS = 637_000
+
+
+def parts_per_second_year(scenario: Scenario, parts: int = YEAR_PARTS) -> float:
+    """Parts per second of one long run with motor wear on (the cell's wear clock and its
+    stops included), the path already solved."""
+    s = scenario.with_overrides({"run.parts": parts, "wear.enabled": True})
+    return parts / best_seconds(lambda: _streamed(s), 1)
 
 
 def events_per_part(scenario: Scenario) -> float:
@@ -176,6 +190,8 @@ def benchmarks(scenario_file: str | Path = "scenarios/baseline.yaml", *,
             s.with_overrides({"run.parts": 5_000}))
         ceiling = out["simpy_timeouts_per_s"] / events
         out[f"ceiling_ratio_{name}"] = out[f"parts_per_s_{name}_500k"] / ceiling
+    out["parts_per_s_adaptive_year_wear"] = parts_per_second_year(
+        base.with_overrides({"controller.policy": "adaptive"}))
     if processes:
         out["peak_mb_1m_parts"] = peak_mb()
         out["cold_run_s"] = cold_run_seconds()

@@ -45,6 +45,7 @@ from cell.sections import (  # noqa: F401 - the schema, re-exported
     RobotSettings,
     RunSettings,
     SensorSettings,
+    WearSettings,
 )
 from cell.settings import Section, error_from_validation, model_at, unwrap_optional
 
@@ -66,6 +67,7 @@ class Scenario(Section):
     controller: ControllerSettings = ControllerSettings()
     run: RunSettings = RunSettings()
     mintime: MinTimeSettings = MinTimeSettings()
+    wear: WearSettings = WearSettings()
     failures: FailureSettings | None = None
     """Breakdowns and repairs (docs/model.md, "When equipment fails"); absent: none."""
     sensor: SensorSettings = SensorSettings()
@@ -262,6 +264,10 @@ def _length_and_failures(s: Scenario, file: object) -> None:
 
         check_hours(s, _DEFAULTS.run.parts, file)
         check_failures(s.failures, file)
+    if s.wear.enabled and s.failures is not None and s.failures.robot is None:
+        raise ScenarioError(file, "wear.enabled", True,
+                            "with a failures: section, wear needs failures.robot (its "
+                            "time_to_repair is a worn motor's replacement)")
 
 
 # --------------------------------------------------------------------------- files

@@ -276,6 +276,29 @@ class MinTimeSettings(Section):
     name), as in baseline.yaml; empty: no torque bounds."""
 
 
+# --------------------------------------------------------------------------- wear
+class WearSettings(Section):
+    """Motor wear from how hard each cycle drives the joints (SPEC §10; docs/wear.md): an
+    inverse power law in the step rate, carried by the cumulative exposure model, Weibull in
+    the exposure (Nelson 1990, *Accelerated Testing*).  Off by default: no value here is
+    known for the MICROBOT; each is an assumption to sweep."""
+
+    enabled: bool = Field(False, strict=True)
+    """Wear the motors and stop the robot when one wears out; off, nothing changes."""
+    exponent: float = _num(1.0, ge=0.0, le=20.0)
+    """p of η(S) = η0 (S0/S)^p, S a joint's step rate over its rated maximum.  1: life in
+    steps, the rolling-bearing case (L10h ∝ 1/speed); 0: life in hours of motion whatever
+    the speed (a stepper's winding heats with its near-constant current)."""
+    rated_life_h: float = _num(5000.0, gt=0.0, le=1e7)
+    """η0: a motor's Weibull characteristic life in hours of motion at ``reference_stress``."""
+    reference_stress: float = _num(0.75, gt=0.0, le=1.0)
+    """S0: the stress the rated life is quoted at; the motors' nominal 75 % (§7.2)."""
+    shape: float = _num(2.0, gt=0.0, le=20.0)
+    """β, the Weibull shape in the exposure: above 1, the motor wears out."""
+    repair_h: float = _num(4.0, ge=0.0, le=MAX_TIME_S / 3600.0)
+    """Hours the robot is down while a worn motor is replaced."""
+
+
 # --------------------------------------------------------------------------- failures
 class TimeDistribution(Section):
     """A time (s) as a scipy.stats distribution, named and parametrised as ``arrivals`` is."""

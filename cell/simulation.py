@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 import simpy
 
-from cell import accounting, oee
+from cell import accounting, oee, wear_clock
 from cell.assembly import AssembledCell, assemble
 from cell.bound import parts_bound
 from cell.controller import Controller, SensorView, View
@@ -77,6 +77,7 @@ class SimResult:
     stops tracking), belt changes as flat arrays; the record objects are made when
     first asked for.
     """
+    wear: wear_clock.WearResult | None = None  # with wear.enabled: its measures and stops
 
     def __init__(self, summary: RunSummary, rows: list[tuple[Any, ...]] | None = None,
                  belt_log: BeltLog | None = None):
@@ -320,7 +321,8 @@ def simulate(scenario: Scenario | AssembledCell,
     acct = policy.accounting()
     env = simpy.Environment()
     log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows)
-    downtime = None if s.failures is None else Downtime(env, s.failures, seed)
+    downtime = None if s.failures is None else Downtime(  # wear counted by the robot's clock
+        env, s.failures, seed, wear_clock.for_failures(cell, seed))
     conveyor = InputConveyor(env, k.v_nom, k.input_length, belts.told(0),
                              stoppable=downtime is not None)
     output = OutputConveyor(env, k.u_nom, log.delivered_part, belts.told(1))
@@ -329,6 +331,7 @@ def simulate(scenario: Scenario | AssembledCell,
     conveyor.feeder = feeder
     view = _view(cell, seed, n, feeder, conveyor, output)
     Controller(env, k, policy, view, conveyor, output, robot, log)
+    wear = wear_clock.alone(cell, robot, seed, downtime)  # wear: without failures (or None)
     if downtime is None and horizon is None:
         env.run()
     else:
@@ -347,6 +350,7 @@ def simulate(scenario: Scenario | AssembledCell,
     summary.parts_bound = parts_bound(k, feeder.fed_s[summary.warmup_parts:n])
     result = SimResult(summary, rows, belts if keep_belts else None)
     result.downtime, result.timelines = downtime, lines
+    result.wear = wear_clock.measures(wear, downtime, env.now)
     return result
 
 

@@ -69,6 +69,15 @@ def stress_counts() -> tuple[int, int]:
     return int((ad.delivered_vs_fixed_ci_low > 0).sum()), len(ad)
 
 
+def wear_verdict(p: float | None = None) -> dict:
+    """reports/reliability's verdict at exponent p (the largest swept if None), and its flip."""
+    from cell.reporting.reliability import flip_exponent, verdicts
+
+    v = verdicts(pd.read_csv(REPORTS / "reliability" / "reliability.csv"))
+    row = v.iloc[-1] if p is None else v[v["wear_exponent"] == p].iloc[0]
+    return {**row.to_dict(), "flip": flip_exponent(v)}
+
+
 def mintime(model: str) -> float:
     doc = json.loads((REPORTS / "mintime" / "cycles.json").read_text())
     return float(doc["models"][model]["cycle_thesis_logic_s"])
@@ -144,6 +153,16 @@ CHECKS: list[tuple[str, Callable[[], str]]] = [
     (r"the same draws at (\d+) of \d+ points", lambda: f"{stress_counts()[0]}"),
     (r"the same draws at \d+ of (\d+) points", lambda: f"{stress_counts()[1]}"),
     (r"an estimated dynamic model it is ([\d.]+) s", lambda: f"{mintime('minimum-time (dynamic)'):.4f}"),
+    (r"wear exponent above p ≈ ([\d.]+)", lambda: f"{wear_verdict()['flip']:.2f}"),
+    (r"At p = (\d+) the fixed robot at", lambda: f"{wear_verdict()['wear_exponent']:g}"),
+    (r"the fixed robot at ([\d.]+) s has \d+ %",
+     lambda: f"{wear_verdict()['shortest_cycle_s']:.4f}"),
+    (r"s has (\d+) % shorter mean time",
+     lambda: f"{100 * (1 - wear_verdict()['mtbf_ratio']):.0f}"),
+    (r"robot, ([\d.]+) against [\d.]+ h of downtime a year",
+     lambda: f"{wear_verdict()['down_fixed_h']:.1f}"),
+    (r"robot, [\d.]+ against ([\d.]+) h of downtime a year",
+     lambda: f"{wear_verdict()['down_adaptive_h']:.1f}"),
     (r"acceleration bounds ([\d.]+) s", lambda: f"{mintime('minimum-time (kinematic)'):.4f}"),
     # the worked what-if
     (r"It loses ([\d.]+) parts per 500-part run on the thesis's arrivals",

@@ -99,7 +99,19 @@ def simulated(scenario: Scenario, progress: bool = False) -> Any:
         bar.update(n - bar.n)
     parts = pd.DataFrame({f: np.frombuffer(columns[f]) for f in FRAME_FIELDS})
     parts = parts.astype({"part": np.int64, "picked": bool})
-    return SimpleNamespace(parts=parts, belts=result.belt_histories(), summary=result.summary)
+    return SimpleNamespace(parts=parts, belts=result.belt_histories(), summary=result.summary,
+                           stops=run_stops(result))
+
+
+def run_stops(result: Any) -> tuple[tuple[str, str, float, float], ...]:
+    """(equipment, cause, from_s, to_s) of every stop of a run: its failures and planned
+    stops (``failures:``), and the robot's stops for a worn motor (``wear:``)."""
+    if getattr(result, "downtime", None) is not None:  # failures.csv's rows, wear's included
+        rows = [(s.equipment, s.cause, s.from_s, s.to_s) for s in result.stops()]
+    else:
+        wear = getattr(result, "wear", None)
+        rows = [("robot", "wear", a, b) for a, b, _ in (wear.stops if wear else [])]
+    return tuple(sorted(rows, key=lambda r: (r[2], r[0])))
 
 
 def simulate_scenes(scenario: Scenario, policies: list[str], first: int, count: int,
@@ -128,9 +140,11 @@ def simulate_scenes(scenario: Scenario, policies: list[str], first: int, count: 
             # (controller.ideal_cycle_s) is the non-adaptive panel's alone, as in cell figures
             own = {"controller.ideal_cycle_s": None} if policy == "adaptive" else {}
             s = scenario.with_overrides({"controller.policy": policy, "run.parts": n, **own})
-            runs.append((frames_input(simulated(s, progress), s), s))
-        from_s = min(float(data.arrival_s[first - 1]) for data, _ in runs)
-        scenes = [build_scene(data, table, s, from_s=from_s) for data, s in runs]
+            run = simulated(s, progress)
+            runs.append((frames_input(run, s), s, run.stops))
+        from_s = min(float(data.arrival_s[first - 1]) for data, _, _ in runs)
+        scenes = [build_scene(data, table, s, from_s=from_s, stops=stops)
+                  for data, s, stops in runs]
         _, t1 = window(scenes, first, count)
         if all(sc.data.arrival_s[-1] > t1 for sc in scenes):
             return scenes

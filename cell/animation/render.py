@@ -39,6 +39,7 @@ from cell.animation.scene import (
     robot_at,
     shown_between,
 )
+from cell.animation.stops import mark_stops
 from cell.animation.writers import CanvasGifWriter, Mp4Writer
 from cell.errors import one_line, shown_path
 from cell.figures.layout import BELT_COLOUR, named_points
@@ -338,6 +339,7 @@ def draw_frame(panel: Panel, t: float) -> None:
     texts["robot"].set_text(f"robot: {REGIME_LABELS[reg]}, part {d.part[state.part[0]]}" if reg
                             else "robot: waiting at B")
     texts["robot"].set_color(colour)
+    mark_stops(sc.stopped_at(t), texts, (upper, fore))
 
 
 def render(scenes: list[Scene], times: Floats, out: Path, *, fps: int, dpi: float,

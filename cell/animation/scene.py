@@ -159,6 +159,14 @@ class Scene:
     off_output_s: Floats
     """(n,) instant a part set down is out of view, a part's size past the output belt's
     drawn end (:func:`output_gone_y`); it leaves the scene then (NaN if not picked)."""
+    stops: tuple[tuple[str, str, float, float], ...] = ()
+    """(equipment, cause, from_s, to_s) of every stop of the run: a failure, a worn motor, a
+    planned stop (failures.csv's rows)."""
+
+    def stopped_at(self, t: float) -> dict[str, tuple[str, float]]:
+        """The equipment stopped at instant t: name -> (cause, seconds until it is back)."""
+        return {name: (cause, end - t) for name, cause, start, end in self.stops
+                if start <= t < end}
 
     @property
     def b_xy(self) -> Floats:
@@ -189,7 +197,8 @@ def output_gone_y(scenario: Scenario, table: StepTable) -> float:
 
 
 def build_scene(data: AnimationInput, table: StepTable, scenario: Scenario,
-                from_s: float = -math.inf) -> Scene:
+                from_s: float = -math.inf,
+                stops: tuple[tuple[str, str, float, float], ...] = ()) -> Scene:
     """Time the robot's cycles move by move (``timeline``, §6.1), find each lost part's fall
     and when each part set down has left the drawn output belt.
 
@@ -210,7 +219,8 @@ def build_scene(data: AnimationInput, table: StepTable, scenario: Scenario,
     y_td = np.where(data.picked, travel(data.output_belt, data.touchdown_s), np.nan)
     to_gone = output_gone_y(scenario, table) - float(table.path.xyz_in[table.path.td, 1])
     off = np.where(data.picked, time_at(data.output_belt, y_td + to_gone), np.nan)
-    return Scene(data, table, scenario, cycles.astype(np.int64), t_s, fall, x_drop, y_td, off)
+    return Scene(data, table, scenario, cycles.astype(np.int64), t_s, fall, x_drop, y_td, off,
+                 tuple(stops))
 
 
 # --------------------------------------------------------------------------- the parts
