@@ -179,8 +179,19 @@ HOSTILE = {
 }
 
 
+@pytest.fixture
+def short_tmp():
+    """A folder with a short name: a value the message shows (the trace's full path) is cut
+    at 80 characters, and pytest-xdist's tmp_path is longer than that on its own."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="cell-") as tmp:
+        yield Path(tmp)
+
+
 @pytest.mark.parametrize("case", sorted(HOSTILE))
-def test_hostile_scenario_one_line_exit_2_nothing_written(tmp_path, capsys, case):
+def test_hostile_scenario_one_line_exit_2_nothing_written(short_tmp, capsys, case):
+    tmp_path = short_tmp
     text, key, value = HOSTILE[case]
     (tmp_path / "trace.csv").write_text("interarrival_s\n22.0\n-4.0\n21.0\n")
     path = _hostile(tmp_path, text)
