@@ -51,7 +51,7 @@ def figures_data() -> str:
     rows += [{"run": f"non-adaptive {cycle:.4f}", **run.summary}
              for cycle, run in sorted(runs.non_adaptive.items(), reverse=True)]
     out = io.StringIO()
-    pd.DataFrame(rows).to_csv(out, index=False, float_format=repr, lineterminator="\n")
+    pd.DataFrame(rows).to_csv(out, index=False, float_format=lambda v: repr(float(v)), lineterminator="\n")
     return out.getvalue()
 
 
