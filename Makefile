@@ -17,8 +17,12 @@ $(STAMP): pyproject.toml
 
 venv: $(STAMP)
 
+# Two pytest-xdist workers (TEST_WORKERS=0 runs in one process); the hostile suite's counts
+# are summed over the workers (tests/conftest.py).
+TEST_WORKERS ?= 2
+
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n $(TEST_WORKERS)
 
 # Each sweep target starts from an empty build folder: a sweep refuses to replace results
 # without --resume, and a report regenerated here must come from this code, not reused tasks.

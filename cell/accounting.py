@@ -9,7 +9,9 @@
   left out); for the non-adaptive table, docs/accounting.md's reconstruction of how Table
   7.1 was computed (:func:`thesis_non_adaptive`).
 
-All functions are pure and vectorised over leading axes (replications).
+All functions are pure and vectorised over leading axes (replications, the parts on the last
+axis): a (3, 10) input gives three runs' figures, a (10,) one a float for the run
+(``tests/test_accounting.py`` checks each row against the run alone).
 """
 
 from __future__ import annotations
@@ -47,14 +49,28 @@ def pct_off(actual_cycle_s: float, ideal_cycle_s: float) -> float:
 def thesis_adaptive(next_interarrival_s: ArrayLike, time_between_deliveries_s: ArrayLike
                     ) -> Accounts:
     """Step 6.2 accounting: IP_i = T_{i+1} / D_i with D_i the robot's motion time
-    between deliveries (NaN for parts not delivered); actual cycle = mean D."""
+    between deliveries (NaN for parts not delivered); actual cycle = mean D over the
+    delivered parts (the last axis), one per replication (a float for one run)."""
     tn = np.asarray(next_interarrival_s, dtype=float)
     d = np.asarray(time_between_deliveries_s, dtype=float)
     ip = tn / d
+    if d.ndim <= 1:
+        actual, mean_ip = _delivered_means(d.reshape(-1), ip.reshape(-1))
+        return Accounts(d, ip, actual, mean_ip)
+    # Each row as a run of its own: the same sums, bit for bit, as one run's.
+    n = d.shape[-1]
+    rows = [_delivered_means(dr, ir) for dr, ir in zip(d.reshape(-1, n), ip.reshape(-1, n))]
+    shape = d.shape[:-1]
+    return Accounts(d, ip, np.array([r[0] for r in rows]).reshape(shape),
+                    np.array([r[1] for r in rows]).reshape(shape))
+
+
+def _delivered_means(d: NDArray[np.float64], ip: NDArray[np.float64]) -> tuple[float, float]:
+    """Mean D and mean IP of one run's delivered parts (NaN if none was delivered)."""
     ok = np.isfinite(d)
-    actual = float(d[ok].mean()) if ok.any() else float("nan")
-    mean_ip = float(ip[ok].mean()) if ok.any() else float("nan")
-    return Accounts(d, ip, actual, mean_ip)
+    if not ok.any():
+        return float("nan"), float("nan")
+    return float(d[ok].mean()), float(ip[ok].mean())
 
 
 class ThesisNonAdaptive(NamedTuple):
@@ -114,4 +130,9 @@ def thesis_adaptive_memoryless(next_interarrival_s: ArrayLike, nominal_cycle_s: 
     tn = np.asarray(next_interarrival_s, dtype=float)
     d = np.clip(tn, shortest_cycle_s, nominal_cycle_s)
     ip = tn / d
-    return Accounts(d, ip, float(np.mean(d, axis=-1)), float(np.mean(ip, axis=-1)))
+    return Accounts(d, ip, _scalar(np.mean(d, axis=-1)), _scalar(np.mean(ip, axis=-1)))
+
+
+def _scalar(means: NDArray[np.float64]) -> NDArray[np.float64] | float:
+    """One run's mean as a float, several runs' as their array."""
+    return float(means) if means.ndim == 0 else means

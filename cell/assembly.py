@@ -14,6 +14,7 @@ before neither solves the path nor imports what solving needs (scipy's splines).
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import math
 from pathlib import Path
@@ -121,9 +122,9 @@ def _blame(s: Scenario) -> tuple[str, Any, str]:
     thesis's cell, the first whose thesis value alone makes every point reachable."""
     from cell.path import build_path
 
-    changed = [k for k in GEOMETRY_KEYS if s.get(k) != _THESIS.get(k)]
+    changed = [k for k in GEOMETRY_KEYS if s.get(k) != _thesis().get(k)]
     for key in changed:
-        trial = _with(s, key, _THESIS.get(key))
+        trial = _with(s, key, _thesis().get(key))
         if trial is None:
             continue
         try:
@@ -181,7 +182,7 @@ def _solved_timing(s: Scenario) -> RobotTiming:
         return _timing(geometry_of(s), motors_of(s), bounds)
     except InfeasibleError as exc:
         key = "robot.motors.max_rate_no_load_rad_s"
-        if s.get(key) == _THESIS.get(key):
+        if s.get(key) == _thesis().get(key):
             key = "mintime.dynamics_file"
         raise ScenarioError(s.source, key, s.get(key),
                             f"{exc} of the dynamic model ({s.mintime.dynamics_file})") from None
@@ -244,8 +245,11 @@ def _timing_key(s: Scenario) -> dict[str, Any] | None:
 _TIMINGS: Remembered[RobotTiming] = Remembered("timing", timing_to_plain, timing_from_plain)
 
 
-#: The thesis's cell, against which a changed key is blamed.
-_THESIS = default_scenario()
+@functools.cache
+def _thesis() -> Scenario:
+    """The thesis's cell, which a changed key is blamed against (read when first needed)."""
+    return default_scenario()
+
 #: Keys that set how fast the robot can move, in the order blame is given.
 SPEED_KEYS = ("mintime.rate_fraction", "robot.motors.max_rate_no_load_rad_s",
               "robot.motors.max_rate_full_load_rad_s", "robot.motors.nominal_fraction",
@@ -259,7 +263,7 @@ def _checked(s: Scenario, t: RobotTiming) -> RobotTiming:
                   t.r3_pre.floor_s + t.r3_post.floor_s)
     if longest <= MAX_TIME_S:
         return t
-    key = next((k for k in SPEED_KEYS if s.get(k) != _THESIS.get(k)
+    key = next((k for k in SPEED_KEYS if s.get(k) != _thesis().get(k)
                 and (k != "mintime.rate_fraction" or s.robot.timing == "minimum-time")),
                "robot.motors.max_rate_no_load_rad_s")
     raise ScenarioError(s.source, key, s.get(key),
@@ -352,9 +356,9 @@ def _absorbable(t: RobotTiming, v_nom: float, r1_most_s: float) -> float:
 def _tracking_blame(s: Scenario, belt: str, speed: float) -> tuple[str, Any]:
     """The belt's speed, unless a changed motor or load key alone makes it untrackable."""
     for key in SPEED_KEYS[1:-1]:
-        if s.get(key) == _THESIS.get(key):
+        if s.get(key) == _thesis().get(key):
             continue
-        trial = _with(s, key, _THESIS.get(key))
+        trial = _with(s, key, _thesis().get(key))
         if trial is None:
             continue
         t = robot_timing(trial)

@@ -120,8 +120,7 @@ class Controller:
         self.process = env.process(self.run())
 
     def run(self):  # noqa: ANN201 (SimPy generator)
-        """Once per part: locals bound, the clock read as ``env._now`` (what ``env.now``
-        returns, without the property call)."""
+        """Once per part, with locals bound."""
         env, robot, view, plan_for = self.env, self.robot, self.view, self.policy.plan
         replan_in, replan_out, u_nom = self.conveyor.replan, self.output.replan, self.k.u_nom
         output_floor, u_min = self.output.belt.then, self.k.output_min
@@ -135,7 +134,7 @@ class Controller:
         residual = self.k.r3_post_nom + self.k.r4_nom
         while True:
             part: Any = yield get()
-            now = env._now
+            now = env.now
             if not robot.free_at_s <= now + EPS_S:  # the robot is not back: the part rides on
                 part.missed = True
                 flag(part, robot.loss(now))  # let go, or lost to downtime

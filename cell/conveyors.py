@@ -255,7 +255,7 @@ class InputConveyor:
     def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
         """New speed plan from the controller (see :meth:`Belt.plan`), made as a part
         reaches B: before the next part is timed."""
-        if self.env._now < self.due_s:
+        if self.env.now < self.due_s:
             raise RuntimeError("the input belt was replanned while a part was on its way to B")
         self.belt.plan(t1, v1, t2, v2)
         feeder = self.feeder
@@ -268,7 +268,7 @@ class InputConveyor:
         while True:
             part = yield get()
             i = part.part - 1
-            now = env._now  # env.now without the property call (also below)
+            now = env.now
             delay = time_at(x_fed[i] + length) - now
             if delay < 0.0:  # max(delay, 0) without the builtin call
                 delay = 0.0
@@ -339,7 +339,7 @@ class OutputConveyor:
         env, get, travel, delivered = self.env, self.placed.get, self.belt.travel, self.delivered
         while True:
             part = yield get()
-            td = part.touchdown_s = env._now
+            td = part.touchdown_s = env.now
             x = travel(td)
             last_x = self.last_td_x
             if last_x is not None:

@@ -54,8 +54,7 @@ class Feeder:
         self.process = env.process(self.run())
 
     def run(self):  # noqa: ANN201 (SimPy generator)
-        """Once per part: locals bound, the clock read as ``env._now`` (what ``env.now``
-        returns, without the property call)."""
+        """Once per part, with locals bound."""
         env, drop, fed, t = self.env, self.conveyor.drop, self.fed_s, self.interarrival_s
         timeout, travel, flag = env.timeout, self.conveyor.belt.travel, self.flag
         after = Timer(env).after  # env.timeout's schedule, without a new event a part
@@ -63,9 +62,9 @@ class Feeder:
         clear_at = -float("inf")
         for i in range(self.n_parts):
             f = fed[i]
-            delay = f - env._now
+            delay = f - env.now
             yield after(delay if delay > 0.0 else 0.0)  # max(delay, 0): after a hold it may be due
-            x = travel(env._now)
+            x = travel(env.now)
             if x < clear_at - CLEAR_TOL_IN:
                 belt = self.conveyor.belt
                 self.holding = True

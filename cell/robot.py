@@ -177,14 +177,14 @@ class Robot:
     def order(self, part: Any, to_lo_s: float, to_td_s: float, cycle_s: float) -> None:
         """Start a cycle now (the robot must be free): lift-off ``to_lo_s``, touch-down
         ``to_td_s`` and back at B ``cycle_s`` from now."""
-        self.free_at_s = self.env._now + cycle_s
+        self.free_at_s = self.env.now + cycle_s
         self.orders.put((part, to_lo_s, to_td_s))
 
     def run(self):  # noqa: ANN201 (SimPy generator)
         env, set_down, get = self.env, self.output.put_after, self.orders.get
         while True:
             part, to_lo_s, to_td_s = yield get()
-            part.pick_s = env._now + to_lo_s
+            part.pick_s = env.now + to_lo_s
             set_down(part, to_td_s)  # touch-down: B + (B → TD), as a timeout would fall
 
     def run_stoppable(self):  # noqa: ANN201 (SimPy generator)

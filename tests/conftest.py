@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections import Counter
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -124,3 +125,29 @@ def sweeps() -> SimpleNamespace:
     after some runs."""
     return SimpleNamespace(write=write_sweep, bookkeeping=thesis_bookkeeping,
                            first_draw=first_draw, Interrupt=Interrupt)
+
+
+# --------------------------------------------------------------------------- hostile counts
+# The hostile-input suite counts its cases (tests/hostile/harness.py); under pytest-xdist each
+# worker counts its own, sent to the controller, which prints the sum after pytest's summary.
+_WORKER_COUNTS: Counter[str] = Counter()
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    from tests.hostile.harness import counts
+
+    if hasattr(session.config, "workeroutput"):  # an xdist worker: hand the counts over
+        session.config.workeroutput["hostile_counts"] = dict(counts())
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node, error) -> None:  # noqa: ANN001 (pytest-xdist's hook)
+    _WORKER_COUNTS.update(getattr(node, "workeroutput", {}).get("hostile_counts", {}))
+
+
+def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter) -> None:
+    from tests.hostile.harness import counts, summary_line
+
+    total = counts() + _WORKER_COUNTS
+    if total["cases"]:
+        terminalreporter.write_line(summary_line(total))

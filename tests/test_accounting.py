@@ -111,3 +111,29 @@ def test_a_non_adaptive_run_keeps_the_reconstructed_books(ideal):
     assert summary.parts_missed_thesis == int(books.missed) > 0
     assert summary.actual_cycle_thesis_s == pytest.approx(float(books.actual_cycle_s), rel=1e-12)
     assert summary.ip_thesis == pytest.approx(float(books.mean_ip), rel=1e-12)
+
+
+def test_every_accounting_is_vectorised_over_replications(draws):
+    """A (3, 10) input gives each row's figures, bit for bit what the row gives alone."""
+    from cell.accounting import thesis_adaptive_memoryless
+
+    t = draws[:3, :11]
+    d = np.where(t[:, 1:] < 20.0, np.nan, np.minimum(t[:, 1:], 22.5872))  # some parts lost
+    d[2] = np.nan                                                           # a run with none delivered
+    shortest = 20.0907
+    for many, one in ((lambda: thesis_adaptive(t[:, 1:], d), lambda i: thesis_adaptive(t[i, 1:], d[i])),
+                      (lambda: thesis_adaptive_memoryless(t, 22.5872, shortest),
+                       lambda i: thesis_adaptive_memoryless(t[i], 22.5872, shortest)),
+                      (lambda: thesis_non_adaptive(t, 21.0), lambda i: thesis_non_adaptive(t[i], 21.0)),
+                      (lambda: thesis_non_adaptive_held(t, 21.0, 2),
+                       lambda i: thesis_non_adaptive_held(t[i], 21.0, 2))):
+        r = many()
+        assert np.shape(r.actual_cycle_s) == (3,) and np.shape(r.mean_ip) == (3,)
+        for i in range(3):
+            alone = one(i)
+            np.testing.assert_array_equal(r.actual_cycle_s[i], alone.actual_cycle_s)
+            np.testing.assert_array_equal(r.mean_ip[i], alone.mean_ip)
+            np.testing.assert_array_equal(r.ip[i], alone.ip)
+    assert np.isnan(thesis_adaptive(t[:, 1:], d).actual_cycle_s[2])
+    assert isinstance(thesis_adaptive(t[0, 1:], d[0]).actual_cycle_s, float)
+    assert np.shape(thesis_adaptive(t[None, :, 1:], d[None]).mean_ip) == (1, 3)

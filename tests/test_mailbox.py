@@ -152,3 +152,60 @@ def test_a_timer_wakes_its_process_as_a_timeout_would(delays):
         return log
 
     assert wakes(True) == wakes(False)
+
+
+def test_a_waiting_event_is_not_triggered_until_an_item_is_put():
+    """As on SimPy's own events: pending while the receiver waits, triggered once put, the
+    box's re-armed event too (it used to say triggered while it waited)."""
+    env = simpy.Environment()
+    box = Mailbox(env)
+    states = []
+
+    def consumer():  # noqa: ANN202
+        for _ in range(3):
+            event = box.get()
+            states.append(event.triggered)
+            yield event
+
+    def producer():  # noqa: ANN202
+        for i in range(3):
+            yield env.timeout(1.0)
+            getter = box._getter
+            box.put(i)
+            states.append(getter.triggered)
+
+    env.process(consumer())
+    env.process(producer())
+    env.run()
+    assert states == [False, True, False, True, False, True]
+
+
+def test_another_simpy_version_is_refused_with_what_to_install():
+    from cell.mailbox import check_simpy
+
+    check_simpy("4.1.1")
+    for version in ("4.2.0", "5.0", "3.0.13", "dev"):
+        with pytest.raises(ImportError,
+                           match=r"SimPy 4\.1 \(found SimPy .*pip install 'simpy>=4\.1\.1,<4\.2'"):
+            check_simpy(version)
+
+
+@pytest.mark.parametrize("policy", ["adaptive", "non-adaptive"])
+def test_the_model_gives_the_same_parts_with_simpy_store_and_env_timeout(monkeypatch, baseline, policy):
+    """The whole cell run with the public-API hand-offs (simpy.Store, env.timeout) in place
+    of Mailbox and Timer: every part's record and every belt change the same, bit for bit."""
+    from cell import conveyors, feeder, robot
+    from cell.mailbox import StoreMailbox, TimeoutTimer
+    from cell.simulation import simulate
+
+    scenario = baseline.with_overrides({"run.parts": 300, "controller.policy": policy})
+    fast = simulate(scenario)
+    for module, name, public in ((conveyors, "Mailbox", StoreMailbox), (robot, "Mailbox", StoreMailbox),
+                                 (feeder, "Timer", TimeoutTimer)):
+        monkeypatch.setattr(module, name, public)
+    reference = simulate(scenario)
+    # repr: every float to the last bit, NaN equal to NaN
+    assert repr(fast.records) == repr(reference.records) and len(fast.records) == 300
+    assert repr(fast.belt_changes) == repr(reference.belt_changes)
+    assert repr(fast.summary) == repr(reference.summary)
+    assert fast.summary.parts_missed > 0 or policy == "adaptive"   # the runs exercise a lost part

@@ -259,15 +259,21 @@ def test_stopping_rule_does_not_depend_on_how_data_arrive():
              | precision_reached({k: streams[k][:150] for k in keys[1::2]}, 0.03, min_n=10))
     assert split == whole
     # With batches of b the loop stops at the first checked n = b, 2b, ... whose prefix is precise.
+    # The reference: Student's interval of each prefix, as stats.t.interval(0.95, n - 1, mean,
+    # sem) gives it (loc + scale * ppf(q)), with the ppf of every n computed at once.
+    n_all = np.arange(2, 801)
+    q_lo, q_hi = stats.t.ppf(0.025, n_all - 1), stats.t.ppf(0.975, n_all - 1)
+    precise = {}
+    for k, v in streams.items():
+        mean = np.array([np.mean(v[:n]) for n in n_all])
+        sem = np.array([stats.sem(v[:n]) for n in n_all])
+        precise[k] = dict(zip(n_all.tolist(), ((mean + sem * q_hi) - (mean + sem * q_lo)) / 2
+                              <= 0.02 * np.abs(mean)))
     for batch in (1, 4, 25):
         counts, _ = run_to_precision(streams, 0.02, batch=batch, min_n=10, max_n=800)
-        for k, v in streams.items():
+        for k in streams:
             checks = [n for n in range(batch, 801, batch) if n >= 10]
-            first = next((n for n in checks
-                          if np.diff(stats.t.interval(0.95, n - 1, np.mean(v[:n]),
-                                                      stats.sem(v[:n])))[0] / 2
-                          <= 0.02 * abs(np.mean(v[:n]))), 800)
-            assert counts[k] == first
+            assert counts[k] == next((n for n in checks if precise[k][n]), 800)
 
 
 def test_precision_reached_validates():

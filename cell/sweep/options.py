@@ -7,15 +7,14 @@ sweep file, the key and the value.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Hashable, Mapping, Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from cell.errors import ScenarioError
-from cell.records import RunSummary
 from cell.scenario import known_key
-from cell.settings import write_instead
+from cell.sweep.schema import PrecisionFile, read, whole_number
+from cell.sweep.schema import summary_measures as summary_measures  # re-exported
 
 if TYPE_CHECKING:
     from cell.sweep.spec import Point, Sweep
@@ -23,14 +22,6 @@ if TYPE_CHECKING:
 #: Keys the sweep itself sets for every run; they cannot be varied in a grid.
 RESERVED = {"controller.policy": "list policies under 'policies'",
             "run.seed": "every replication gets its own stream from the sweep's 'seed'"}
-PRECISION_KEYS = ("precision", "measure", "min", "max", "confidence")
-
-
-def summary_measures() -> list[str]:
-    """The numeric columns of a run's summary (:class:`cell.records.RunSummary`), in order:
-    what a report summarises and a precision can be asked of."""
-    return [f.name for f in fields(RunSummary)
-            if isinstance(f.default, (int, float)) and f.name != "seed"]
 
 
 @dataclass(frozen=True)
@@ -79,17 +70,6 @@ def show(value: Any) -> str:
     if isinstance(value, (list, tuple)):
         return "[" + ", ".join(show(v) for v in value) + "]"
     return str(value)
-
-
-def whole(raw: Mapping[str, Any], key: str, default: Any, lo: int, file: object,
-          shown: str | None = None) -> int:
-    """``raw[key]`` (``default`` if absent) as a whole number of at least ``lo``; a float of one
-    (``20.0``) is refused too, as a scenario's counts are, but told to write ``20``."""
-    value = raw.get(key, default)
-    if isinstance(value, bool) or not isinstance(value, int) or value < lo:
-        hint = write_instead("int_from_float", value) if isinstance(value, float) and value >= lo else ""
-        raise ScenarioError(file, shown or key, value, f"must be a whole number of at least {lo}{hint}")
-    return value
 
 
 def reserved(key: str, values: Any) -> str | None:
@@ -146,30 +126,12 @@ def read_replications(raw: Mapping[str, Any], file: object) -> tuple[int, Precis
     """``replications``: a whole number, or a precision to reach (then the number is ``max``)."""
     spec = raw.get("replications")
     if not isinstance(spec, Mapping):
-        return whole(raw, "replications", None, 1, file), None
-    for key in spec:
-        if key not in PRECISION_KEYS:
-            raise ScenarioError(file, f"replications.{key}", spec[key],
-                                "unknown key (known: " + ", ".join(PRECISION_KEYS) + ")")
-    precision = spec.get("precision")
-    if isinstance(precision, bool) or not isinstance(precision, (int, float)) \
-            or not 0 < precision < math.inf:
-        raise ScenarioError(file, "replications.precision", precision, "must be a number above 0: "
-                            "the largest confidence half-width, as a fraction of |mean|")
-    measure = spec.get("measure")
-    known = summary_measures()
-    if measure not in known:
-        raise ScenarioError(file, "replications.measure", measure,
-                            "must be a numeric column of a run's summary, e.g. "
-                            "parts_per_hr_wallclock (known: " + ", ".join(known) + ")")
-    min_n = whole(spec, "min", 10, 2, file, "replications.min")
-    max_n = whole(spec, "max", None, min_n, file, "replications.max")
-    confidence = spec.get("confidence", 0.95)
-    if isinstance(confidence, bool) or not isinstance(confidence, (int, float)) \
-            or not 0 < confidence < 1:
-        raise ScenarioError(file, "replications.confidence", confidence,
-                            "must be a number between 0 and 1, e.g. 0.95")
-    return max_n, Precision(float(precision), str(measure), min_n, max_n, float(confidence))
+        try:
+            return whole_number(spec, 1), None
+        except ValueError as exc:
+            raise ScenarioError(file, "replications", spec, str(exc)) from None
+    p = read(PrecisionFile, spec, file, "replications.")
+    return p.max, Precision(p.precision, p.measure, p.min, p.max, p.confidence)
 
 
 def read_baseline(raw: Any, sweep: Sweep, file: object) -> Baseline:

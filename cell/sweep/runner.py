@@ -30,6 +30,7 @@ from __future__ import annotations
 import concurrent.futures as cf
 import contextlib
 import functools
+import multiprocessing
 import os
 import signal
 import sys
@@ -262,9 +263,9 @@ def _guarded(sweep: Sweep, task: Task, call: Callable[[], list[dict[str, Any]]]
 def _close(executor: cf.Executor | None, client: Any, wait: bool) -> None:
     """Shut the executor down; without ``wait`` (a stop: Ctrl-C, kill, an error) kill and reap
     local workers at once, as Python 3.14's ``kill_workers()``: a worker left to finish a task
-    whose result is thrown away would outlive the sweep, or hang its exit."""
+    whose result is thrown away would outlive the sweep, or hang its exit (its multiprocessing children)."""
     if isinstance(executor, cf.ProcessPoolExecutor):
-        workers = [] if wait else list((executor._processes or {}).values())
+        workers = [] if wait else multiprocessing.active_children()
         executor.shutdown(wait=wait, cancel_futures=not wait)
         for process in workers:
             process.kill()

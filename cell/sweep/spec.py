@@ -62,9 +62,9 @@ from cell.sweep.options import (
     reserved,
     show,
     summary_measures,
-    whole,
 )
 from cell.sweep.policy_names import check_policy_names
+from cell.sweep.schema import SweepFile, read
 
 if TYPE_CHECKING:
     from cell.policies.base import CellConstants
@@ -75,8 +75,7 @@ MAX_RUNS = 10_000_000
 #: Checking this many points or more shows progress.
 SHOW_CHECKING = 1_000
 
-SWEEP_KEYS = ("name", "description", "base", "set", "grid", "policies",
-              "replications", "seed", "batch", "baseline")
+SWEEP_KEYS = tuple(SweepFile.model_fields)
 __all__ = ["RESERVED", "SWEEP_KEYS", "Baseline", "Pair", "Point", "Precision", "Sweep", "Task",
            "load_sweep", "summary_measures"]
 
@@ -240,14 +239,7 @@ def load_sweep(path: str | Path) -> Sweep:
     path = catalog.resolve(path)
     raw = load_mapping(path, "sweep")
     catalog.refuse_other_kind(raw, path, "sweep")
-    for key in raw:
-        if key not in SWEEP_KEYS:
-            raise ScenarioError(path, str(key), raw[key],
-                                "unknown key (known: " + ", ".join(SWEEP_KEYS) + ")")
-    if not isinstance(raw.get("base"), str) or not raw["base"].strip():
-        raise ScenarioError(path, "base", raw.get("base"),
-                            "name the base scenario: a file (relative to the sweep file) or "
-                            "a built-in one (`cell scenarios`)")
+    doc = read(SweepFile, raw, path)  # keys, types and bounds (pydantic, as a scenario's)
     base_path = catalog.resolve(raw["base"], beside=path.parent)  # or a built-in by name
     if not base_path.exists():
         raise ScenarioError(path, "base", raw["base"],
@@ -255,9 +247,7 @@ def load_sweep(path: str | Path) -> Sweep:
                             "(`cell scenarios` lists them)")
     base = load_scenario(base_path)
 
-    fixed = raw.get("set") or {}
-    if not isinstance(fixed, dict):
-        raise ScenarioError(path, "set", fixed, "must be a mapping of dotted keys to values")
+    fixed = doc.set or {}
     for key, value in fixed.items():
         if not known_key(str(key)):
             raise ScenarioError(path, str(key), value, "unknown key: no such setting in a scenario")
@@ -293,8 +283,8 @@ def load_sweep(path: str | Path) -> Sweep:
     replications, precision = read_replications(raw, path)
     if precision is not None:
         refuse_measure_unset(precision.measure, list(per_policy), path)
-    seed = whole(raw, "seed", base.run.seed, 0, path)
-    batch = whole(raw, "batch", min(20, precision.min_n if precision else replications), 1, path)
+    seed = base.run.seed if doc.seed is None else doc.seed
+    batch = min(20, precision.min_n if precision else replications) if doc.batch is None else doc.batch
 
     keys = tuple(dict.fromkeys(itertools.chain(shared, *per_policy.values())))
     n_points = sum(math.prod(len(v) for v in {**shared, **own}.values())
@@ -324,8 +314,8 @@ def load_sweep(path: str | Path) -> Sweep:
             checking.update()
     checking.close()
 
-    name = raw.get("name", path.stem)
-    sweep = Sweep(str(path), str(name), str(raw.get("description", "")), base,
+    name = path.stem if doc.name is None else doc.name
+    sweep = Sweep(str(path), str(name), "" if doc.description is None else str(doc.description), base,
                   tuple(fixed.items()), keys, tuple(points), replications, seed, batch,
                   precision)
     if "baseline" in raw:

@@ -21,7 +21,50 @@ import pandas as pd
 
 from cell.cli import main
 
-COUNT: Counter[str] = Counter()
+WHERE = ("in-process", "subprocess", "kill step")
+OUTCOMES = ("refused", "ran", "other")
+
+
+@dataclass
+class Case:
+    """One hostile input: where it ran, and how it was judged (None until judged: "other")."""
+
+    where: str
+    outcome: str | None = None
+
+    def judged(self, outcome: str) -> None:
+        """The first judgement stands: a result checked twice is still one case."""
+        if self.outcome is None:
+            self.outcome = outcome
+
+
+CASES: list[Case] = []
+
+
+def case(where: str, outcome: str | None = None) -> Case:
+    """A new case of the session (``where``: one of :data:`WHERE`)."""
+    assert where in WHERE and outcome in (None, *OUTCOMES)
+    CASES.append(Case(where, outcome))
+    return CASES[-1]
+
+
+def counts() -> Counter[str]:
+    """The session's cases by where they ran and by outcome; each breakdown sums to "cases"."""
+    out: Counter[str] = Counter(cases=len(CASES))
+    for c in CASES:
+        out[c.where] += 1
+        out[c.outcome or "other"] += 1
+    return out
+
+
+def summary_line(n: Counter[str]) -> str:
+    """The line printed after pytest's summary (an error if a breakdown does not add up)."""
+    where, outcomes = sum(n[w] for w in WHERE), sum(n[o] for o in OUTCOMES)
+    if not where == outcomes == n["cases"]:
+        raise AssertionError(f"hostile counts do not add up: {dict(n)}")
+    return (f"hostile inputs: {n['cases']} cases ({n['in-process']} in-process, {n['subprocess']} in "
+            f"subprocesses, {n['kill step']} kill steps): {n['refused']} refused in one line, "
+            f"{n['ran']} ran sanely, {n['other']} checked otherwise (kill steps, --help)")
 
 
 @dataclass
@@ -30,6 +73,7 @@ class Result:
     code: int
     out: str
     err: str
+    case: Case
 
     @property
     def err_lines(self) -> list[str]:
@@ -42,8 +86,7 @@ def cli(*argv: object) -> Result:
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         code = main(args)
-    COUNT["in-process"] += 1
-    return Result(args, code, out.getvalue(), err.getvalue())
+    return Result(args, code, out.getvalue(), err.getvalue(), case("in-process"))
 
 
 def tree(path: Path) -> dict[str, bytes] | None:
@@ -62,7 +105,7 @@ def refused(res: Result, *needles: str, nothing_in: Path | None = None,
             before: dict[str, bytes] | None = None) -> str:
     """Exit 2, exactly one line on stderr (``cell: error: ...``) holding every needle, no
     traceback; ``nothing_in`` absent, or unchanged from ``before``."""
-    COUNT["refused"] += 1
+    res.case.judged("refused")
     assert res.code == 2, f"{res.argv}: exit {res.code}\n{res.err[-2000:]}"
     lines = res.err_lines
     assert len(lines) == 1, f"{res.argv}: {len(lines)} lines on stderr:\n{res.err[:3000]}"
@@ -95,7 +138,7 @@ SANE = 1e14
 def ran_sanely(res: Result, out: Path, parts: int) -> pd.Series:
     """Exit 0, nothing on stderr but the command's own one-line warnings, the whole set, ``parts``
     conserved, summary values finite and sane."""
-    COUNT["ran"] += 1
+    res.case.judged("ran")
     assert res.code == 0, f"{res.argv}: exit {res.code}: {res.err[-2000:]}"
     noise = [line for line in res.err_lines if not line.startswith("cell: warning: ")]
     assert not noise, f"{res.argv}: stderr of an accepted run: {res.err[:2000]}"
