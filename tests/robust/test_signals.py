@@ -83,7 +83,7 @@ def test_run_terminated_leaves_no_output_and_no_staging(tmp_path):
     assert _left(tmp_path) == ["tmp"] and list((tmp_path / "tmp").iterdir()) == []
 
 
-def test_sweep_terminated_keeps_finished_tasks_and_resumes(tmp_path):
+def test_sweep_terminated_keeps_its_finished_tasks_for_resume(tmp_path):
     sweep = tmp_path / "sweep.yaml"
     sweep.write_text(f"base: {BASELINE}\ngrid: {{run.parts: [2000, 2001, 2002, 2003, 2004, "
                      "2005, 2006, 2007]}\nreplications: 3\nseed: 1\n")
