@@ -402,7 +402,7 @@ def make_policy(s: Scenario, k: CellConstants) -> Policy:
     except CellError:
         raise
     except Exception as exc:  # noqa: BLE001 - a plug-in's failure, named
-        raise registry.PluginError(name, "could not be built", exc) from exc
+        raise registry.PluginError.of(name, "could not be built", exc) from exc
     return check_policy(policy, name, k)
 
 

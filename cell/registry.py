@@ -29,15 +29,15 @@ _entry_points: dict[str, Any] | None = None
 
 
 class PluginError(CellError):
-    """A policy that cannot be loaded or built: one line naming it and its error."""
+    """A policy that cannot be loaded or built: one line naming it and its error (a plain
+    message, so it crosses to and from a sweep's worker processes intact)."""
 
-    def __init__(self, name: str, what: str, exc: BaseException):
-        where = ""
+    @classmethod
+    def of(cls, name: str, what: str, exc: BaseException) -> PluginError:
         module = getattr(exc, "name", None) if isinstance(exc, ImportError) else None
-        if module:
-            where = f" (module {module})"
-        super().__init__(f"policy {name!r} {what}{where}: {type(exc).__name__}: "
-                         f"{one_line(str(exc) or '(no message)', 200)}")
+        where = f" (module {module})" if module else ""
+        return cls(f"policy {name!r} {what}{where}: {type(exc).__name__}: "
+                   f"{one_line(str(exc) or '(no message)', 200)}")
 
 
 def _plugins() -> dict[str, Any]:
@@ -105,8 +105,8 @@ def load(name: str, source: object = None) -> Any:
     except Exception as exc:  # noqa: BLE001 - a plug-in's own failure, named
         if interrupted(exc):  # an import that Ctrl-C cut short
             raise
-        raise PluginError(name, "could not be loaded", exc) from exc
+        raise PluginError.of(name, "could not be loaded", exc) from exc
     if not callable(cls):
-        raise PluginError(name, "is not a policy class",
-                          TypeError(f"{type(cls).__name__} object is not callable"))
+        raise PluginError.of(name, "is not a policy class",
+                             TypeError(f"{type(cls).__name__} object is not callable"))
     return cls

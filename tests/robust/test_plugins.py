@@ -174,3 +174,16 @@ def test_a_plug_in_that_cannot_be_imported_is_one_line(tmp_path, module, message
     assert p.returncode == 2, p.stderr
     assert p.stderr.splitlines() == [f"cell: error: policy 'broken-plugin' {message}"]
     assert not out.exists()
+
+
+def test_a_sweep_of_a_bad_plug_in_is_one_line_and_leaves_no_folder(bad, tmp_path, capsys):
+    bad.change = {"input_next": math.nan}
+    sweep = tmp_path / "sweep.yaml"
+    sweep.write_text(f"base: {catalog.path('baseline')}\nset: {{run.parts: 20}}\n"
+                     f"policies: [{NAME}]\nreplications: 2\n")
+    out = tmp_path / "out"
+    code = main(["sweep", str(sweep), "--out", str(out), "--workers", "1"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and err[-1].startswith("cell: error: ")
+    assert f"policy {NAME!r} planned input_next = nan: not finite" in err[-1]
+    assert os.listdir(tmp_path) == ["sweep.yaml"]

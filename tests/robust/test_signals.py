@@ -83,7 +83,7 @@ def test_run_terminated_leaves_no_output_and_no_staging(tmp_path):
     assert _left(tmp_path) == ["tmp"] and list((tmp_path / "tmp").iterdir()) == []
 
 
-def test_sweep_terminated_keeps_finished_tasks_and_resumes(tmp_path):
+def test_sweep_terminated_keeps_its_finished_tasks_for_resume(tmp_path):
     sweep = tmp_path / "sweep.yaml"
     sweep.write_text(f"base: {BASELINE}\ngrid: {{run.parts: [2000, 2001, 2002, 2003, 2004, "
                      "2005, 2006, 2007]}\nreplications: 3\nseed: 1\n")
@@ -95,3 +95,40 @@ def test_sweep_terminated_keeps_finished_tasks_and_resumes(tmp_path):
     kept = {p.name: p.read_bytes() for p in _glob(out, "tasks/task-*.csv")}
     assert kept and not (out / "replications.csv").exists()
     assert _glob(out, "tasks/.task-*.tmp") == []
+
+
+def _swallowed_then(number: int, error: BaseException):
+    """A command that gets ``number`` while it works, loses the KeyboardInterrupt it raised
+    (as code that catches too much would), then fails with ``error``: the race of Ctrl-C and
+    ffmpeg, which the same Ctrl-C stopped first (a broken pipe, or its exit status)."""
+    def main(args):
+        try:
+            os.kill(os.getpid(), number)
+            for _ in range(1000):  # the handler runs here
+                pass
+        except KeyboardInterrupt:
+            pass
+        raise error
+    return main
+
+
+@pytest.mark.parametrize("number", [signal.SIGINT, signal.SIGTERM])
+@pytest.mark.parametrize("error", [BrokenPipeError(32, "Broken pipe"),
+                                   RuntimeError("ffmpeg stopped with exit status 255")],
+                         ids=["broken pipe", "another error"])
+def test_a_stop_that_became_another_error_is_still_the_stop(monkeypatch, capsys, number, error):
+    from cell.cli import main
+
+    monkeypatch.setattr("cell.commands.scenarios.main", _swallowed_then(number, error))
+    assert main(["scenarios"]) == LINES[number][0]
+    assert capsys.readouterr().err == LINES[number][1] + "\n"
+
+
+def test_a_refusal_that_came_of_a_stop_is_the_stop(monkeypatch, capsys):
+    from cell.cli import main
+    from cell.errors import CellError
+
+    monkeypatch.setattr("cell.commands.scenarios.main",
+                        _swallowed_then(signal.SIGINT, CellError("a.mp4: ffmpeg stopped")))
+    assert main(["scenarios"]) == 130
+    assert capsys.readouterr().err == "cell: interrupted\n"
