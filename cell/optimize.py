@@ -79,7 +79,7 @@ def open_study(study: Study, out: Path, resume: bool) -> Any:
     study's; trials a killed run left running are marked failed (and run again)."""
     import optuna
 
-    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    optuna.logging.set_verbosity(optuna.logging.ERROR)  # refused trials: in trials.csv, with the reason
     url, exists = storage_url(out), (out / DB_NAME).exists()
     if exists and not resume:
         raise CellError(f"{out}: holds a study already; add --resume to continue it, or choose "
@@ -188,7 +188,7 @@ def worker(source: str, out: str) -> int:
 
     from cell.study import load_study
 
-    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    optuna.logging.set_verbosity(optuna.logging.ERROR)  # refused trials: in trials.csv, with the reason
     study = load_study(source, corners=False)
     o = optuna.load_study(study_name=study.name, storage=storage_url(Path(out)))
     return work(study, o)

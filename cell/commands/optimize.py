@@ -22,7 +22,7 @@ DESCRIPTION = ("Search a study file's keys with Optuna (TPE for one objective, N
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("study", help="study YAML file (docs/usage.md, the study file)")
+    p.add_argument("study", help="study YAML file, or a built-in one by name (optimize)")
     p.add_argument("--out", required=True, help="directory for the study and its results")
     workers_argument(p)
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
@@ -38,7 +38,9 @@ def main(args: argparse.Namespace) -> int:
 
     out = OutputDir.check(args.out, ("study.db", "study.db-journal", *FILES))
     check_workers(args.workers, args.scheduler)
-    study = load_study(args.study)  # every problem before anything is written
+    from cell import catalog
+
+    study = load_study(catalog.resolve(args.study))  # every problem before anything is written
     if study.settings.select is not None and study.settings.select.n0 > study.settings.select.max:
         from cell.errors import ScenarioError
 
@@ -57,6 +59,7 @@ def main(args: argparse.Namespace) -> int:
     done = counted(o, running=False)
     bar = Progress(study.settings.trials, f"optimize {study.name}", "trials")
     bar.update(done)
+    _kill_stops()
     try:
         run_workers(study, out, o, args.workers or 1, args.scheduler, bar)
     except KeyboardInterrupt:
@@ -65,11 +68,25 @@ def main(args: argparse.Namespace) -> int:
         print(f"cell optimize: stopped; {kept} finished trial{'s' if kept != 1 else ''} kept in "
               f"{out / 'study.db'}: the same command with --resume runs only the rest",
               file=sys.stderr)
-        return 130
+        return 130  # as the shell reports Ctrl-C
     bar.close()
-    written = write_results(study, o, out, f"cell optimize {shlex.quote(args.study)} --out ...")
+    shown = shlex.quote(catalog.shown(study.source))
+    written = write_results(study, o, out, f"cell optimize {shown} --out ...")
     print(f"wrote {out}: " + ", ".join(Path(p).name for p in written))
     return 0
+
+
+def _kill_stops() -> None:
+    """A kill (SIGTERM) stops the study as Ctrl-C does: finished trials kept, one line."""
+    import signal
+    import threading
+
+    def stop(signum: int, frame: Any) -> None:
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        raise KeyboardInterrupt
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, stop)
 
 
 def write_results(study: Study, o: Any, out: Path, command: str) -> list[Path]:
