@@ -321,8 +321,8 @@ def simulate(scenario: Scenario | AssembledCell,
     acct = policy.accounting()
     env = simpy.Environment()
     log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows)
-    downtime = None if s.failures is None else Downtime(  # wear counted by the robot's clock
-        env, s.failures, seed, wear_clock.for_failures(cell, seed))
+    downtime = None if s.failures is None else Downtime(env, s.failures, seed)
+    wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
     conveyor = InputConveyor(env, k.v_nom, k.input_length, belts.told(0),
                              stoppable=downtime is not None)
     output = OutputConveyor(env, k.u_nom, log.delivered_part, belts.told(1))

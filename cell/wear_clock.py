@@ -4,7 +4,7 @@ Two ways in.  With ``wear:`` alone, :func:`alone` wraps the robot's orders: each
 stretch times wear the motors (:class:`WearClock`) and, when one wears out, the robot stops
 ``wear.repair_h`` once it is back at B.  With ``failures.robot`` as well, the failures'
 robot clock counts the wear instead of a drawn time to failure (:class:`WearExposure`,
-:func:`for_failures`): the robot stops mid-move, waits for a crew and is repaired for a
+:func:`count_on`): the robot stops mid-move, waits for a crew and is repaired for a
 drawn ``failures.robot.time_to_repair``, and failures.csv says ``wear``.  Either way the
 run's measures come back as :class:`WearResult` (:func:`measures`).
 """
@@ -221,13 +221,13 @@ class WearResult:
         return self.measures[key]
 
 
-def for_failures(cell: Any, seed: int | np.random.SeedSequence) -> WearExposure | None:
-    """The failures' robot clock counting wear, if the scenario asks for wear and the robot
-    can fail (None otherwise)."""
+def count_on(downtime: Any, cell: Any, seed: int | np.random.SeedSequence) -> None:
+    """Have the failures' robot clock count wear (before the failures are attached), if the
+    scenario asks for wear and the robot can fail."""
     s = cell.scenario
-    if not s.wear.enabled or s.failures is None or s.failures.robot is None:
-        return None
-    return _exposure(cell.table, cell.timing, s.wear, seed)
+    if downtime is None or not s.wear.enabled or s.failures.robot is None:
+        return
+    downtime.robot_exposure = _exposure(cell.table, cell.timing, s.wear, seed)
 
 
 def alone(cell: Any, robot: Any, seed: int | np.random.SeedSequence,

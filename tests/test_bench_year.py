@@ -1,26 +1,31 @@
-"""The bench's year-long figure with wear on (cell.bench.parts_per_second_year)."""
+"""The bench's year-long figure with failures and wear on (cell.bench.parts_per_second_year)."""
 
 from __future__ import annotations
 
 import math
 
-import pytest
-
 from cell import bench
 from cell.scenario import default_scenario
 
 
-def test_the_year_figure_runs_the_long_run_with_wear_on(monkeypatch) -> None:
+def test_the_year_figure_runs_with_failures_and_wear_on(monkeypatch) -> None:
+    """The figure is parts arrived per second of one run of the given hours, with every
+    piece of equipment able to fail and the robot's clock counting wear."""
     seen = []
     real = bench._streamed
 
     def spy(scenario):  # noqa: ANN001, ANN202
+        seen.append(result := real(scenario))
         seen.append(scenario)
-        return real(scenario)
+        return result
 
     monkeypatch.setattr(bench, "_streamed", spy)
-    rate = bench.parts_per_second_year(default_scenario(), parts=400)
+    rate = bench.parts_per_second_year(default_scenario(), hours=3.0)
+    result, s = seen
     assert math.isfinite(rate) and rate > 0
-    (s,) = seen
-    assert s.wear.enabled and s.run.parts == 400
-    assert bench.YEAR_PARTS * 22.586 / 3600 == pytest.approx(4000, rel=1e-3)
+    assert s.wear.enabled and s.run.hours == 3.0
+    assert all(getattr(s.failures, name) is not None
+               for name in ("robot", "input_belt", "output_belt", "sensor"))
+    assert result.wear is not None  # the robot's clock counted wear
+    assert 3600 * 3 / 23.5 < result.summary.parts_arrived < 3600 * 3 / 21.5
+    assert bench.YEAR_H == 250 * 16
