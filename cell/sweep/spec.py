@@ -246,7 +246,6 @@ def load_sweep(path: str | Path) -> Sweep:
                             f"no such scenario file ({base_path}) nor built-in scenario "
                             "(`cell scenarios` lists them)")
     base = load_scenario(base_path)
-
     fixed = doc.set or {}
     for key, value in fixed.items():
         if not known_key(str(key)):
@@ -254,30 +253,9 @@ def load_sweep(path: str | Path) -> Sweep:
         found = reserved(str(key), [value])
         if found:
             raise ScenarioError(path, str(key), value, f"cannot be set here: {RESERVED[found]}")
-
     shared, names = grid(raw["grid"], path, "grid") if "grid" in raw else ({}, {})
-    policies_raw = raw.get("policies", [base.controller.policy])
-    check_policy_names(policies_raw, path)  # cell.sweep.policy_names
-    per_policy: dict[str, dict[str, list[Any]]] | None = None
-    named_by_policy: dict[str, dict[str, list[str]]] = {}
-    if isinstance(policies_raw, list) and policies_raw:
-        per_policy = {p: {} for p in policies_raw}
-    elif isinstance(policies_raw, dict) and policies_raw:
-        per_policy = {}
-        for p, g in policies_raw.items():
-            per_policy[p], own_names = grid(g, path, f"policies.{p}") if g else ({}, {})
-            named_by_policy[p] = {**names, **own_names}
-    if not per_policy:
-        raise ScenarioError(path, "policies", policies_raw, "must list at least one of "
-                            + ", ".join(registry.names()) + " (a list, or policy: {key: [values]})")
-    for policy, own in per_policy.items():
-        if policy not in registry.names():
-            raise ScenarioError(path, "policies", policy,
-                                "must be one of " + ", ".join(registry.names()))
-        for key in set(own) & set(shared):
-            raise ScenarioError(path, f"policies.{policy}", key,
-                                "varied both in 'grid' and under the policy; keep one")
-
+    check_policy_names(raw.get("policies", [base.controller.policy]), path)  # one name each
+    per_policy, named_by_policy = _policies(raw, path, base, shared, names)
     refuse_set_and_varied(fixed, {"grid": shared, **{f"policies.{p}": g
                                                       for p, g in per_policy.items()}}, path)
     replications, precision = read_replications(raw, path)
@@ -296,6 +274,52 @@ def load_sweep(path: str | Path) -> Sweep:
         raise ScenarioError(path, "replications", replications,
                             f"{n_points:,} points x {replications:,} replications: at most "
                             f"{MAX_RUNS:,} runs in one sweep")
+    points = _points(path, base, fixed, shared, names, per_policy, named_by_policy, n_points)
+
+    name = path.stem if doc.name is None else doc.name
+    sweep = Sweep(str(path), str(name), "" if doc.description is None else str(doc.description), base,
+                  tuple(fixed.items()), keys, tuple(points), replications, seed, batch,
+                  precision)
+    if "baseline" in raw:
+        baseline = read_baseline(raw["baseline"], sweep, path)
+        sweep = dataclasses.replace(sweep, baseline=baseline)
+    return sweep
+
+
+PolicyGrids = dict[str, dict[str, list[Any]]]
+PolicyNames = dict[str, dict[str, list[str]]]
+
+
+def _policies(raw: dict[Any, Any], path: Path, base: Scenario, shared: dict[str, list[Any]],
+              names: dict[str, list[str]]) -> tuple[PolicyGrids, PolicyNames]:
+    """``policies``: each policy's own grid, and its named values (the shared grid's too)."""
+    policies_raw = raw.get("policies", [base.controller.policy])
+    per_policy: PolicyGrids | None = None
+    named_by_policy: PolicyNames = {}
+    if isinstance(policies_raw, list) and policies_raw:
+        per_policy = {p: {} for p in policies_raw}
+    elif isinstance(policies_raw, dict) and policies_raw:
+        per_policy = {}
+        for p, g in policies_raw.items():
+            per_policy[p], own_names = grid(g, path, f"policies.{p}") if g else ({}, {})
+            named_by_policy[p] = {**names, **own_names}
+    if not per_policy:
+        raise ScenarioError(path, "policies", policies_raw, "must list at least one of "
+                            + ", ".join(registry.names()) + " (a list, or policy: {key: [values]})")
+    for policy, own in per_policy.items():
+        if policy not in registry.names():
+            raise ScenarioError(path, "policies", policy,
+                                "must be one of " + ", ".join(registry.names()))
+        for key in set(own) & set(shared):
+            raise ScenarioError(path, f"policies.{policy}", key,
+                                "varied both in 'grid' and under the policy; keep one")
+    return per_policy, named_by_policy
+
+
+def _points(path: Path, base: Scenario, fixed: dict[Any, Any], shared: dict[str, list[Any]],
+            names: dict[str, list[str]], per_policy: PolicyGrids, named_by_policy: PolicyNames,
+            n_points: int) -> list[Point]:
+    """Every grid point of every policy, its scenario built and checked (:func:`_check_point`)."""
     points: list[Point] = []
     checking = Progress(n_points, f"checking {path.name}", "points",
                         enabled=n_points >= SHOW_CHECKING)
@@ -313,15 +337,7 @@ def load_sweep(path: str | Path) -> Sweep:
                                 **_check_point(scenario, path)))
             checking.update()
     checking.close()
-
-    name = path.stem if doc.name is None else doc.name
-    sweep = Sweep(str(path), str(name), "" if doc.description is None else str(doc.description), base,
-                  tuple(fixed.items()), keys, tuple(points), replications, seed, batch,
-                  precision)
-    if "baseline" in raw:
-        baseline = read_baseline(raw["baseline"], sweep, path)
-        sweep = dataclasses.replace(sweep, baseline=baseline)
-    return sweep
+    return points
 
 
 def overload_warning(sweep: Sweep) -> str | None:
