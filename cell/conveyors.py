@@ -45,7 +45,8 @@ class Belt:
     writer) and dropped, so a long run keeps a few entries, not its history.
     """
 
-    __slots__ = ("_t", "_x", "_v", "on_change", "max_speed_in_s", "min_speed_in_s", "_halted")
+    __slots__ = ("_t", "_x", "_v", "on_change", "max_speed_in_s", "min_speed_in_s", "_halted",
+                 "_anchor")
 
     def __init__(self, speed_in_s: float,
                  on_change: Callable[[float, float], Any] | None = None):
@@ -63,6 +64,9 @@ class Belt:
         """The slowest of them."""
         self._halted: tuple[float, list[tuple[float, float]]] | None = None
         """While stopped by a failure: the speed it ran at and the changes planned after."""
+        self._anchor: tuple[float, float, float] = (0.0, 0.0, speed_in_s)
+        """The last settled change (instant, travel, speed): still in force when a replan
+        from a later instant has settled past the present (a stop then starts from it)."""
 
     @property
     def held(self) -> int:
@@ -156,6 +160,8 @@ class Belt:
             if v < lo:
                 lo = v
         self.max_speed_in_s, self.min_speed_in_s = hi, lo
+        if n:
+            self._anchor = (self._t[n - 1], self._x[n - 1], vs[n - 1])
         told = self.on_change
         if told is not None:
             ts = self._t
@@ -171,6 +177,11 @@ class Belt:
         """Stand from instant t (now) on: speed 0, parts stay where they are; what was
         planned after t is kept for :meth:`restart` (docs/model.md, "When equipment fails")."""
         ts, vs = self._t, self._v
+        if ts[0] > t:  # a replan from a later instant settled the change in force now: stop
+            t0, x0, v0 = self._anchor  # from it, every held change kept for the restart
+            self._halted = (v0, list(zip(ts, vs)))
+            self._t, self._x, self._v = [t], [x0 + v0 * (t - t0)], [0.0]
+            return
         k = bisect_right(ts, t)
         later = list(zip(ts[k:], vs[k:]))
         running = vs[k - 1] if k > 0 else vs[0]

@@ -125,8 +125,8 @@ def measure(r: RunSummary, column: Callable[[str], np.ndarray], downtime: Any,
             ("maintenance", *_spans(stops, lambda n, c: n == "robot" and c == "maintenance")),
             ("down", *_spans(stops, lambda n, c: n != "sensor" and c != "maintenance"))], "up"),
             end_s, ("maintenance", "down", "up"))
-    planned = 1.0 - cell_share["maintenance"]
-    up_s = cell_share["up"] * end_s
+    planned = cell_share["up"] + cell_share["down"]  # the run less planned stops (exactly 1 × up
+    up_s = cell_share["up"] * end_s                   # when nothing failed, never above it)
     r.availability = cell_share["up"] / planned if planned > 0 else math.nan
     r.performance = fastest_cycle_s * r.parts_delivered / up_s if up_s > 0 else math.nan
     good = r.parts_delivered - r.spacing_outside_tol

@@ -12,7 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import cell.simulation
+import cell.horizon
 from cell.scenario import Scenario
 from cell.simulation import SimResult, simulate
 from tests.hostile.harness import cli, refused, tree
@@ -27,7 +27,7 @@ def run_trace(s: Scenario, times: list[float], seed: int = 11) -> SimResult:
         assert n == len(times)
         return np.asarray(times, dtype=float)
 
-    with mock.patch.object(cell.simulation, "interarrival_times", draws):
+    with mock.patch.object(cell.horizon, "interarrival_times", draws):
         return simulate(s, seed=seed)
 
 
