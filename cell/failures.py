@@ -220,7 +220,9 @@ class RobotStops:
                     if self.stop is not None or (belt is not None and belt.stopped):
                         self._doing(STOPPED if self.stop is not None else MOVING_NOT, math.inf)
                         yield env.event()  # until whatever holds the robot lets go
-                    self._doing(i, start + left + max(rest, 0.0))
+                    # a planned stop due: the robot will not be free for a part at B
+                    self._doing(i, start + left + max(rest, 0.0)
+                                if self.maintenance_due is None else math.inf)
                     yield env.timeout(left)
                     left = 0.0
                 except simpy.Interrupt:
@@ -279,15 +281,15 @@ class RobotStops:
             yield env.timeout(max(k * every_s - env.now, 0.0))
             if self.in_cycle or self.stop is not None:
                 self.maintenance_due = env.event()
+                self.robot.free_at_s = math.inf  # no new part once back at B
                 yield self.maintenance_due
             else:
                 self.stop = "maintenance"
                 self._doing(STOPPED, math.inf)
             key = self.cell.begin("robot", "maintenance", "")
             yield env.timeout(duration_s)
-            self.stop = None
-            self.at_rest()
             self.cell.end(key)
+            self.repaired()
             k = max(k + 1, math.floor(env.now / every_s) + 1)
 
 
