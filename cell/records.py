@@ -234,7 +234,7 @@ class RunSummary:
     """The arrivals' mean inter-arrival time (the distribution's or the trace's)."""
     fastest_cycle_s: float = NAN
     """The robot's fastest cycle: R II and R IV at the motors' peak."""
-    utilisation: float = NAN
+    offered_load: float = NAN
     """Fastest cycle over mean inter-arrival time: 1 or more, the cell cannot keep up."""
     warmup_parts: int = 0
     """Parts left out of every measure above as warm-up (run.warmup_parts)."""
@@ -243,7 +243,7 @@ class RunSummary:
     sim_end_s: float = NAN
     """Simulated time when the run ended."""
     robot_busy_fraction: float = NAN
-    """Share of the run the robot was in motion (``utilisation`` is a load, not this)."""
+    """Share of the run the robot was in motion (``offered_load`` is a ratio of rates, not this)."""
     robot_waiting_fraction: float = NAN
     """Share of the run the robot was up and still with a part on its way to B."""
     robot_idle_fraction: float = NAN

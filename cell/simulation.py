@@ -401,7 +401,7 @@ def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, 
         output_speed_max_in_s=float(vout.max()) if vout.size else math.nan,
         r1_nominal_s=k.r1_nom, r2_nominal_s=k.r2_nom, nominal_cycle_s=k.cycle_nom,
         nominal_from=k.nominal_from, mean_interarrival_s=k.mean_interarrival_s,
-        fastest_cycle_s=k.fastest_cycle_s, utilisation=k.utilisation, warmup_parts=w,
+        fastest_cycle_s=k.fastest_cycle_s, offered_load=k.offered_load, warmup_parts=w,
         sim_end_s=end_s)
     for name, counted in LIMIT_COUNTS.items():
         setattr(r, counted.field, count(name))

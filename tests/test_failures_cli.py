@@ -61,4 +61,4 @@ def test_without_failures_a_run_writes_its_three_files_and_the_busy_fraction(tmp
     summary = pd.read_csv(out / "summary.csv").iloc[0]
     assert summary.robot_down_fraction == 0 and summary.availability == 1
     assert f"robot busy (in motion) {summary.robot_busy_fraction:.3f}" in text
-    assert "utilisation" in text
+    assert f"offered load (fastest cycle / mean inter-arrival) {summary.offered_load:.3f}" in text

@@ -125,5 +125,5 @@ def test_the_command_warns_of_an_overload_as_cell_run_does(tmp_path: Path, monke
     assert main(["figures", "--scenario", str(scenario), "--out", str(tmp_path / "f")]) == 0
     err = capsys.readouterr().err
     expected = run_warnings(assemble(load_scenario(scenario)).k)
-    assert expected and expected[0].startswith("utilisation ")
+    assert expected and expected[0].startswith("offered load ")
     assert err.splitlines() == [f"cell: warning: {line}" for line in expected]

@@ -47,7 +47,7 @@ def test_cell_run_writes_its_files_when_stdout_is_closed(tmp_path, unbuffered):
 
 
 def test_cell_run_writes_its_files_when_stderr_is_closed(tmp_path):
-    """A warning on stderr (utilisation over 1) met the closed pipe during the run."""
+    """A warning on stderr (offered load over 1) met the closed pipe during the run."""
     out = tmp_path / "run"
     res = _with_closed_reader(["run", "baseline", "--set", "run.parts=5", "--set",
                                "arrivals={distribution: gamma, mean_s: 5, cv: 0.5}",

@@ -22,7 +22,7 @@ def test_a_run_of_one_delivery_prints_its_undefined_figures_as_dashes(tmp_path: 
     (tmp_path / "s.yaml").write_text("arrivals:\n  trace_csv: trace.csv\nrun:\n  parts: 3\n")
     assert main(["run", str(tmp_path / "s.yaml"), "--out", str(tmp_path / "out")]) == 0
     shown = capsys.readouterr()
-    assert "cell: warning: utilisation" in shown.err
+    assert "cell: warning: offered load" in shown.err
     assert not re.search(r"\bnan\b", shown.out, re.IGNORECASE), shown.out
     lines = dict(re.split(r"\s{2,}", line, maxsplit=1) for line in shown.out.splitlines()
                  if re.search(r"\s{2,}", line))

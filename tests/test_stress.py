@@ -26,7 +26,7 @@ def synthetic(rng: np.random.Generator, advantage: float, n: int = 12) -> pd.Dat
             rows.append({"policy": policy, "replication": r, "arrivals.distribution": "gamma",
                          "arrivals.cv": 0.5, "arrivals.mean_s": 19.8925, "parts_delivered": d,
                          "parts_missed": 500 - d, "parts_per_hr_wallclock": d / 2.0,
-                         "fastest_cycle_s": 18.0841, "utilisation": 18.0841 / 19.8925,
+                         "fastest_cycle_s": 18.0841, "offered_load": 18.0841 / 19.8925,
                          "spacing_outside_tol": 0.0, "limit_input_floor": 1.0,
                          "limit_r4_peak": 2.0, "limit_r2_peak": 0.0, "limit_input_ceiling": 0.0,
                          "limit_output_floor": 0.0, "parts_held": 0.0, "parts_bound": 500.0,

@@ -17,7 +17,7 @@ def point(cv: float, mean_s: float, lost: float, floor: float, n: int = 4) -> pd
             rows.append({"policy": policy, "replication": r, "arrivals.distribution": "gamma",
                          "arrivals.cv": cv, "arrivals.mean_s": mean_s, "parts_delivered": d,
                          "parts_missed": 500.0 - d, "parts_per_hr_wallclock": d / 3.0,
-                         "fastest_cycle_s": 18.0841, "utilisation": 18.0841 / mean_s,
+                         "fastest_cycle_s": 18.0841, "offered_load": 18.0841 / mean_s,
                          "spacing_outside_tol": 0.0, "limit_input_floor": at_floor,
                          "limit_r4_peak": 0.0, "limit_r2_peak": 0.0, "limit_input_ceiling": 0.0,
                          "limit_output_floor": 0.0, "parts_held": 2.0})

@@ -73,7 +73,7 @@ def test_a_sweep_and_a_run_say_overload_in_the_same_words(sweeps, tmp_path):
                                          "controller.nominal_cycle_s": None}))
     ran = warnings(assemble(sweep.points[0].scenario).k)[0]
     swept = overload_warning(sweep)
-    assert ran.startswith("utilisation 1.206: ") and swept.startswith("1 of 1 points have ")
+    assert ran.startswith("offered load 1.206: ") and swept.startswith("1 of 1 points have ")
     assert ran.endswith("fastest cycle (18.08 s) is not shorter than the mean inter-arrival "
                         "time (15.00 s); the cell cannot keep up on average and every policy "
                         "will lose parts")
@@ -83,20 +83,20 @@ def test_a_sweep_and_a_run_say_overload_in_the_same_words(sweeps, tmp_path):
 
 
 def test_cli_warns_of_points_that_cannot_keep_up(sweeps, tmp_path, capsys):
-    """Utilisation 1 or more at some points: one warning line, as cell run gives for a run."""
+    """Offered load 1 or more at some points: one warning line, as cell run gives for a run."""
     arrivals = {"distribution": "gamma", "mean_s": 22.0, "cv": 0.3}
     path = sweeps.write(tmp_path, policies=["adaptive"], grid={"arrivals.mean_s": [15, 22, 17]},
                         set={"run.parts": 20, "arrivals": arrivals,
                              "controller.nominal_cycle_s": None})
     assert main(["sweep", str(path), "--out", str(tmp_path / "o"), "--workers", "1"]) == 0
     warned = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
-    assert len(warned) == 1 and "2 of 3 points have utilisation 1 or more" in warned[0]
+    assert len(warned) == 1 and "2 of 3 points have offered load 1 or more" in warned[0]
     assert "at arrivals.mean_s 15" in warned[0]  # the worst: fastest cycle 18.08 s over 15 s
     quiet = sweeps.write(tmp_path, policies=["adaptive"], grid={"arrivals.mean_s": [22, 25]},
                          set={"run.parts": 20, "arrivals": arrivals,
                               "controller.nominal_cycle_s": None})
     assert main(["sweep", str(quiet), "--out", str(tmp_path / "q"), "--workers", "1"]) == 0
-    assert "utilisation" not in capsys.readouterr().err
+    assert "offered load" not in capsys.readouterr().err
 
 
 def test_cli_reports_any_sweep(sweeps, tmp_path, monkeypatch, capsys):

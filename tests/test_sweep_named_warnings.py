@@ -13,6 +13,6 @@ def test_overload_warning_names_a_named_value(sweeps, tmp_path):
                                     grid={"arrivals.params": {"thesis": THESIS, "rush": FAST}},
                                     set={"run.parts": 20}))
     line = overload_warning(sweep)
-    assert line is not None and line.startswith("1 of 2 points have utilisation 1 or more")
+    assert line is not None and line.startswith("1 of 2 points have offered load 1 or more")
     assert "at arrivals.params rush)" in line
     assert "loc" not in line and "{" not in line

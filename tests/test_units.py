@@ -9,7 +9,7 @@ import pytest
 
 from cell.assembly import assemble
 from cell.cli import main
-from cell.reporting.units import CYCLE_RATIO, LOW_UTILISATION, unit_warnings
+from cell.reporting.units import CYCLE_RATIO, LOW_OFFERED_LOAD, unit_warnings
 from cell.scenario import default_scenario
 
 BASE = default_scenario().with_overrides({"run.parts": 20})
@@ -29,16 +29,17 @@ def test_the_thesis_cell_and_its_neighbours_get_no_warning() -> None:
 def test_a_mean_in_milliseconds_is_named_with_the_belt_it_makes() -> None:
     lines = warned(**{"arrivals.distribution": "gamma", "arrivals.mean_s": 22_000, "arrivals.cv": 0.3})
     assert len(lines) == 1
-    assert lines[0].startswith("utilisation 0.000") and "a part every 22000 s on average (6.11 h)" in lines[0]
+    assert lines[0].startswith("offered load 0.000")
+    assert "a part every 22000 s on average (6.11 h)" in lines[0]
     assert "milliseconds? arrivals.mean_s is read in seconds" in lines[0]
     assert "is 132000 in (3.35 km)" in lines[0]  # 2 x 3 in/s x 22000 s
     assert warned(**{"arrivals.distribution": "gamma", "arrivals.mean_s": 22_000, "arrivals.cv": 0.3,
                      "belts.input_length_in": 135.5})[0].endswith("is read in seconds")
 
 
-def test_the_utilisation_threshold() -> None:
+def test_the_offered_load_threshold() -> None:
     k = assemble(BASE).k
-    slow = k.fastest_cycle_s / LOW_UTILISATION
+    slow = k.fastest_cycle_s / LOW_OFFERED_LOAD
     expon = {"arrivals.distribution": "expon", "arrivals.cv": 1}
     assert warned(**expon, **{"arrivals.mean_s": 0.99 * slow}) == []
     assert len(warned(**expon, **{"arrivals.mean_s": 1.01 * slow})) == 1
@@ -60,7 +61,7 @@ def test_cell_run_warns_of_a_trace_in_milliseconds_and_runs(tmp_path: Path, caps
     scenario.write_text("arrivals: {trace_csv: msv.csv}\nrun: {parts: 5}\n")
     assert main(["run", str(scenario), "--out", str(tmp_path / "out")]) == 0
     err = capsys.readouterr().err
-    assert "cell: warning: utilisation 0.00081: a part every 22333.3 s on average (6.2 h)" in err
+    assert "cell: warning: offered load 0.00081: a part every 22333.3 s on average (6.2 h)" in err
     assert "are the times in milliseconds? arrivals.trace_csv (msv.csv) is read in seconds" in err
     assert (tmp_path / "out" / "summary.csv").is_file()
 

@@ -125,7 +125,7 @@ def choose(fits: Sequence[Fit], values: ArrayLike,
     accepts, the one nearest the data's mean, and among those their sd.  ValueError, naming
     each fit and why, if a scenario accepts none.
 
-    The mean sets the utilisation, and the spread the queueing, so a fit that moves them
+    The mean sets the offered load, and the spread the queueing, so a fit that moves them
     misleads every what-if built on it.  On data no family describes the MLE can move them
     far: a free threshold slides next to the minimum when many gaps share it (a line that
     runs at one pace, with bursts of long gaps), and the likelihood then rewards a spike

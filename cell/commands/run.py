@@ -79,8 +79,8 @@ def main(args: argparse.Namespace) -> int:
             _write_failures(out, result)
     print(format_summary(result.summary, thesis_figures(scenario)))
     r = result.summary
-    print(f"robot busy (in motion) {r.robot_busy_fraction:.3f} of the run, beside its load "
-          f"(utilisation) {r.utilisation:.3f}")
+    print(f"robot busy (in motion) {r.robot_busy_fraction:.3f} of the run, beside its offered "
+          f"load (fastest cycle / mean inter-arrival) {r.offered_load:.3f}")
     shown = out.target
     if scenario.failures is None:
         print(f"wrote {shown}/parts.csv, summary.csv and belts.csv")

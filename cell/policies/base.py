@@ -89,7 +89,7 @@ class CellConstants:
             self.output_min * (self.r1_nom + self.r2_nom) - 1e-6
 
     @property
-    def utilisation(self) -> float:
+    def offered_load(self) -> float:
         """Fastest cycle over mean inter-arrival time: 1 or more, the cell cannot keep up."""
         return self.fastest_cycle_s / self.mean_interarrival_s
 

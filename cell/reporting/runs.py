@@ -40,7 +40,7 @@ def run_heading(cell: AssembledCell) -> str:
     heading = (f"cell run: {s.name} ({cell.policy.name}), {length}, seed {s.run.seed}\n"
                f"nominal cycle {k.cycle_nom:.4f} s ({source}); mean inter-arrival "
                f"{k.mean_interarrival_s:.4f} s; the robot's fastest cycle {k.fastest_cycle_s:.4f} "
-               f"s: utilisation {k.utilisation:.3f}")
+               f"s: offered load {k.offered_load:.3f}")
     trace = s.arrivals.trace_csv
     if trace is not None:
         from cell.arrivals import read_trace
@@ -62,8 +62,8 @@ def warnings(k: CellConstants, nominal: bool = True) -> list[str]:
     from cell.sweep.spec import nominal_gap, overloaded
 
     out = []
-    if k.utilisation >= 1:
-        out.append(overloaded(f"utilisation {k.utilisation:.3f}",
+    if k.offered_load >= 1:
+        out.append(overloaded(f"offered load {k.offered_load:.3f}",
                               (k.fastest_cycle_s, k.mean_interarrival_s)))
     if nominal and abs(nominal_gap(k)) > NOMINAL_MISMATCH:  # NaN: the cycle follows the arrivals
         out.append(nominal_off(nominal_mismatch(k.cycle_nom, k.mean_interarrival_s)))

@@ -66,7 +66,7 @@ def table(reps: pd.DataFrame) -> pd.DataFrame:
             row: dict[str, Any] = {
                 "family": family, "cv": cv, "mean_s": mean,
                 "load": mean / float(runs["fastest_cycle_s"].iloc[0]),
-                "utilisation": float(runs["utilisation"].iloc[0]), "policy": policy,
+                "offered_load": float(runs["offered_load"].iloc[0]), "policy": policy,
                 "n": delivered["n"], "parts_delivered": delivered["mean"],
                 "parts_delivered_ci_low": delivered["ci_low"],
                 "parts_delivered_ci_high": delivered["ci_high"],
@@ -138,12 +138,12 @@ def reading(t: pd.DataFrame) -> list[str]:
             f"whose cycle is the arrivals' mean, loses {min(lost_fx):.1f}-{max(lost_fx):.1f}: every "
             "part that comes even slightly early reaches B while it is busy, and falls, whatever "
             "the mean (its losses do not change with the load, since its cycle scales with it).")
-    over = ad[ad["utilisation"] >= 1.0]
+    over = ad[ad["offered_load"] >= 1.0]
     if len(over):
         ceiling = 3600.0 * over.iloc[0]["load"] / over.iloc[0]["mean_s"]   # 3600 / fastest cycle
         fx_over = fx.loc[[(r.family, r.cv, r.mean_s) for r in over.itertuples()]]
         out.append(
-            f"**Overloaded (utilisation 1 or more: {len(over)} points).** Both robots lose parts, "
+            f"**Overloaded (offered load 1 or more: {len(over)} points).** Both robots lose parts, "
             f"as the run warns: the adaptive robot {over['parts_lost'].min():.0f}-"
             f"{over['parts_lost'].max():.0f} per 500, the fixed one "
             f"{fx_over['parts_lost'].min():.0f}-{fx_over['parts_lost'].max():.0f}. The adaptive "
@@ -183,13 +183,13 @@ def promises(ad: pd.DataFrame, fx: pd.DataFrame) -> list[str]:
     down 45 ± 0.25 in behind the last), and the bound."""
     out = []
     none_lost = ad[ad["parts_lost"] == 0]
-    fast = ad[ad["utilisation"] < 1.0]
+    fast = ad[ad["offered_load"] < 1.0]
     where = "; ".join(f"{family} cv {cv:g} at load {g['load'].min():.2f}-{g['load'].max():.2f}"
                       for (family, cv), g in none_lost.groupby(["family", "cv"]))
     out.append(
         f"**No part lost.** The adaptive robot loses no part in any run at {len(none_lost)} of "
         f"{len(ad)} points" + (f" ({where})" if where else "") + "; where the robot can keep up "
-        f"(utilisation below 1) it loses at most {fast[fast['cv'] <= 0.1]['parts_lost'].max():.1f} "
+        f"(offered load below 1) it loses at most {fast[fast['cv'] <= 0.1]['parts_lost'].max():.1f} "
         f"parts per 500 where cv is at most 0.1, {fast[fast['cv'] <= 0.5]['parts_lost'].max():.1f} "
         f"where it is at most 0.5, and {fast['parts_lost'].max():.1f} anywhere. A part is lost "
         "when it comes so soon after the last that even R IV and R II at their peaks and the "

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 from cell.assembly import AssembledCell
 
-#: Below this utilisation (the robot's fastest cycle over the mean inter-arrival time) the
+#: Below this offered load (the robot's fastest cycle over the mean inter-arrival time) the
 #: arrivals look like milliseconds; the thesis's cell runs at about 0.8.
-LOW_UTILISATION = 0.05
+LOW_OFFERED_LOAD = 0.05
 #: A stated nominal cycle this many times the arrivals' mean, or this many times shorter,
 #: looks like a unit slip (seconds are 1000 ms, a minute is 60 s).
 CYCLE_RATIO = 10.0
@@ -40,7 +40,7 @@ def cycle_slip(cell: AssembledCell) -> bool:
 
 
 def unit_warnings(cell: AssembledCell) -> list[str]:
-    """One line each: a utilisation below :data:`LOW_UTILISATION`; a stated nominal cycle
+    """One line each: an offered load below :data:`LOW_OFFERED_LOAD`; a stated nominal cycle
     more than :data:`CYCLE_RATIO` times off the arrivals' mean (:func:`cycle_slip`; the line
     says what ``cell.reporting.runs.warnings`` would, which then leaves it out).  The line
     about a long cycle adds the input belt's length when that is derived from it."""
@@ -48,11 +48,11 @@ def unit_warnings(cell: AssembledCell) -> list[str]:
     mean = k.mean_interarrival_s
     out: list[str] = []
     long_cycle = False
-    if k.utilisation < LOW_UTILISATION:
+    if k.offered_load < LOW_OFFERED_LOAD:
         a = s.arrivals
         where = f"arrivals.trace_csv ({a.trace_csv})" if a.trace_csv is not None else \
             "arrivals.mean_s" if a.mean_s is not None else "arrivals.params"
-        out.append(f"utilisation {k.utilisation:.3g}: a part every {mean:.6g} s on average"
+        out.append(f"offered load {k.offered_load:.3g}: a part every {mean:.6g} s on average"
                    f"{_duration(mean)}, and the robot's fastest cycle is {k.fastest_cycle_s:.4g} s: "
                    f"are the times in milliseconds? {where} is read in seconds")
         long_cycle = k.nominal_from == "arrivals"

@@ -92,7 +92,7 @@ class Point:
     scenario: Scenario
     names: tuple[tuple[str, str], ...] = ()
     """For keys whose grid values are named: the name of the value here."""
-    utilisation: float = math.nan
+    offered_load: float = math.nan
     """The robot's fastest cycle over the mean inter-arrival time here (1 or more: the cell
     cannot keep up on average)."""
     nominal_gap: float = math.nan
@@ -341,20 +341,20 @@ def _points(path: Path, base: Scenario, fixed: dict[Any, Any], shared: dict[str,
 
 
 def overload_warning(sweep: Sweep) -> str | None:
-    """One line if some points' cells cannot keep up on average (utilisation 1 or more,
+    """One line if some points' cells cannot keep up on average (offered load 1 or more,
     as ``cell run`` warns of a run), naming the worst; else None."""
-    over = [p for p in sweep.points if p.utilisation >= 1]
+    over = [p for p in sweep.points if p.offered_load >= 1]
     if not over:
         return None
-    worst = max(over, key=lambda p: p.utilisation)
+    worst = max(over, key=lambda p: p.offered_load)
     where = ", ".join(f"{k} {worst.name_of(k) or show(v)}" for k, v in worst.values) \
         or worst.policy
-    return overloaded(f"{len(over)} of {len(sweep.points)} points have utilisation 1 or more "
-                      f"(up to {worst.utilisation:.3f}, at {where})")
+    return overloaded(f"{len(over)} of {len(sweep.points)} points have offered load 1 or more "
+                      f"(up to {worst.offered_load:.3f}, at {where})")
 
 
 def overloaded(how_much: str, times_s: tuple[float, float] | None = None) -> str:
-    """The one line saying a cell cannot keep up on average (utilisation 1 or more), opened
+    """The one line saying a cell cannot keep up on average (offered load 1 or more), opened
     by ``how_much``: for a sweep's points (:func:`overload_warning`) and for a run
     (:func:`cell.reporting.runs.warnings`, with its fastest cycle and mean inter-arrival
     time, s)."""
@@ -368,14 +368,14 @@ def overloaded(how_much: str, times_s: tuple[float, float] | None = None) -> str
 def _check_point(scenario: Scenario, file: object) -> dict[str, float]:
     """Assemble a grid point's cell now, so that no bad point is found after work began;
     an error names the sweep file, with the key and value it was about.  Returns the
-    point's utilisation and nominal_gap (:class:`Point`)."""
+    point's offered load and nominal_gap (:class:`Point`)."""
     from cell.assembly import assemble
 
     try:
         k = assemble(scenario).k
     except ScenarioError as exc:
         raise ScenarioError(file, exc.key, exc.value, exc.why) from None
-    return {"utilisation": k.utilisation, "nominal_gap": nominal_gap(k)}
+    return {"offered_load": k.offered_load, "nominal_gap": nominal_gap(k)}
 
 
 def nominal_gap(k: CellConstants) -> float:

@@ -39,7 +39,7 @@ def test_an_overloaded_cell_is_warned_of_as_cell_run_warns(
                         "run: {parts: 20}\n")
     assert cli(["run", str(scenario), "--out", str(tmp_path / "run")]) == 0
     run = said(capsys)
-    assert len(run) == 1 and run[0].startswith("cell: warning: utilisation 1.130: ")
+    assert len(run) == 1 and run[0].startswith("cell: warning: offered load 1.130: ")
     assert cli(["animate", str(scenario), "--out", str(tmp_path / "a.gif"), "--parts", "1",
                 "--speed", "200", "--dpi", "20"]) == 0
     assert said(capsys) == run
