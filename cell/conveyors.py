@@ -107,6 +107,9 @@ class Belt:
             raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}")
         ts, xs, vs = self._t, self._x, self._v
         t0 = ts[-1]
+        if t0 > t1 + EPS_S and len(ts) > 1 and ts[-2] < t1:  # one change planned after t1
+            del ts[-1], xs[-1], vs[-1]  # (the output belt's floor): dropped, as below
+            t0 = ts[-1]
         if t0 < t1 and t2 is not None and t1 < t2:
             # the controller's every replan: both changes after the last one, which alone
             # is kept (the general case below, unrolled)
@@ -133,10 +136,14 @@ class Belt:
 
     def then(self, t: float, v: float) -> None:
         """And from instant t, after every change planned, run at v (a third change)."""
-        if not v > 0 or not t > self._t[-1]:
+        ts, xs, vs = self._t, self._x, self._v
+        t0 = ts[-1]
+        if not v > 0 or not t > t0:
             raise ValueError(f"a belt's further change must come after its last and be "
                              f"positive, got {t!r}, {v!r}")
-        self._run_from(t, v)
+        xs.append(xs[-1] + vs[-1] * (t - t0))  # _run_from's append, inline (once a part)
+        ts.append(t)
+        vs.append(v)
 
     def _run_from(self, t: float, v: float) -> None:
         """Run at v from instant t on (at or before the last change: that change's speed is v)."""

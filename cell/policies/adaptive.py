@@ -48,6 +48,7 @@ from cell.records import (
     RunSummary,
 )
 
+_new = object.__new__
 #: The spacing contract plans the output belt's floor this long after the instant the next
 #: part is expected at B (a decision on time replans first, so nothing changes then).
 FLOOR_MARGIN_S = 1.0
@@ -65,7 +66,8 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
     None if no part is coming.  ``gap_in``: how far the last part set down has
     travelled on the output belt (None before the first).  ``lag``: B → LO at v,
     if the caller has it already.  ``idle_s``: seconds since that part was set down
-    (to name the cause when the spacing cannot be kept).
+    (to name the cause when the spacing cannot be kept; None: both causes are marked,
+    :class:`Adaptive` names the one once it knows).
 
     Departures from the thesis (docs/model.md), none of which binds on its arrivals:
     step 3.2 slows the input belt no further than its floor, taking time off R II
@@ -126,10 +128,15 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
     ttsot = r1a + r1b + r2
     u, out_flags = (k.u_nom, 0) if gap_in is None else output_speed(k, gap_in, ttsot, r3a, idle_s)
     flags |= out_flags
-    return Plan(r1_pre=r1a, r1_post=r1b, r2=r2, r3_pre=r3a, r3_post=r3b, r4=r4,
-                input_speed=v, input_after_lo=w, input_next=v_next, output_to_g=u,
-                to_g=ttsot, cycle=cycle, limits=flags,
-                output_floor_at=floor_at(k, nxt, w, v_next, cycle, ttsot + r3a))
+    # the plan field by field, by name (a third of the keyword call's cost, once a part)
+    plan = _new(Plan)
+    plan.r1_pre, plan.r1_post, plan.r2, plan.r3_pre, plan.r3_post, plan.r4 = \
+        r1a, r1b, r2, r3a, r3b, r4
+    plan.input_speed, plan.input_after_lo, plan.input_next = v, w, v_next
+    plan.output_to_g, plan.to_g, plan.cycle, plan.limits, plan.steers_belts = \
+        u, ttsot, cycle, flags, True
+    plan.output_floor_at = floor_at(k, nxt, w, v_next, cycle, ttsot + r3a)
+    return plan
 
 
 def output_speed(k: CellConstants, gap_in: float, ttsot: float, r3a: float,
@@ -145,7 +152,8 @@ def output_speed(k: CellConstants, gap_in: float, ttsot: float, r3a: float,
         u = k.output_min
         flags = OUTPUT_FLOOR
         if rest + u * ttsot > k.spacing + k.tol:  # off: name the cause
-            flags |= spacing_cause(k, idle_s, ttsot, r3a)
+            flags |= spacing_cause(k, idle_s, ttsot, r3a) if idle_s is not None else \
+                SPACING_CAUSE
         return u, flags
     if u > k.output_max:
         return k.output_max, OUTPUT_CEILING
@@ -173,6 +181,10 @@ def floor_at(k: CellConstants, nxt: tuple[float, float] | None, w: float, v_next
         (b - (w * run if run > 0 else 0.0)) / v_next
     t_e = (eta if eta > cycle else cycle) + FLOOR_MARGIN_S
     return t_e if k.u_nom * (t_e - td) <= k.floor_gap_in else td
+
+
+#: Both spacing causes: the mark of a part set down off spacing whose cause is still to name.
+SPACING_CAUSE = SPACING_WAIT | SPACING_UNFORESEEN
 
 
 def spacing_cause(k: CellConstants, idle_s: float | None, ttsot: float, r3a: float) -> int:
@@ -203,8 +215,11 @@ class Adaptive(Policy):
     def plan(self, view: CellView) -> Plan:
         v = view.input_speed()
         lag = self._lag(v)
-        return adaptive_plan(self.k, v, view.next_part(lag, v), view.output_gap(), lag,
-                             view.since_touchdown())
+        plan = adaptive_plan(self.k, v, view.next_part(lag, v), view.output_gap(), lag)
+        if plan.limits & SPACING_CAUSE:  # spacing off: name why (the time since TD, read
+            plan.limits = plan.limits & ~SPACING_CAUSE | spacing_cause(  # only then)
+                self.k, view.since_touchdown(), plan.to_g, plan.r3_pre)
+        return plan
 
     def accounting(self) -> MotionTimeAccounting:
         return AdaptiveAccounting(self)
