@@ -25,6 +25,7 @@ if TYPE_CHECKING:
     from cell.mintime.regimes import PlannerBounds, RegimePath
     from cell.motors import Motors
     from cell.path import CellGeometry
+    from cell.scenario import Scenario
 
 RICHARDSON = tuple(460 * 2 ** k for k in range(5))
 
@@ -44,10 +45,11 @@ def regime_time(rp: RegimePath, motors: Motors, bounds: PlannerBounds, geometry:
     return plan(regime_rows(rp, motors, bounds, geometry, n)[2]).time_s
 
 
-def benchmarks(repeat: int = 5) -> dict[str, float]:
+def _kinematic_speed(repeat: int) -> tuple[list[RegimePath], dict[str, np.ndarray], dict[str, float]]:
+    """The velocity + acceleration case against toppra on 460 and 2000 points: the free
+    regimes' paths, their peak velocity bounds and the timings (ms) and relative time gaps."""
     from cell.assembly import geometry_of, motors_of, planner_bounds, step_table
-    from cell.dynamics import chain
-    from cell.mintime.planner import PathRows, path_grid, plan, torque_rows, velocity_rows
+    from cell.mintime.planner import path_grid
     from cell.mintime.reference import toppra_profile
     from cell.mintime.regimes import FREE_REGIMES, regime_path, regime_rows
     from cell.scenario import load_scenario
@@ -73,12 +75,19 @@ def benchmarks(repeat: int = 5) -> dict[str, float]:
         out[f"mintime_ms_{n}"] = 1e3 * best_seconds(lambda: ours(n), repeat)       # noqa: B023
         out[f"toppra_ms_{n}"] = 1e3 * best_seconds(lambda: theirs(n), repeat)      # noqa: B023
         out[f"mintime_vs_toppra_time_rel_{n}"] = float(max(abs(x - y) / y for x, y in zip(a, b)))
+    return paths, vmax, out
 
-    # Torque (baseline dynamic model) on R IV at 460 points: toppra calls the same inverse
-    # dynamics once per grid point and coefficient, the planner batches it.
-    base = load_scenario("baseline")
-    base_geometry, base_motors, base_bounds = geometry_of(base), motors_of(base), planner_bounds(base)
-    model = base_bounds.dynamics
+
+def _torque_speed(base: Scenario, paths: list[RegimePath],
+                  vmax: dict[str, np.ndarray]) -> dict[str, float]:
+    """Torque (baseline dynamic model) on R IV at 460 points: toppra calls the same inverse
+    dynamics once per grid point and coefficient, the planner batches it."""
+    from cell.assembly import planner_bounds
+    from cell.dynamics import chain
+    from cell.mintime.planner import PathRows, path_grid, plan, torque_rows, velocity_rows
+    from cell.mintime.reference import toppra_profile
+
+    model = planner_bounds(base).dynamics
     assert model is not None, "scenarios/baseline.yaml names a dynamics file"
     r4 = next(rp for rp in paths if rp.regime == "R4")
     ch = chain(model, base.robot.l2_in, base.robot.l3_in, r4.load_oz, r4.tcp_in)
@@ -96,14 +105,32 @@ def benchmarks(repeat: int = 5) -> dict[str, float]:
                               inv_dyn=lambda q, qd, qdd: ch.rnea(q, qd, qdd, friction=False),
                               tau_max=tau)[1]
 
-    out["mintime_torque_ms_460"] = 1e3 * best_seconds(ours_tau, 3)
-    out["toppra_torque_ms_460"] = 1e3 * best_seconds(theirs_tau, 1)
+    return {"mintime_torque_ms_460": 1e3 * best_seconds(ours_tau, 3),
+            "toppra_torque_ms_460": 1e3 * best_seconds(theirs_tau, 1)}
 
+
+def _r4_dynamic_rel_err(base: Scenario) -> float:
+    """R IV under the baseline's dynamic model on its default grid against the converged
+    (Richardson) time."""
+    from cell.assembly import geometry_of, motors_of, planner_bounds, step_table
+    from cell.mintime.regimes import regime_path
+
+    base_geometry, base_motors, base_bounds = geometry_of(base), motors_of(base), planner_bounds(base)
     base_r4 = regime_path(step_table(base), "R4", base_geometry)
     r4_times = [regime_time(base_r4, base_motors, base_bounds, base_geometry, n) for n in RICHARDSON]
     default = regime_time(base_r4, base_motors, base_bounds, base_geometry)
     t_inf = converged_time(r4_times)
-    out["mintime_r4_dynamic_rel_err"] = abs(default - t_inf) / t_inf
+    return abs(default - t_inf) / t_inf
+
+
+def benchmarks(repeat: int = 5) -> dict[str, float]:
+    """Speed against toppra (kinematic and torque cases) and R IV's accuracy (module docstring)."""
+    from cell.scenario import load_scenario
+
+    paths, vmax, out = _kinematic_speed(repeat)
+    base = load_scenario("baseline")
+    out.update(_torque_speed(base, paths, vmax))
+    out["mintime_r4_dynamic_rel_err"] = _r4_dynamic_rel_err(base)
     return {k: round(v, 3) if "ms" in k else v for k, v in out.items()}
 
 

@@ -101,6 +101,64 @@ def _wrap_from(angle: NDArray[np.float64], lo: float) -> NDArray[np.float64]:
     return lo + np.mod(angle - lo, 2 * np.pi)
 
 
+_Branch = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_], NDArray[np.bool_]]
+
+
+def _ik_branch(th1: NDArray[np.float64], t: NDArray[np.float64], arm: Arm) -> _Branch:
+    """One θ1 branch of the closed-form solution for frames t (N, 4, 4): the joint
+    angles q (N, 5), the radial reach r, which poses are out of reach and which
+    joints fall outside Table 3.1's ranges."""
+    n, o, a, p = t[:, :3, 0], t[:, :3, 1], t[:, :3, 2], t[:, :3, 3]
+    z = p[:, 2]
+    lim = arm.limits_rad
+    c1, s1 = np.cos(th1), np.sin(th1)
+    th234 = np.arctan2(-(c1 * a[:, 0] + s1 * a[:, 1]), a[:, 2])
+    th5 = np.arctan2(c1 * n[:, 1] - s1 * n[:, 0], c1 * o[:, 1] - s1 * o[:, 0])
+    r = c1 * p[:, 0] + s1 * p[:, 1]
+    c3 = (r**2 + z**2 - arm.l2**2 - arm.l3**2) / (2 * arm.l2 * arm.l3)
+    reach_bad = np.abs(c3) > 1.0 + 1e-12
+    c3 = np.clip(c3, -1.0, 1.0)
+    s3 = -np.sqrt(1.0 - c3**2)
+    th3 = np.arctan2(s3, c3)
+    k1 = arm.l2 + arm.l3 * c3
+    th2 = np.arctan2(k1 * z - arm.l3 * s3 * r, k1 * r + arm.l3 * s3 * z)
+    th4 = th234 - th2 - th3
+    q = np.stack([th1, th2, th3, th4, th5], axis=-1)
+    q[:, 3] = _wrap_from(q[:, 3], lim[3, 0] - LIMIT_TOL_RAD)
+    q[:, 4] = _wrap_from(q[:, 4], lim[4, 0] - LIMIT_TOL_RAD)
+    outside = (q < lim[:, 0] - LIMIT_TOL_RAD) | (q > lim[:, 1] + LIMIT_TOL_RAD)
+    return q, r, reach_bad, outside
+
+
+def _pose_name(p: NDArray[np.float64], i: int, label: Callable[[int], str] | None) -> str:
+    """How an error names pose i: ``label(i)`` if given, else its wrist position."""
+    if label is not None:
+        return label(i)
+    return "pose at p = (" + ", ".join(f"{v:.4f}" for v in p[i]) + ") in the robot frame"
+
+
+def _check_reach(r: NDArray[np.float64], z: NDArray[np.float64], reach_bad: NDArray[np.bool_],
+                 arm: Arm, name: Callable[[int], str]) -> None:
+    """Raise :class:`UnreachableError` for the first pose out of reach (|C3| > 1)."""
+    if reach_bad.any():
+        i = int(np.flatnonzero(reach_bad)[0])
+        dist = float(np.hypot(r[i], z[i]))
+        raise UnreachableError(
+            f"{name(i)} is out of reach: the wrist would be {dist:.4f} in from the shoulder, "
+            f"the arm reaches {abs(arm.l2 - arm.l3):.4f} to {arm.l2 + arm.l3:.4f} in", i, None)
+
+
+def _check_ranges(q: NDArray[np.float64], outside: NDArray[np.bool_], arm: Arm,
+                  name: Callable[[int], str]) -> None:
+    """Raise :class:`UnreachableError` for the first joint outside its range."""
+    if outside.any():
+        i, j = (int(v) for v in np.argwhere(outside)[0])
+        lo, hi = np.degrees(arm.limits_rad[j])
+        raise UnreachableError(
+            f"{name(i)} needs {JOINTS[j]} ({JOINT_NAMES[j]}) = {np.degrees(q[i, j]):.3f}°, "
+            f"outside its range [{lo:g}°, {hi:g}°]", i, j)
+
+
 def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *,
                        label: Callable[[int], str] | None = None) -> NDArray[np.float64]:
     """Joint angles (..., 5) for target frames T5 (..., 4, 4), in closed form
@@ -115,56 +173,22 @@ def inverse_kinematics(t5: ArrayLike, arm: Arm = Arm(), *,
     t = np.asarray(t5, dtype=float)
     shape = t.shape[:-2]
     t = t.reshape(-1, 4, 4)
-    n, o, a, p = t[:, :3, 0], t[:, :3, 1], t[:, :3, 2], t[:, :3, 3]
-    z = p[:, 2]
-    lim = arm.limits_rad
-
-    def solve(th1: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64],
-                                                  NDArray[np.float64], NDArray[np.bool_]]:
-        c1, s1 = np.cos(th1), np.sin(th1)
-        th234 = np.arctan2(-(c1 * a[:, 0] + s1 * a[:, 1]), a[:, 2])
-        th5 = np.arctan2(c1 * n[:, 1] - s1 * n[:, 0], c1 * o[:, 1] - s1 * o[:, 0])
-        r = c1 * p[:, 0] + s1 * p[:, 1]
-        c3 = (r**2 + z**2 - arm.l2**2 - arm.l3**2) / (2 * arm.l2 * arm.l3)
-        reach_bad = np.abs(c3) > 1.0 + 1e-12
-        c3 = np.clip(c3, -1.0, 1.0)
-        s3 = -np.sqrt(1.0 - c3**2)
-        th3 = np.arctan2(s3, c3)
-        k1 = arm.l2 + arm.l3 * c3
-        th2 = np.arctan2(k1 * z - arm.l3 * s3 * r, k1 * r + arm.l3 * s3 * z)
-        th4 = th234 - th2 - th3
-        q = np.stack([th1, th2, th3, th4, th5], axis=-1)
-        q[:, 3] = _wrap_from(q[:, 3], lim[3, 0] - LIMIT_TOL_RAD)
-        q[:, 4] = _wrap_from(q[:, 4], lim[4, 0] - LIMIT_TOL_RAD)
-        outside = (q < lim[:, 0] - LIMIT_TOL_RAD) | (q > lim[:, 1] + LIMIT_TOL_RAD)
-        return q, r, reach_bad, outside
+    p = t[:, :3, 3]
 
     def name(i: int) -> str:
-        if label is not None:
-            return label(i)
-        return "pose at p = (" + ", ".join(f"{v:.4f}" for v in p[i]) + ") in the robot frame"
+        return _pose_name(p, i, label)
 
     # θ1 points the arm at the wrist, or away from it when the wrist sits behind the base
     # axis (θ2 > 90°): of the two, the one that keeps every joint inside its range.
     # Reach does not depend on the branch (|r| is the same), so it is checked first.
-    q, r, reach_bad, outside = solve(np.arctan2(p[:, 1], p[:, 0]))
-    if reach_bad.any():
-        i = int(np.flatnonzero(reach_bad)[0])
-        dist = float(np.hypot(r[i], z[i]))
-        raise UnreachableError(
-            f"{name(i)} is out of reach: the wrist would be {dist:.4f} in from the shoulder, "
-            f"the arm reaches {abs(arm.l2 - arm.l3):.4f} to {arm.l2 + arm.l3:.4f} in", i, None)
+    q, r, reach_bad, outside = _ik_branch(np.arctan2(p[:, 1], p[:, 0]), t, arm)
+    _check_reach(r, p[:, 2], reach_bad, arm, name)
     if outside.any():
-        q_b, _, _, outside_b = solve(np.arctan2(-p[:, 1], -p[:, 0]))
+        q_b, _, _, outside_b = _ik_branch(np.arctan2(-p[:, 1], -p[:, 0]), t, arm)
         better: NDArray[np.bool_] = np.asarray(outside.any(axis=1) & ~outside_b.any(axis=1))
         q = np.where(better[:, None], q_b, q)
         outside = np.where(better[:, None], outside_b, outside)
-        if outside.any():
-            i, j = (int(v) for v in np.argwhere(outside)[0])
-            lo, hi = np.degrees(lim[j])
-            raise UnreachableError(
-                f"{name(i)} needs {JOINTS[j]} ({JOINT_NAMES[j]}) = {np.degrees(q[i, j]):.3f}°, "
-                f"outside its range [{lo:g}°, {hi:g}°]", i, j)
+        _check_ranges(q, outside, arm, name)
     return q.reshape(shape + (5,))
 
 

@@ -46,12 +46,8 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
     if dated:  # arrival times as date-times (ISO 8601, e.g. 2026-03-02 08:15:04.5): seconds
         values, dated = _stamps_as_seconds(cells, values)
     finite = np.isfinite(values)
-    if not (times or sorted_ok) and values.size >= MIN_VALUES and finite.all() \
-            and np.all(np.diff(values) >= 0.0) and np.ptp(values) > 0.0:
-        seen = f"{values.size} values rising from {cells.iloc[0]} to {cells.iloc[-1]}"
-        raise ScenarioError(p, column, seen,
-                            "the column never decreases, so it looks like arrival times, not gaps: "
-                            "use --times to fit their differences (or --gaps if these are sorted gaps)")
+    if not (times or sorted_ok):
+        _refuse_rising(p, column, cells, values, finite)
     bad = np.flatnonzero(~finite if times else ~finite | (values < 0.0) | (values > most))
     if bad.size:
         i = int(bad[0])
@@ -59,15 +55,42 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
                             _why_unusable(cells.iloc[i], values[i], times=times, dated=dated, most=most))
     noun = "values"
     if times:
-        step = np.diff(values)
-        back = np.flatnonzero(~(step > 0.0) | (step > most))
-        if back.size and step[back[0]] != 0.0:  # a first repeated time is said below
-            i = int(back[0]) + 1
-            why = (f"arrival times must increase: not after {cells.iloc[i - 1]} on line {lines[i - 1]}"
-                   if step[i - 1] < 0.0 else f"{step[i - 1]:.10g} s after line {lines[i - 1]}; "
-                   f"gaps must be at most {most:g} s")
-            raise ScenarioError(p, f"{column}[line {lines[i]}]", cells.iloc[i], why)
-        values, noun = step, "gaps"
+        values, noun = _time_gaps(p, column, lines, cells, values, most), "gaps"
+    _check_fittable(p, column, lines, cells, values, times=times, noun=noun)
+    return values
+
+
+def _refuse_rising(p: Path, column: str, cells: Any, values: NDArray[np.float64],
+                   finite: NDArray[np.bool_]) -> None:
+    """Refuse as arrival times a column of :data:`MIN_VALUES` or more finite gaps that never
+    decreases (and is not all equal)."""
+    if values.size >= MIN_VALUES and finite.all() \
+            and np.all(np.diff(values) >= 0.0) and np.ptp(values) > 0.0:
+        seen = f"{values.size} values rising from {cells.iloc[0]} to {cells.iloc[-1]}"
+        raise ScenarioError(p, column, seen,
+                            "the column never decreases, so it looks like arrival times, not gaps: "
+                            "use --times to fit their differences (or --gaps if these are sorted gaps)")
+
+
+def _time_gaps(p: Path, column: str, lines: list[int], cells: Any, values: NDArray[np.float64],
+               most: float) -> NDArray[np.float64]:
+    """The differences of arrival times, refused where a time goes back or a gap is over ``most``
+    (a first repeated time is left to :func:`_check_fittable`)."""
+    step = np.diff(values)
+    back = np.flatnonzero(~(step > 0.0) | (step > most))
+    if back.size and step[back[0]] != 0.0:  # a first repeated time is said below
+        i = int(back[0]) + 1
+        why = (f"arrival times must increase: not after {cells.iloc[i - 1]} on line {lines[i - 1]}"
+               if step[i - 1] < 0.0 else f"{step[i - 1]:.10g} s after line {lines[i - 1]}; "
+               f"gaps must be at most {most:g} s")
+        raise ScenarioError(p, f"{column}[line {lines[i]}]", cells.iloc[i], why)
+    return step
+
+
+def _check_fittable(p: Path, column: str, lines: list[int], cells: Any, values: NDArray[np.float64],
+                    *, times: bool, noun: str) -> None:
+    """Refuse gaps no continuous distribution fits: any zero, fewer than :data:`MIN_VALUES`,
+    or all equal."""
     zero = np.flatnonzero(values == 0.0)  # Weibull's, gamma's, lognorm's likelihood is 0 or inf there
     if zero.size:
         i = int(zero[0]) + times
@@ -83,7 +106,6 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
     if np.ptp(values) == 0.0:
         raise ScenarioError(p, column, f"all {values.size} {noun} = {values[0]:g}",
                             f"{noun} without variation cannot be fitted")
-    return values
 
 
 #: An ISO 8601 date, or date and time (what ``--times`` reads as a time stamp).

@@ -17,6 +17,7 @@ from cell.assembly import step_table
 from cell.figures import arrivals, layout, motion, runs, tip
 from cell.figures.style import style
 from cell.scenario import Scenario
+from cell.steptable import StepTable
 
 #: Figure number -> file stem, as written into the output folder.
 FILES: dict[int, str] = {
@@ -58,6 +59,56 @@ def file_stem(number: int, scenario: Scenario) -> str:
     return f"fig{number}_{family}_{'pdf' if number == 13 else 'cdf'}"
 
 
+def _draw_path_figures(scenario: Scenario, table: StepTable, wanted: set[int],
+                       path: dict[int, Path], done: Callable[[Path], None]) -> None:
+    """Fig. 8, 9 and 12 (the cell and the path), 13/14 (the arrivals)."""
+    if 8 in wanted:
+        done(layout.fig08_working_environment(scenario, table, path[8]))
+    if 9 in wanted:
+        done(layout.fig09_path(scenario, table, path[9]))
+    if 12 in wanted:
+        done(layout.fig12_hand_length(scenario, path[12]))
+    if wanted & {13, 14}:
+        x = arrivals.draws(scenario, scenario.run.parts)
+        if 13 in wanted:
+            done(arrivals.fig13_pdf(scenario, x, path[13]))
+        if 14 in wanted:
+            done(arrivals.fig14_cdf(scenario, x, path[14]))
+
+
+def _draw_motion_figures(scenario: Scenario, table: StepTable, wanted: set[int],
+                         path: dict[int, Path], done: Callable[[Path], None]) -> None:
+    """Fig. 15-21: the arm's motion along the path."""
+    # drawn on the joints' travel; Fig. 17-21's whole steps on the simulation's own timing
+    tl = motion.nominal_timeline(table, scenario, motion.joint_travel_min_times(table))
+    steps_tl = motion.nominal_timeline(table, scenario)
+    if 15 in wanted:
+        done(motion.fig15_coordinates(table, tl, path[15]))
+    if 16 in wanted:
+        done(motion.fig16_joint_angles(table, tl, path[16]))
+    for joint in range(5):
+        if 17 + joint in wanted:
+            done(motion.fig_joint_rate(table, tl, steps_tl, scenario, joint,
+                                        path[17 + joint]))
+
+
+def _draw_run_figures(scenario: Scenario, table: StepTable, wanted: set[int],
+                      path: dict[int, Path], done: Callable[[Path], None]) -> None:
+    """Fig. 22-30, from simulated runs (only those the wanted figures need)."""
+    if wanted & set(range(22, 31)):
+        sims = runs.simulate_runs(scenario, tuple(
+            c for n, c in runs.IP_FIGURES.items() if n in wanted))
+        if 22 in wanted:
+            done(tip.fig22_tip_velocity(sims, table, scenario, path[22]))
+        if 23 in wanted:
+            done(runs.fig23_lumped(sims, scenario, path[23]))
+        if 24 in wanted:
+            done(runs.fig24_running(sims, scenario, path[24]))
+        for number, cycle in runs.IP_FIGURES.items():
+            if number in wanted:
+                done(runs.fig_ip(sims, cycle, number, path[number]))
+
+
 def make_figures(scenario: Scenario, out: str | Path, *, parts: int | None = None,
                  only: Iterable[int] | None = None,
                  progress: Callable[[Path], None] | None = None,
@@ -86,39 +137,7 @@ def make_figures(scenario: Scenario, out: str | Path, *, parts: int | None = Non
     wanted -= set(skipped)
     with style():
         table = step_table(scenario)
-        if 8 in wanted:
-            done(layout.fig08_working_environment(scenario, table, path[8]))
-        if 9 in wanted:
-            done(layout.fig09_path(scenario, table, path[9]))
-        if 12 in wanted:
-            done(layout.fig12_hand_length(scenario, path[12]))
-        if wanted & {13, 14}:
-            x = arrivals.draws(scenario, scenario.run.parts)
-            if 13 in wanted:
-                done(arrivals.fig13_pdf(scenario, x, path[13]))
-            if 14 in wanted:
-                done(arrivals.fig14_cdf(scenario, x, path[14]))
-        # drawn on the joints' travel; Fig. 17-21's whole steps on the simulation's own timing
-        tl = motion.nominal_timeline(table, scenario, motion.joint_travel_min_times(table))
-        steps_tl = motion.nominal_timeline(table, scenario)
-        if 15 in wanted:
-            done(motion.fig15_coordinates(table, tl, path[15]))
-        if 16 in wanted:
-            done(motion.fig16_joint_angles(table, tl, path[16]))
-        for joint in range(5):
-            if 17 + joint in wanted:
-                done(motion.fig_joint_rate(table, tl, steps_tl, scenario, joint,
-                                            path[17 + joint]))
-        if wanted & set(range(22, 31)):
-            sims = runs.simulate_runs(scenario, tuple(
-                c for n, c in runs.IP_FIGURES.items() if n in wanted))
-            if 22 in wanted:
-                done(tip.fig22_tip_velocity(sims, table, scenario, path[22]))
-            if 23 in wanted:
-                done(runs.fig23_lumped(sims, scenario, path[23]))
-            if 24 in wanted:
-                done(runs.fig24_running(sims, scenario, path[24]))
-            for number, cycle in runs.IP_FIGURES.items():
-                if number in wanted:
-                    done(runs.fig_ip(sims, cycle, number, path[number]))
+        _draw_path_figures(scenario, table, wanted, path, done)
+        _draw_motion_figures(scenario, table, wanted, path, done)
+        _draw_run_figures(scenario, table, wanted, path, done)
     return written

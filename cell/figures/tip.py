@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 from matplotlib.artist import Artist
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from numpy.typing import ArrayLike, NDArray
 
@@ -97,6 +98,78 @@ def hand_moves(table: StepTable) -> tuple[int, int]:
     return int(change[0]), int(change[-1])
 
 
+def _belt_curve(ax: Axes, run: Run, row: pd.Series,
+                tl: Timeline) -> tuple[Artist, float, float, NDArray[np.float64]]:
+    """The input belt's speed over the part's cycle, drawn with time 0 at LO: the artist,
+    the speeds just before and at LO, and the speeds drawn."""
+    hist = run.belts["input"]
+    at_b, pick = float(row["at_bot_s"]), float(row["pick_s"])
+    before, after = belt_speed_at(hist, pick - 1e-6), belt_speed_at(hist, pick)
+    end = at_b + float(tl.t_s[-1])
+    changes = [(at_b, before)] + [(w, v) for w, v in hist if at_b < w <= end + 1e-9]
+    bt = np.array([w for w, _ in changes] + [end]) - pick
+    bv = np.array([v for _, v in changes])
+    curve = ax.stairs(bv, bt, baseline=None, color=POLICY_COLOURS["non-adaptive"], lw=1.4,
+                      ls="--", label="input belt speed")
+    return curve, before, after, bv
+
+
+def _regime_averages(ax: Axes, table: StepTable, t: NDArray[np.float64], row: pd.Series,
+                     curves: list[Artist]) -> dict[int, tuple[float, float]]:
+    """Each regime's average tip velocity drawn over its span (appended to ``curves``);
+    the spans, by regime."""
+    spans = {}
+    for r in (1, 2, 3, 4):
+        pts = table.regime_points(r)
+        spans[r] = (float(t[pts[0]]), float(t[pts[-1]]))
+        curves.append(ax.hlines(float(row[f"v_r{r}_in_s"]), *spans[r], colors="0.45",
+                                linestyles=":", lw=1.3,
+                                label="regime's average tip velocity (velocity state vector)"
+                                if r == 1 else None))  # type: ignore[arg-type]  # None: no legend entry
+    return spans
+
+
+def _regime_labels(ax: Axes, row: pd.Series, spans: dict[int, tuple[float, float]]) -> list[Label]:
+    """Each regime's average velocity written on its line."""
+    labels: list[Label] = []
+    for r in (1, 2, 3, 4):
+        v = float(row[f"v_r{r}_in_s"])
+        lo, hi = spans[r]
+        # R I's from LO on, clear of the hatching; the others centred on their regime
+        x, ha, dx = (0.0, "left", 3) if r == 1 else ((lo + hi) / 2, "center", 0)
+        text = ax.annotate(f"{REGIME_LABELS[r]} {v:.3f}", (x, v), xytext=(dx, 3),
+                           textcoords="offset points", fontsize=8, color="0.25", ha=ha,
+                           va="center")
+        labels.append(Label(text, [(dx + sx, dy) for _, dy in OFFSETS for sx in SHIFTS],
+                            (max(lo, 0.0), hi)))
+    return labels
+
+
+def _hand_labels(ax: Axes, table: StepTable, tl: Timeline, t: NDArray[np.float64],
+                 tip: NDArray[np.float64]) -> list[Label]:
+    """The moves in which the fingers close and open, each pointed at on the tip curve."""
+    labels: list[Label] = []
+    grasp, release = hand_moves(table)
+    for move, what in ((grasp, "fingers close on the part"), (release, "fingers open")):
+        mid = float(t[move - 1] + t[move]) / 2
+        text = ax.annotate(f"{what}: one move,\n{tl.dt_s[move]:.3f} s at {tip[move - 1]:.2f} in/s",
+                           (mid, float(tip[move - 1])), xytext=(8, -8), textcoords="offset points",
+                           fontsize=7.5, color="0.2", ha="left", va="top",
+                           arrowprops={"arrowstyle": "-", "color": "0.4", "lw": 0.6})
+        labels.append(Label(text, [(dx, dy) for dy in (-8, -20, -34, -50, 10, 26)
+                                   for dx in (8, 20, -100, 40)]))
+    return labels
+
+
+def _lag_note(ax: Axes, lag: float, before: float) -> Label:
+    """The note on the look-ahead lag before LO (§5.3 3.1)."""
+    note = ax.annotate(f"◀ look-ahead lag {lag:.4f} s: B → LO at {before:.3f} in/s;\n"
+                       f"   the input belt may change only from LO on", (0.0, 0.0),
+                       xytext=(6, 0), textcoords="offset points", ha="left", va="bottom", fontsize=8.5,
+                       bbox={"fc": "white", "ec": "0.6", "lw": 0.6})
+    return Label(note, [(6, dy) for dy in range(250, -1, -10)])
+
+
 def fig22_figure(runs: Runs, table: StepTable, s: Scenario) -> Figure:
     """Fig. 22, drawn and laid out (not saved)."""
     fig, ax = new_figure(22, "Robot Tip Velocity of a Transfer", size=(9.0, 5.4))
@@ -111,23 +184,9 @@ def fig22_figure(runs: Runs, table: StepTable, s: Scenario) -> Figure:
     tip = tip_speeds(table, tl)
     curves: list[Artist] = [ax.stairs(tip, t, baseline=None, color="black", lw=1.5,
                                       label="tool-centre speed along the path")]
-    hist = run.belts["input"]
-    at_b, pick = float(row["at_bot_s"]), float(row["pick_s"])
-    before, after = belt_speed_at(hist, pick - 1e-6), belt_speed_at(hist, pick)
-    end = at_b + float(tl.t_s[-1])
-    changes = [(at_b, before)] + [(w, v) for w, v in hist if at_b < w <= end + 1e-9]
-    bt = np.array([w for w, _ in changes] + [end]) - pick
-    bv = np.array([v for _, v in changes])
-    curves.append(ax.stairs(bv, bt, baseline=None, color=POLICY_COLOURS["non-adaptive"], lw=1.4,
-                            ls="--", label="input belt speed"))
-    spans = {}
-    for r in (1, 2, 3, 4):
-        pts = table.regime_points(r)
-        spans[r] = (float(t[pts[0]]), float(t[pts[-1]]))
-        curves.append(ax.hlines(float(row[f"v_r{r}_in_s"]), *spans[r], colors="0.45",
-                                linestyles=":", lw=1.3,
-                                label="regime's average tip velocity (velocity state vector)"
-                                if r == 1 else None))
+    belt, before, after, bv = _belt_curve(ax, run, row, tl)
+    curves.append(belt)
+    spans = _regime_averages(ax, table, t, row, curves)
     lag_box = ax.axvspan(-lag, 0, facecolor="none", hatch="///", edgecolor="0.6", lw=0)
     mark_events(ax, {"LO": 0.0, "TD": float(tl.t_s[p.td] - lag)})
     nxt = (f"next part {float(run.parts['interarrival_s'].iloc[i + 1]):.3f} s behind"
@@ -143,31 +202,8 @@ def fig22_figure(runs: Runs, table: StepTable, s: Scenario) -> Figure:
     fig.legend(loc="outside lower center", ncols=3, fontsize=8.5)
     freeze_layout(fig)
 
-    labels: list[Label] = []
-    for r in (1, 2, 3, 4):
-        v = float(row[f"v_r{r}_in_s"])
-        lo, hi = spans[r]
-        # R I's from LO on, clear of the hatching; the others centred on their regime
-        x, ha, dx = (0.0, "left", 3) if r == 1 else ((lo + hi) / 2, "center", 0)
-        text = ax.annotate(f"{REGIME_LABELS[r]} {v:.3f}", (x, v), xytext=(dx, 3),
-                           textcoords="offset points", fontsize=8, color="0.25", ha=ha,
-                           va="center")
-        labels.append(Label(text, [(dx + sx, dy) for _, dy in OFFSETS for sx in SHIFTS],
-                            (max(lo, 0.0), hi)))
-    grasp, release = hand_moves(table)
-    for move, what in ((grasp, "fingers close on the part"), (release, "fingers open")):
-        mid = float(t[move - 1] + t[move]) / 2
-        text = ax.annotate(f"{what}: one move,\n{tl.dt_s[move]:.3f} s at {tip[move - 1]:.2f} in/s",
-                           (mid, float(tip[move - 1])), xytext=(8, -8), textcoords="offset points",
-                           fontsize=7.5, color="0.2", ha="left", va="top",
-                           arrowprops={"arrowstyle": "-", "color": "0.4", "lw": 0.6})
-        labels.append(Label(text, [(dx, dy) for dy in (-8, -20, -34, -50, 10, 26)
-                                   for dx in (8, 20, -100, 40)]))
-    note = ax.annotate(f"◀ look-ahead lag {lag:.4f} s: B → LO at {before:.3f} in/s;\n"
-                       f"   the input belt may change only from LO on", (0.0, 0.0),
-                       xytext=(6, 0), textcoords="offset points", ha="left", va="bottom", fontsize=8.5,
-                       bbox={"fc": "white", "ec": "0.6", "lw": 0.6})
-    labels.append(Label(note, [(6, dy) for dy in range(250, -1, -10)]))
+    labels = _regime_labels(ax, row, spans) + _hand_labels(ax, table, tl, t, tip)
+    labels.append(_lag_note(ax, lag, before))
     place_clear(ax, labels, avoid=[*curves, *ax.lines], avoid_boxes=[lag_box])
     return fig
 

@@ -220,8 +220,7 @@ def _umax(b: tuple[float, ...], x: float, sd: float) -> float:
     best = math.inf
     for j in range(0, len(b), 3):
         v = b[j] + b[j + 1] * sd + b[j + 2] * x
-        if v < best:
-            best = v
+        best = min(best, v)
     return best
 
 
@@ -231,8 +230,7 @@ def _umin(b: tuple[float, ...], x: float, sd: float) -> float:
     best = -math.inf
     for j in range(0, len(b), 3):
         v = b[j] + b[j + 1] * sd + b[j + 2] * x
-        if v > best:
-            best = v
+        best = max(best, v)
     return best
 
 
@@ -308,16 +306,9 @@ def _where(s: Array, i: int) -> str:
     return f"s = {s[i]:.4f}"
 
 
-def plan(rows: PathRows, sdot_start: float = 0.0, sdot_end: float = 0.0) -> Profile:
-    """The minimum-time profile under ``rows`` from ``sdot_start`` to ``sdot_end``.
-
-    Raises :class:`NoMotionError` (a :class:`CellError`) naming where motion
-    stops being possible: the limit curve at zero, a start or end state above
-    it, or no way to keep moving.
-    """
-    s = np.asarray(rows.s, float)
-    n = len(s)
-    if n < 2 or np.any(np.diff(s) <= 0):
+def _checked_limit(rows: PathRows, s: Array, sdot_start: float, sdot_end: float) -> Array:
+    """The velocity-limit curve, once the grid and both end states are found admissible."""
+    if len(s) < 2 or np.any(np.diff(s) <= 0):
         raise NoMotionError("the path grid must have at least 2 increasing points")
     limit = velocity_limit(rows)
     inner = limit[1:-1] <= 0
@@ -327,11 +318,23 @@ def plan(rows: PathRows, sdot_start: float = 0.0, sdot_end: float = 0.0) -> Prof
                             "velocity (the velocity-limit curve is zero there)")
     if sdot_start > limit[0] * (1 + 1e-9) or sdot_end > limit[-1] * (1 + 1e-9):
         raise NoMotionError("the start or end path velocity is above the velocity-limit curve")
-    mvc = limit * limit
+    return limit
+
+
+def plan(rows: PathRows, sdot_start: float = 0.0, sdot_end: float = 0.0) -> Profile:
+    """The minimum-time profile under ``rows`` from ``sdot_start`` to ``sdot_end``.
+
+    Raises :class:`NoMotionError` (a :class:`CellError`) naming where motion
+    stops being possible: the limit curve at zero, a start or end state above
+    it, or no way to keep moving.
+    """
+    s = np.asarray(rows.s, float)
+    n = len(s)
+    limit = _checked_limit(rows, s, sdot_start, sdot_end)
     ups, downs = _bound_lists(rows, limit)
     sq = math.sqrt
     ds = np.diff(s).tolist()
-    mvc_l = mvc.tolist()
+    mvc_l = (limit * limit).tolist()
 
     # Backward: maximum deceleration from the end, never above the limit curve.
     xb = [0.0] * n
@@ -349,8 +352,7 @@ def plan(rows: PathRows, sdot_start: float = 0.0, sdot_end: float = 0.0) -> Prof
     phase = np.zeros(n - 1, dtype=np.int8)
     xf[0] = min(sdot_start ** 2, xb[0])
     for i in range(n - 1):
-        d, x0 = ds[i], xf[i]
-        cap = xb[i + 1]
+        d, x0, cap = ds[i], xf[i], xb[i + 1]
         u0 = _umax(ups[i], x0, sq(x0))
         if u0 == math.inf or x0 + 2.0 * d * u0 >= cap:
             x1 = cap
@@ -369,8 +371,7 @@ def plan(rows: PathRows, sdot_start: float = 0.0, sdot_end: float = 0.0) -> Prof
     if np.any(speed <= 0):
         i = int(np.flatnonzero(speed <= 0)[0])
         raise NoMotionError(f"no motion possible at {_where(s, i)}: the path velocity is zero")
-    time_s = float(elapsed_s(s, sdot)[-1])
-    return Profile(s, sdot, limit, phase, time_s, _switches(s, phase))
+    return Profile(s, sdot, limit, phase, float(elapsed_s(s, sdot)[-1]), _switches(s, phase))
 
 
 def elapsed_s(s: Array, sdot: Array) -> Array:

@@ -49,13 +49,13 @@ def _cycles(cycles: Sequence[float]) -> str:
     return ", ".join(text[:-1]) + " and " + text[-1] if len(text) > 1 else text[0]
 
 
-def reading_by_cycle(table: pd.DataFrame, policy: str, parts: int | None,
-                      replications: pd.DataFrame | None = None) -> list[str]:
-    """A policy published row by row (Table 7.1): agreement, and where the accountings part."""
+Means = Mapping[tuple[float, str, str], Any]
+
+
+def _against_thesis(table: pd.DataFrame, policy: str, cycles: list[float]) -> list[str]:
+    """How many published parts missed, actual cycles and IPs fall inside the range of 95 %
+    of single runs (thesis's accounting), and how far Vavg R IV is from its column."""
     out: list[str] = []
-    cycles = list(dict.fromkeys(table.loc[table["policy"] == policy, "ideal_cycle_s"]))
-    mean = {(c, a, m): row_of(table, policy, c, a, m)["mean"]
-            for c in cycles for a in ACCOUNTINGS for m in MEASURES}
     checked, outside = 0, []
     for c in cycles:
         for m in ("parts_missed", "actual_cycle_s", "ip"):
@@ -78,7 +78,11 @@ def reading_by_cycle(table: pd.DataFrame, policy: str, parts: int | None,
         out.append(f"Vavg R IV differs from the published column by at most {max(vv):.5f} in/s"
                    + (" (the R IV length over the shortened R IV time: the same in every run)."
                       if fixed else "."))
+    return out
 
+
+def _where_parted(mean: Means, cycles: list[float], parts: int | None) -> str:
+    """Parts missed and actual cycle in both accountings at the longest and shortest cycle."""
     top, bottom = cycles[0], cycles[-1]
     tm, wm = mean[top, "thesis", "parts_missed"], mean[top, "wallclock", "parts_missed"]
     ta, wa = mean[top, "thesis", "actual_cycle_s"], mean[top, "wallclock", "actual_cycle_s"]
@@ -88,12 +92,17 @@ def reading_by_cycle(table: pd.DataFrame, policy: str, parts: int | None,
     gap_top, gap_bottom = ta / wa - 1, tb / wb - 1
     trend = ("narrows as the cycle shortens and losses grow rare"
              if abs(gap_bottom) < abs(gap_top) else "widens as the cycle shortens")
-    out.append(
+    return (
         f"**Where the accountings part.** At {top:.4f} s the thesis's bookkeeping loses "
         f"{tm:.1f}{of} parts on average against {wm:.1f} on the wall clock, and its actual "
         f"cycle is {ta:.2f} s against {wa:.2f} s ({gap_top:+.1%}). At {bottom:.4f} s it is "
         f"{tmb:.1f} against {wmb:.1f} parts and {tb:.2f} against {wb:.2f} s "
         f"({gap_bottom:+.1%}): the gap {trend}.")
+
+
+def _why_losses_differ(mean: Means, cycles: list[float]) -> list[str]:
+    """Why the thesis loses more (D = T + C) or fewer parts than the wall clock, by cycle."""
+    out: list[str] = []
     more = [c for c in cycles
             if mean[c, "thesis", "parts_missed"] > mean[c, "wallclock", "parts_missed"] + 0.5]
     fewer = [c for c in cycles
@@ -115,28 +124,55 @@ def reading_by_cycle(table: pd.DataFrame, policy: str, parts: int | None,
         out.append(
             "Both accountings lose the same number of parts; they part in how the time between "
             "deliveries is booked: the thesis adds a whole robot cycle per lost part (D = T + C).")
+    return out
+
+
+def _ip_ratio(mean: Means, cycles: list[float]) -> list[str]:
+    """The thesis's IP column, T(i+1) / (2 D(i)), against the wall-clock IP."""
+    top, bottom = cycles[0], cycles[-1]
     ratios = [mean[c, "wallclock", "ip"] / mean[c, "thesis", "ip"] for c in cycles
               if mean[c, "thesis", "ip"] > 0]
-    if ratios:
-        out.append(
-            f"IP: the thesis's column averages T(i+1) / (2 D(i)), a doubled denominator, so it "
-            f"reads {min(ratios):.2f}–{max(ratios):.2f} times lower than the wall-clock IP "
-            f"({mean[top, 'thesis', 'ip']:.4f} against {mean[top, 'wallclock', 'ip']:.4f} at "
-            f"{top:.4f} s, {mean[bottom, 'thesis', 'ip']:.4f} against "
-            f"{mean[bottom, 'wallclock', 'ip']:.4f} at {bottom:.4f} s).")
+    if not ratios:
+        return []
+    return [
+        f"IP: the thesis's column averages T(i+1) / (2 D(i)), a doubled denominator, so it "
+        f"reads {min(ratios):.2f}–{max(ratios):.2f} times lower than the wall-clock IP "
+        f"({mean[top, 'thesis', 'ip']:.4f} against {mean[top, 'wallclock', 'ip']:.4f} at "
+        f"{top:.4f} s, {mean[bottom, 'thesis', 'ip']:.4f} against "
+        f"{mean[bottom, 'wallclock', 'ip']:.4f} at {bottom:.4f} s)."]
+
+
+def _throughput(mean: Means, policy: str, cycles: list[float], parts: int | None) -> list[str]:
+    """Parts/hr at the longest cycle against the ideal cycle's, the table's and the text's cut."""
+    top = cycles[0]
+    tm = mean[top, "thesis", "parts_missed"]
     ideal_pph = 3600 / top
     cut_t = 1 - mean[top, "thesis", "parts_per_hr"] / ideal_pph
     cut_w = 1 - mean[top, "wallclock", "parts_per_hr"] / ideal_pph
     thesis_pph = thesis_value(policy, top, "thesis", "parts_per_hr")
-    if math.isfinite(thesis_pph) and parts:
-        out.append(
-            f"Throughput at {top:.4f} s: the thesis's accounting gives "
-            f"{mean[top, 'thesis', 'parts_per_hr']:.1f} parts/hr, {cut_t:.0%} below the "
-            f"{ideal_pph:.1f}/hr of the ideal cycle (the thesis's table: "
-            f"{1 - thesis_pph / ideal_pph:.0%}), while {tm / parts:.1%} of the parts are lost "
-            f"(the thesis's text: {published.TEXT_THROUGHPUT_CUT:.1%}, 206 of 500): the table's parts/hr and "
-            f"the text's throughput cut measure different things. On the wall clock the cut is "
-            f"{cut_w:.0%}.")
+    if not (math.isfinite(thesis_pph) and parts):
+        return []
+    return [
+        f"Throughput at {top:.4f} s: the thesis's accounting gives "
+        f"{mean[top, 'thesis', 'parts_per_hr']:.1f} parts/hr, {cut_t:.0%} below the "
+        f"{ideal_pph:.1f}/hr of the ideal cycle (the thesis's table: "
+        f"{1 - thesis_pph / ideal_pph:.0%}), while {tm / parts:.1%} of the parts are lost "
+        f"(the thesis's text: {published.TEXT_THROUGHPUT_CUT:.1%}, 206 of 500): the table's parts/hr and "
+        f"the text's throughput cut measure different things. On the wall clock the cut is "
+        f"{cut_w:.0%}."]
+
+
+def reading_by_cycle(table: pd.DataFrame, policy: str, parts: int | None,
+                      replications: pd.DataFrame | None = None) -> list[str]:
+    """A policy published row by row (Table 7.1): agreement, and where the accountings part."""
+    cycles = list(dict.fromkeys(table.loc[table["policy"] == policy, "ideal_cycle_s"]))
+    mean = {(c, a, m): row_of(table, policy, c, a, m)["mean"]
+            for c in cycles for a in ACCOUNTINGS for m in MEASURES}
+    out = _against_thesis(table, policy, cycles)
+    out.append(_where_parted(mean, cycles, parts))
+    out += _why_losses_differ(mean, cycles)
+    out += _ip_ratio(mean, cycles)
+    out += _throughput(mean, policy, cycles, parts)
     return out
 
 
