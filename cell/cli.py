@@ -52,7 +52,7 @@ class Parser(argparse.ArgumentParser):
     """argparse with usage errors on one line (``cell run: error: ...``) and no exit."""
 
     def error(self, message: str) -> NoReturn:
-        raise _UsageError(f"{self.prog}: {message} (see {self.prog} --help)")
+        raise _UsageError(f"{self.prog}: error: {message} (see {self.prog} --help)")
 
 
 class _UsageError(Exception):
@@ -74,7 +74,13 @@ def build_parser() -> argparse.ArgumentParser:
         module = _module(name)
         p = sub.add_parser(name, help=module.HELP, description=module.DESCRIPTION)
         module.add_arguments(p)
+        SUBPARSERS[name] = p
     return parser
+
+
+#: Each subcommand's parser, by name, as build_parser made it: an argument the subcommand
+#: does not know is its usage error, pointing to its own --help.
+SUBPARSERS: dict[str, argparse.ArgumentParser] = {}
 
 
 def _fail(message: str) -> int:
@@ -148,9 +154,13 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _main(argv: Sequence[str] | None) -> int:
     parser = build_parser()
     try:
-        args = parser.parse_args(argv)
+        args, extra = parser.parse_known_args(argv)
+        if extra:
+            SUBPARSERS.get(args.command, parser).error(
+                "unrecognized arguments: " + " ".join(extra))
     except _UsageError as exc:
-        return _fail(str(exc))
+        print(one_line(str(exc), 1000), file=sys.stderr)  # "cell run: error: ... (see ...)"
+        return 2
     except SystemExit as exc:  # --help, --version: printed, done
         return exc.code if isinstance(exc.code, int) else 0
     try:

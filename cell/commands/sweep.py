@@ -11,7 +11,7 @@ import threading
 from pathlib import Path
 from typing import Any
 
-from cell.commands import check_workers, workers_argument
+from cell.commands import check_workers, set_argument, workers_argument
 from cell.interrupts import exit_now
 
 HELP = "replicated sweep over scenario keys, with its report"
@@ -31,6 +31,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--report", default=None, metavar="DIR",
                    help="also write the report into DIR, as a unit (into DIR/NAME/ if DIR "
                         "holds other files)")
+    set_argument(p)  # on top of the sweep file's set: (a key the grid varies is refused)
+    p.add_argument("--format", choices=("csv", "parquet"), default="csv",
+                   help="parquet: also write replications.parquet (the same table)")
 
 
 class _Stop:
@@ -86,7 +89,9 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
 
     out = check_out(args.out)  # before the sweep file's points are built and checked
     check_workers(args.workers, args.scheduler)
-    sweep = load_sweep(args.sweep)
+    from cell.overrides import parse_sets
+
+    sweep = load_sweep(args.sweep, parse_sets(args.sets))
     check_owner(sweep, out, args.resume)  # no results of another sweep, nor this one's, lost
     target = None
     if args.report:
@@ -112,6 +117,12 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
         print(f"cell sweep: stopped; {kept} finished task{'s' if kept != 1 else ''} kept in "
               f"{args.out}: the same command with --resume runs only the rest", file=sys.stderr)
         return stop.code
+    if args.format == "parquet":
+        from cell.output import atomic_path
+        from cell.output.parquet import csv_to_parquet
+
+        with atomic_path(Path(args.out) / "replications.parquet") as tmp:
+            csv_to_parquet(Path(args.out) / "replications.csv", tmp)
     counts = sorted(set(outcome.counts.values()))
     reps = (f"{counts[0]}" if len(counts) == 1 else f"{counts[0]}-{counts[-1]}")
     print(f"wrote {Path(args.out) / 'replications.csv'}: {len(sweep.points)} points x "

@@ -227,6 +227,7 @@ def prepare(sweep: Sweep, out: Path, resume: bool) -> None:
         for stale in finished_tasks(out):
             stale.unlink()
         (out / "replications.csv").unlink(missing_ok=True)
+    (out / "replications.parquet").unlink(missing_ok=True)  # --format parquet remakes it
     doc: dict[str, Any] = {"sweep": sweep.source, "name": sweep.name,
                            "fingerprint": sweep.fingerprint(),
                            ANY_COUNT: any_count,

@@ -230,9 +230,10 @@ class Sweep:
         return out
 
 
-def load_sweep(path: str | Path) -> Sweep:
+def load_sweep(path: str | Path, sets: dict[str, Any] | None = None) -> Sweep:
     """Read and validate a sweep file (or a built-in one by name); every grid point's
-    scenario is built and checked."""
+    scenario is built and checked.  ``sets``: dotted keys set on top of its ``set:``
+    (``cell sweep --set``), checked as that is."""
     from cell import catalog
     from cell.yamlio import load_mapping
 
@@ -257,6 +258,7 @@ def load_sweep(path: str | Path) -> Sweep:
     fixed = raw.get("set") or {}
     if not isinstance(fixed, dict):
         raise ScenarioError(path, "set", fixed, "must be a mapping of dotted keys to values")
+    fixed = {**fixed, **(sets or {})}
     for key, value in fixed.items():
         if not known_key(str(key)):
             raise ScenarioError(path, str(key), value, "unknown key: no such setting in a scenario")
