@@ -9,13 +9,14 @@ against replication r (common random numbers).
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from collections.abc import Sequence
 
 import pandas as pd
 
 from cell.analysis.stats import PAIRED_KEYS, SUMMARY_KEYS, paired_difference, summarise
-from cell.sweep import Column, Sweep, grid_columns
+from cell.sweep import Column, Pair, Sweep, grid_columns
 from cell.sweep.windows import pair_apart, window_measures
 
 #: Columns of replications.csv that are not measures.
@@ -62,6 +63,18 @@ def summary_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
                                        *SUMMARY_KEYS])
 
 
+def all_pairs(sweep: Sweep) -> list[Pair]:
+    """The sweep's paired comparisons (:meth:`Sweep.pairs`: against its ``baseline:`` if
+    it names one) and, with a baseline, the policies' against each other as well: naming
+    a baseline adds its comparison to theirs."""
+    pairs = sweep.pairs()
+    if sweep.baseline is None:
+        return pairs
+    seen = {(p.point, p.versus) for p in pairs}
+    return pairs + [p for p in dataclasses.replace(sweep, baseline=None).pairs()
+                    if (p.point, p.versus) not in seen]
+
+
 def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     """``differences.csv``: each pair of points, replication by replication, per measure.
 
@@ -72,7 +85,7 @@ def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     columns, names = grid_columns(sweep), measures(replications, sweep)
     windowed = set(window_measures())
     rows = []
-    for pair in sweep.pairs():
+    for pair in all_pairs(sweep):
         compared = [m for m in names if m not in windowed] if pair_apart(sweep, pair) else names
         a, b = sweep.points[pair.point], sweep.points[pair.versus]
         runs_a, runs_b = runs_of(replications, sweep, pair.point), \
