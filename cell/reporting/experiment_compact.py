@@ -56,18 +56,25 @@ def difference_cell(d: Mapping[Any, Any]) -> str:
     return f"*{text}*" if float(d["ci_low"]) <= 0.0 <= float(d["ci_high"]) else text
 
 
-def comparison_name(policy: str, versus: str, policies: Sequence[str]) -> str:
-    """A difference column's heading: ``adaptive − non-adaptive``, ``adaptive − baseline``."""
+def comparison_name(policy: str, versus: str, policies: Sequence[str],
+                    row: Mapping[Any, Any] | None = None, cols: Sequence[str] = ()) -> str:
+    """A difference column's heading: ``adaptive − non-adaptive``, ``adaptive − baseline``;
+    two scenarios compared (``cell compare``: the baseline named by its scenario's name):
+    ``heavy-gamma − baseline``, by ``row``'s values of ``cols``."""
     if versus in policies:
         return f"{policy} − {versus}"
-    return f"{policy} − baseline"
+    if versus.startswith(policy + " at ") or row is None or not cols:
+        return f"{policy} − baseline"
+    return " ".join(show(row[c]) for c in cols) + f" − {versus}"
 
 
 def baseline_words(differences: pd.DataFrame, policies: Sequence[str]) -> str | None:
     """What the baseline is, in words (``arrivals.params = thesis``), if a column has one."""
     for r in differences.to_dict("records"):
         if str(r["versus"]) not in policies:
-            return against(str(r["policy"]), str(r["versus"]), at=False)
+            v = str(r["versus"])
+            return against(str(r["policy"]), v, at=False) if v.startswith(f"{r['policy']} at ") \
+                else v
     return None
 
 
@@ -91,7 +98,7 @@ def compact_table(h: Headline, summary: pd.DataFrame, differences: pd.DataFrame,
             load_of.setdefault(tuple(show(r[c]) for c in cols), []).append(shown)
     compared: list[str] = []
     for d in differences[differences["measure"] == h.column].to_dict("records"):
-        name = comparison_name(str(d["policy"]), str(d["versus"]), policies)
+        name = comparison_name(str(d["policy"]), str(d["versus"]), policies, d, cols)
         if name not in compared:
             compared.append(name)
         rows.setdefault(tuple(show(d[c]) for c in cols), {})[name] = difference_cell(d)

@@ -59,7 +59,7 @@ def effects(h: Headline, differences: pd.DataFrame, cols: Sequence[str],
         recs = [r for r in group.to_dict("records") if math.isfinite(float(r["mean"]))]
         if not recs:
             continue
-        name = comparison_name(str(a), str(b), policies)
+        name = comparison_name(str(a), str(b), policies, recs[0], cols)
         order = sorted(recs, key=lambda r: -abs(float(r["mean"])))
         big, small = order[0], order[-1]
         if all(float(r["mean"]) == 0.0 and not float(r["sd"]) > 0 for r in recs):

@@ -393,4 +393,4 @@ def comparison(a: Scenario, b: Scenario, labels: tuple[str, str], replications: 
     return Sweep(f"{la} against {lb}", "compare", f"{la} against {lb}", a, (), ("scenario",),
                  (pa, pb), replications, seed, min(batch, replications),
                  baseline=Baseline(b.controller.policy, (("scenario", lb),),
-                                   text=f"{lb} ({b.controller.policy})"))
+                                   text=lb))  # the report names the scenarios, not policies

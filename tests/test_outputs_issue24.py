@@ -1,0 +1,91 @@
+"""Issue 24's outputs: a run's folder is not replaced unless --force, belts.csv holds real
+changes only, Parquet holds what the CSV does, cell sweep takes --set, usage errors point to
+the subcommand's help once, a refusal names the key to change, and cell compare judges two
+scenarios fed at different rates on rate-free measures."""
+
+from __future__ import annotations
+
+import duckdb
+import pandas as pd
+
+from cell.cli import main
+
+RUN = ["run", "baseline", "--set", "run.parts=30"]
+
+
+def test_run_into_another_runs_folder_is_refused_and_left_as_it_was(tmp_path, capsys):
+    out = tmp_path / "r"
+    assert main([*RUN, "--out", str(out)]) == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    capsys.readouterr()
+    assert main([*RUN, "--set", "run.seed=5", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "another run's files" in err and "--force" in err and err.count("\n") == 1
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    assert main([*RUN, "--set", "run.seed=5", "--out", str(out), "--force"]) == 0
+    assert (out / "parts.csv").read_bytes() != before["parts.csv"]
+
+
+def test_belts_csv_has_one_row_per_real_change(tmp_path):
+    out = tmp_path / "r"
+    assert main(["run", "baseline", "--set", "run.parts=200", "--out", str(out)]) == 0
+    belts = pd.read_csv(out / "belts.csv")
+    for _, b in belts.groupby("belt"):
+        v = b["speed_in_s"].to_numpy()
+        assert len(v) > 10 and (v[1:] != v[:-1]).all()  # no row repeats the speed before it
+
+
+def test_parquet_holds_the_csvs_columns_types_and_values(tmp_path):
+    csv, pq = tmp_path / "c", tmp_path / "p"
+    assert main([*RUN, "--out", str(csv)]) == 0
+    assert main([*RUN, "--out", str(pq), "--format", "parquet"]) == 0
+    assert sorted(p.name for p in pq.iterdir()) == ["belts.parquet", "parts.parquet",
+                                                    "summary.parquet"]
+    for name in ("parts", "summary", "belts"):
+        a = pd.read_csv(csv / f"{name}.csv")
+        b = pd.read_parquet(pq / f"{name}.parquet")
+        pd.testing.assert_frame_equal(a, b)
+        d = duckdb.sql(f"select * from read_parquet('{pq / f'{name}.parquet'}')").df()
+        assert list(d.columns) == list(a.columns) and len(d) == len(a)
+        for c in a.columns:  # the same values whichever engine reads them
+            if pd.api.types.is_numeric_dtype(a[c]):
+                pd.testing.assert_series_equal(a[c], d[c].astype(a[c].dtype), check_names=False)
+
+
+def test_sweep_takes_set_and_parquet(sweeps, tmp_path):
+    path = sweeps.write(tmp_path, set={"run.parts": 10}, grid={"belts.output_nominal_in_s": [1.8, 2.0]},
+                        policies=["adaptive"], replications=2, batch=2)
+    out = tmp_path / "o"
+    assert main(["sweep", str(path), "--out", str(out), "--workers", "1", "--set", "run.parts=12",
+                 "--format", "parquet"]) == 0
+    frame = pd.read_csv(out / "replications.csv")
+    assert (frame["parts_arrived"] == 12).all()  # --set over the file's set:
+    pd.testing.assert_frame_equal(frame, pd.read_parquet(out / "replications.parquet"))
+
+
+def test_a_usage_error_points_to_the_subcommands_help_once(capsys):
+    assert main(["sweep", "x", "--out", "y", "--frobnicate"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "cell sweep: error: unrecognized arguments: --frobnicate (see cell sweep --help)"
+
+
+def test_a_heavy_part_refused_names_the_belt_speed_key(tmp_path, capsys):
+    assert main([*RUN, "--set", "part.weight_oz=12", "--out", str(tmp_path / "r")]) == 2
+    err = capsys.readouterr().err
+    assert "part.weight_oz" in err and "belts.output_nominal_in_s" in err
+    assert not (tmp_path / "r").exists()
+
+
+def test_compare_at_different_rates_judges_on_service_level(tmp_path, capsys):
+    fast = tmp_path / "fast.yaml"
+    fast.write_text("name: fast\narrivals: {distribution: gamma, mean_s: 18.0, cv: 0.1}\n"
+                    "controller: {nominal_cycle_s: null}\n")
+    assert main(["compare", str(fast), "baseline", "--set", "run.parts=40", "--replications", "4",
+                 "--policy", "non-adaptive", "--workers", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "arrival rates differ" in out
+    assert "Parts per hour (wall clock)" in out and "not judged (arrival rates differ)" in out
+    line = next(x for x in out.splitlines() if x.strip().startswith("Service level"))
+    assert "means" in line and " - baseline" in line
+    assert out.splitlines()[-1].startswith("Overall, on the rate-free measures")
+    assert "(non-adaptive) against baseline (non-adaptive)" in out  # --policy: both sides
