@@ -35,11 +35,11 @@ def mean_cell(s: Mapping[Any, Any], runs: int | None = None) -> str:
     n, mean = int(s["n"]), float(s["mean"])
     if n == 0:
         return "—"
-    of = f" ({n} of {runs} runs)" if runs is not None and n < runs else ""
+    of = f" (from {n} of {runs} runs)" if runs is not None and n < runs else ""
     if n == 1 or not math.isfinite(float(s["sd"])):
         return f"{number(mean)}{of}"
     if float(s["sd"]) == 0.0:
-        return f"{number(mean)} (exact){of}"
+        return f"{number(mean)} (no variation){of}"
     return plus_minus(mean, half_width(s)) + of
 
 

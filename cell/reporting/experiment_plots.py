@@ -183,7 +183,7 @@ def title(values: Sequence[tuple[str, str]], width: int = TITLE_WIDTH) -> str:
     characters where it can be."""
     lines: list[str] = []
     for c, v in values:
-        item = f"{key_words(c.removesuffix(NAME_SUFFIX))} = {v}"
+        item = f"{c.removesuffix(NAME_SUFFIX)} = {v}"
         if lines and len(lines[-1]) + 2 + len(item) <= width:
             lines[-1] += ", " + item
         else:
