@@ -158,7 +158,8 @@ def compare_run(capsys, a: Path | str, b: Path | str, *more: str) -> tuple[str, 
 
 
 def verdict_rows(out: str) -> dict[str, str]:
-    return {line.split("  ")[1].strip(): line for line in out.splitlines()[1:]}
+    return {line.split("  ")[1].strip(): line for line in out.splitlines()[1:]
+            if line.startswith("  ")}  # not the overall line (issue 24)
 
 
 def test_compare_warns_once_when_run_lengths_differ_and_leaves_counts_uncompared(

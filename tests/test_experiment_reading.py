@@ -5,7 +5,7 @@ from __future__ import annotations
 import pandas as pd
 
 from cell.analysis.stats import PAIRED_KEYS, summarise
-from cell.reporting.experiment_reading import reading
+from cell.reporting.experiment_explain import reading
 from cell.reporting.headlines import HEADLINES
 from cell.sweep import load_sweep
 

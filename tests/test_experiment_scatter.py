@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from cell.analysis.stats import PAIRED_KEYS, summarise
-from cell.reporting.experiment_reading import reading
+from cell.reporting.experiment_explain import reading
 from cell.reporting.experiment_text import cell
 from cell.reporting.headlines import HEADLINES
 

@@ -8,14 +8,15 @@ parts lost.  All drawn from ``summary.csv`` and ``differences.csv``.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 
 import numpy as np
 import pandas as pd
 
 from cell.reporting.experiment_compact import comparison_name, load_column
-from cell.reporting.experiment_reading import where
+from cell.reporting.experiment_reading import _scatter, where
 from cell.reporting.headlines import Headline, half_width, number, plus_minus
+from cell.sweep import Sweep
 
 #: The counts of :data:`cell.records.LIMIT_COUNTS` as the Reading names them.
 LIMIT_WORDS = {
@@ -203,4 +204,37 @@ def causes(summary: pd.DataFrame, cols: Sequence[str], policies: Sequence[str]) 
         else:
             text += "; no limit count follows them"
         out.append(text)
+    return out
+
+
+def reading(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
+            cols: Sequence[str], present: Sequence[Headline],
+            whole: Collection[str] = ()) -> list[str]:
+    """What the tables do not say (:mod:`cell.reporting.experiment_explain`): per headline
+    measure its largest effects, where they depend on the point, where a policy does not
+    move and why, and where single runs scatter so widely that the mean says little; then
+    what costs each point its parts, and which limit follows a trend in the parts lost.
+    ``whole``: the measures that count things (shown as whole numbers)."""
+    policies = sweep.policies
+    out: list[str] = []
+    if differences.empty:
+        out.append("No paired differences: the sweep runs one policy and names no "
+                   "`baseline:`; name a point there to compare the others with it.")
+    for h in present:
+        said = effects(h, differences, cols, policies)
+        text = ["; ".join(said) + "." if said else ""]
+        text += [s[:1].upper() + s[1:] + "." for s in unmoved(h, summary, policies)]
+        text += _scatter(h, summary, cols, h.column in whole)
+        text = [t for t in text if t]
+        if text:
+            out.append(f"- **{h.title}.** " + " ".join(text))
+    where_lost = costs(summary, cols, policies)
+    if where_lost:
+        out.append("")
+        out.append("**What costs the parts, per point** (means per run):")
+        out += [f"- {line}" for line in where_lost]
+    trends = causes(summary, cols, policies)
+    if trends:
+        out.append("")
+        out += [f"- {t[:1].upper() + t[1:]}." for t in trends]
     return out

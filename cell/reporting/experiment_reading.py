@@ -5,13 +5,12 @@ that show a grid point's values (:mod:`cell.reporting.experiment_text` lays them
 from __future__ import annotations
 
 import math
-from collections.abc import Collection, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import pandas as pd
 
 from cell.reporting.headlines import Headline, decimals, half_width, number, plus_minus
-from cell.sweep import Sweep
 from cell.sweep.columns import NAME_SUFFIX
 
 
@@ -43,41 +42,6 @@ def against(a: str, b: str, at: bool = True) -> str:
     if b.startswith(a + " at "):
         return b[len(a) + 1:] if at else b[len(a) + 4:]
     return b
-
-
-def reading(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
-            cols: Sequence[str], present: Sequence[Headline],
-            whole: Collection[str] = ()) -> list[str]:
-    """What the tables do not say (:mod:`cell.reporting.experiment_explain`): per headline
-    measure its largest effects, where they depend on the point, where a policy does not
-    move and why, and where single runs scatter so widely that the mean says little; then
-    what costs each point its parts, and which limit follows a trend in the parts lost.
-    ``whole``: the measures that count things (shown as whole numbers)."""
-    from cell.reporting.experiment_explain import causes, costs, effects, unmoved
-
-    policies = sweep.policies
-    out: list[str] = []
-    if differences.empty:
-        out.append("No paired differences: the sweep runs one policy and names no "
-                   "`baseline:`; name a point there to compare the others with it.")
-    for h in present:
-        said = effects(h, differences, cols, policies)
-        text = ["; ".join(said) + "." if said else ""]
-        text += [s[:1].upper() + s[1:] + "." for s in unmoved(h, summary, policies)]
-        text += _scatter(h, summary, cols, h.column in whole)
-        text = [t for t in text if t]
-        if text:
-            out.append(f"- **{h.title}.** " + " ".join(text))
-    where_lost = costs(summary, cols, policies)
-    if where_lost:
-        out.append("")
-        out.append("**What costs the parts, per point** (means per run):")
-        out += [f"- {line}" for line in where_lost]
-    trends = causes(summary, cols, policies)
-    if trends:
-        out.append("")
-        out += [f"- {t[:1].upper() + t[1:]}." for t in trends]
-    return out
 
 
 def _scatter(h: Headline, summary: pd.DataFrame, cols: Sequence[str],

@@ -19,7 +19,8 @@ import pandas as pd
 from cell.analysis.stats import precision_reached, relative_half_width
 from cell.reporting.experiment_compact import baseline_words, compact_table
 from cell.reporting.experiment_data import runs_of
-from cell.reporting.experiment_reading import against, reading, show, single_runs
+from cell.reporting.experiment_explain import reading
+from cell.reporting.experiment_reading import against, show, single_runs
 from cell.reporting.headlines import (
     HEADLINES,
     Headline,
