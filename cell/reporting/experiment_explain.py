@@ -14,9 +14,10 @@ import numpy as np
 import pandas as pd
 
 from cell.reporting.experiment_compact import comparison_name, load_column
-from cell.reporting.experiment_reading import _scatter, where
-from cell.reporting.headlines import Headline, half_width, number, plus_minus
+from cell.reporting.experiment_reading import _scatter, show, where
+from cell.reporting.headlines import Headline, decimals, half_width, number, plus_minus
 from cell.sweep import Sweep
+from cell.sweep.columns import NAME_SUFFIX
 
 #: The counts of :data:`cell.records.LIMIT_COUNTS` as the Reading names them.
 LIMIT_WORDS = {
@@ -79,8 +80,6 @@ def effects(h: Headline, differences: pd.DataFrame, cols: Sequence[str],
 
 
 def _values(row: dict, cols: Sequence[str]) -> str:
-    from cell.reporting.experiment_reading import show
-
     return ", ".join(show(row[c]) for c in cols) or "the point"
 
 
@@ -124,6 +123,37 @@ def _why(summary: pd.DataFrame, policy: str, measure: str) -> str:
     if len(lost) and np.all(lost == 0):
         return "it loses no part at any point"
     return "the keys varied leave it within its intervals"
+
+
+def trend(h: Headline, summary: pd.DataFrame, cols: Sequence[str]) -> list[str]:
+    """With no comparison of ``h`` to say its effect (one policy, no ``baseline:``), along a
+    single numeric key: each policy's mean at the first and last values that have one (a
+    run too short for a rate has none), when they differ as shown."""
+    if len(cols) != 1 or cols[0].endswith(NAME_SUFFIX):
+        return []
+    col, out = cols[0], []
+    for policy, group in summary[summary["measure"] == h.column].groupby("policy", sort=False):
+        if pd.to_numeric(group[col], errors="coerce").isna().any():
+            continue
+        group = group[np.isfinite(group["mean"].to_numpy(dtype=float))]
+        if len(group) < 2:
+            continue
+        first, last = group.iloc[0], group.iloc[-1]
+        a, b = _ends(first, last)
+        if a != b:
+            out.append(f"{str(policy).capitalize()} goes from {a} at {col} = "
+                       f"{show(first[col])} to {b} at {show(last[col])}.")
+    return out
+
+
+def _ends(first: pd.Series, last: pd.Series) -> tuple[str, str]:
+    """Two summary rows' means to the precision of the wider interval (of the one there is,
+    when an end has a single replication); as plain figures when neither varies."""
+    if float(first["sd"]) == 0.0 and float(last["sd"]) == 0.0:
+        return number(float(first["mean"])), number(float(last["mean"]))
+    halves = [w for w in (half_width(first), half_width(last)) if math.isfinite(w)]
+    d = decimals(max(halves, default=math.nan))
+    return f"{float(first['mean']):.{d}f}", f"{float(last['mean']):.{d}f}"
 
 
 def costs(summary: pd.DataFrame, cols: Sequence[str], policies: Sequence[str]) -> list[str]:
@@ -211,7 +241,8 @@ def reading(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
             cols: Sequence[str], present: Sequence[Headline],
             whole: Collection[str] = ()) -> list[str]:
     """What the tables do not say (:mod:`cell.reporting.experiment_explain`): per headline
-    measure its largest effects, where they depend on the point, where a policy does not
+    measure its largest effects (with no comparison of it, each policy's trend along the
+    key), where they depend on the point, where a policy does not
     move and why, and where single runs scatter so widely that the mean says little; then
     what costs each point its parts, and which limit follows a trend in the parts lost.
     ``whole``: the measures that count things (shown as whole numbers)."""
@@ -224,6 +255,7 @@ def reading(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
         said = effects(h, differences, cols, policies)
         text = ["; ".join(said) + "." if said else ""]
         text += [s[:1].upper() + s[1:] + "." for s in unmoved(h, summary, policies)]
+        text += [] if said else trend(h, summary, cols)
         text += _scatter(h, summary, cols, h.column in whole)
         text = [t for t in text if t]
         if text:
