@@ -52,15 +52,33 @@ def test_parquet_holds_the_csvs_columns_types_and_values(tmp_path):
                 pd.testing.assert_series_equal(a[c], d[c].astype(a[c].dtype), check_names=False)
 
 
-def test_sweep_takes_set_and_parquet(sweeps, tmp_path):
+def test_sweep_takes_set_and_writes_its_result_file_as_parquet_instead(sweeps, tmp_path):
+    """``--format parquet``: replications.parquet is the result file, replications.csv is
+    not written; it holds what the CSV of the same sweep holds (columns, types, values, as
+    pandas and DuckDB read it), and --resume reads the tasks back into it again."""
     path = sweeps.write(tmp_path, set={"run.parts": 10}, grid={"belts.output_nominal_in_s": [1.8, 2.0]},
-                        policies=["adaptive"], replications=2, batch=2)
-    out = tmp_path / "o"
-    assert main(["sweep", str(path), "--out", str(out), "--workers", "1", "--set", "run.parts=12",
-                 "--format", "parquet"]) == 0
-    frame = pd.read_csv(out / "replications.csv")
-    assert (frame["parts_arrived"] == 12).all()  # --set over the file's set:
-    pd.testing.assert_frame_equal(frame, pd.read_parquet(out / "replications.parquet"))
+                        policies=["adaptive"], replications=2, batch=1)
+    csv, pq = tmp_path / "c", tmp_path / "p"
+    for out, fmt in ((csv, "csv"), (pq, "parquet")):
+        assert main(["sweep", str(path), "--out", str(out), "--workers", "1", "--set",
+                     "run.parts=12", "--format", fmt]) == 0
+    assert not (pq / "replications.csv").exists() and not (csv / "replications.parquet").exists()
+    frame = pd.read_csv(csv / "replications.csv")
+    assert (frame["parts_arrived"] == 12).all() and len(frame) == 4  # --set over the file's set
+    pd.testing.assert_frame_equal(frame, pd.read_parquet(pq / "replications.parquet"))
+    d = duckdb.sql(f"select * from read_parquet('{pq / 'replications.parquet'}')").df()
+    assert list(d.columns) == list(frame.columns) and len(d) == len(frame)
+    # a resumed sweep, a task lost: the result file is assembled again, still Parquet only
+    (pq / "replications.parquet").unlink()
+    next((pq / "tasks").iterdir()).unlink()
+    assert main(["sweep", str(path), "--out", str(pq), "--workers", "1", "--set",
+                 "run.parts=12", "--format", "parquet", "--resume"]) == 0
+    pd.testing.assert_frame_equal(frame, pd.read_parquet(pq / "replications.parquet"))
+    # and the same folder resumed as CSV: the Parquet file goes, one result file is left
+    assert main(["sweep", str(path), "--out", str(pq), "--workers", "1", "--set",
+                 "run.parts=12", "--resume"]) == 0
+    assert (pq / "replications.csv").read_bytes() == (csv / "replications.csv").read_bytes()
+    assert not (pq / "replications.parquet").exists()
 
 
 def test_a_usage_error_points_to_the_subcommands_help_once(capsys):

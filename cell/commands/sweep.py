@@ -33,7 +33,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "holds other files)")
     set_argument(p)  # on top of the sweep file's set: (a key the grid varies is refused)
     p.add_argument("--format", choices=("csv", "parquet"), default="csv",
-                   help="parquet: also write replications.parquet (the same table)")
+                   help="the result file: replications.csv (default) or, with parquet, "
+                        "replications.parquet in its place (the same table)")
 
 
 class _Stop:
@@ -107,7 +108,8 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
     try:
         with lock(out):  # a second sweep into the same --out is refused
             outcome = run_sweep(sweep, out, workers=args.workers, scheduler=args.scheduler,
-                                resume=args.resume, replicate=simulate_summary)
+                                resume=args.resume, replicate=simulate_summary,
+                                result_format=args.format)
     except BaseException as exc:  # stopped: by Ctrl-C or kill, whatever it broke on the way
         if stop.signum is None and not isinstance(exc, KeyboardInterrupt):
             raise
@@ -117,15 +119,9 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
         print(f"cell sweep: stopped; {kept} finished task{'s' if kept != 1 else ''} kept in "
               f"{args.out}: the same command with --resume runs only the rest", file=sys.stderr)
         return stop.code
-    if args.format == "parquet":
-        from cell.output import atomic_path
-        from cell.output.parquet import csv_to_parquet
-
-        with atomic_path(Path(args.out) / "replications.parquet") as tmp:
-            csv_to_parquet(Path(args.out) / "replications.csv", tmp)
     counts = sorted(set(outcome.counts.values()))
     reps = (f"{counts[0]}" if len(counts) == 1 else f"{counts[0]}-{counts[-1]}")
-    print(f"wrote {Path(args.out) / 'replications.csv'}: {len(sweep.points)} points x "
+    print(f"wrote {outcome.path}: {len(sweep.points)} points x "
           f"{reps} replications ({outcome.tasks_run} tasks run, "
           f"{outcome.tasks_reused} reused)")
     if target is not None:

@@ -3,7 +3,9 @@ values that reading its CSV gives (:func:`pandas.read_csv`), so the two read bac
 
 The CSV stays the one way results are made (streamed rows, fixed float format, the
 byte-identical reruns the tests check); the Parquet file is that CSV read and written
-once more with pyarrow, so it holds the same rounded values, never others.
+once more with pyarrow, so it holds the same rounded values, never others.  A sweep's
+``replications.parquet`` is written so from the CSV text in memory, in place of
+``replications.csv``.
 """
 
 from __future__ import annotations
@@ -24,4 +26,15 @@ def csv_to_parquet(csv_path: str | os.PathLike[str], parquet_path: str | os.Path
     import pandas as pd
 
     frame = pd.read_csv(csv_path)
+    frame.to_parquet(parquet_path, engine="pyarrow", index=False)
+
+
+def csv_text_to_parquet(text: str, parquet_path: str | os.PathLike[str]) -> None:
+    """A CSV file's ``text`` as Parquet at ``parquet_path``, as :func:`csv_to_parquet` writes
+    that file: the values and types :func:`pandas.read_csv` gives it."""
+    import io
+
+    import pandas as pd
+
+    frame = pd.read_csv(io.StringIO(text))
     frame.to_parquet(parquet_path, engine="pyarrow", index=False)

@@ -47,7 +47,7 @@ from cell.output import atomic_path, float_formatter, write_csv
 from cell.progress import Progress
 from cell.scenario import Scenario
 from cell.sweep.columns import Column, grid_columns, point_values
-from cell.sweep.outdir import TASK_DIR, check_out, prepare
+from cell.sweep.outdir import RESULT_FILES, TASK_DIR, check_out, prepare
 from cell.sweep.spec import Sweep, Task, overload_warning
 from cell.sweep.windows import window_warning
 
@@ -143,6 +143,8 @@ class Outcome:
     def replications(self) -> pd.DataFrame:
         import pandas as pd
 
+        if self.path.suffix == ".parquet":
+            return pd.read_parquet(self.path)
         return pd.read_csv(self.path)
 
 
@@ -288,8 +290,9 @@ WORKERS_PER_CORE = 4
 def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
               scheduler: str | None = None, resume: bool = False,
               replicate: Replicate = simulate_summary, progress: bool = True,
-              warn_windows: bool = True) -> Outcome:
-    """Run (or finish, with ``resume``) a sweep into ``out``; write replications.csv.
+              warn_windows: bool = True, result_format: str = "csv") -> Outcome:
+    """Run (or finish, with ``resume``) a sweep into ``out``; write replications.csv, or
+    with ``result_format="parquet"`` replications.parquet instead (:data:`RESULT_FILES`).
 
     ``replicate`` is what one replication does; the default simulates the cell.
     It must be a module-level function when tasks run in other processes.
@@ -355,7 +358,7 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     # The files the rounds wrote, point by point: a round's tasks start where it does
     # (``min`` need not be a multiple of ``batch``), not where cutting from 0 would.
     tasks = (t for p in counts for r in rounds if p in r for t in sweep.iter_tasks({p: r[p]}))
-    path = _assemble(sweep, task_dir, tasks, out / "replications.csv")
+    path = _assemble(sweep, task_dir, tasks, out / RESULT_FILES[result_format])
     return Outcome(path, run, reused, counts)
 
 
@@ -379,7 +382,10 @@ def _measure(sweep: Sweep, task_dir: Path, task: Task, measure: str) -> list[flo
 
 
 def _assemble(sweep: Sweep, task_dir: Path, tasks: Iterable[Task], target: Path) -> Path:
-    """``replications.csv`` from the task files, in the tasks' order (each file read once).
+    """``replications.csv`` from the task files, in the tasks' order (each file read once);
+    a ``target`` ending in ``.parquet`` gets that CSV as Parquet
+    (:func:`cell.output.parquet.csv_text_to_parquet`: the same columns, types and values),
+    and the other format's file, from an earlier run of the sweep, goes.
 
     Assembled from the files, never from the results in memory: a resumed sweep and
     an uninterrupted one go through the same bytes.
@@ -390,9 +396,26 @@ def _assemble(sweep: Sweep, task_dir: Path, tasks: Iterable[Task], target: Path)
         frame = _finished(sweep, task_dir, task)
         names.update(dict.fromkeys(frame.columns))
         frames.append(frame)
-    with atomic_path(target) as tmp, open(tmp, "w", encoding="utf-8", newline="") as stream:
+
+    def write(stream: Any) -> None:
         for i, frame in enumerate(frames):
             frame.reindex(columns=list(names)).to_csv(
                 stream, header=i == 0, index=False, float_format=float_formatter(),
                 lineterminator="\n")
+
+    if target.suffix == ".parquet":
+        import io
+
+        from cell.output.parquet import csv_text_to_parquet
+
+        text = io.StringIO()
+        write(text)
+        with atomic_path(target) as tmp:
+            csv_text_to_parquet(text.getvalue(), tmp)
+    else:
+        with atomic_path(target) as tmp, open(tmp, "w", encoding="utf-8", newline="") as stream:
+            write(stream)
+    for name in RESULT_FILES.values():
+        if name != target.name:
+            (target.parent / name).unlink(missing_ok=True)
     return target
