@@ -49,10 +49,12 @@ MEMORY_HINTS = {
 
 
 class Parser(argparse.ArgumentParser):
-    """argparse with usage errors on one line (``cell run: error: ...``) and no exit."""
+    """argparse with usage errors on one line (``cell: error: run: ... (see cell run --help)``)
+    and no exit."""
 
     def error(self, message: str) -> NoReturn:
-        raise _UsageError(f"{self.prog}: error: {message} (see {self.prog} --help)")
+        sub = self.prog.partition(" ")[2]  # "cell run" -> "run": named once, not "cell" twice
+        raise _UsageError(f"{sub + ': ' if sub else ''}{message} (see {self.prog} --help)")
 
 
 class _UsageError(Exception):
@@ -158,9 +160,8 @@ def _main(argv: Sequence[str] | None) -> int:
         if extra:
             SUBPARSERS.get(args.command, parser).error(
                 "unrecognized arguments: " + " ".join(extra))
-    except _UsageError as exc:
-        print(one_line(str(exc), 1000), file=sys.stderr)  # "cell run: error: ... (see ...)"
-        return 2
+    except _UsageError as exc:  # "cell: error: run: ... (see cell run --help)"
+        return _fail(str(exc))
     except SystemExit as exc:  # --help, --version: printed, done
         return exc.code if isinstance(exc.code, int) else 0
     try:

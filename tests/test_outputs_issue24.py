@@ -84,7 +84,8 @@ def test_sweep_takes_set_and_writes_its_result_file_as_parquet_instead(sweeps, t
 def test_a_usage_error_points_to_the_subcommands_help_once(capsys):
     assert main(["sweep", "x", "--out", "y", "--frobnicate"]) == 2
     err = capsys.readouterr().err.strip()
-    assert err == "cell sweep: error: unrecognized arguments: --frobnicate (see cell sweep --help)"
+    # every refusal opens "cell: error: "; the subcommand is named once, with its own --help
+    assert err == "cell: error: sweep: unrecognized arguments: --frobnicate (see cell sweep --help)"
 
 
 def test_a_heavy_part_refused_names_the_belt_speed_key(tmp_path, capsys):

@@ -18,7 +18,7 @@ import pandas as pd
 
 from cell.analysis.stats import precision_reached, relative_half_width
 from cell.reporting.experiment_compact import baseline_words, compact_table
-from cell.reporting.experiment_data import runs_of
+from cell.reporting.experiment_data import run_counts, runs_of
 from cell.reporting.experiment_explain import reading
 from cell.reporting.experiment_reading import against, show, single_runs
 from cell.reporting.headlines import (
@@ -134,7 +134,7 @@ def markdown(summary: pd.DataFrame, differences: pd.DataFrame, replications: pd.
                   "[`table_7_1.csv`](table_7_1.csv).", ""]
     lines += _precision(replications, summary, sweep, cols)
     present = [h for h in HEADLINES if h.column in set(summary["measure"])]
-    runs = [len(runs_of(replications, sweep, i)) for i in range(len(sweep.points))]
+    runs = run_counts(replications, sweep)
     whole = {h.column for h in present  # counts: every run's value a whole number
              if np.all(np.mod(replications[h.column].dropna().to_numpy(float), 1) == 0)}
     for h in present:
