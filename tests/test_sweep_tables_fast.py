@@ -11,7 +11,7 @@ import pandas as pd
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from cell.analysis.stats import paired_difference, summarise, summarise_many
+from cell.analysis.stats import paired_difference, paired_many, summarise, summarise_many
 from cell.reporting.experiment_data import (
     all_pairs,
     difference_table,
@@ -31,6 +31,23 @@ VALUES = st.lists(st.one_of(st.floats(-1e6, 1e6), st.just(float("nan")), st.just
 def test_summarise_many_is_summarise_of_each(arrays):
     got = summarise_many([np.array(a, dtype=float) for a in arrays])
     want = [summarise(np.array(a, dtype=float)) for a in arrays]
+    assert len(got) == len(want)
+    for g, w in zip(got, want, strict=True):
+        assert list(g) == list(w)
+        assert np.array_equal(list(g.values()), list(w.values()), equal_nan=True), (g, w)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.integers(0, 12).flatmap(lambda n: st.tuples(
+    st.lists(st.one_of(st.floats(-1e3, 1e3), st.just(float("nan")), st.just(2.0)),
+             min_size=n, max_size=n),
+    st.lists(st.one_of(st.floats(-1e3, 1e3), st.just(2.0)), min_size=n, max_size=n))),
+    max_size=8))
+def test_paired_many_is_paired_difference_of_each(pairs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        got = paired_many([(np.array(a), np.array(b)) for a, b in pairs])
+        want = [paired_difference(np.array(a), np.array(b)) for a, b in pairs]
     assert len(got) == len(want)
     for g, w in zip(got, want, strict=True):
         assert list(g) == list(w)

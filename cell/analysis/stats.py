@@ -11,7 +11,7 @@ failed replication recorded as NaN does not poison a summary.
 from __future__ import annotations
 
 import math
-from collections.abc import Hashable, Mapping
+from collections.abc import Hashable, Mapping, Sequence
 from typing import TypeVar
 
 import numpy as np
@@ -90,7 +90,7 @@ def summarise(x: ArrayLike, confidence: float = 0.95,
             "run_p2_5": p_lo, "run_p97_5": p_hi}
 
 
-def summarise_many(arrays: list[ArrayLike], confidence: float = 0.95) -> list[dict[str, float]]:
+def summarise_many(arrays: Sequence[ArrayLike], confidence: float = 0.95) -> list[dict[str, float]]:
     """:func:`summarise` of each array, the same figures bit for bit, with the single runs'
     percentiles of all arrays of one length taken in one numpy call (what a sweep's
     ``summary.csv`` spent most of its time on: ``cell bench``, ``sweep_overhead_ms_per_point``).
@@ -140,6 +140,40 @@ def paired_difference(a: ArrayLike, b: ArrayLike, confidence: float = 0.95) -> d
     ci = res.confidence_interval(confidence)
     return {"n": n, "mean": mean, "sd": sd, "ci_low": float(ci.low), "ci_high": float(ci.high),
             "p_value": float(res.pvalue)}
+
+
+def paired_many(pairs: Sequence[tuple[ArrayLike, ArrayLike]], confidence: float = 0.95
+                ) -> list[dict[str, float]]:
+    """:func:`paired_difference` of each pair, the same figures bit for bit, with the t-tests
+    of all pairs of one length run as one ``scipy.stats.ttest_rel`` over rows (one call
+    of it per pair was most of a sweep's ``differences.csv``)."""
+    _check_confidence(confidence)
+    out: list[dict[str, float] | None] = []
+    rows: dict[int, list[tuple[int, NDArray[np.float64], NDArray[np.float64]]]] = {}
+    for i, (a, b) in enumerate(pairs):
+        x, y = np.asarray(a, dtype=float).ravel(), np.asarray(b, dtype=float).ravel()
+        if x.shape != y.shape:
+            raise ValueError(f"paired samples differ in length: {x.size} and {y.size}")
+        keep = ~(np.isnan(x) | np.isnan(y))
+        x, y = x[keep], y[keep]
+        if x.size < 2 or _mean_sd(x - y)[1] == 0.0:
+            out.append(paired_difference(x, y, confidence))  # no t-test there
+        else:
+            out.append(None)
+            rows.setdefault(x.size, []).append((i, x, y))
+    if rows:
+        from scipy import stats
+
+        for group in rows.values():
+            res = stats.ttest_rel(np.stack([g[1] for g in group]),
+                                  np.stack([g[2] for g in group]), axis=1)
+            ci = res.confidence_interval(confidence)
+            low, high, p = (np.asarray(v).ravel() for v in (ci.low, ci.high, res.pvalue))
+            for j, (i, x, y) in enumerate(group):
+                mean, sd = _mean_sd(x - y)
+                out[i] = {"n": x.size, "mean": mean, "sd": sd, "ci_low": float(low[j]),
+                          "ci_high": float(high[j]), "p_value": float(p[j])}
+    return [o for o in out if o is not None]
 
 
 def relative_half_width(x: ArrayLike, confidence: float = 0.95) -> float:

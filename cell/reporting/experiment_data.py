@@ -16,7 +16,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-from cell.analysis.stats import PAIRED_KEYS, SUMMARY_KEYS, paired_difference, summarise_many
+from cell.analysis.stats import PAIRED_KEYS, SUMMARY_KEYS, paired_many, summarise_many
 from cell.sweep import Column, Pair, Sweep, grid_columns
 from cell.sweep.windows import pair_apart, window_measures
 
@@ -121,7 +121,8 @@ def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     """
     columns, names = grid_columns(sweep), measures(replications, sweep)
     windowed = set(window_measures())
-    rows = []
+    rows: list[dict[str, object]] = []
+    samples: list[tuple[np.ndarray, np.ndarray]] = []
     found = _Rows(replications, sweep)
     reps = found.column("replication")
     for pair in all_pairs(sweep):
@@ -134,11 +135,11 @@ def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
         _, ia, ib = np.intersect1d(reps[at_a], reps[at_b], assume_unique=True,
                                    return_indices=True)
         for m in compared:
-            with warnings.catch_warnings():  # nearly equal pairs: scipy warns, the sd says it
-                warnings.filterwarnings("ignore", "Precision loss", RuntimeWarning)
-                x = found.values(pair.point, m)[ia]
-                y = found.values(pair.versus, m)[ib]
-                d = paired_difference(x, y, sweep.confidence)
-            rows.append({**keys, "policy": a.policy, "versus": pair.label, "measure": m, **d})
+            samples.append((found.values(pair.point, m)[ia], found.values(pair.versus, m)[ib]))
+            rows.append({**keys, "policy": a.policy, "versus": pair.label, "measure": m})
+    with warnings.catch_warnings():  # nearly equal pairs: scipy warns, the sd says it
+        warnings.filterwarnings("ignore", "Precision loss", RuntimeWarning)
+        for row, d in zip(rows, paired_many(samples, sweep.confidence), strict=True):
+            row.update(d)
     return pd.DataFrame(rows, columns=[*[c.name for c in columns], "policy", "versus", "measure",
                                        *PAIRED_KEYS])
