@@ -12,7 +12,8 @@ whether it needs another ``batch`` (:func:`cell.analysis.stats.precision_reached
 :func:`~cell.analysis.stats.next_round`).  A round's tasks are ordinary tasks, so
 ``--resume`` replays the same rounds from the files.
 
-``OUT/replications.csv`` is always assembled from those files in a fixed order
+``OUT/replications.csv`` (or, with ``result_format="parquet"``, ``replications.parquet``
+in its place; :mod:`cell.sweep.results`) is always assembled from those files in a fixed order
 (point, then replication), so it is byte-identical however the sweep was run: no
 result depends on the number of workers or the order tasks finish in.  Its
 columns: ``policy``; ``point`` (index of the grid point within its policy); the
