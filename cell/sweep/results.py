@@ -45,9 +45,10 @@ def _publish(text: str, path: Path) -> None:
     """``text`` as the task file ``path``, whole or not at all: written beside it as
     ``.NAME.cell-PID.tmp`` (removed by :func:`cell.sweep.outdir.prepare` if a kill leaves it)
     and renamed over it.  Unlike :func:`cell.output.atomic_path` there is no fsync and no
-    scan of the folder for stale files, which cost a sweep point about 20 ms in a folder of
-    a few hundred tasks (``cell bench``, ``sweep_overhead_ms_per_point``): a task file a
-    power cut leaves damaged is found so by :func:`read_task`, and ``--resume`` runs it again."""
+    scan of the folder for stale files (12.9 ms of wall time a task in a folder of 300
+    files, against 0.8 ms so, on a busy machine; ``cell bench``,
+    ``sweep_overhead_ms_per_point``): a task file a power cut leaves damaged is found so
+    by :func:`read_task`, and ``--resume`` runs it again."""
     tmp = path.with_name(f".{path.name}.cell-{os.getpid()}.tmp")
     with failing(str(path)):
         path.parent.mkdir(parents=True, exist_ok=True)
