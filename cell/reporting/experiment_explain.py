@@ -15,7 +15,7 @@ import pandas as pd
 
 from cell.reporting.experiment_compact import comparison_name, load_column
 from cell.reporting.experiment_reading import _scatter, show, where
-from cell.reporting.headlines import Headline, decimals, half_width, number, plus_minus
+from cell.reporting.headlines import Headline, decimals, half_width, number, plus_minus, too_few
 from cell.sweep import Sweep
 from cell.sweep.columns import NAME_SUFFIX
 
@@ -58,8 +58,13 @@ def effects(h: Headline, differences: pd.DataFrame, cols: Sequence[str],
     out = []
     rows = differences[differences["measure"] == h.column]
     for (a, b), group in rows.groupby(["policy", "versus"], sort=False):
-        recs = [r for r in group.to_dict("records") if math.isfinite(float(r["mean"]))]
-        if not recs:
+        every = group.to_dict("records")
+        recs = [r for r in every if math.isfinite(float(r["mean"]))]
+        if not recs:  # no replication gives the measure for both (runs too short)
+            what = h.title if h.title[1:2].isupper() else h.title[:1].lower() + h.title[1:]
+            n = max(int(r["n"]) for r in every)
+            out.append(f"{comparison_name(str(a), str(b), policies, every[0], cols)} not "
+                       f"compared, {too_few(n, what)}")
             continue
         name = comparison_name(str(a), str(b), policies, recs[0], cols)
         order = sorted(recs, key=lambda r: -abs(float(r["mean"])))
