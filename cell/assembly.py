@@ -291,9 +291,12 @@ def constants(s: Scenario, timing: RobotTiming) -> CellConstants:
         speed = getattr(b, f"{belt}_nominal_in_s")
         if speed > most:
             key, value = _tracking_blame(s, belt, speed)
+            speed_key = f"belts.{belt}_nominal_in_s"
+            change = "" if key == speed_key else f" (with this {key}); set {speed_key} to " \
+                f"at most {most:.4f}, or change {key}"
             raise ScenarioError(s.source, key, value,
                                 f"the robot can follow the {belt} belt ({speed:g} in/s) down to "
-                                f"{where} at no more than {most:.4f} in/s")
+                                f"{where} at no more than {most:.4f} in/s{change}")
     t = timing
     r1a, r1b = t.r1_time(b.input_nominal_in_s)
     r3a, r3b = t.r3_time(b.output_nominal_in_s)

@@ -15,6 +15,8 @@ merged in by ``cell bench``):
 * a year of two shifts (``run.hours`` 4,000) of the adaptive robot with failures of the
   robot, both belts and the sensor and motor wear on (:data:`YEAR_FAILURES`), parts per
   second, one run;
+* the overhead of a sweep point beyond its simulation (ms; a 200-point sweep of
+  20-part runs, loaded, run, assembled and tabled in one process);
 * whole processes: ``cell run baseline`` from a cold start (median of several,
   the disk cache warm as after any first run), ``cell sweep`` of Table 7.1 on two
   workers (700,000 parts), and the peak memory of ``cell run`` of 1,000,000 parts.
@@ -43,6 +45,9 @@ from cell.stopwatch import best_seconds
 #: Targets (the bench prints whether each is met; nothing fails on them).
 TARGETS = {"flat": 0.9, "ceiling_ratio": 0.5, "cold_run_s": 0.7, "sweep_table_7_1_s": 5.0,
            "peak_mb_1m_parts": 500.0}
+
+#: A sweep point's cost beyond its simulation (:func:`sweep_overhead_ms_per_point`), ms.
+TARGETS["sweep_overhead_ms_per_point"] = 5.0
 
 
 def _streamed(scenario: Scenario) -> Any:
@@ -191,6 +196,47 @@ def peak_mb(parts: int = 1_000_000) -> float:
     return int(out.split()[-1]) / 1024.0
 
 
+_SIMULATED = [0.0]  # seconds inside the replications of :func:`sweep_overhead_ms_per_point`
+
+
+def _timed_replication(scenario: Scenario, seed: Any) -> Any:
+    from cell.sweep import simulate_summary
+
+    t0 = time.perf_counter()
+    try:
+        return simulate_summary(scenario, seed)
+    finally:
+        _SIMULATED[0] += time.perf_counter() - t0
+
+
+def sweep_overhead_ms_per_point(points: int = 200, parts: int = 20) -> float:
+    """Milliseconds a sweep point costs beyond its simulation: a sweep of ``points`` points
+    (one 20-part replication each, one process) loaded and checked, run into a folder, its
+    ``replications.csv`` assembled and its summary and difference tables made, less the
+    time inside the replications themselves.  Best of three."""
+    import yaml
+
+    from cell.reporting.experiment import difference_table, summary_table
+    from cell.sweep import load_sweep, run_sweep
+
+    spans = []
+    with tempfile.TemporaryDirectory() as tmp:
+        doc = {"name": "overhead", "base": "baseline", "set": {"run.parts": parts},
+               "grid": {"belts.output_nominal_in_s": [round(1.8 + 0.5 * i / points, 6)
+                                                      for i in range(points)]},
+               "policies": ["adaptive"], "replications": 1, "batch": 1, "seed": 1}
+        (Path(tmp) / "sweep.yaml").write_text(yaml.safe_dump(doc), encoding="utf-8")
+        for i in range(3):
+            _SIMULATED[0] = 0.0
+            t0 = time.perf_counter()
+            sweep = load_sweep(Path(tmp) / "sweep.yaml")
+            frame = run_sweep(sweep, Path(tmp) / f"out{i}", workers=1, progress=False,
+                              replicate=_timed_replication, warn_windows=False).replications
+            summary_table(frame, sweep), difference_table(frame, sweep)
+            spans.append(time.perf_counter() - t0 - _SIMULATED[0])
+    return 1e3 * min(spans) / points
+
+
 def benchmarks(scenario_file: str | Path = "scenarios/baseline.yaml", *,
                processes: bool = True) -> dict[str, Any]:
     """The simulation's figures (the scenario file if present, else the built-in defaults);
@@ -210,6 +256,7 @@ def benchmarks(scenario_file: str | Path = "scenarios/baseline.yaml", *,
         out[f"ceiling_ratio_{name}"] = out[f"parts_per_s_{name}_500k"] / ceiling
     out["parts_per_s_adaptive_year_failures"] = parts_per_second_year(
         base.with_overrides({"controller.policy": "adaptive"}))
+    out["sweep_overhead_ms_per_point"] = sweep_overhead_ms_per_point()
     if processes:
         out["peak_mb_1m_parts"] = peak_mb()
         out["cold_run_s"] = cold_run_seconds()
@@ -233,4 +280,7 @@ def verdicts(results: dict[str, Any]) -> list[tuple[str, str, str, bool]]:
         if key in results:
             rows.append((key, f"{results[key]:.2f} {unit}", f"<= {TARGETS[key]:g} {unit}",
                          results[key] <= TARGETS[key]))
+    if "sweep_overhead_ms_per_point" in results:
+        key, most = "sweep_overhead_ms_per_point", TARGETS["sweep_overhead_ms_per_point"]
+        rows.append((key, f"{results[key]:.2f} ms", f"<= {most:g} ms", results[key] <= most))
     return rows

@@ -59,10 +59,12 @@ MEMORY_HINTS = {
 
 
 class Parser(argparse.ArgumentParser):
-    """argparse with usage errors on one line (``cell run: error: ...``) and no exit."""
+    """argparse with usage errors on one line (``cell: error: run: ... (see cell run --help)``)
+    and no exit."""
 
     def error(self, message: str) -> NoReturn:
-        raise _UsageError(f"{self.prog}: {message} (see {self.prog} --help)")
+        sub = self.prog.partition(" ")[2]  # "cell run" -> "run": named once, not "cell" twice
+        raise _UsageError(f"{sub + ': ' if sub else ''}{message} (see {self.prog} --help)")
 
 
 class _UsageError(Exception):
@@ -84,7 +86,13 @@ def build_parser() -> argparse.ArgumentParser:
         module = _module(name)
         p = sub.add_parser(name, help=module.HELP, description=module.DESCRIPTION)
         module.add_arguments(p)
+        SUBPARSERS[name] = p
     return parser
+
+
+#: Each subcommand's parser, by name, as build_parser made it: an argument the subcommand
+#: does not know is its usage error, pointing to its own --help.
+SUBPARSERS: dict[str, argparse.ArgumentParser] = {}
 
 
 def _fail(message: str) -> int:
@@ -249,8 +257,11 @@ def _where() -> int:
 def _main(argv: Sequence[str] | None) -> int:
     parser = build_parser()
     try:
-        args = parser.parse_args(argv)
-    except _UsageError as exc:
+        args, extra = parser.parse_known_args(argv)
+        if extra:
+            SUBPARSERS.get(args.command, parser).error(
+                "unrecognized arguments: " + " ".join(extra))
+    except _UsageError as exc:  # "cell: error: run: ... (see cell run --help)"
         return _fail(str(exc))
     except SystemExit as exc:  # --help, --version: printed, done
         return exc.code if isinstance(exc.code, int) else 0

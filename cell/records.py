@@ -56,7 +56,8 @@ class LimitCount(NamedTuple):
 LIMIT_COUNTS: dict[str, LimitCount] = {
     "r4_peak": LimitCount("limit_r4_peak", "R IV at the base's peak rate"),
     "r2_peak": LimitCount("limit_r2_peak", "R II at the motors' peak"),
-    "input_floor": LimitCount("limit_input_floor", "input belt at its floor (next part let go)"),
+    "input_floor": LimitCount("limit_input_floor",
+                              "picks with the input belt at its floor (the part after each let go)"),
     "input_ceiling": LimitCount("limit_input_ceiling", "input belt at its ceiling (robot waited)"),
     "input_tracking": LimitCount("limit_input_tracking",
                                  "input belt held to the robot's tracking limit"),

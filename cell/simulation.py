@@ -160,21 +160,27 @@ class BeltLog:
         if not self.keep and self.sink is None:
             return None
         mark, times, speeds, sink = self.belt.append, self.t.append, self.v.append, self.sink
+        last = [math.nan]  # the belt's speed so far: a "change" to the same speed is none
 
         def keep(t: float, v: float) -> None:
             mark(belt)
             times(t)
             speeds(v)
         if sink is None:
-            return keep
-        name = _BELTS[belt]
-        if not self.keep:
-            return lambda t, v: sink(BeltChange(name, t, v))
+            told = keep
+        else:
+            name = _BELTS[belt]
 
-        def both(t: float, v: float) -> None:
-            keep(t, v)
-            sink(BeltChange(name, t, v))
-        return both
+            def told(t: float, v: float) -> None:
+                if self.keep:
+                    keep(t, v)
+                sink(BeltChange(name, t, v))
+
+        def changed(t: float, v: float) -> None:
+            if v != last[0]:
+                last[0] = v
+                told(t, v)
+        return changed
 
 
 class RunLog:

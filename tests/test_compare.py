@@ -113,14 +113,19 @@ def test_verdict_says_which_is_better_on_each_measure():
                                 ("ip_wallclock", 0.21, 0.01, 0.20, 0.22),
                                 ("actual_cycle_wallclock_s", -0.5, 2.0, -1.9, 0.9))])
     text = verdict(summary, diffs, sweep)
-    lines = {line.split("  ")[1].strip(): line for line in text.splitlines()[1:]}
+    lines = verdict_rows(text)
     assert "a better: a delivers 100.0 ± 2.0 parts more than b per 500-part run" \
         in lines["Parts delivered"]
     assert "a better: a loses 100.0 ± 2.0 parts fewer than b per 500-part run" \
         in lines["Parts lost (wall clock)"]
-    assert "a better (nearer 1)" in lines["IP (wall clock, eq. 5.1)"]
+    assert "a better (nearer 1 is better)" in lines["IP (wall clock, eq. 5.1)"] \
+        and "means 1.01 against 0.8" in lines["IP (wall clock, eq. 5.1)"]
     assert "neither" in lines["Actual cycle (wall clock, s)"]
     assert "interval includes 0: no difference shown" in lines["Actual cycle (wall clock, s)"]
+    assert "means 500 against 400" in lines["Parts delivered"]  # both sides' means, A first
+    # one overall line: a ahead on three measures, neither on the fourth
+    assert text.splitlines()[-1] == ("Overall, on the headline measures: a better (a better "
+                                     "on 3, b on 0, neither on 1 of 4)")
 
 
 @pytest.mark.parametrize(("args", "shows"), [
@@ -158,7 +163,8 @@ def compare_run(capsys, a: Path | str, b: Path | str, *more: str) -> tuple[str, 
 
 
 def verdict_rows(out: str) -> dict[str, str]:
-    return {line.split("  ")[1].strip(): line for line in out.splitlines()[1:]}
+    return {line.split("  ")[1].strip(): line for line in out.splitlines()[1:]
+            if line.startswith("  ")}  # not the overall line (issue 24)
 
 
 def test_compare_warns_once_when_run_lengths_differ_and_leaves_counts_uncompared(

@@ -29,7 +29,7 @@ SAYS = {
                                    "fewer than fitted on the wall clock (interval excludes 0)",
     "Actual cycle (wall clock, s)": "fitted better: non_adaptive runs a wall-clock actual cycle "
                                     "12.21 ± 0.26 s longer than fitted (interval excludes 0)",
-    "IP (wall clock, eq. 5.1)": "fitted better (nearer 1): non_adaptive reaches a wall-clock IP "
+    "IP (wall clock, eq. 5.1)": "fitted better (nearer 1 is better): non_adaptive reaches a wall-clock IP "
                                 "0.290 ± 0.020 lower than fitted (interval excludes 0)",
     "Spacings outside 45 ± 0.25 in": "fitted better: non_adaptive leaves 330.0 ± 1.1 more "
                                      "spacings outside 45 ± 0.25 in than fitted per 500-part "
@@ -57,8 +57,12 @@ def sweep():
 
 
 def lines_of(text: str) -> dict[str, str]:
-    return {line[2:].split("  ")[0]: line.split("  ", 2)[2].strip()
-            for line in text.splitlines()[1:]}
+    """Each headline's verdict, without the means said after it (issue 24: 'means A against
+    B') and without the overall line."""
+    titles = {h.title for h in HEADLINES}
+    out = {line[2:].split("  ")[0]: line.split("  ", 2)[2].strip().split("; means ")[0]
+           for line in text.splitlines()[1:] if line.startswith("  ")}
+    return {k: v for k, v in out.items() if k in titles}
 
 
 def test_every_headline_reads_with_a_as_its_subject(sweep):

@@ -125,8 +125,13 @@ def test_report_md_prints_the_tables_intervals(known_report):
     q = diffs[(diffs["measure"] == "parts_delivered")].iloc[0]
     half = (q["ci_high"] - q["ci_low"]) / 2
     d = 1 - math.floor(math.log10(half))
-    assert (f"adaptive delivers {q['mean']:.{d}f} ± {half:.{d}f} parts more than non-adaptive "
-            "per 20-part run (95 % CI, paired over 12 replications)") in text
+    # the paired difference is the last column of its point's row in the measure's table
+    table = text.split("## Parts delivered")[1].split("\n## ")[0]
+    assert "| belts.output_nominal_in_s | non-adaptive | adaptive | adaptive − non-adaptive |" \
+        in table
+    row = next(line for line in table.splitlines()
+               if line.startswith(f"| {q['belts.output_nominal_in_s']:g} |"))
+    assert row.endswith(f"| {q['mean']:+.{d}f} ± {half:.{d}f} |")
     # no variation is said, not shown as a zero-width interval
     assert "7 (no variation)" in text and "7.0 ± 0.0" not in text
     for name in ("fig_parts_delivered.png", "fig_parts_per_hr_wallclock.png",
@@ -251,7 +256,13 @@ def test_a_trace_driven_sweep_says_no_variation(sweeps, tmp_path):
     assert "No variation between replications" in text and "trace" in text
     assert not [line for line in text.splitlines() if line.startswith("|") and " ± " in line]
     assert "(no variation)" in text
-    assert "in every one of 3 replications (no variation between replications)" in text
+    # the difference, the same in every replication, is shown exact, without an interval
+    reps = pd.read_csv(tmp_path / "o" / "replications.csv")
+    diff = (reps[reps["policy"] == "adaptive"]["parts_delivered"].to_numpy()
+            - reps[reps["policy"] == "non-adaptive"]["parts_delivered"].to_numpy())
+    assert len(diff) == 3 and len(set(diff)) == 1 and diff[0] != 0
+    table = text.split("## Parts delivered")[1].split("\n## ")[0]
+    assert table.rstrip().endswith(f"| {diff[0]:+d} (exact) |")
 
 
 # --------------------------------------------------------------------------- a small real sweep
@@ -307,10 +318,17 @@ def test_baseline_point_differences(sweeps, tmp_path):
                       progress=False).replications
     d = difference_table(frame, sweep)
     d = d[d["measure"] == "parts_per_hr_wallclock"]
+    base = d[d["versus"] == "non-adaptive at belts.output_nominal_in_s = 2"]
     # three points against non-adaptive at 2.0: the output belt adds 4 x 0.5 = 2 parts/hr
-    assert sorted(zip(d["policy"], d["belts.output_nominal_in_s"], d["mean"].round(9))) == [
+    assert sorted(zip(base["policy"], base["belts.output_nominal_in_s"],
+                      base["mean"].round(9))) == [
         ("adaptive", 2.0, 0.0), ("adaptive", 2.5, 2.0), ("non-adaptive", 2.5, 2.0)]
-    assert set(d["versus"]) == {"non-adaptive at belts.output_nominal_in_s = 2"}
+    # and, beside them, the policies against each other (issue 24): the same parts per hour
+    # for both, as ``known`` gives them; at 2.0 that pair is the baseline's, given once
+    pair = d[d["versus"] == "non-adaptive"]
+    assert sorted(zip(pair["policy"], pair["belts.output_nominal_in_s"],
+                      pair["mean"].round(9))) == [("adaptive", 2.5, 0.0)]
+    assert len(d) == len(base) + len(pair)
 
 
 # --------------------------------------------------------------------------- the what-if
@@ -346,7 +364,7 @@ def test_two_varied_keys_give_a_table_row_per_combination_and_panels(sweeps, tmp
                       progress=False).replications
     paths = write_report(frame, sweep, plan_report(sweep, tmp_path / "rep"), "test")
     text = (tmp_path / "rep" / "report.md").read_text()
-    table = text.split("## Parts delivered")[1].split("![")[0]
+    table = text.split("## Parts delivered")[1].split("\n## ")[0]
     assert "| belts.output_nominal_in_s | belts.input_nominal_in_s | non-adaptive | adaptive |" \
         in table
     assert len([line for line in table.splitlines() if line.startswith("| 2")]) == 4

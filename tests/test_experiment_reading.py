@@ -1,11 +1,12 @@
-"""report.md's reading along one numeric key: figures as the tables show them."""
+"""report.md's reading along one numeric key, for a sweep of one policy (no comparison to
+give an effect, so the trend is its effect): figures as the tables show them."""
 
 from __future__ import annotations
 
 import pandas as pd
 
 from cell.analysis.stats import PAIRED_KEYS, summarise
-from cell.reporting.experiment_reading import reading
+from cell.reporting.experiment_explain import reading
 from cell.reporting.headlines import HEADLINES
 from cell.sweep import load_sweep
 
@@ -19,21 +20,22 @@ def trend(sweeps, tmp_path, runs: dict[float, list[float]]) -> str:
                              **summarise(x)} for v, x in runs.items()])
     differences = pd.DataFrame(columns=[KEY, "policy", "versus", "measure", *PAIRED_KEYS])
     (text,) = [t for t in reading(summary, differences, sweep, [KEY], HEADLINES[:1])
-               if t.startswith("**")]
+               if t.startswith("- **")]
     return text
 
 
 def test_a_measure_with_no_variation_reads_as_the_table_shows_it(sweeps, tmp_path):
     """Every run delivers all 60 parts at both ends: '60', as the table's '60 (no
-    variation)', and 'stays at', not 'goes from 60.0000 ... to 60.0000'."""
+    variation)', and 'does not move', not 'goes from 60.0000 ... to 60.0000'."""
     text = trend(sweeps, tmp_path, {2.0: [60] * 4, 2.5: [60] * 4})
-    assert f"Adaptive stays at 60 from {KEY} = 2 to 2.5." in text
+    assert "Adaptive does not move (60 at all 2 points)" in text
     assert "60.0000" not in text and "goes from" not in text
 
 
 def test_a_measure_that_moves_reads_from_one_end_to_the_other(sweeps, tmp_path):
     text = trend(sweeps, tmp_path, {2.0: [40, 42, 41, 43], 2.5: [50, 52, 51, 53]})
     assert f"Adaptive goes from 41.5 at {KEY} = 2 to 51.5 at 2.5." in text
+    assert "does not move" not in text
 
 
 def test_an_end_without_a_value_is_passed_over_not_read_as_nan(sweeps, tmp_path):

@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from cell.analysis.stats import PAIRED_KEYS, summarise
-from cell.reporting.experiment_reading import reading
+from cell.reporting.experiment_explain import reading
 from cell.reporting.experiment_text import cell
 from cell.reporting.headlines import HEADLINES
 
@@ -26,7 +26,8 @@ def scatter(sweeps, tmp_path, runs: list[float], h=SPACINGS, whole: bool = True)
     differences = pd.DataFrame(columns=[KEY, "policy", "versus", "measure", *PAIRED_KEYS])
     text = reading(pd.DataFrame([row]), differences, sweep, [KEY], [h],
                    {h.column} if whole else ())
-    return cell(row, whole) + " ¦ " + " ".join(t for t in text if t.startswith("**"))
+    said = [t.removeprefix("- ") for t in text]  # the Reading's bullets (issue 24)
+    return cell(row, whole) + " ¦ " + " ".join(t for t in said if t.startswith("**"))
 
 
 def test_a_count_that_is_0_or_1_does_not_scatter_widely(sweeps, tmp_path):

@@ -22,7 +22,8 @@ def test_input_floor_counts_picked_parts_whose_next_part_is_let_go():
     assert floor.sum() > 20 and r.summary["limit_input_floor"] == floor.sum()
     assert p["picked"].to_numpy()[floor].all()            # the counted parts were picked
     assert missed[1:][floor[:-1]].all()                   # and each one's next part let go
-    assert "next part let go" in LIMIT_COUNTS["input_floor"].label
+    label = LIMIT_COUNTS["input_floor"].label   # counts picks, not the parts lost (issue 24)
+    assert label.startswith("picks") and "the part after each let go" in label
 
 
 def test_no_floor_is_counted_when_r2_takes_up_the_whole_wait():

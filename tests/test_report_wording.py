@@ -1,5 +1,5 @@
 """report.md's wording: a mean from fewer runs than the point had says so, and the reading
-names the differences furthest from and nearest to zero (not "largest" of negatives)."""
+names the difference furthest from zero (by size, not "largest" of negatives) and where."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ import pandas as pd
 
 from cell.reporting.experiment import difference_table, summary_table
 from cell.reporting.experiment_text import markdown
+from cell.reporting.headlines import half_width, plus_minus
 from cell.sweep import load_sweep, run_sweep
 
 
@@ -35,17 +36,25 @@ def test_a_mean_from_fewer_runs_says_how_many(sweeps, tmp_path):
         assert "from" not in line
 
 
-def test_the_reading_says_furthest_from_and_nearest_zero(sweeps, tmp_path):
+def test_the_reading_gives_the_largest_difference_and_where(sweeps, tmp_path):
+    """The parts lost's comparison: its largest difference (by size) and its point; when the
+    smallest's interval lies apart from it, that one too, as an interaction."""
     text, _, differences = report(sweeps, tmp_path, set={"run.parts": 40},
                                   grid={"belts.output_nominal_in_s": [1.8, 2.0, 2.2]},
                                   policies=["adaptive", "non-adaptive"], replications=4,
                                   batch=4)
     lost = differences[differences["measure"] == "parts_missed"]
-    far = lost.loc[lost["mean"].abs().idxmax()]
-    line = next(x for x in text.splitlines() if x.startswith("**Parts lost (wall clock).**"))
-    assert "largest" not in line and "smallest" not in line
-    sign = "+" if far["mean"] >= 0 else "-"
-    at = f"(at belts.output_nominal_in_s = {far['belts.output_nominal_in_s']:g})"
-    said = line.split("furthest from zero ")[1]
-    assert said.startswith(sign) and said.split(" (at")[0] != "" and at in said.split(", nearest")[0]
-    assert ", nearest zero " in said
+    far, near = lost.loc[lost["mean"].abs().idxmax()], lost.loc[lost["mean"].abs().idxmin()]
+    line = next(x for x in text.splitlines() if x.startswith("- **Parts lost (wall clock).**"))
+    said = line.split(f"{far['policy']} − {far['versus']} ")[1]
+
+    def shown(r) -> str:
+        return plus_minus(float(r["mean"]), half_width(r), signed=True)
+
+    key = "belts.output_nominal_in_s"
+    apart = max(far["ci_low"], near["ci_low"]) > min(far["ci_high"], near["ci_high"])
+    if apart:
+        assert said.startswith(f"from {shown(near)} ({near[key]:g}) to {shown(far)} "
+                               f"({far[key]:g})") and "an interaction" in said
+    else:
+        assert said.startswith(f"{shown(far)} at most ({far[key]:g}), the same within")

@@ -51,6 +51,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="write report.md, summary.csv, differences.csv, figures and "
                         "replications.csv into DIR")
     set_argument(p)
+    p.add_argument("--policy", default=None, metavar="NAME",
+                   help="run this policy on both sides (controller.policy of A and B)")
 
 
 def _stem(arg: str) -> str:
@@ -130,6 +132,8 @@ def main(args: argparse.Namespace) -> int:
     from cell.sweep.spec import MAX_RUNS, comparison
 
     sets = parse_sets(args.sets)
+    if args.policy is not None:
+        sets["controller.policy"] = args.policy
     a, b = load_scenario(args.a, sets), load_scenario(args.b, sets)
     if args.replications < 2:
         raise CellError(f"--replications {args.replications}: must be at least 2 "
@@ -162,7 +166,7 @@ def main(args: argparse.Namespace) -> int:
     from cell.reporting.experiment import difference_table, summary_table
 
     tables = summary_table(replications, sweep), difference_table(replications, sweep)
-    print(verdict(*tables, sweep))
+    print(verdict(*tables, sweep, replications))
     if target is not None:
         from cell.reporting.experiment import write_report
 
@@ -184,11 +188,13 @@ def command_line(args: argparse.Namespace, seed: int) -> str:
     return shlex.join(words)
 
 
-def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> str:
+def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
+            replications: pd.DataFrame | None = None) -> str:
     """A few lines: per headline measure, which is better, and A's difference from B (A - B)
     as a sentence with A its subject (``b better: a delivers 3.1 ± 0.4 parts fewer than b
     ...``).  Counts and extremes are not compared if A and B take them over different
     windows (run length, warm-up)."""
+    from cell.commands.compare_rates import overall, rate_free, rates_differ, still_sides
     from cell.reporting.headlines import (
         HEADLINES,
         better,
@@ -201,6 +207,7 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> s
 
     (la, a), (lb, b) = _sides(sweep)
     differ = windows_apart(a.scenario, b.scenario)
+    demand = rates_differ(summary, la, lb)
     parts = a.scenario.run.parts if a.scenario.run.parts == b.scenario.run.parts else None
     level = f"{sweep.confidence * 100:g} %"
     length = (f" of {parts} part{'s' if parts != 1 else ''}" if parts else
@@ -208,8 +215,14 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> s
     lines = [f"{la} ({a.policy}) against {lb} ({b.policy}): {sweep.replications} replications"
              f"{length}, seed {sweep.seed}, common random numbers; A - B with its paired "
              f"{level} confidence interval"]
+    if demand:
+        lines.append(f"  {demand}")
+    lines += [f"  {w}" for w in still_sides(summary, la, lb)]
     apart = ", ".join(f"run.{k} {va} against {vb}" for k, va, vb in differ)
-    width = max(len(h.title) for h in HEADLINES)
+    sides: list[tuple[str, int]] = []
+    from cell.commands.compare_rates import RATE_FREE
+
+    width = max(len(t) for t in [*(h.title for h in HEADLINES), *(r[0] for r in RATE_FREE)])
     for h in HEADLINES:
         d = differences[differences["measure"] == h.column]
         windowed = window_kind(h.column)
@@ -238,6 +251,24 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep) -> s
         side = better(h, float(means[la]), float(means[lb])) if judged else 0
         who = {1: f"{la} better", -1: f"{lb} better", 0: "neither"}[side]
         if h.better == "one" and side:
-            who += " (nearer 1)"
-        lines.append(f"  {h.title:<{width}}  {who}: {what}")
+            who += " (nearer 1 is better)"
+        if demand and h.column in DEMAND_BOUND:
+            who = "not judged (arrival rates differ)"
+            side = 0
+        elif not (demand and h.column in DEMAND_BOUND):
+            sides.append((h.title, side))
+        shown = f"{number(float(means[la]))} against {number(float(means[lb]))}"
+        lines.append(f"  {h.title:<{width}}  {who}: {what}; means {shown}")
+    if replications is not None:
+        for title, side, line in rate_free(replications, sweep, la, lb, width):
+            lines.append(line)
+            if demand:
+                sides.append((title, side))
+    lines.append(overall(sides, la, lb, bool(demand)))
     return "\n".join(lines)
+
+
+#: Measures that grow with the demand: with different arrival rates they say more parts
+#: came, not which cell is better, and are left unjudged (the rate-free ones judge).
+DEMAND_BOUND = frozenset({"parts_per_hr_wallclock", "parts_delivered", "parts_missed",
+                          "spacing_outside_tol", "actual_cycle_wallclock_s"})

@@ -11,7 +11,7 @@ import threading
 from pathlib import Path
 from typing import Any
 
-from cell.commands import check_workers, workers_argument
+from cell.commands import check_workers, set_argument, workers_argument
 from cell.interrupts import exit_now
 
 HELP = "replicated sweep over scenario keys, with its report"
@@ -40,6 +40,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="with --select-best: the probability of correct selection (default 0.95)")
     p.add_argument("--goal", choices=("maximize", "minimize"), default=None,
                    help="with --select-best: whether more is better (default: by the measure)")
+    set_argument(p)  # on top of the sweep file's set: (a key the grid varies is refused)
+    p.add_argument("--format", choices=("csv", "parquet"), default="csv",
+                   help="the result file: replications.csv (default) or, with parquet, "
+                        "replications.parquet in its place (the same table)")
 
 
 class _Stop:
@@ -96,7 +100,9 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
     out = check_out(args.out)  # before the sweep file's points are built and checked
     _check_select(args)
     check_workers(args.workers, args.scheduler)
-    sweep = load_sweep(args.sweep)
+    from cell.overrides import parse_sets
+
+    sweep = load_sweep(args.sweep, parse_sets(args.sets))
     check_owner(sweep, out, args.resume)  # no results of another sweep, nor this one's, lost
     target = None
     if args.report:
@@ -112,7 +118,8 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
     try:
         with lock(out):  # a second sweep into the same --out is refused
             outcome = run_sweep(sweep, out, workers=args.workers, scheduler=args.scheduler,
-                                resume=args.resume, replicate=simulate_summary)
+                                resume=args.resume, replicate=simulate_summary,
+                                result_format=args.format)
     except BaseException as exc:  # stopped: by Ctrl-C or kill, whatever it broke on the way
         if stop.signum is None and not isinstance(exc, KeyboardInterrupt):
             raise
@@ -124,7 +131,7 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
         return stop.code
     counts = sorted(set(outcome.counts.values()))
     reps = (f"{counts[0]}" if len(counts) == 1 else f"{counts[0]}-{counts[-1]}")
-    print(f"wrote {Path(args.out) / 'replications.csv'}: {len(sweep.points)} points x "
+    print(f"wrote {outcome.path}: {len(sweep.points)} points x "
           f"{reps} replications ({outcome.tasks_run} tasks run, "
           f"{outcome.tasks_reused} reused)")
     if target is not None:

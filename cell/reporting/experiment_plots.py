@@ -110,7 +110,7 @@ def draw(h: Headline, rows: pd.DataFrame, sweep: Sweep, plan: Layout,
     ncols = min(3, n)
     nrows = math.ceil(n / ncols)
     fig = Figure(figsize=(min(12.0, 1.0 + 5.2 * ncols), 3.8 * nrows + 0.6), layout="constrained")
-    axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
+    axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False, sharey=True).ravel())
     level = f"{sweep.confidence * 100:g} %"
     if h.per_run:  # a count is never below 0, nor is its interval drawn there
         rows = rows.assign(ci_low=rows["ci_low"].clip(lower=0.0))
@@ -139,6 +139,35 @@ def draw(h: Headline, rows: pd.DataFrame, sweep: Sweep, plan: Layout,
         fig.legend(list(drawn.values()), list(drawn), loc="outside lower center",
                    ncols=_legend_columns(list(drawn), fig.get_figwidth()))
     return fig
+
+
+#: Scenario keys in words, for an axis.
+KEY_WORDS = {
+    "arrivals.mean_s": "mean inter-arrival time (s)",
+    "arrivals.cv": "inter-arrival coefficient of variation",
+    "arrivals.params": "inter-arrival distribution",
+    "belts.input_nominal_in_s": "input belt's nominal speed (in/s)",
+    "belts.output_nominal_in_s": "output belt's nominal speed (in/s)",
+    "controller.ideal_cycle_s": "fixed robot cycle (s)",
+    "controller.nominal_cycle_s": "nominal robot cycle (s)",
+    "part.weight_oz": "part weight (oz)",
+    "run.parts": "parts per run",
+}
+#: Unit suffixes of a key's last part, in words.
+UNITS = (("_in_s", "in/s"), ("_oz", "oz"), ("_in", "in"), ("_pct", "%"), ("_s", "s"))
+
+
+def key_words(key: str) -> str:
+    """A scenario key as an axis label: in words where known (``input belt's nominal
+    speed (in/s)``), else its last parts with spaces and the unit its suffix names."""
+    if key in KEY_WORDS:
+        return KEY_WORDS[key]
+    head, _, leaf = key.rpartition(".")
+    for suffix, unit in UNITS:
+        if leaf.endswith(suffix):
+            words = f"{head.rpartition('.')[2]} {leaf.removesuffix(suffix)}".replace("_", " ")
+            return f"{words.strip()} ({unit})"
+    return f"{head.rpartition('.')[2]} {leaf}".replace("_", " ").strip()
 
 
 def _legend_columns(labels: Sequence[str], width_in: float) -> int:
@@ -195,7 +224,7 @@ def _select(rows: pd.DataFrame, cols: Sequence[str], combo: Sequence[str]) -> pd
 
 def _panel(ax: Axes, h: Headline, rows: pd.DataFrame, sweep: Sweep, plan: Layout,
            colours: dict[str, str]) -> None:
-    ax.set_ylabel(h.title)
+    ax.set_ylabel(h.title + (", per run" if h.per_run else ""))
     policies = sweep.policies
     lines = _series(rows, plan, policies)
     step = min(0.08, 0.6 / max(len(lines), 1))
@@ -233,7 +262,7 @@ def _panel(ax: Axes, h: Headline, rows: pd.DataFrame, sweep: Sweep, plan: Layout
     if not numeric:
         ax.set_xticks(range(len(ticks)), ticks, rotation=0 if len(ticks) < 5 else 30)
         ax.set_xlim(-0.6, len(ticks) - 0.4)
-    ax.set_xlabel(x.removesuffix(NAME_SUFFIX))
+    ax.set_xlabel(key_words(x.removesuffix(NAME_SUFFIX)))
 
 
 def _points(ax: Axes, xs: Sequence[float], r: pd.DataFrame, colour: str, label: str,

@@ -30,6 +30,15 @@ ANY_COUNT = "fingerprint_any_replications"
 MOST = "replications_run_most"
 
 
+#: A sweep's result file, by ``cell sweep --format``: one of them, never both.
+RESULT_FILES = {"csv": "replications.csv", "parquet": "replications.parquet"}
+
+
+def _results(out: Path) -> list[str]:
+    """The result files (:data:`RESULT_FILES`) in ``out``."""
+    return [name for name in RESULT_FILES.values() if (out / name).exists()]
+
+
 def check_out(out: str | Path) -> Path:
     """Refuse, before any work, a sweep directory that cannot be used: an empty name, a
     file, a directory under a file, one holding a ``sweep.json`` that is not a sweep's, or
@@ -55,7 +64,7 @@ def check_out(out: str | Path) -> Path:
 def _results_without_manifest(path: Path) -> str | None:
     """What a sweep would replace in ``path`` (its ``replications.csv``, task files),
     named for the message, when there is no manifest to say a sweep wrote them."""
-    found = ["replications.csv"] if (path / "replications.csv").exists() else []
+    found = _results(path)
     found += [str(p.relative_to(path)) for p in finished_tasks(path)[:1]]
     return ", ".join(found) or None
 
@@ -82,7 +91,7 @@ def check_owner(sweep: Sweep, out: Path, resume: bool) -> None:
     manifest = out / MANIFEST
     found = _manifest(manifest) if manifest.is_file() else None
     tasks = len(finished_tasks(out))
-    if not isinstance(found, dict) or not (tasks or (out / "replications.csv").exists()):
+    if not isinstance(found, dict) or not (tasks or _results(out)):
         return
     flag = f"--out {out}" + (" (--resume)" if resume else "")
     if found.get("fingerprint") != sweep.fingerprint():
@@ -97,7 +106,7 @@ def check_owner(sweep: Sweep, out: Path, resume: bool) -> None:
                             f"replications: {sweep.replications}, or remove the folder")
     if resume:
         return
-    if (out / "replications.csv").exists():
+    if _results(out):
         raise CellError(f"--out {out}: holds a finished run of this sweep ({tasks} tasks): add "
                         "--resume to reuse it (nothing runs again), or remove the folder")
     raise CellError(f"--out {out}: holds {tasks} finished task{'s' if tasks != 1 else ''} of "
@@ -226,7 +235,8 @@ def prepare(sweep: Sweep, out: Path, resume: bool) -> None:
     if not resume:  # nothing of this sweep's, nor of another's, is lost (check_owner)
         for stale in finished_tasks(out):
             stale.unlink()
-        (out / "replications.csv").unlink(missing_ok=True)
+        for name in RESULT_FILES.values():
+            (out / name).unlink(missing_ok=True)
     doc: dict[str, Any] = {"sweep": sweep.source, "name": sweep.name,
                            "fingerprint": sweep.fingerprint(),
                            ANY_COUNT: any_count,

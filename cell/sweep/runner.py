@@ -12,7 +12,8 @@ whether it needs another ``batch`` (:func:`cell.analysis.stats.precision_reached
 :func:`~cell.analysis.stats.next_round`).  A round's tasks are ordinary tasks, so
 ``--resume`` replays the same rounds from the files.
 
-``OUT/replications.csv`` is always assembled from those files in a fixed order
+``OUT/replications.csv`` (or, with ``result_format="parquet"``, ``replications.parquet``
+in its place; :mod:`cell.sweep.results`) is always assembled from those files in a fixed order
 (point, then replication), so it is byte-identical however the sweep was run: no
 result depends on the number of workers or the order tasks finish in.  Its
 columns: ``policy``; ``point`` (index of the grid point within its policy); the
@@ -45,11 +46,11 @@ import numpy as np
 
 from cell.cache import Identity, memo
 from cell.errors import CellError
-from cell.output import atomic_path, float_formatter, write_csv
 from cell.progress import Progress
 from cell.scenario import Scenario
-from cell.sweep.columns import Column, grid_columns, point_values
-from cell.sweep.outdir import MANIFEST, TASK_DIR, check_out, finished_tasks, prepare
+from cell.sweep.columns import grid_columns
+from cell.sweep.outdir import MANIFEST, RESULT_FILES, TASK_DIR, check_out, finished_tasks, prepare
+from cell.sweep.results import assemble_results, measure_values, read_task, task_records, write_task
 from cell.sweep.spec import Sweep, Task, overload_warning
 from cell.sweep.windows import window_warning
 
@@ -61,8 +62,6 @@ if TYPE_CHECKING:  # pandas is imported when first needed: local workers start w
 #: A replication: (scenario, stream) -> the run's summary row.
 Replicate = Callable[[Scenario, np.random.SeedSequence], Mapping[str, Any]]
 
-#: Float digits in the per-task files: enough to round-trip exactly.
-TASK_FLOAT_FORMAT = "%.17g"
 #: Seconds a dask client gets to close (a scheduler gone away does not answer).
 CLOSE_TIMEOUT_S = 5
 #: Tasks in flight on a dask cluster at once (local workers: twice their number).
@@ -96,41 +95,6 @@ def _plain(value: Any) -> Any:
     return value.item() if isinstance(value, np.generic) else value
 
 
-def _task_frame(sweep: Sweep, columns: Sequence[Column], task: Task,
-                rows: Sequence[Mapping[str, Any]]) -> pd.DataFrame:
-    import pandas as pd
-
-    point = sweep.points[task.point]
-    records = []
-    for r, summary in zip(range(task.first, task.last), rows, strict=True):
-        record: dict[str, Any] = {"policy": point.policy, "point": point.index}
-        record.update(point_values(columns, point, summary))
-        record["seed"] = sweep.seed
-        record["replication"] = r
-        record.update({k: v for k, v in summary.items() if k not in record})
-        records.append(record)
-    return pd.DataFrame.from_records(records)
-
-
-def _read_task(sweep: Sweep, path: Path, task: Task) -> pd.DataFrame | None:
-    """A finished task's rows, or None if the file is missing or not this task's."""
-    if not path.is_file():
-        return None
-    import pandas as pd
-
-    try:
-        frame = pd.read_csv(path)
-    except (OSError, ValueError):
-        return None
-    if len(frame) != task.size or not {"replication", "policy", "point"} <= set(frame.columns):
-        return None
-    point = sweep.points[task.point]
-    if list(frame["replication"]) != list(range(task.first, task.last)) \
-            or (frame["policy"] != point.policy).any() or (frame["point"] != point.index).any():
-        return None
-    return frame
-
-
 @dataclass
 class Outcome:
     """What :func:`run_sweep` did; ``replications`` reads ``replications.csv`` when asked."""
@@ -145,6 +109,8 @@ class Outcome:
     def replications(self) -> pd.DataFrame:
         import pandas as pd
 
+        if self.path.suffix == ".parquet":
+            return pd.read_parquet(self.path)
         return pd.read_csv(self.path)
 
 
@@ -283,8 +249,9 @@ WORKERS_PER_CORE = 4
 def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
               scheduler: str | None = None, resume: bool = False,
               replicate: Replicate = simulate_summary, progress: bool = True,
-              warn_windows: bool = True) -> Outcome:
-    """Run (or finish, with ``resume``) a sweep into ``out``; write replications.csv.
+              warn_windows: bool = True, result_format: str = "csv") -> Outcome:
+    """Run (or finish, with ``resume``) a sweep into ``out``; write replications.csv, or
+    with ``result_format="parquet"`` replications.parquet instead (:data:`RESULT_FILES`).
 
     ``replicate`` is what one replication does; the default simulates the cell.
     It must be a module-level function when tasks run in other processes.
@@ -312,14 +279,13 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
                        enabled=progress)
 
         def done(task: Task, rows: list[dict[str, Any]]) -> None:
-            write_csv(_task_frame(sweep, columns, task, rows), task_dir / task.filename,
-                      float_format=TASK_FLOAT_FORMAT)
+            write_task(task_records(sweep, columns, task, rows), task_dir / task.filename)
             bar.update(task.size)
 
         def todo(ranges: dict[int, tuple[int, int]]) -> Iterable[Task]:
             nonlocal run, reused
             for task in sweep.iter_tasks(ranges):
-                if resume and _read_task(sweep, task_dir / task.filename, task) is not None:
+                if resume and read_task(sweep, task_dir / task.filename, task) is not None:
                     reused += 1
                     bar.update(task.size)
                 else:
@@ -339,7 +305,7 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
 
                 q = sweep.precision
                 for task in sweep.iter_tasks(ranges):
-                    values[task.point] += _measure(sweep, task_dir, task, q.measure)
+                    values[task.point] += measure_values(sweep, task_dir, task, q.measure)
                 reached = precision_reached(values, q.precision, q.confidence, q.min_n)
                 more = next_round(counts, reached, sweep.batch, q.max_n)
                 ranges = {p: (counts[p], counts[p] + k) for p, k in more.items() if k}
@@ -358,7 +324,7 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     # The files the rounds wrote, point by point: a round's tasks start where it does
     # (``min`` need not be a multiple of ``batch``), not where cutting from 0 would.
     tasks = (t for p in counts for r in rounds if p in r for t in sweep.iter_tasks({p: r[p]}))
-    path = _assemble(sweep, task_dir, tasks, out / "replications.csv")
+    path = assemble_results(sweep, task_dir, tasks, out / RESULT_FILES[result_format])
     return Outcome(path, run, reused, counts)
 
 
@@ -372,41 +338,3 @@ def _unmade(out: Path) -> None:
     with contextlib.suppress(OSError):
         (out / TASK_DIR).rmdir()
 
-
-def _finished(sweep: Sweep, task_dir: Path, task: Task) -> pd.DataFrame:
-    """A finished task's rows, from its file (:func:`_read_task`); an error if it is gone."""
-    frame = _read_task(sweep, task_dir / task.filename, task)
-    if frame is None:
-        raise CellError(f"{task_dir / task.filename}: missing or damaged; rerun the sweep")
-    return frame
-
-
-def _measure(sweep: Sweep, task_dir: Path, task: Task, measure: str) -> list[float]:
-    """A finished task's values of the precision's measure, from its file."""
-    frame = _finished(sweep, task_dir, task)
-    if measure not in frame.columns:
-        raise CellError(f"{sweep.source}: replications.measure = {measure!r}: the replications "
-                        "have no such column")
-    import pandas as pd
-
-    return [float(v) for v in pd.to_numeric(frame[measure], errors="coerce")]
-
-
-def _assemble(sweep: Sweep, task_dir: Path, tasks: Iterable[Task], target: Path) -> Path:
-    """``replications.csv`` from the task files, in the tasks' order (each file read once).
-
-    Assembled from the files, never from the results in memory: a resumed sweep and
-    an uninterrupted one go through the same bytes.
-    """
-    frames = []
-    names: dict[str, None] = {}
-    for task in tasks:
-        frame = _finished(sweep, task_dir, task)
-        names.update(dict.fromkeys(frame.columns))
-        frames.append(frame)
-    with atomic_path(target) as tmp, open(tmp, "w", encoding="utf-8", newline="") as stream:
-        for i, frame in enumerate(frames):
-            frame.reindex(columns=list(names)).to_csv(
-                stream, header=i == 0, index=False, float_format=float_formatter(),
-                lineterminator="\n")
-    return target

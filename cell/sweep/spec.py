@@ -230,9 +230,10 @@ class Sweep:
         return out
 
 
-def load_sweep(path: str | Path) -> Sweep:
+def load_sweep(path: str | Path, sets: dict[str, Any] | None = None) -> Sweep:
     """Read and validate a sweep file (or a built-in one by name); every grid point's
-    scenario is built and checked."""
+    scenario is built and checked.  ``sets``: dotted keys set on top of its ``set:``
+    (``cell sweep --set``), checked as that is."""
     from cell import catalog
     from cell.yamlio import load_mapping
 
@@ -246,7 +247,7 @@ def load_sweep(path: str | Path) -> Sweep:
                             f"no such scenario file ({base_path}) nor built-in scenario "
                             "(`cell scenarios` lists them)")
     base = load_scenario(base_path)
-    fixed = doc.set or {}
+    fixed = {**(doc.set or {}), **(sets or {})}  # --set on top of the file's set:
     for key, value in fixed.items():
         if not known_key(str(key)):
             raise ScenarioError(path, str(key), value, "unknown key: no such setting in a scenario")
@@ -399,5 +400,4 @@ def comparison(a: Scenario, b: Scenario, labels: tuple[str, str], replications: 
     return Sweep(f"{la} against {lb}", "compare", f"{la} against {lb}", a, (), ("scenario",),
                  (pa, pb), replications, seed, min(batch, replications),
                  baseline=Baseline(b.controller.policy, (("scenario", lb),),
-                                   text=f"{lb} ({b.controller.policy})"))
-
+                                   text=lb))  # the report names the scenarios, not policies

@@ -85,7 +85,7 @@ def test_cell_run_killed_at_any_step_leaves_the_old_set_or_the_new(tmp_path, fal
     from cell.cli import main
 
     target = tmp_path / "run"
-    argv = ["run", "baseline", "--set", "run.parts=8", "--out", str(target)]
+    argv = ["run", "baseline", "--set", "run.parts=8", "--out", str(target), "--force"]  # again
     seen = _every_kill(tmp_path, target, lambda: _quiet(main, argv + ["--set", "run.seed=1"]),
                        lambda: _quiet(main, argv + ["--set", "run.seed=2"]), NAMES, fallback)
     assert seen <= {"old", "new", "absent"}
