@@ -171,6 +171,8 @@ class RobotStops:
         """Motion intervals, (from, to) pairs."""
         self._moving_since = math.nan
         self.maintenance_due: simpy.Event | None = None
+        self.proc: Any = None
+        """The process of the cycle under way (what a stop interrupts)."""
 
     def loss(self, now: float) -> int:
         """A part at B with the robot not back: lost to downtime if a stop kept it away."""
@@ -179,8 +181,10 @@ class RobotStops:
 
     def touch(self) -> None:
         """Something that can hold the robot changed: its legs look again."""
-        if self.in_cycle and self.env.active_process is not self.robot.process:
-            self.robot.process.interrupt()
+        proc = self.proc
+        if self.in_cycle and proc is not None and proc.is_alive and \
+                self.env.active_process is not proc:
+            proc.interrupt()
 
     def _doing(self, leg: int, free_at: float) -> None:
         now = self.env.now
@@ -202,6 +206,7 @@ class RobotStops:
         cycle = part.motion_cycle_s
         legs = (to_lo, part.r1_s - to_lo, part.r2_s, r3_pre, r3_post, cycle - to_td - r3_post)
         self.planned_free, self.in_cycle, self.part = env.now + cycle, True, part
+        self.proc = env.active_process
         for clock in self.clocks:
             clock.exposure.cycle(legs)
         rest = cycle
@@ -215,7 +220,9 @@ class RobotStops:
                     if self.stop is not None or (belt is not None and belt.stopped):
                         self._doing(STOPPED if self.stop is not None else MOVING_NOT, math.inf)
                         yield env.event()  # until whatever holds the robot lets go
-                    self._doing(i, start + left + max(rest, 0.0))
+                    # a planned stop due: the robot will not be free for a part at B
+                    self._doing(i, start + left + max(rest, 0.0)
+                                if self.maintenance_due is None else math.inf)
                     yield env.timeout(left)
                     left = 0.0
                 except simpy.Interrupt:
@@ -274,15 +281,15 @@ class RobotStops:
             yield env.timeout(max(k * every_s - env.now, 0.0))
             if self.in_cycle or self.stop is not None:
                 self.maintenance_due = env.event()
+                self.robot.free_at_s = math.inf  # no new part once back at B
                 yield self.maintenance_due
             else:
                 self.stop = "maintenance"
                 self._doing(STOPPED, math.inf)
             key = self.cell.begin("robot", "maintenance", "")
             yield env.timeout(duration_s)
-            self.stop = None
-            self.at_rest()
             self.cell.end(key)
+            self.repaired()
             k = max(k + 1, math.floor(env.now / every_s) + 1)
 
 
@@ -381,10 +388,6 @@ class Downtime:
         """Every stop, those still under way ending at ``end_s``, in order of start."""
         out = self.stops + [(n, c, a, end_s, p) for n, c, a, p in self._open.values()]
         return sorted(out, key=lambda row: (row[2], EQUIPMENT.index(row[0])))
-
-    def robot_equipment(self) -> Equipment | None:
-        """The robot's failures (a wear model replaces its ``exposure`` before the run)."""
-        return next((e for e in self.equipment if e.name == "robot"), None)
 
 
 def _while_stopped(belt: Any, replan: Callable[..., None]) -> Callable[..., None]:

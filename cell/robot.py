@@ -188,7 +188,9 @@ class Robot:
             set_down(part, to_td_s)  # touch-down: B + (B → TD), as a timeout would fall
 
     def run_stoppable(self):  # noqa: ANN201 (SimPy generator)
-        get, cycle = self.orders.get, self.cycle
+        """Each order in a process of its own, which a stop interrupts (an interrupt that
+        comes once it is over is dropped, as SimPy drops them for a finished process)."""
+        env, get, cycle = self.env, self.orders.get, self.cycle
         while True:
             order = yield get()
-            yield from cycle(*order)
+            yield env.process(cycle(*order))

@@ -55,6 +55,8 @@ def check_run(s, seed):
     # every summary value finite (the thesis's bookkeeping has no cycle when it counts
     # every part lost: then, and only then, its cycle and rates are undefined)
     undefined = POLICY_ONLY | (THESIS_RATES if m.parts_missed_thesis == m.parts_arrived else set())
+    if m.robot_failures == 0:  # no failure: no time between failures, none to repair
+        undefined |= {"mtbf_observed_s", "mttr_observed_s"}
     for name in SUMMARY_COLUMNS:
         value = getattr(m, name)
         if isinstance(value, float) and name not in undefined:

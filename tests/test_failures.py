@@ -186,7 +186,7 @@ def test_parts_are_conserved_and_belts_physical_under_any_failures(f, policy, le
         r.parts_in_cell
     assert 0 <= r.parts_lost_downtime <= r.parts_missed
     if "run.parts" in length:
-        assert r.parts_in_cell == 0 and r.parts_arrived == 80
+        assert r.parts_in_cell == 0 and r.parts_arrived == s.run.parts
     parts = res.parts
     delivered = parts[parts.touchdown_s.notna()]
     assert (delivered.touchdown_s.diff().dropna() >= 0).all()  # set down in order
@@ -290,3 +290,21 @@ def test_a_wear_exposure_drives_the_robots_failure_clock(monkeypatch):
     r4 = (np.minimum(end, first.from_s) - np.minimum(end - parts.r4_s, first.from_s)).clip(0)
     assert r4.sum() == pytest.approx(100.0, abs=1e-6)
     assert wear.cycles == len(parts)
+
+
+def test_planned_stops_come_back_and_cost_the_parts_they_cover():
+    f = {"maintenance": {"every_h": 1.0, "duration_min": 10.0}}
+    res = simulate(load_scenario("baseline", {"run.hours": 3.0, "failures": f}))
+    stops = res.stops()
+    assert [s.cause for s in stops] == ["maintenance", "maintenance"]  # at 1 h and 2 h
+    for s in stops:  # each starts once the robot is back at B, and lasts its 10 minutes
+        assert 3600.0 <= s.from_s % 3600.0 + 3600.0 < 3600.0 + 60.0
+        assert s.to_s - s.from_s == pytest.approx(600.0)
+    r = res.summary
+    assert r.robot_maintenance_fraction == pytest.approx(1200.0 / 10800.0)
+    # the parts lost are those that reached B during the stops: about 1200 s of arrivals
+    assert abs(r.parts_lost_downtime - 1200.0 / 22.586) <= 3
+    assert r.parts_in_cell <= 2 and r.availability == 1.0
+    busy_after = [x for x in res.state_spans() if x.equipment == "robot" and x.state == "busy"
+                  and x.from_s > stops[-1].to_s]
+    assert busy_after  # the robot works again after its last stop
