@@ -201,7 +201,7 @@ def _check_targets(args: argparse.Namespace) -> None:
     out, report = given["out"], given["report"]
     if out is not None and report is not None and args.command == "sweep":
         o, r = os.path.realpath(out), os.path.realpath(report)
-        if r == o or r.startswith(o.rstrip(os.sep) + os.sep):
+        if r.startswith(o.rstrip(os.sep) + os.sep):  # (--report DIR = --out: NAME/ in it)
             raise CellError(f"--report {shown_path(report)}: inside the results folder "
                             f"--out {shown_path(out)}, whose files are the sweep's: "
                             "choose another place")

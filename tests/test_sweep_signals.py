@@ -87,7 +87,7 @@ def _kill(proc: subprocess.Popen[str]) -> None:
 
 @pytest.mark.parametrize(("when", "send", "code", "said"), [
     (_while_loading, _ctrl_c, 130, "cell: interrupted"),
-    (_while_loading, _timeout, 143, "cell: interrupted"),
+    (_while_loading, _timeout, 143, "cell: terminated"),  # SIGTERM is said as such (issue 25)
     (_when_a_worker_starts, _ctrl_c, 130, "cell sweep: stopped; "),
     (_when_a_worker_starts, _timeout, 143, "cell sweep: stopped; "),
     (_after_some_tasks, _kill, 143, "cell sweep: stopped; "),

@@ -21,7 +21,7 @@ from cell.sweep.columns import NAME_SUFFIX
 
 #: The summary column that says how loaded a point's robot is (its fastest cycle over the
 #: mean inter-arrival time), under its new name first.
-LOAD_COLUMNS = ("load", "utilisation")
+LOAD_COLUMNS = ("offered_load", "load", "utilisation")  # today's name, then older sweeps'
 
 
 def load_column(summary: pd.DataFrame) -> str | None:
