@@ -46,7 +46,7 @@ stress: $(STAMP)
 sensor: $(STAMP)
 	rm -rf build/sensor
 	$(PY) -m cell sweep scenarios/sensor.yaml --out build/sensor --workers $(WORKERS)
-	MPLBACKEND=Agg $(PY) -m cell.reporting.sensor build/sensor/replications.csv reports/sensor
+	MPLBACKEND=Agg $(PY) -m cell.reporting.sensor_map build/sensor/replications.csv reports/sensor
 
 # The reliability study (issue 21): both policies with motor wear, a year of two shifts a run.
 reliability: $(STAMP)
@@ -55,10 +55,10 @@ reliability: $(STAMP)
 
 figures: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m cell figures --out reports/figures
-	$(PY) -m cell.reporting.mintime
+	$(PY) -m cell.reporting.planner_report
 
 animation: $(STAMP)
-	$(PY) -m cell.animation reports/animation/both.gif
+	$(PY) -m cell.reporting.animation reports/animation/both.gif
 
 bench: $(STAMP)
 	$(PY) -m cell bench --out reports/bench.json

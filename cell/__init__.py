@@ -6,7 +6,7 @@ evenly spaced, on an output conveyor while parts arrive at random.  The maths
 processes are thin shells around them.
 """
 
-from cell.errors import CellError, ScenarioError, UnreachableError
+from cell.plumbing.errors import CellError, ScenarioError, UnreachableError
 
 __all__ = ["CellError", "ScenarioError", "UnreachableError", "__version__"]
 __version__ = "0.1.0"

@@ -2,6 +2,6 @@
 
 import sys
 
-from cell.cli import main
+from cell.cli.main import main
 
 sys.exit(main())

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 import yaml
 
-from cell import catalog
-from cell.assembly import constants, robot_timing, step_table
-from cell.scenario import Scenario, default_scenario, load_scenario
+from cell.scenario import catalog
+from cell.scenario.schema import Scenario, default_scenario, load_scenario
+from cell.sim.assembly import constants, robot_timing, step_table
 
 
 @pytest.fixture(scope="session")

@@ -1,4 +1,4 @@
-"""Fault injection for the kill tests: the k-th file-system step of ``cell.output`` kills the
+"""Fault injection for the kill tests: the k-th file-system step of ``cell.plumbing.output.atomic`` kills the
 process with SIGKILL, as a power cut or ``kill -9`` would, at every step in turn."""
 
 from __future__ import annotations
@@ -8,9 +8,9 @@ import signal
 from collections.abc import Callable
 from typing import Any
 
-import cell.output as output
+import cell.plumbing.output.atomic as output
 
-#: The ``os`` functions counted as steps (with ``cell.output``'s open and exchange).
+#: The ``os`` functions counted as steps (with ``cell.plumbing.output.atomic``'s open and exchange).
 STEPS = ("rename", "replace", "unlink", "rmdir", "mkdir", "fsync", "link")
 
 

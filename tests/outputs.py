@@ -9,7 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from cell.output import OutputDir
+from cell.plumbing.output.atomic import OutputDir
 
 NAMES = ["parts.csv", "summary.csv", "belts.csv"]
 ROOT = Path(__file__).resolve().parent.parent

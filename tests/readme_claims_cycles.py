@@ -14,7 +14,7 @@ from .readme_sources import Sources, claim, value
 
 # Fig. 23-24
 def _lots(values: pd.Series) -> np.ndarray:
-    from cell.figures.runs import LOT
+    from cell.reporting.figures.runs import LOT
 
     v = values.to_numpy(dtype=float)
     return np.nanmean(v[: len(v) // LOT * LOT].reshape(-1, LOT), axis=1)
@@ -25,7 +25,7 @@ def _lots(values: pd.Series) -> np.ndarray:
        "s). Its mean as the thesis counted is {} s, **{} %**: this matches the thesis's \"{} "
        "percent out of spec\"")
 def _fig23(f: Sources, n: list[str]) -> Iterable[tuple[Any, ...]]:
-    from cell.figures.runs import LOT
+    from cell.reporting.figures.runs import LOT
 
     a, na = f.runs.adaptive.parts, f.runs.non_adaptive[22.5872].parts
     ideal = f.s.controller.nominal_cycle_s
@@ -67,7 +67,7 @@ def _fig23_wall(f: Sources, n: list[str]) -> Iterable[tuple[Any, ...]]:
 
 @claim("the adaptive one (thesis count) reads {} s after {} parts and {} s after {}")
 def _fig24_adaptive(f: Sources, n: list[str]) -> Iterable[tuple[Any, ...]]:
-    from cell.figures.runs import running_mean
+    from cell.reporting.figures.runs import running_mean
 
     y = running_mean(f.runs.adaptive.parts["thesis_interval_s"])
     return [(n[0], y[int(value(n[1])) - 1]), (n[2], y[int(value(n[3])) - 1])]
@@ -77,7 +77,7 @@ def _fig24_adaptive(f: Sources, n: list[str]) -> Iterable[tuple[Any, ...]]:
        "to {} s on the wall clock) and only slowly drifts to {} s (thesis count) or {} s (wall "
        "clock)")
 def _fig24_non_adaptive(f: Sources, n: list[str]) -> Iterable[tuple[Any, ...]]:
-    from cell.figures.runs import running_mean
+    from cell.reporting.figures.runs import running_mean
 
     d = f.runs.non_adaptive[22.5872].parts
     first = int(value(n[2]))
@@ -92,7 +92,7 @@ def _fig24_non_adaptive(f: Sources, n: list[str]) -> Iterable[tuple[Any, ...]]:
        "the wall clock; the thesis reports {};")
 def _fig25_adaptive(f: Sources, n: list[str]) -> Iterable[tuple[Any, ...]]:
     a = f.runs.adaptive.parts
-    from cell.thesis import TABLE_7_1_CYCLES
+    from cell.reporting.published import TABLE_7_1_CYCLES
 
     return [(n[0], TABLE_7_1_CYCLES[0]), (n[1], a["ip_thesis"].min()), (n[2], a["ip_thesis"].max()),
             (n[3], a["ip_thesis"].mean()), (n[4], a["ip_wallclock"].mean()),
@@ -101,7 +101,7 @@ def _fig25_adaptive(f: Sources, n: list[str]) -> Iterable[tuple[Any, ...]]:
 
 @claim("gives {} and a cycle {} % short, next to the thesis's \"within {} percent\"")
 def _memoryless(f: Sources, n: list[str]) -> Iterable[tuple[Any, ...]]:
-    from cell.thesis import ADAPTIVE_CYCLE_PCT
+    from cell.reporting.published import ADAPTIVE_CYCLE_PCT
 
     summary = f.runs.adaptive.summary
     return [(n[0], summary["ip_thesis_memoryless"]),

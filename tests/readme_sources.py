@@ -52,20 +52,20 @@ class Sources:
 
     @cached_property
     def s(self) -> Any:
-        from cell.scenario import load_scenario
+        from cell.scenario.schema import load_scenario
 
         return load_scenario("baseline")
 
     @cached_property
     def table(self) -> Any:
-        from cell.assembly import step_table
+        from cell.sim.assembly import step_table
 
         return step_table(self.s)
 
     @cached_property
     def tl(self) -> Any:
         """The figures' nominal transfer (Fig. 15-21), moves timed on the joints' travel."""
-        from cell.figures.motion import joint_travel_min_times, nominal_timeline
+        from cell.reporting.figures.motion import joint_travel_min_times, nominal_timeline
 
         return nominal_timeline(self.table, self.s, joint_travel_min_times(self.table))
 
@@ -86,7 +86,7 @@ class Sources:
 
     @cached_property
     def runs(self) -> Any:
-        from cell.figures.runs import simulate_runs
+        from cell.reporting.figures.runs import simulate_runs
 
         return simulate_runs(self.s)
 
@@ -112,7 +112,7 @@ class Sources:
     @cached_property
     def draws(self) -> np.ndarray:
         """The run's inter-arrival times, as the feeder draws them (Fig. 13-14)."""
-        from cell.figures.arrivals import draws
+        from cell.reporting.figures.interarrival import draws
 
         return draws(self.s, self.s.run.parts)
 
@@ -123,7 +123,13 @@ class Sources:
 
     @cached_property
     def fig22(self) -> dict[str, Any]:
-        from cell.figures.tip import belt_speed_at, hand_moves, pick_transfer, tip_speeds, transfer_timeline
+        from cell.reporting.figures.tip import (
+            belt_speed_at,
+            hand_moves,
+            pick_transfer,
+            tip_speeds,
+            transfer_timeline,
+        )
 
         run = self.runs.adaptive
         row = run.parts.iloc[pick_transfer(run)]

@@ -1,21 +1,21 @@
 """Any sweep's report: ``cell sweep SWEEP --report DIR`` and ``cell compare --out DIR``.
 
-From a sweep's ``replications.csv`` (:mod:`cell.sweep.runner`) this writes, as
-one unit (:class:`cell.output.OutputDir`: the whole set appears at once or not
+From a sweep's ``replications.csv`` (:mod:`cell.experiments.sweep.runner`) this writes, as
+one unit (:class:`cell.plumbing.output.atomic.OutputDir`: the whole set appears at once or not
 at all):
 
 - ``summary.csv``: tidy long form, one row per (grid point, policy, measure) for
   every numeric column of the runs' summaries: the grid's columns, ``policy``,
   ``measure``, ``n``, ``mean``, ``sd``, the confidence interval of the mean
   ``ci_low``/``ci_high`` (Student t) and ``run_p2_5``/``run_p97_5``, where
-  95 % of single runs fall (:func:`cell.analysis.stats.summarise`);
-- ``differences.csv``: the paired comparisons of :meth:`cell.sweep.Sweep.pairs`
+  95 % of single runs fall (:func:`cell.experiments.stats.summarise`);
+- ``differences.csv``: the paired comparisons of :meth:`cell.experiments.sweep.Sweep.pairs`
   -- replication r of both points drew the same parts (common random numbers),
   so the difference is taken replication by replication: the grid's columns,
   ``policy``, ``versus``, ``measure``, ``n``, ``mean``, ``sd``, ``ci_low``,
-  ``ci_high``, ``p_value`` (:func:`cell.analysis.stats.paired_difference`);
+  ``ci_high``, ``p_value`` (:func:`cell.experiments.stats.paired_difference`);
 - ``report.md``: a table, a figure and the paired differences per headline
-  measure (:mod:`cell.reporting.headlines`), and a reading drawn from the numbers
+  measure (:mod:`cell.reporting.formatting`), and a reading drawn from the numbers
   (:mod:`cell.reporting.experiment_text`);
 - ``fig_<measure>.png`` per headline measure (:mod:`cell.reporting.experiment_plots`);
 - for a sweep laid out like Table 7.1, ``table_7_1.csv`` and ``table_7_1.md``
@@ -39,14 +39,14 @@ from pathlib import Path
 
 import pandas as pd
 
-from cell.errors import CellError
-from cell.output import OutputDir
+from cell.experiments.sweep import Sweep
+from cell.experiments.sweep.windows import window_warning
+from cell.plumbing.errors import CellError
+from cell.plumbing.output.atomic import OutputDir
 from cell.reporting.experiment_data import difference_table, measures, summary_table
 from cell.reporting.experiment_plots import figures
 from cell.reporting.experiment_text import markdown
 from cell.reporting.table_7_1 import is_table_7_1, table_7_1_files
-from cell.sweep import Sweep
-from cell.sweep.windows import window_warning
 
 REPORT_FILES = ("report.md", "summary.csv", "differences.csv", "fig_*.png")
 TABLE_7_1_FILES = ("table_7_1.csv", "table_7_1.md")
@@ -109,7 +109,7 @@ def write_report(replications: pd.DataFrame, sweep: Sweep, target: Target,
     A target that names ``replications.csv`` gets the replications too.  ``tables``:
     the summary and difference tables if already made from these replications.
     ``caveat`` opens report.md; by default the sweep's window warning, if it has one
-    (:func:`cell.sweep.windows.window_warning`)."""
+    (:func:`cell.experiments.sweep.windows.window_warning`)."""
     if caveat is None:
         caveat = window_warning(sweep)
     summary, differences = tables or (summary_table(replications, sweep),

@@ -15,9 +15,9 @@ from typing import Any
 
 import pandas as pd
 
+from cell.experiments.sweep.columns import NAME_SUFFIX
 from cell.reporting.experiment_reading import against, show
-from cell.reporting.headlines import Headline, half_width, number, plus_minus, table_head, table_row
-from cell.sweep.columns import NAME_SUFFIX
+from cell.reporting.formatting import Headline, half_width, number, plus_minus, table_head, table_row
 
 #: The summary column that says how loaded a point's robot is (its fastest cycle over the
 #: mean inter-arrival time), under its new name first.

@@ -1,9 +1,9 @@
 """The numbers of an experiment's report: ``summary.csv`` and ``differences.csv``
 (:mod:`cell.reporting.experiment`), from a sweep's ``replications.csv``.
 
-Every interval comes from :mod:`cell.analysis.stats` (Student t, scipy.stats):
-:func:`~cell.analysis.stats.summarise` per point, and
-:func:`~cell.analysis.stats.paired_difference` per pair of points, replication r
+Every interval comes from :mod:`cell.experiments.stats` (Student t, scipy.stats):
+:func:`~cell.experiments.stats.summarise` per point, and
+:func:`~cell.experiments.stats.paired_difference` per pair of points, replication r
 against replication r (common random numbers).
 """
 
@@ -16,9 +16,9 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-from cell.analysis.stats import PAIRED_KEYS, SUMMARY_KEYS, paired_many, summarise_many
-from cell.sweep import Column, Pair, Sweep, grid_columns
-from cell.sweep.windows import pair_apart, window_measures
+from cell.experiments.stats import PAIRED_KEYS, SUMMARY_KEYS, paired_many, summarise_many
+from cell.experiments.sweep import Column, Pair, Sweep, grid_columns
+from cell.experiments.sweep.windows import pair_apart, window_measures
 
 #: Columns of replications.csv that are not measures.
 NOT_MEASURES = {"policy", "point", "seed", "replication"}
@@ -54,8 +54,8 @@ class _Rows:
     :func:`runs_of` gives them) and each column as one array, found once for all points.
     Slicing the frame point by point and summarising one measure at a time cost a point of
     41 measures 12.8 ms for ``summary.csv`` and 13.1 ms for ``differences.csv`` (CPU time,
-    100 points of 2 replications); with this and :func:`~cell.analysis.stats.summarise_many`
-    and :func:`~cell.analysis.stats.paired_many`, 1.5 and 1.1 ms (``cell bench``,
+    100 points of 2 replications); with this and :func:`~cell.experiments.stats.summarise_many`
+    and :func:`~cell.experiments.stats.paired_many`, 1.5 and 1.1 ms (``cell bench``,
     ``sweep_overhead_ms_per_point``)."""
 
     def __init__(self, replications: pd.DataFrame, sweep: Sweep):
@@ -120,7 +120,7 @@ def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
 
     The grid columns hold the compared point's values, or its partner's for a key
     only the partner varies.  A pair whose points run over different windows
-    (:mod:`cell.sweep.windows`) has no rows for the counts and extremes.
+    (:mod:`cell.experiments.sweep.windows`) has no rows for the counts and extremes.
     """
     columns, names = grid_columns(sweep), measures(replications, sweep)
     windowed = set(window_measures())

@@ -13,13 +13,13 @@ from collections.abc import Collection, Sequence
 import numpy as np
 import pandas as pd
 
+from cell.experiments.sweep import Sweep
+from cell.experiments.sweep.columns import NAME_SUFFIX
 from cell.reporting.experiment_compact import comparison_name, load_column
 from cell.reporting.experiment_reading import _scatter, show, where
-from cell.reporting.headlines import Headline, decimals, half_width, number, plus_minus, too_few
-from cell.sweep import Sweep
-from cell.sweep.columns import NAME_SUFFIX
+from cell.reporting.formatting import Headline, decimals, half_width, number, plus_minus, too_few
 
-#: The counts of :data:`cell.records.LIMIT_COUNTS` as the Reading names them.
+#: The counts of :data:`cell.sim.records.LIMIT_COUNTS` as the Reading names them.
 LIMIT_WORDS = {
     "limit_input_floor": "picks at the input belt's floor (the part after each let go)",
     "limit_input_ceiling": "input belt at its ceiling (robot waited)",

@@ -28,11 +28,11 @@ import pandas as pd
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from cell.experiments.sweep import Sweep, grid_columns
+from cell.experiments.sweep.columns import NAME_SUFFIX
 from cell.reporting.experiment_reading import show
 from cell.reporting.experiment_text import display_columns
-from cell.reporting.headlines import HEADLINES, Headline
-from cell.sweep import Sweep, grid_columns
-from cell.sweep.columns import NAME_SUFFIX
+from cell.reporting.formatting import HEADLINES, Headline
 
 DPI = 110
 #: Most panels a figure gets; a grid with more combinations gets no figures.

@@ -10,8 +10,8 @@ from typing import Any
 
 import pandas as pd
 
-from cell.reporting.headlines import Headline, decimals, half_width, number, plus_minus
-from cell.sweep.columns import NAME_SUFFIX
+from cell.experiments.sweep.columns import NAME_SUFFIX
+from cell.reporting.formatting import Headline, decimals, half_width, number, plus_minus
 
 
 def show(value: Any) -> str:

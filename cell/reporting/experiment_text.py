@@ -3,7 +3,7 @@
 ``differences.csv`` (:mod:`cell.reporting.experiment`).
 
 Every interval printed is one of those tables' (Student t, scipy.stats via
-:mod:`cell.analysis.stats`); a measure that does not vary between replications
+:mod:`cell.experiments.stats`); a measure that does not vary between replications
 is said to, rather than shown with a zero-width interval.
 """
 
@@ -16,12 +16,15 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from cell.analysis.stats import precision_reached, relative_half_width
+from cell.experiments.stats import precision_reached, relative_half_width
+from cell.experiments.sweep import Sweep, grid_columns
+from cell.experiments.sweep.columns import NAME_SUFFIX
+from cell.experiments.sweep.windows import AUTO
 from cell.reporting.experiment_compact import baseline_words, compact_table
 from cell.reporting.experiment_data import run_counts, runs_of
 from cell.reporting.experiment_explain import reading
 from cell.reporting.experiment_reading import against, show, single_runs
-from cell.reporting.headlines import (
+from cell.reporting.formatting import (
     HEADLINES,
     Headline,
     half_width,
@@ -31,9 +34,6 @@ from cell.reporting.headlines import (
     table_row,
     too_few,
 )
-from cell.sweep import Sweep, grid_columns
-from cell.sweep.columns import NAME_SUFFIX
-from cell.sweep.windows import AUTO
 
 #: Sentences listed per measure before the rest is left to differences.csv.
 MAX_SENTENCES = 12

@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from cell.output import OutputDir
+from cell.plumbing.output.atomic import OutputDir
 
 FILES = ("reliability.csv", "reliability.png", "README.md")
 #: Hours of a year of two shifts (250 days × 16 h), what downtime is quoted per.
@@ -43,9 +43,9 @@ FIXED, ADAPTIVE = "non-adaptive", "adaptive"
 
 
 def wear_summary(scenario: Any, seed: np.random.SeedSequence) -> Mapping[str, Any]:
-    """One replication: the run's summary row and its wear measures (cell.wear)."""
-    from cell.simulation import simulate
-    from cell.sweep.runner import _assembled
+    """One replication: the run's summary row and its wear measures (cell.sim.wear)."""
+    from cell.experiments.sweep.runner import _assembled
+    from cell.sim.simulation import simulate
 
     result = simulate(_assembled(scenario), seed=seed, keep_parts=False, keep_belts=False)
     return {**result.summary.as_dict(), **(result.wear.measures if result.wear else {})}
@@ -118,7 +118,7 @@ def flip_exponent(v: pd.DataFrame) -> float | None:
 
 
 def headline(t: pd.DataFrame) -> str:
-    """The one sentence the README quotes (tests/test_reliability.py checks it)."""
+    """The one sentence the README quotes (tests/reporting/test_reliability.py checks it)."""
     v = verdicts(t)
     holds = v[v["holds"]]["wear_exponent"].tolist()
     flip = flip_exponent(v)
@@ -276,8 +276,8 @@ def write(replications: str | Path, out_dir: str | Path) -> Path:
 def run(sweep_file: str | Path, build: str | Path, out_dir: str | Path,
         workers: int = 2) -> Path:
     """Run the sweep with the wear measures into ``build``, then write the report."""
-    from cell.sweep.runner import run_sweep
-    from cell.sweep.spec import load_sweep
+    from cell.experiments.sweep.runner import run_sweep
+    from cell.experiments.sweep.spec import load_sweep
 
     OutputDir.check(out_dir, FILES, option="DIR")
     outcome = run_sweep(load_sweep(sweep_file), build, workers=workers, replicate=wear_summary)
@@ -285,7 +285,7 @@ def run(sweep_file: str | Path, build: str | Path, out_dir: str | Path,
 
 
 if __name__ == "__main__":  # pragma: no cover
-    from cell.errors import CellError
+    from cell.plumbing.errors import CellError
 
     try:
         print(f"wrote {run(sys.argv[1], sys.argv[2], sys.argv[3])}")

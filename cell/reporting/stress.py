@@ -26,14 +26,14 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from cell.analysis.stats import paired_difference, summarise
-from cell.output import OutputDir
-from cell.records import LIMIT_COUNTS
+from cell.experiments.stats import paired_difference, summarise
+from cell.plumbing.output.atomic import OutputDir
+from cell.sim.records import LIMIT_COUNTS
 
 KEYS = ("arrivals.distribution", "arrivals.cv", "arrivals.mean_s")
 FILES = ("stress.csv", "stress.png", "README.md")
 POLICIES = ("non-adaptive", "adaptive")
-#: The limits counted in stress.csv (their summary columns, cell.records.LIMIT_COUNTS).
+#: The limits counted in stress.csv (their summary columns, cell.sim.records.LIMIT_COUNTS).
 LIMITS = tuple(LIMIT_COUNTS[name].field for name in ("input_floor", "r4_peak", "r2_peak",
                                                       "input_ceiling", "output_floor",
                                                       "held_at_feeder", "output_ceiling",
@@ -42,7 +42,7 @@ LIMITS = tuple(LIMIT_COUNTS[name].field for name in ("input_floor", "r4_peak", "
 #: off 45 ± 0.25 in wherever the robot is fast enough (load >= 1) and cv <= 0.5.
 SPACING_PROMISE_PCT = 1.0
 #: The property tests allow the adaptive robot this many fewer parts (of 500) than the
-#: fixed-cycle one on the same draws (tests/test_any_arrivals.py scales it to its runs).
+#: fixed-cycle one on the same draws (tests/scenario/test_any_arrivals.py scales it to its runs).
 MARGIN_PARTS = 3
 
 
@@ -308,7 +308,7 @@ def write(replications: str | Path, out_dir: str | Path) -> Path:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    from cell.errors import CellError
+    from cell.plumbing.errors import CellError
 
     try:
         print(f"wrote {write(*sys.argv[1:3])}")

@@ -15,7 +15,7 @@ general files, the two that :func:`table_7_1_files` makes:
 Two accountings of the same runs (docs/accounting.md): ``thesis`` reproduces the thesis's
 bookkeeping, ``wallclock`` counts on the clock of a physically consistent cell.
 
-What the thesis published for each policy is data (:data:`cell.thesis.PUBLISHED`):
+What the thesis published for each policy is data (:data:`cell.reporting.published.PUBLISHED`):
 a policy published row by row (Table 7.1) gets the thesis's table beside ours, one
 published as a single run gets one row; :data:`LAYOUTS` maps each policy to its
 published figures, its tables and its reading.
@@ -31,13 +31,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
-from cell import catalog
-from cell import thesis as published
-from cell.analysis.stats import summarise
-from cell.errors import CellError
+from cell.experiments.stats import summarise
+from cell.plumbing.errors import CellError
+from cell.reporting import published
 from cell.reporting.experiment_data import runs_of
-from cell.reporting.headlines import half_width, table_head, table_row
-from cell.reporting.runs import is_thesis_cell
+from cell.reporting.formatting import half_width, table_head, table_row
+from cell.reporting.run_summary import is_thesis_cell
 from cell.reporting.table_7_1_reading import (
     ACCOUNTINGS,
     LABELS,
@@ -49,11 +48,12 @@ from cell.reporting.table_7_1_reading import (
     row_of,
     thesis_value,
 )
-from cell.scenario import load_scenario
+from cell.scenario import catalog
+from cell.scenario.schema import load_scenario
 
 if TYPE_CHECKING:
-    from cell.scenario import Scenario
-    from cell.sweep import Sweep
+    from cell.experiments.sweep import Sweep
+    from cell.scenario.schema import Scenario
 
 COLUMNS = ["policy", "ideal_cycle_s", "accounting", "measure", "thesis",
            "mean", "ci_low", "ci_high", "run_p2_5", "run_p97_5"]
@@ -91,8 +91,8 @@ def summary_column(accounting: str, measure: str, columns: Sequence[str]) -> str
 def fixed_cycle(s: Scenario) -> float:
     """The non-adaptive robot's cycle in ``s``, as ``cell run`` runs it (a Table 7.1 row's,
     Fig. 23/24's): ``controller.ideal_cycle_s``, else the nominal cycle
-    (:func:`cell.assembly.nominal_cycle`: the arrivals' mean when the scenario sets none)."""
-    from cell.assembly import nominal_cycle
+    (:func:`cell.sim.assembly.nominal_cycle`: the arrivals' mean when the scenario sets none)."""
+    from cell.sim.assembly import nominal_cycle
 
     c = s.controller.ideal_cycle_s
     return float(c) if c is not None else nominal_cycle(s)
@@ -102,7 +102,7 @@ def is_table_7_1(sweep: Sweep) -> bool:
     """Whether the sweep can be laid out as Table 7.1, beside the thesis's figures: it
     varies at most the robot cycle, runs only policies the thesis published figures for, a
     fixed number of times, on the thesis's own cell (any robot timing:
-    :func:`~cell.reporting.runs.is_thesis_cell`)."""
+    :func:`~cell.reporting.run_summary.is_thesis_cell`)."""
     if not (set(sweep.keys) <= {VARIED_KEY} and sweep.precision is None
             and all(p.policy in published.PUBLISHED for p in sweep.points)):
         return False
@@ -113,7 +113,7 @@ def is_table_7_1(sweep: Sweep) -> bool:
 
 def statistics(values: Sequence[float] | np.ndarray) -> dict[str, float]:
     """Mean, its t confidence interval and the 2.5/97.5 percentiles of single runs
-    (:func:`cell.analysis.stats.summarise`); one run: a zero-width interval."""
+    (:func:`cell.experiments.stats.summarise`); one run: a zero-width interval."""
     x = np.asarray(values, dtype=float)
     s = summarise(x[np.isfinite(x)], CONFIDENCE)
     if s["n"] == 1:

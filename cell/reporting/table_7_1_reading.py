@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from cell import thesis as published
+from cell.reporting import published
 
 ACCOUNTINGS = ("thesis", "wallclock")
 MEASURES = published.TABLE_7_1_MEASURES

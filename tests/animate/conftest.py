@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import pytest
 
-from cell.animation import simulate_scenes
-from cell.animation.scene import Scene
-from cell.scenario import Scenario, default_scenario
+from cell.reporting.animation.movie import simulate_scenes
+from cell.reporting.animation.scene import Scene
+from cell.scenario.schema import Scenario, default_scenario
 
 from .helpers import COUNT, FIRST
 

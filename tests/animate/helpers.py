@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import cumulative_trapezoid  # type: ignore[import-untyped]
 
-from cell.animation.scene import Scene, window
-from cell.scenario import Scenario
+from cell.reporting.animation.scene import Scene, window
+from cell.scenario.schema import Scenario
 
 FIRST, COUNT = 2, 6
 

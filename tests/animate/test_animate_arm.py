@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cell.animation.robot import arm_pose, robot_state
-from cell.animation.scene import Scene
-from cell.figures.motion import timeline
-from cell.scenario import Scenario
+from cell.reporting.animation.arm_pose import arm_pose, robot_state
+from cell.reporting.animation.scene import Scene
+from cell.reporting.figures.motion import timeline
+from cell.scenario.schema import Scenario
 
 from .helpers import FIRST, named_points
 

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cell.animation import simulate_scenes
-from cell.animation.robot import robot_state
-from cell.animation.scene import FALLING, Scene, build_scene, frame_times, parts_at, window
-from cell.scenario import Scenario
+from cell.reporting.animation.arm_pose import robot_state
+from cell.reporting.animation.movie import simulate_scenes
+from cell.reporting.animation.scene import FALLING, Scene, build_scene, frame_times, parts_at, window
+from cell.scenario.schema import Scenario
 
 FIRST, COUNT = 3000, 3
 
@@ -42,7 +42,7 @@ def test_the_robot_is_where_a_scene_with_every_cycle_puts_it(deep: list[Scene]) 
 
 
 def test_every_part_a_frame_shows_has_its_label_and_few_others_do(deep: list[Scene]) -> None:
-    from cell.animation.render import build_figure
+    from cell.reporting.animation.render import build_figure
 
     t0, t1 = window(deep, FIRST, COUNT)
     times = frame_times(t0, t1, 1.0)
@@ -62,9 +62,9 @@ def test_every_part_a_frame_shows_has_its_label_and_few_others_do(deep: list[Sce
 def test_the_frames_kept_from_a_streamed_run_are_the_full_runs(scenario: Scenario, policy: str) -> None:
     """The few fields a deep run keeps per part (flat arrays, the belts streamed) give the
     same frames' input as the run's full records: every array equal, dtype and all."""
-    from cell.animation import simulated
-    from cell.animation.scene import frames_input
-    from cell.simulation import simulate
+    from cell.reporting.animation.movie import simulated
+    from cell.reporting.animation.scene import frames_input
+    from cell.sim.simulation import simulate
 
     s = scenario.with_overrides({"controller.policy": policy, "run.parts": 400,
                                  "arrivals.params.scale": 3.0})  # belts at their limits too
@@ -80,7 +80,7 @@ def test_the_frames_kept_from_a_streamed_run_are_the_full_runs(scenario: Scenari
 
 def test_a_long_run_before_the_window_shows_its_progress(scenario: Scenario, monkeypatch: pytest.MonkeyPatch,
                                                           capsys: pytest.CaptureFixture[str]) -> None:
-    import cell.animation as animation
+    import cell.reporting.animation.movie as animation
 
     monkeypatch.setattr(animation, "PROGRESS_FROM_PARTS", 100)
     animation.simulated(scenario.with_overrides({"run.parts": 300}), progress=True)

@@ -5,10 +5,10 @@ from __future__ import annotations
 import pytest
 from matplotlib.colors import to_rgba
 
-from cell.animation import simulate_scenes
-from cell.animation.render import build_figure, draw_frame
-from cell.animation.stops import DOWN_COLOUR, duration, stop_lines
-from cell.scenario import default_scenario
+from cell.reporting.animation.movie import simulate_scenes
+from cell.reporting.animation.render import build_figure, draw_frame
+from cell.reporting.animation.stops import DOWN_COLOUR, duration, stop_lines
+from cell.scenario.schema import default_scenario
 
 
 def test_the_repair_clock_reads_hours_minutes_seconds() -> None:

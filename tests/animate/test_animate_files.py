@@ -11,12 +11,12 @@ from pathlib import Path
 import pytest
 from PIL import Image, ImageSequence
 
-from cell.animation import animate
-from cell.animation.scene import TAIL_S
-from cell.commands.animate import add_arguments
-from cell.commands.animate import main as cmd_animate
-from cell.errors import CellError
-from cell.scenario import Scenario
+from cell.cli.animate_command import add_arguments
+from cell.cli.animate_command import main as cmd_animate
+from cell.plumbing.errors import CellError
+from cell.reporting.animation.movie import animate
+from cell.reporting.animation.scene import TAIL_S
+from cell.scenario.schema import Scenario
 
 
 def gif_durations_ms(path: Path) -> list[int]:
@@ -31,7 +31,7 @@ def gif_frames(path: Path) -> int:
 
 
 def test_a_short_gif_is_written_whole(tmp_path: Path, scenario: Scenario) -> None:
-    from cell.simulation import simulate
+    from cell.sim.simulation import simulate
 
     parts = simulate(scenario.with_overrides({"run.parts": 3})).parts
     step = 20.0                                   # --speed 120 at 6 fps
@@ -68,7 +68,7 @@ def no_simulation(monkeypatch: pytest.MonkeyPatch) -> None:
     def refuse(*args: object, **kwargs: object) -> None:
         raise AssertionError("simulated before checking --out")
 
-    monkeypatch.setattr("cell.simulation.simulate", refuse)
+    monkeypatch.setattr("cell.sim.simulation.simulate", refuse)
 
 
 def test_mp4_without_ffmpeg_is_one_clear_error(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
@@ -94,14 +94,15 @@ def test_a_failed_render_leaves_nothing(tmp_path: Path, scenario: Scenario,
         out.write_bytes(b"GIF89a")
         raise RuntimeError("interrupted")
 
-    monkeypatch.setattr("cell.animation.render.render", half)
+    monkeypatch.setattr("cell.reporting.animation.render.render", half)
     with pytest.raises(RuntimeError):
         animate(scenario, tmp_path / "a.gif", parts=1, progress=False)
     assert list(tmp_path.iterdir()) == []
 
 
 def test_importing_the_command_loads_no_plotting() -> None:
-    code = "import sys, cell.animation; print('matplotlib' in sys.modules, 'numpy' in sys.modules)"
+    code = ("import sys, cell.reporting.animation.movie; "
+            "print('matplotlib' in sys.modules, 'numpy' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["False", "False"]
 

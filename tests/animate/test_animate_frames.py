@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cell.animation.scene import ABSENT, HAND, OUTPUT, Scene, parts_at
-from cell.scenario import Scenario
+from cell.reporting.animation.scene import ABSENT, HAND, OUTPUT, Scene, parts_at
+from cell.scenario.schema import Scenario
 
 from .helpers import integrated, named_points, output_reach, sample_times, square_centres
 
@@ -20,8 +20,8 @@ def test_drawn_parts_sit_where_the_belts_travel_puts_them(scenes: list[Scene], s
     records put there, each where the belt's integrated travel has carried it: dropped
     ``input_length`` upstream of B, fallen off at F (lying just past it), or set down at TD
     (and kept until it is a part's size past the farthest output belt drawn)."""
-    from cell.animation.render import build_figure, draw_frame
-    from cell.animation.scene import FALL_S
+    from cell.reporting.animation.render import build_figure, draw_frame
+    from cell.reporting.animation.scene import FALL_S
 
     panel = build_figure(scenes, dpi=20.0)[1][policy]
     sc = scenes[policy]
@@ -62,7 +62,7 @@ def test_a_part_far_past_the_output_belts_drawn_end_has_left_the_scene(
         scenes: list[Scene], scenario: Scenario, policy: int) -> None:
     """A part set down rides the output belt while any of it can be drawn, and is gone (no
     square, no label) once the belt has carried it well past the farthest belt drawn."""
-    from cell.animation.render import build_figure, draw_frame
+    from cell.reporting.animation.render import build_figure, draw_frame
 
     panel = build_figure(scenes, dpi=20.0)[1][policy]
     sc = scenes[policy]
@@ -99,7 +99,7 @@ def test_a_lone_part_at_the_strips_end_shows_nothing_past_it(scenes: list[Scene]
     when it shares the strip with others (matplotlib's one-path shortcut is not taken)."""
     from matplotlib.colors import to_rgba
 
-    from cell.animation.render import PART_COLOUR, build_figure
+    from cell.reporting.animation.render import PART_COLOUR, build_figure
 
     fig, panels = build_figure(scenes, dpi=100.0)
     strip = panels[0].parts_out
@@ -126,8 +126,9 @@ def test_a_frame_looks_the_robot_up_once_and_draws_the_held_part_between_the_fin
         scenes: list[Scene], monkeypatch: pytest.MonkeyPatch) -> None:
     """While a part is in the hand, one frame asks for the joints once, and the part (its
     number) is drawn midway between the finger tips drawn in the same frame."""
-    from cell.animation import render, robot
-    from cell.animation.render import build_figure, draw_frame
+    from cell.reporting.animation import arm_pose as robot
+    from cell.reporting.animation import render
+    from cell.reporting.animation.render import build_figure, draw_frame
 
     sc = scenes[0]
     d = sc.data

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 from matplotlib.text import Text
 
-from cell.animation import simulate_scenes
-from cell.animation.scene import INPUT, Scene, parts_at
-from cell.scenario import Scenario
+from cell.reporting.animation.movie import simulate_scenes
+from cell.reporting.animation.scene import INPUT, Scene, parts_at
+from cell.scenario.schema import Scenario
 
 from .helpers import sample_times
 
@@ -22,7 +22,7 @@ def header_texts(fig) -> list[Text]:  # noqa: ANN001
 
 
 def test_each_panel_names_the_scenario_the_seed_and_a_fixed_cycle(scenario: Scenario) -> None:
-    from cell.animation.render import build_figure
+    from cell.reporting.animation.render import build_figure
 
     s = scenario.with_overrides({"name": "slow-robot", "run.seed": 7})
     fixed = s.with_overrides({"controller.policy": "non-adaptive", "controller.ideal_cycle_s": 21.0})
@@ -43,7 +43,7 @@ def test_each_panel_names_the_scenario_the_seed_and_a_fixed_cycle(scenario: Scen
 
 
 def test_the_thesis_fixed_cycle_is_the_one_the_run_used(scenes: list[Scene]) -> None:
-    from cell.animation.render import header
+    from cell.reporting.animation.render import header
 
     assert header(scenes[0]) == "baseline · seed 1984"
     assert header(scenes[1]) == "baseline · seed 1984 · fixed cycle 22.5872 s"
@@ -53,7 +53,7 @@ def test_the_thesis_fixed_cycle_is_the_one_the_run_used(scenes: list[Scene]) -> 
 def test_part_numbers_stay_inside_their_squares(scenes: list[Scene], offset: int) -> None:
     """Parts renumbered as deep into a run (``--from-part``): every label shown on the input
     belt in the close-up, where squares are not turned, fits inside its square."""
-    from cell.animation.render import build_figure, draw_frame
+    from cell.reporting.animation.render import build_figure, draw_frame
 
     deep = dataclasses.replace(scenes[0], data=dataclasses.replace(
         scenes[0].data, part=scenes[0].data.part + offset))
@@ -81,7 +81,7 @@ def test_part_numbers_stay_inside_their_squares(scenes: list[Scene], offset: int
 
 
 def test_the_clock_reads_hours_past_an_hour() -> None:
-    from cell.animation.render import clock
+    from cell.reporting.animation.render import clock
 
     assert clock(0.0) == "t =    0.0 s"
     assert clock(3599.94) == "t = 3599.9 s"

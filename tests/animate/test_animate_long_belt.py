@@ -10,14 +10,14 @@ import numpy as np
 import pytest
 from matplotlib.colors import to_rgb
 
-from cell.animation import simulate_scenes
-from cell.animation.scene import INPUT, parts_at
-from cell.scenario import Scenario
+from cell.reporting.animation.movie import simulate_scenes
+from cell.reporting.animation.scene import INPUT, parts_at
+from cell.scenario.schema import Scenario
 
 
 def _strip_pixels(scenario: Scenario, t_s: float) -> tuple[np.ndarray, int]:
     """The input strip's pixels (rows, columns, RGB) at ``t_s``, and how many parts it holds."""
-    from cell.animation.render import build_figure, draw_frame
+    from cell.reporting.animation.render import build_figure, draw_frame
 
     scenes = simulate_scenes(scenario, ["adaptive"], 1, 2)
     fig, panels = build_figure(scenes, dpi=100.0)
@@ -45,7 +45,7 @@ def test_the_input_belt_and_its_parts_are_visible_however_long(scenario: Scenari
                                                                 length_in: float) -> None:
     """The belt band fills at least a quarter of the strip's height, and every part on the
     belt shows at least a pixel column of its colour."""
-    from cell.animation.render import BELT_COLOUR, PART_COLOUR
+    from cell.reporting.animation.render import BELT_COLOUR, PART_COLOUR
 
     long = scenario.with_overrides({"belts.input_length_in": length_in})
     first_arrival = 24.85  # the default seed's first part; both parts are dropped by 60 s

@@ -8,10 +8,10 @@ from pathlib import Path
 
 import pytest
 
-from cell.animation import animate
-from cell.cli import main as cli
-from cell.errors import CellError
-from cell.scenario import Scenario
+from cell.cli.main import main as cli
+from cell.plumbing.errors import CellError
+from cell.reporting.animation.movie import animate
+from cell.scenario.schema import Scenario
 
 
 @pytest.mark.parametrize("ffmpeg", [True, False])
@@ -60,8 +60,8 @@ def test_both_policies_show_a_fixed_robot_at_its_own_cycle(tmp_path: Path) -> No
     """``--policy both`` of a non-adaptive scenario with its own cycle: the fixed panel runs
     at that cycle, the adaptive one at the nominal cycle (it used to be refused: the adaptive
     policy takes no ideal_cycle_s)."""
-    from cell.animation import simulate_scenes
-    from cell.scenario import load_scenario
+    from cell.reporting.animation.movie import simulate_scenes
+    from cell.scenario.schema import load_scenario
 
     s = load_scenario("non_adaptive", {"controller.ideal_cycle_s": 21.0})
     adaptive, fixed = simulate_scenes(s, ["adaptive", "non-adaptive"], 1, 2, progress=False)
@@ -79,8 +79,8 @@ def test_a_nominal_cycle_in_ms_is_warned_of_as_cell_run_warns(
     assert cli(["run", "baseline", *common, "--out", str(tmp_path / "run")]) == 0
     run = said(capsys)
     assert len(run) == 1 and "ms" in run[0] and "%" not in run[0], run
-    from cell.commands.animate import notes
-    from cell.scenario import load_scenario
+    from cell.cli.animate_command import notes
+    from cell.scenario.schema import load_scenario
 
     scenario = load_scenario("baseline", {"controller.nominal_cycle_s": 22587, "run.parts": 2})
     assert [f"cell: {line}" for line in notes(scenario, 1, 1)] == run

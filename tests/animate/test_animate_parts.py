@@ -12,9 +12,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cell.animation import simulate_scenes
-from cell.animation.scene import HAND, INPUT, OUTPUT, Scene, parts_at, time_at, travel
-from cell.scenario import Scenario
+from cell.reporting.animation.movie import simulate_scenes
+from cell.reporting.animation.scene import HAND, INPUT, OUTPUT, Scene, parts_at, time_at, travel
+from cell.scenario.schema import Scenario
 
 from .helpers import COUNT, FIRST, integrated, named_points, sample_times
 
@@ -118,7 +118,7 @@ def test_both_policies_see_the_same_parts(scenes: list[Scene]) -> None:
 
 def test_the_belts_are_the_runs_recorded_history(scenes: list[Scene], scenario: Scenario) -> None:
     """The animation's belts are the run's own speed changes (belts.csv), nothing recomputed."""
-    from cell.simulation import simulate
+    from cell.sim.simulation import simulate
 
     for sc in scenes:
         d = sc.data
@@ -132,8 +132,8 @@ def test_the_belts_are_the_runs_recorded_history(scenes: list[Scene], scenario: 
 
 
 def test_the_demo_shows_a_part_the_fixed_cycle_loses_and_the_adaptive_saves() -> None:
-    from cell.animation import DEMO_FIRST, DEMO_PARTS
-    from cell.scenario import load_scenario
+    from cell.reporting.animation.movie import DEMO_FIRST, DEMO_PARTS
+    from cell.scenario.schema import load_scenario
 
     adaptive, fixed = simulate_scenes(load_scenario("baseline"), ["adaptive", "non-adaptive"],
                                       DEMO_FIRST, DEMO_PARTS)

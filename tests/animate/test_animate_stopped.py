@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from cell.cli import main as cli
-from cell.output import atomic_path
+from cell.cli.main import main as cli
+from cell.plumbing.output.atomic import atomic_path
 
 from ..outputs import dead_pid
 

@@ -7,5 +7,6 @@ import pytest
 
 @pytest.fixture(autouse=True)
 def _no_fsync(monkeypatch: pytest.MonkeyPatch) -> None:
-    """Durability is not under test here (tests/test_output.py kills writers): skip the disk flushes."""
+    """Durability is not under test here (tests/plumbing/test_output.py kills writers): skip the
+    disk flushes."""
     monkeypatch.setattr("os.fsync", lambda fd: None)

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from cell.cli import main
+from cell.cli.main import main
 
 WHERE = ("in-process", "subprocess", "kill step")
 OUTCOMES = ("refused", "ran", "other")

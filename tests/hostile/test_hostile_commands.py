@@ -27,15 +27,15 @@ TRACE = "interarrival_s\n" + "".join(f"{22 + (i * 7919 % 13) / 5:.3f}\n" for i i
 
 #: command -> (arguments before --out, the dotted path of the work it must not start, kind of output)
 COMMANDS: dict[str, tuple[list[str], str, str]] = {
-    "run": (["run", "baseline", "--set", "run.parts=3"], "cell.scenario.load_scenario", "dir"),
-    "path": (["path", "baseline"], "cell.scenario.load_scenario", "file"),
+    "run": (["run", "baseline", "--set", "run.parts=3"], "cell.scenario.schema.load_scenario", "dir"),
+    "path": (["path", "baseline"], "cell.scenario.schema.load_scenario", "file"),
     "mintime": (["mintime", "mintime_kinematic", "--set", "mintime.grid_points=30"],
-                "cell.scenario.load_scenario", "dir"),
-    "figures": (["figures"], "cell.scenario.load_scenario", "dir"),
-    "animate": (["animate", "baseline", "--parts", "1"], "cell.scenario.load_scenario", "file.gif"),
-    "bench": (["bench"], "cell.bench.benchmarks", "file"),
-    "schema": (["schema"], "cell.scenario.json_schema", "file"),
-    "fit": (["fit", "{trace}"], "cell.analysis.fit_input.read_column", "file.yaml"),
+                "cell.scenario.schema.load_scenario", "dir"),
+    "figures": (["figures"], "cell.scenario.schema.load_scenario", "dir"),
+    "animate": (["animate", "baseline", "--parts", "1"], "cell.scenario.schema.load_scenario", "file.gif"),
+    "bench": (["bench"], "cell.bench.throughput.benchmarks", "file"),
+    "schema": (["schema"], "cell.scenario.schema.json_schema", "file"),
+    "fit": (["fit", "{trace}"], "cell.experiments.fit_input.read_column", "file.yaml"),
 }
 
 
@@ -175,16 +175,17 @@ def test_disk_full_while_writing_keeps_the_old_output(tmp_path: Path, monkeypatc
                                                       command: str, room: int) -> None:
     """The disk fills after the work, at the first byte or a few hundred bytes in: one line
     naming the output, and the output of the previous run unchanged, nothing else left."""
-    import cell.output
+    import cell.plumbing.output.atomic
 
     argv = _argv(command, tmp_path)
     kind = COMMANDS[command][2]
     out = tmp_path / ("old" if kind == "dir" else "old." + (kind.partition(".")[2] or "txt"))
     assert cli(*argv, "--out", out).code == 0
     before = tree(out)
-    real_open = cell.output._open
-    monkeypatch.setattr(cell.output, "_open", lambda *a, **k: _FillingFile(real_open(*a, **k), room))
-    if command == "fit":  # the figure is drawn by matplotlib, not through cell.output
+    real_open = cell.plumbing.output.atomic._open
+    monkeypatch.setattr(cell.plumbing.output.atomic, "_open",
+                        lambda *a, **k: _FillingFile(real_open(*a, **k), room))
+    if command == "fit":  # the figure is drawn by matplotlib, not through cell.plumbing.output.atomic
         monkeypatch.setattr("matplotlib.figure.Figure.savefig", _enospc)
     again = ["--force"] if command == "run" else []  # cell run keeps another run's files without it
     refused(cli(*argv, "--out", out, *again), "old", "no space left on device", nothing_in=out,
@@ -193,14 +194,14 @@ def test_disk_full_while_writing_keeps_the_old_output(tmp_path: Path, monkeypatc
 
 def test_figures_disk_full_keeps_the_old_set(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A figure set whose last PNG meets a full disk: the old set stays whole (drawing stubbed)."""
-    import cell.figures
-    from cell.figures.style import save
+    import cell.reporting.figures.thesis_figures
+    from cell.reporting.figures.style import save
 
     def fake(scenario: Any, out: Path, progress: Any = None, **kw: Any) -> list[Path]:
         from matplotlib.figure import Figure
 
         written = []
-        for i, stem in enumerate(list(cell.figures.FILES.values())[:3]):
+        for i, stem in enumerate(list(cell.reporting.figures.thesis_figures.FILES.values())[:3]):
             if i == 2:
                 monkeypatch.setattr(Figure, "savefig", _enospc)
             written.append(save(Figure(), Path(out) / f"{stem}.png"))
@@ -210,7 +211,7 @@ def test_figures_disk_full_keeps_the_old_set(tmp_path: Path, monkeypatch: pytest
     out.mkdir()
     (out / "fig08_working_environment.png").write_bytes(b"old")
     before = tree(out)
-    monkeypatch.setattr(cell.figures, "make_figures", fake)
+    monkeypatch.setattr(cell.reporting.figures.thesis_figures, "make_figures", fake)
     refused(cli("figures", "--out", out), "no space left on device", nothing_in=out, before=before)
 
 
@@ -236,9 +237,9 @@ def _raising(exc: BaseException) -> Any:
 ], ids=lambda v: type(v).__name__ if isinstance(v, BaseException) else None)
 def test_the_top_turns_anticipated_failures_into_one_line(monkeypatch: pytest.MonkeyPatch, exc: BaseException,
                                                            words: tuple[str, ...]) -> None:
-    import cell.commands.run
+    import cell.cli.run_command
 
-    monkeypatch.setattr(cell.commands.run, "main", _raising(exc))
+    monkeypatch.setattr(cell.cli.run_command, "main", _raising(exc))
     refused(cli("run", "baseline", "--out", "OUT"), *words)
 
 
@@ -246,9 +247,9 @@ def test_a_real_memory_error_is_one_line(tmp_path: Path, monkeypatch: pytest.Mon
     """numpy refusing a 2**45-element array (256 TiB), inside the simulation."""
     import numpy as np
 
-    import cell.simulation
+    import cell.sim.simulation
 
-    monkeypatch.setattr(cell.simulation, "simulate", lambda *a, **k: np.ones(2**45))
+    monkeypatch.setattr(cell.sim.simulation, "simulate", lambda *a, **k: np.ones(2**45))
     out = tmp_path / "out"
     refused(cli("run", "baseline", "--out", out), "ran out of memory", nothing_in=out)
 
@@ -257,9 +258,9 @@ def test_a_real_memory_error_is_one_line(tmp_path: Path, monkeypatch: pytest.Mon
                                  OSError(errno.EBADF, "a bug")])
 def test_an_unexpected_exception_keeps_its_traceback(monkeypatch: pytest.MonkeyPatch,
                                                      exc: BaseException) -> None:
-    import cell.commands.run
+    import cell.cli.run_command
 
-    monkeypatch.setattr(cell.commands.run, "main", _raising(exc))
+    monkeypatch.setattr(cell.cli.run_command, "main", _raising(exc))
     with pytest.raises(type(exc)):
         cli("run", "baseline", "--out", "OUT")
 
@@ -298,7 +299,7 @@ def test_help_and_version_exit_0(capsys: pytest.CaptureFixture[str]) -> None:
 ])
 def test_animate_options_refused_before_simulating(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
                                                    option: str, value: str, words: str) -> None:
-    _forbid(monkeypatch, "cell.animation.simulate_scenes")
+    _forbid(monkeypatch, "cell.reporting.animation.movie.simulate_scenes")
     out = tmp_path / "a.gif"
     refused(cli("animate", "baseline", option, value, "--out", out), option, words, nothing_in=out)
 
@@ -362,9 +363,9 @@ def _subprocess(tmp: Path, *argv: str, code: str | None = None) -> Result:
 
 SUBPROCESS_MEMORY = """
 import sys, numpy
-import cell.simulation
-cell.simulation.simulate = lambda *a, **k: numpy.ones(2**45)
-from cell.cli import main
+import cell.sim.simulation
+cell.sim.simulation.simulate = lambda *a, **k: numpy.ones(2**45)
+from cell.cli.main import main
 sys.exit(main(sys.argv[1:]))
 """
 SUBPROCESS_BUG = SUBPROCESS_MEMORY.replace("lambda *a, **k: numpy.ones(2**45)", "lambda *a, **k: 1 / 0")

@@ -1,6 +1,6 @@
 """Every scenario key, walked from the schema, given hostile values through ``--set`` and files.
 
-For each setting of :class:`cell.scenario.Scenario` the generator derives its type and bounds
+For each setting of :class:`cell.scenario.schema.Scenario` the generator derives its type and bounds
 from the pydantic fields and produces values of two kinds: those the schema itself forbids
 (wrong type, booleans for numbers, text, lists, mappings, null, ±inf, nan, 1e300, beyond a
 bound, integers of 39 and 45 digits), which must be refused in one line naming the key; and
@@ -22,7 +22,7 @@ import pytest
 from annotated_types import Ge, Gt, Le, Lt
 from pydantic import BaseModel
 
-from cell.scenario import Scenario, default_scenario
+from cell.scenario.schema import Scenario, default_scenario
 
 from .harness import cli, ran_sanely, refused
 

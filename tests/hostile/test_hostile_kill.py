@@ -16,8 +16,8 @@ from pathlib import Path
 
 import pytest
 
-import cell.output as output
-from cell.output import OutputDir
+import cell.plumbing.output.atomic as output
+from cell.plumbing.output.atomic import OutputDir
 
 from ..killing import die_at_step
 from .harness import case, tree
@@ -82,7 +82,7 @@ def test_cell_run_killed_at_any_step_leaves_the_old_set_or_the_new(tmp_path, fal
     """The real ``cell run`` (a forked process), SIGKILLed at each file-system step in turn."""
     if not fallback and output._renameat2 is None:
         pytest.skip("no renameat2 here")
-    from cell.cli import main
+    from cell.cli.main import main
 
     target = tmp_path / "run"
     argv = ["run", "baseline", "--set", "run.parts=8", "--out", str(target), "--force"]  # again
@@ -94,7 +94,7 @@ def test_cell_run_killed_at_any_step_leaves_the_old_set_or_the_new(tmp_path, fal
 def test_mintime_report_killed_at_any_step_leaves_the_old_set_or_the_new(tmp_path):
     """``reports/mintime`` written by the planner's report, killed at each step: its files are the
     old set or the new, never a mix."""
-    from cell.reporting import mintime as report
+    from cell.reporting import planner_report as report
 
     target = tmp_path / "mintime"
 

@@ -219,7 +219,7 @@ def test_sweep_outputs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, label: s
 def test_sweep_workers_are_bounded(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     import concurrent.futures as cf
 
-    import cell.sweep.runner as runner
+    import cell.experiments.sweep.runner as runner
 
     asked = []
 

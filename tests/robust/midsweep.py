@@ -6,7 +6,7 @@ from __future__ import annotations
 import threading
 import time
 
-from cell.sweep.runner import simulate_summary
+from cell.experiments.sweep.runner import simulate_summary
 
 STARTED = threading.Event()
 _state = {"calls": 0, "stop_after": None}

@@ -9,8 +9,9 @@ import os
 
 import pytest
 
-from cell import cache, catalog
-from cell.cli import main
+from cell.cli.main import main
+from cell.plumbing import cache
+from cell.scenario import catalog
 
 RUN = ["run", str(catalog.path("baseline")), "--set", "run.parts=40"]
 

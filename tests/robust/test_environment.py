@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from cell import catalog
+from cell.scenario import catalog
 
 BASELINE = str(catalog.path("baseline"))
 RUN = ["run", BASELINE, "--set", "run.parts=20"]
@@ -112,13 +112,13 @@ def test_a_sweep_on_two_workers_under_twelve_open_files_is_one_line(tmp_path):
     (["run", "baseline", "--out", "/sys/o"], "under /sys"),
 ])
 def test_impossible_outputs_are_refused_before_any_work(tmp_path, monkeypatch, capsys, args, says):
-    from cell.cli import main
+    from cell.cli.main import main
 
     sweep = tmp_path / "sweep.yaml"
     sweep.write_text(f"base: {BASELINE}\nset: {{run.parts: 20}}\nreplications: 2\n")
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr("cell.sweep.runner.run_sweep", None)  # reached: a TypeError, not 2
-    monkeypatch.setattr("cell.simulation.simulate", None)
+    monkeypatch.setattr("cell.experiments.sweep.runner.run_sweep", None)  # reached: a TypeError, not 2
+    monkeypatch.setattr("cell.sim.simulation.simulate", None)
     code = main([str(sweep) if a == "SWEEP" else a for a in args])
     err = capsys.readouterr().err.splitlines()
     assert code == 2 and len(err) == 1 and says in err[0], err

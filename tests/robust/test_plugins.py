@@ -1,4 +1,4 @@
-"""Plug-in policies checked at the boundary (cell.policies.check, cell.registry.load).
+"""Plug-in policies checked at the boundary (cell.sim.policies.check, cell.scenario.registry.load).
 
 Whatever a policy's ``plan`` returns is checked before the cell acts on it: a NaN, a
 negative or an out-of-range value in any field of the plan stops ``cell run`` with one line
@@ -17,11 +17,11 @@ from types import SimpleNamespace
 
 import pytest
 
-from cell import catalog, registry
-from cell.cli import main
-from cell.policies.base import Policy
-from cell.policies.check import SPEEDS, TIMES, problem
-from cell.policies.fixed import fixed_plan
+from cell.cli.main import main
+from cell.scenario import catalog, registry
+from cell.sim.policies.base import Policy
+from cell.sim.policies.check import SPEEDS, TIMES, problem
+from cell.sim.policies.fixed import fixed_plan
 
 FIELDS = (*TIMES, *SPEEDS, "to_g", "cycle", "limits", "steers_belts")
 NAME = "robust-test-policy"
@@ -96,7 +96,7 @@ def test_a_bad_value_in_any_field_stops_the_run_naming_policy_and_field(field, w
 
 
 def _bounds(k):
-    from cell.policies.check import _bounds as bounds
+    from cell.sim.policies.check import _bounds as bounds
 
     return bounds(k)
 
@@ -143,7 +143,7 @@ def test_a_policy_that_fails_when_built_is_one_line(bad, tmp_path, capsys):
 
 # --------------------------------------------------------------------------- entry points
 def _plugin_dir(tmp_path: Path, module_text: str | None) -> Path:
-    """A folder that installs the entry point ``broken-plugin`` of group cell.policies
+    """A folder that installs the entry point ``broken-plugin`` of group cell.sim.policies
     (``robustplug:Policy``), its module ``module_text`` (None: no module at all)."""
     site = tmp_path / "site"
     dist = site / "robustplug-1.0.dist-info"

@@ -1,4 +1,4 @@
-"""``--scheduler`` fails fast (cell.sweep.cluster): one line, exit 2, no output folder.
+"""``--scheduler`` fails fast (cell.experiments.sweep.cluster): one line, exit 2, no output folder.
 
 Fake schedulers are loopback listeners (127.0.0.1 only), listening before the test connects
 (no race): one that accepts and never answers, one that answers junk, one that sends a
@@ -17,9 +17,9 @@ import time
 
 import pytest
 
-from cell import catalog
-from cell.cli import main
-from cell.sweep import cluster
+from cell.cli.main import main
+from cell.experiments.sweep import cluster
+from cell.scenario import catalog
 
 pytest.importorskip("distributed")
 
@@ -141,7 +141,7 @@ def test_a_scheduler_that_goes_away_mid_sweep_is_one_line_and_resume_finishes(
     sweep = tmp_path / "sweep.yaml"
     sweep.write_text(f"base: {catalog.path('baseline')}\n"
                      "grid: {run.parts: [20, 21, 22, 23]}\nreplications: 2\nseed: 1\n")
-    monkeypatch.setattr("cell.sweep.simulate_summary", midsweep.replicate)
+    monkeypatch.setattr("cell.experiments.sweep.simulate_summary", midsweep.replicate)
     midsweep.reset(stop_after=2)
     out = tmp_path / "out"
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,

@@ -3,7 +3,7 @@
 
 Each test waits for a readiness marker on disk (a temporary folder, a finished task) before
 it sends the signal: no fixed delays.  (A signal in the interpreter's own start, before any
-of cell's code runs, gets Python's default; from ``cell.cli.main`` on, these hold.)
+of cell's code runs, gets Python's default; from ``cell.cli.main.main`` on, these hold.)
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from cell import catalog
+from cell.scenario import catalog
 
 BASELINE = str(catalog.path("baseline"))
 NON_ADAPTIVE = str(catalog.path("non_adaptive"))
@@ -117,18 +117,18 @@ def _swallowed_then(number: int, error: BaseException):
                                    RuntimeError("ffmpeg stopped with exit status 255")],
                          ids=["broken pipe", "another error"])
 def test_a_stop_that_became_another_error_is_still_the_stop(monkeypatch, capsys, number, error):
-    from cell.cli import main
+    from cell.cli.main import main
 
-    monkeypatch.setattr("cell.commands.scenarios.main", _swallowed_then(number, error))
+    monkeypatch.setattr("cell.cli.scenarios_command.main", _swallowed_then(number, error))
     assert main(["scenarios"]) == LINES[number][0]
     assert capsys.readouterr().err == LINES[number][1] + "\n"
 
 
 def test_a_refusal_that_came_of_a_stop_is_the_stop(monkeypatch, capsys):
-    from cell.cli import main
-    from cell.errors import CellError
+    from cell.cli.main import main
+    from cell.plumbing.errors import CellError
 
-    monkeypatch.setattr("cell.commands.scenarios.main",
+    monkeypatch.setattr("cell.cli.scenarios_command.main",
                         _swallowed_then(signal.SIGINT, CellError("a.mp4: ffmpeg stopped")))
     assert main(["scenarios"]) == 130
     assert capsys.readouterr().err == "cell: interrupted\n"

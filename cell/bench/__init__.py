@@ -1,0 +1,1 @@
+"""Speed figures (``cell bench``, ``make bench``)."""

@@ -1,0 +1,286 @@
+"""``cell bench`` / ``make bench``: how fast the simulation runs on this machine.
+
+Measured in one run (the planner's figures, from ``cell.bench.planner_speed``, are
+merged in by ``cell bench``):
+
+* simulated parts per second of each policy at 5,000 and at 500,000 parts: the
+  simulation as a sweep or ``cell run`` drives it (records streamed, none kept),
+  the path already solved; best of several runs at 5,000, one at 500,000;
+* events per part (SimPy events processed over parts), and a bare SimPy process
+  doing ``yield env.timeout(1)`` in a loop (events per second) for scale: the
+  *ceiling ratio* is parts/s over (bare events/s ÷ events per part), the share of
+  SimPy's own speed that the model's Python leaves;
+* the hand-off floor: the five processes passing parts along through the cell's
+  own hand-offs with no model work (microseconds a part), what the model adds to;
+* a year of two shifts (``run.hours`` 4,000) of the adaptive robot with failures of the
+  robot, both belts and the sensor and motor wear on (:data:`YEAR_FAILURES`), parts per
+  second, one run;
+* the overhead of a sweep point beyond its simulation (ms; a 200-point sweep of
+  20-part runs, loaded, run, assembled and tabled in one process);
+* whole processes: ``cell run baseline`` from a cold start (median of several,
+  the disk cache warm as after any first run), ``cell sweep`` of Table 7.1 on two
+  workers (700,000 parts), and the peak memory of ``cell run`` of 1,000,000 parts.
+
+Speed is measured here and reported, never asserted in tests.
+"""
+
+from __future__ import annotations
+
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+import simpy
+
+from cell.plumbing.stopwatch import best_seconds
+from cell.scenario import catalog
+from cell.scenario.schema import Scenario, default_scenario, load_scenario
+from cell.sim.mailbox import Mailbox, Timer
+from cell.sim.simulation import simulate
+
+#: Targets (the bench prints whether each is met; nothing fails on them).
+TARGETS = {"flat": 0.9, "ceiling_ratio": 0.5, "cold_run_s": 0.7, "sweep_table_7_1_s": 5.0,
+           "peak_mb_1m_parts": 500.0}
+
+#: A sweep point's cost beyond its simulation (:func:`sweep_overhead_ms_per_point`), ms.
+TARGETS["sweep_overhead_ms_per_point"] = 5.0
+
+
+def _streamed(scenario: Scenario) -> Any:
+    return simulate(scenario, keep_parts=False, keep_belts=False)
+
+
+def parts_per_second(scenario: Scenario, repeats: int = 5) -> float:
+    """Best-of-``repeats`` simulated parts per second (after one warm-up run)."""
+    _streamed(scenario.with_overrides({"run.parts": 50}))  # solves and caches the path
+    return scenario.run.parts / best_seconds(lambda: _streamed(scenario), repeats)
+
+
+#: A year of two shifts: 250 days × 16 h.
+YEAR_H = 4000.0
+#: The year's failures (ASSUMED, for speed only): the robot's clock counts motor wear
+#: (``wear:``), a worn motor replaced in 2-6 h; the belts fail every 200 h or so on their
+#: operating clock, repaired in about 30 min; the sensor every 500 h, in about 10 min; one
+#: repair crew.
+YEAR_FAILURES = {
+    "robot": {"time_to_failure": {"distribution": "expon", "params": {"scale": 1e9}},
+              "time_to_repair": {"distribution": "uniform",
+                                 "params": {"loc": 7200.0, "scale": 14400.0}}},
+    "input_belt": {"time_to_failure": {"distribution": "expon", "params": {"scale": 720000.0}},
+                   "time_to_repair": {"distribution": "expon", "params": {"scale": 1800.0}}},
+    "output_belt": {"time_to_failure": {"distribution": "expon", "params": {"scale": 720000.0}},
+                    "time_to_repair": {"distribution": "expon", "params": {"scale": 1800.0}}},
+    "sensor": {"time_to_failure": {"distribution": "expon", "params": {"scale": 1.8e6}},
+               "time_to_repair": {"distribution": "expon", "params": {"scale": 600.0}}},
+    "repair": {"crews": 1}}
+
+
+def parts_per_second_year(scenario: Scenario, hours: float = YEAR_H) -> float:
+    """Parts per second of one run of ``hours`` with failures and motor wear on
+    (:data:`YEAR_FAILURES`, ``wear.enabled``): one run, the path already solved."""
+    s = scenario.with_overrides({"run.hours": hours, "wear.enabled": True,
+                                 "failures": YEAR_FAILURES})
+    t0 = time.perf_counter()
+    result = _streamed(s)
+    return result.summary.parts_arrived / (time.perf_counter() - t0)
+
+
+def events_per_part(scenario: Scenario) -> float:
+    """SimPy events processed per part (a run of its own, not timed)."""
+    count = 0
+    step = simpy.Environment.step
+
+    def counted(env: simpy.Environment) -> None:
+        nonlocal count
+        count += 1
+        step(env)
+
+    simpy.Environment.step = counted  # type: ignore[method-assign,assignment]
+    try:
+        _streamed(scenario)
+    finally:
+        simpy.Environment.step = step  # type: ignore[method-assign]
+    return count / scenario.run.parts
+
+
+def simpy_timeouts_per_second(n: int = 200_000, repeats: int = 3) -> float:
+    """A bare SimPy process yielding ``env.timeout(1)`` ``n`` times: events per second."""
+    def once() -> None:
+        env = simpy.Environment()
+
+        def loop(env: simpy.Environment):  # noqa: ANN202
+            for _ in range(n):
+                yield env.timeout(1)
+
+        env.process(loop(env))
+        env.run()
+
+    return n / best_seconds(once, repeats)
+
+
+def handoff_seconds_per_part(n: int = 200_000, repeats: int = 3) -> float:
+    """The cell's five processes handing each part along with the cell's own hand-offs
+    (:class:`~cell.sim.mailbox.Timer`, :class:`~cell.sim.mailbox.Mailbox`: drop, arrival at B,
+    order, set-down) and no model work: seconds a part, the floor under the model.
+
+    With a ceiling ratio r and e events a part, the model's own work may take at most
+    e / (r · bare events/s) minus this a part."""
+    def once() -> None:
+        env = simpy.Environment()
+        loaded, at_bot, orders, placed = (Mailbox(env) for _ in range(4))
+
+        def feeder():  # noqa: ANN202
+            after = Timer(env).after
+            for i in range(n):
+                yield after(22.0)
+                loaded.put(i)
+
+        def relay(box: Mailbox, hand_on: Any, delay: float, wait: bool):  # noqa: ANN202
+            get = box.get
+            while True:
+                part = yield get()
+                if hand_on is not None:
+                    handed = hand_on(part, delay) if delay else hand_on(part)
+                    if wait:
+                        yield handed
+
+        env.process(feeder())
+        env.process(relay(loaded, at_bot.put_after, 5.0, True))   # input conveyor
+        env.process(relay(at_bot, orders.put, 0.0, False))        # controller
+        env.process(relay(orders, placed.put_after, 10.0, False))  # robot
+        env.process(relay(placed, None, 0.0, False))              # output conveyor
+        env.run()
+
+    return best_seconds(once, repeats) / n
+
+
+def _cell(*args: str) -> float:
+    """Seconds a whole ``cell`` process takes (output discarded)."""
+    t0 = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "cell", *args], check=True, stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL)
+    return time.perf_counter() - t0
+
+
+def cold_run_seconds(repeats: int = 7) -> float:
+    """Median wall time of a whole ``cell run baseline`` process (after one to warm the
+    disk cache and the operating system's file cache)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        _cell("run", "baseline", "--out", f"{tmp}/warm")
+        return statistics.median(_cell("run", "baseline", "--out", f"{tmp}/run{i}")
+                                 for i in range(repeats))
+
+
+def sweep_seconds(workers: int = 2) -> float:
+    """Wall time of ``cell sweep`` of Table 7.1 (7 rows x 200 replications x 500 parts)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        return _cell("sweep", str(catalog.path("table_7_1")), "--workers", str(workers),
+                     "--out", f"{tmp}/sweep")
+
+
+def peak_mb(parts: int = 1_000_000) -> float:
+    """Peak resident memory (MB) of ``cell run baseline`` of ``parts`` parts, read as
+    ``ru_maxrss`` of the children of a helper process that runs only it."""
+    with tempfile.TemporaryDirectory() as tmp:
+        helper = ("import resource, subprocess, sys\n"
+                  f"subprocess.run([sys.executable, '-m', 'cell', 'run', 'baseline', '--set', "
+                  f"'run.parts={parts}', '--out', {str(Path(tmp) / 'run')!r}], check=True, "
+                  "stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)\n"
+                  "print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)\n")
+        out = subprocess.run([sys.executable, "-c", helper], check=True, capture_output=True,
+                             text=True).stdout
+    return int(out.split()[-1]) / 1024.0
+
+
+_SIMULATED = [0.0]  # seconds inside the replications of :func:`sweep_overhead_ms_per_point`
+
+
+def _timed_replication(scenario: Scenario, seed: Any) -> Any:
+    from cell.experiments.sweep import simulate_summary
+
+    t0 = time.perf_counter()
+    try:
+        return simulate_summary(scenario, seed)
+    finally:
+        _SIMULATED[0] += time.perf_counter() - t0
+
+
+def sweep_overhead_ms_per_point(points: int = 200, parts: int = 20) -> float:
+    """Milliseconds a sweep point costs beyond its simulation: a sweep of ``points`` points
+    (one 20-part replication each, one process) loaded and checked, run into a folder, its
+    ``replications.csv`` assembled and its summary and difference tables made, less the
+    time inside the replications themselves.  Best of three."""
+    import yaml
+
+    from cell.experiments.sweep import load_sweep, run_sweep
+    from cell.reporting.experiment import difference_table, summary_table
+
+    spans = []
+    with tempfile.TemporaryDirectory() as tmp:
+        doc = {"name": "overhead", "base": "baseline", "set": {"run.parts": parts},
+               "grid": {"belts.output_nominal_in_s": [round(1.8 + 0.5 * i / points, 6)
+                                                      for i in range(points)]},
+               "policies": ["adaptive"], "replications": 1, "batch": 1, "seed": 1}
+        (Path(tmp) / "sweep.yaml").write_text(yaml.safe_dump(doc), encoding="utf-8")
+        for i in range(3):
+            _SIMULATED[0] = 0.0
+            t0 = time.perf_counter()
+            sweep = load_sweep(Path(tmp) / "sweep.yaml")
+            frame = run_sweep(sweep, Path(tmp) / f"out{i}", workers=1, progress=False,
+                              replicate=_timed_replication, warn_windows=False).replications
+            summary_table(frame, sweep), difference_table(frame, sweep)
+            spans.append(time.perf_counter() - t0 - _SIMULATED[0])
+    return 1e3 * min(spans) / points
+
+
+def benchmarks(scenario_file: str | Path = "scenarios/baseline.yaml", *,
+               processes: bool = True) -> dict[str, Any]:
+    """The simulation's figures (the scenario file if present, else the built-in defaults);
+    ``processes=False`` leaves out the whole-process ones."""
+    path = Path(scenario_file)
+    base = load_scenario(path) if path.is_file() else default_scenario()
+    out: dict[str, Any] = {"simpy_timeouts_per_s": simpy_timeouts_per_second(),
+                           "handoff_us_per_part": 1e6 * handoff_seconds_per_part()}
+    for policy, name in (("adaptive", "adaptive"), ("non-adaptive", "non_adaptive")):
+        s = base.with_overrides({"controller.policy": policy})
+        out[f"parts_per_s_{name}_5k"] = parts_per_second(s.with_overrides({"run.parts": 5_000}))
+        out[f"parts_per_s_{name}_500k"] = parts_per_second(
+            s.with_overrides({"run.parts": 500_000}), repeats=1)
+        events = out[f"events_per_part_{name}"] = events_per_part(
+            s.with_overrides({"run.parts": 5_000}))
+        ceiling = out["simpy_timeouts_per_s"] / events
+        out[f"ceiling_ratio_{name}"] = out[f"parts_per_s_{name}_500k"] / ceiling
+    out["parts_per_s_adaptive_year_failures"] = parts_per_second_year(
+        base.with_overrides({"controller.policy": "adaptive"}))
+    out["sweep_overhead_ms_per_point"] = sweep_overhead_ms_per_point()
+    if processes:
+        out["peak_mb_1m_parts"] = peak_mb()
+        out["cold_run_s"] = cold_run_seconds()
+        out["sweep_table_7_1_s"] = sweep_seconds()
+    return out
+
+
+def verdicts(results: dict[str, Any]) -> list[tuple[str, str, str, bool]]:
+    """(figure, value, target, met) for each target that ``results`` has figures for."""
+    rows = []
+    for name in ("adaptive", "non_adaptive"):
+        small, large = results.get(f"parts_per_s_{name}_5k"), results.get(f"parts_per_s_{name}_500k")
+        if small and large:
+            rows.append((f"{name}: parts/s 500k / 5k", f"{large / small:.2f}",
+                         f">= {TARGETS['flat']}", large / small >= TARGETS["flat"]))
+        ratio = results.get(f"ceiling_ratio_{name}")
+        if ratio is not None:
+            rows.append((f"{name}: share of SimPy's ceiling", f"{ratio:.2f}",
+                         f">= {TARGETS['ceiling_ratio']}", ratio >= TARGETS["ceiling_ratio"]))
+    for key, unit in (("cold_run_s", "s"), ("sweep_table_7_1_s", "s"), ("peak_mb_1m_parts", "MB")):
+        if key in results:
+            rows.append((key, f"{results[key]:.2f} {unit}", f"<= {TARGETS[key]:g} {unit}",
+                         results[key] <= TARGETS[key]))
+    if "sweep_overhead_ms_per_point" in results:
+        key, most = "sweep_overhead_ms_per_point", TARGETS["sweep_overhead_ms_per_point"]
+        rows.append((key, f"{results[key]:.2f} ms", f"<= {most:g} ms", results[key] <= most))
+    return rows

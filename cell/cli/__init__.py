@@ -1,0 +1,1 @@
+"""The ``cell`` command: one module a subcommand."""

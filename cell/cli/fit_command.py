@@ -1,0 +1,215 @@
+"""``cell fit TRACE.csv [--column interarrival_s] [--times] [--out SCENARIO.yaml]``: input modelling.
+
+Fits candidate scipy.stats distributions to observed inter-arrival times by maximum
+likelihood (:mod:`cell.experiments.fit`), each within a time budget, prints them ranked with
+their means and sds beside the data's, and writes the ``arrivals:`` block of the best one a
+scenario accepts (each candidate is validated as a scenario holding it:
+:mod:`cell.cli.fit_check`; of those, when the best misses the data's mean or sd, the one
+nearest them: :func:`~cell.experiments.fit_choice.choose`), with a histogram of the data and the
+fitted densities.  A fit that does not stand for the data
+(:func:`~cell.experiments.fit_choice.caution`) is said in a warning and in the block, which then
+points to replaying the data as a trace.  ``--times`` reads the column as arrival times and
+fits the gaps between them; gaps far out of the body of the data are flagged, and
+``--max-gap S`` or ``--drop-outliers`` leaves them out.  ``--as time_to_failure`` (or
+``time_to_repair``) fits times to failure or repair instead, right-censored where
+``--censored COLUMN`` says so (:mod:`cell.experiments.fit_censored`), and writes that block of
+the ``failures:`` section.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from cell.cli.fit_check import BLOCKS
+from cell.cli.fit_write import Data, fitted_block, write
+from cell.plumbing.errors import ScenarioError
+
+HELP = "fit a distribution to observed inter-arrival times (or times to failure or repair); write its block"
+DESCRIPTION = ("Fit scipy.stats distributions to observed inter-arrival times by maximum likelihood, "
+               "each within a time budget (--budget), rank them with their means and sds beside the "
+               "data's, and write the arrivals: block of the best one a scenario accepts (or, if it "
+               "misses the data's mean or sd, the one nearest them), with a histogram of the data under "
+               "the fitted densities. When the written fit's mean or sd is more than 10 % off the data's, "
+               "or the KS test rejects it (p < 0.001), a warning and a CAUTION comment in "
+               "the block say so, with the line that replays the data themselves as a trace "
+               "(arrivals.trace_csv). Gaps far out of the body of the data (beyond Q3 + 3 IQR: a line's "
+               "stoppages) are flagged; --max-gap S or --drop-outliers leaves them out. Zero gaps (two "
+               "parts logged in the same second) are refused, counted: no continuous distribution fits "
+               "them, and leaving them out would lengthen the mean; log the times more finely, or replay "
+               "the gaps as a trace (arrivals.trace_csv takes zeros). With --as time_to_failure or "
+               "time_to_repair the column holds such times, right-censored where --censored COLUMN says "
+               "1, true or yes, and the block written is that one of the failures: section.")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("trace", help="CSV file of observed inter-arrival times (or times to failure "
+                                      "or repair, with --as)")
+    parser.add_argument("--column", default="interarrival_s", help="column to fit (default: %(default)s)")
+    kind = parser.add_mutually_exclusive_group()
+    kind.add_argument("--times", action="store_true",
+                      help="the column holds arrival times (increasing seconds, or ISO date-times): "
+                           "fit the gaps between them")
+    kind.add_argument("--gaps", action="store_true",
+                      help="the column holds gaps even though it never decreases (sorted gaps)")
+    parser.add_argument("--out", default=None, metavar="SCENARIO.yaml",
+                        help="write the block here (default: print it)")
+    parser.add_argument("--figure", default=None, metavar="FILE.png",
+                        help="histogram with the fitted densities (default: beside --out, as .png)")
+    parser.add_argument("--families", default=None, metavar="A,B,...",
+                        help="scipy.stats families to try (default: weibull_min, gamma, lognorm, "
+                             "expon, norm; with --as: weibull_min, gamma, lognorm, expon)")
+    parser.add_argument("--rank-by", choices=("aic", "ks"), default="aic",
+                        help="rank by AIC or by the Kolmogorov-Smirnov D (default: %(default)s)")
+    far = parser.add_mutually_exclusive_group()
+    far.add_argument("--max-gap", type=float, default=None, metavar="S",
+                     help="leave out gaps longer than S seconds (stoppages); the block says so")
+    far.add_argument("--drop-outliers", action="store_true",
+                     help="leave out the gaps beyond Q3 + 3 IQR (far out of the body of the data)")
+    parser.add_argument("--budget", type=float, default=None, metavar="S",
+                        help="seconds each family's fit may take (default 20): one that takes longer "
+                             "is left out, with a line saying so")
+    parser.add_argument("--as", dest="block", choices=BLOCKS, default="arrivals",
+                        help="the block to write: arrivals (default), or time_to_failure or "
+                             "time_to_repair of the failures: section (times, not gaps)")
+    parser.add_argument("--censored", default=None, metavar="COLUMN",
+                        help="with --as: the column saying which times are right-censored (1, true "
+                             "or yes: still working then; 0, false or no: failed, or repaired, then)")
+
+
+def _destination(path: str | Path, option: str, taken: Sequence[Path]) -> Path:
+    """An output file that can be written and overwrites neither the trace nor the other output."""
+    from cell.plumbing.output.atomic import check_file
+
+    p = Path(path)
+    why = ("its directory does not exist" if str(path) and not p.parent.is_dir() else
+           "would overwrite the trace or the other output" if str(path) and
+           p.resolve() in {t.resolve() for t in taken} else "")
+    if why:
+        raise ScenarioError(p, option, str(p), why)
+    check_file(path, option)  # refuses '-' too: no command writes to standard output
+    return p
+
+
+def _outputs(args: argparse.Namespace, trace: Path) -> tuple[Path | None, Path | None]:
+    """--out and the figure (--figure, or beside --out as .png), each checked before any work."""
+    out = _destination(args.out, "--out", [trace]) if args.out is not None else None
+    if args.figure is not None and Path(args.figure).suffix.lower() != ".png":
+        raise ScenarioError("--figure", "--figure", args.figure, "the figure is a PNG: name a .png file")
+    if args.figure is None and out is not None and out.suffix.lower() == ".png":
+        raise ScenarioError(out, "--out", str(out), "the figure goes beside --out as .png, onto --out "
+                            "itself: name --out .yaml, or the figure with --figure")
+    figure_arg = args.figure if args.figure is not None else out.with_suffix(".png") if out else None
+    figure = _destination(figure_arg, "--figure", [trace, *([out] if out else [])]) \
+        if figure_arg is not None else None
+    return out, figure
+
+
+def _seconds_option(value: float | None, option: str) -> None:
+    if value is not None and not (math.isfinite(value) and value > 0.0):
+        raise ScenarioError(option, option, value, "must be a number of seconds > 0")
+
+
+def _families(args: argparse.Namespace, lifetimes: bool) -> list[str]:
+    """The families to try (--families, or the defaults for the block), each checked; and the
+    options that go with --as, or not."""
+    from cell.experiments.fit import DEFAULT_FAMILIES, family_of
+    from cell.experiments.fit_censored import LIFETIME_FAMILIES
+
+    _seconds_option(args.max_gap, "--max-gap")
+    _seconds_option(args.budget, "--budget")
+    if args.censored is not None and not lifetimes:
+        raise ScenarioError("--censored", "--censored", args.censored,
+                            "censored times are times to failure or repair: give --as time_to_failure "
+                            "or --as time_to_repair")
+    if lifetimes and (args.max_gap is not None or args.drop_outliers):
+        option = "--max-gap" if args.max_gap is not None else "--drop-outliers"
+        raise ScenarioError(option, option, args.max_gap if args.max_gap is not None else True,
+                            "leaves out gaps between arrivals, not times to failure or repair")
+    if args.censored is not None and args.times:
+        raise ScenarioError("--censored", "--censored", args.censored,
+                            "with --times the times are differences of a log: none is censored")
+    default = LIFETIME_FAMILIES if lifetimes else DEFAULT_FAMILIES
+    chosen = args.families if args.families is not None else ",".join(default)
+    families = [f.strip() for f in str(chosen).split(",") if f.strip()]
+    for family in families or [""]:
+        try:
+            family_of(family)
+        except ValueError:
+            raise ScenarioError("--families", "--families", family,
+                                "not a continuous distribution in scipy.stats") from None
+    return families
+
+
+def _read(args: argparse.Namespace, trace: Path, lifetimes: bool) -> Data:
+    """The values to fit, from the trace, and the notes and warnings on them."""
+    from cell.experiments.fit import MIN_VALUES
+    from cell.experiments.fit_gaps import far_out, fence, flag, flagged, leave_out
+    from cell.experiments.fit_input import read_column, read_lifetimes
+    from cell.scenario.arrivals import MAX_INTERARRIVAL_S
+
+    if lifetimes and not args.times:
+        values, censored = read_lifetimes(trace, args.column, args.censored)
+        cut = f", {int(censored.sum())} of them right-censored by {args.censored}" if args.censored else ""
+        count = f"{values.size} times{cut}"
+        return Data(values, censored if censored.any() else None, count, _subsampled(values.size, "times"))
+    values = read_column(trace, args.column, times=args.times, sorted_ok=args.gaps or lifetimes,
+                         most=math.inf if lifetimes else MAX_INTERARRIVAL_S)
+    noun = "gaps" if args.times else "values"
+    count = f"{values.size} gaps between {values.size + 1} arrival times" if args.times else \
+        f"{values.size} values"
+    notes: list[str] = []
+    asked = args.max_gap is not None or args.drop_outliers
+    if asked:
+        limit = args.max_gap if args.max_gap is not None else fence(values)
+        how = f"--max-gap {args.max_gap:g}" if args.max_gap is not None else \
+            "--drop-outliers: beyond Q3 + 3 IQR"
+        values, left = leave_out(values, limit, how)
+        notes.append(left)
+        if values.size < MIN_VALUES:
+            option = "--max-gap" if args.max_gap is not None else "--drop-outliers"
+            raise ScenarioError(trace, option, limit,
+                                f"leaves {values.size} {noun}: at least {MIN_VALUES} are needed to fit")
+    tail = far_out(values)
+    said = flag(tail, noun) if flagged(tail) and not (lifetimes or asked) else ""
+    return Data(values, None, count, [n for n in notes if n] + _subsampled(values.size, noun), said)
+
+
+def _subsampled(n: int, noun: str) -> list[str]:
+    from cell.experiments.fit_budget import MAX_FIT_VALUES
+
+    if n <= MAX_FIT_VALUES:
+        return []
+    return [f"fitted to {MAX_FIT_VALUES:,} of the {n:,} {noun}, drawn at random with a fixed seed (the "
+            "same each time): the likelihoods, AIC and KS statistics are theirs; the data's mean and sd "
+            f"are all {n:,}'s"]
+
+
+def _replay(trace: Path, out: Path | None, column: str, times: bool) -> str:
+    """How to replay the data themselves: the trace as it is, named from --out's directory,
+    when its column is a run's (``interarrival_s``, gaps)."""
+    if column != "interarrival_s" or times:
+        return "arrivals.trace_csv (a CSV of the gaps in a column named interarrival_s)"
+    path = os.path.relpath(trace.resolve(), out.resolve().parent) if out is not None else str(trace)
+    return f"arrivals: {{trace_csv: {path}}}"
+
+
+def main(args: argparse.Namespace) -> int:
+    """Fit, print the table, write (or print) the block and the figure."""
+    trace = Path(args.trace)
+    out, figure = _outputs(args, trace)
+    lifetimes = args.block != "arrivals"
+    families = _families(args, lifetimes)
+    data = _read(args, trace, lifetimes)
+    replay = "" if lifetimes else _replay(trace, out, args.column, args.times)
+    result = fitted_block(args, trace, out, data, families, replay)
+    write(args, data, result, out, figure)
+    if data.flag:
+        print(f"cell: warning: {data.flag}", file=sys.stderr)
+    if result.warning:
+        print(f"cell: warning: {result.warning}", file=sys.stderr)
+    return 0

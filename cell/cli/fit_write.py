@@ -1,0 +1,152 @@
+"""``cell fit``'s second half: fit what was read, pick the block to write (each candidate
+validated as a scenario: :mod:`cell.cli.fit_check`), and write it with the figure."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, NamedTuple
+
+from cell.cli.fit_check import scenario_refuses
+from cell.plumbing.errors import ScenarioError
+
+if TYPE_CHECKING:
+    from cell.experiments.fit import Fit
+
+#: Where a time to failure or repair goes.
+EQUIPMENT = "robot, input_belt, output_belt or sensor"
+
+
+class Data(NamedTuple):
+    """What is fitted: the values, which are censored (None: none), what the block's comment
+    calls them, and the notes on what was left out or subsampled."""
+
+    values: Any
+    censored: Any
+    what: str
+    notes: list[str]
+    flag: str = ""
+    """The warning on gaps far out of the body of the data ("" for none)."""
+
+
+class Result(NamedTuple):
+    """The fits, the one written and why (or ""), the warning (or ""), the block and the table."""
+
+    fits: list[Fit]
+    chosen: Fit
+    warning: str
+    block: str
+    table: str
+
+
+def _fits(args: argparse.Namespace, trace: Path, data: Data, families: list[str]) -> list[Fit]:
+    from cell.experiments.fit import fit_trace
+    from cell.experiments.fit_budget import DEFAULT_BUDGET_S
+    from cell.experiments.fit_censored import fit_lifetimes
+
+    budget = args.budget if args.budget is not None else DEFAULT_BUDGET_S
+    try:
+        if args.block == "arrivals":
+            return fit_trace(data.values, families, rank_by=args.rank_by, budget_s=budget)
+        return fit_lifetimes(data.values, data.censored, families, rank_by=args.rank_by, budget_s=budget)
+    except ValueError as exc:
+        raise ScenarioError(trace, args.column, data.what, str(exc)) from None
+
+
+def refusals(fits: list[Fit], key: str, file: object) -> dict[int, str]:
+    """Why a scenario would refuse each fit's block (by ``id``; "" where it accepts it): the
+    quick checks first (:func:`~cell.experiments.fit_choice.unusable`), then the scenario's own
+    validation of the block as it would be written."""
+    from cell.experiments.fit_choice import unusable
+    from cell.experiments.fit_output import block_yaml
+    from cell.scenario.arrivals import MAX_INTERARRIVAL_S
+
+    most = MAX_INTERARRIVAL_S if key == "arrivals" else math.inf
+    return {id(f): unusable(f, most) or scenario_refuses(block_yaml(f, key, str(file)), key, file)
+            for f in fits}
+
+
+def _method(fit: Fit, data: Data) -> str:
+    """The block's line on how the fit was made ("" for the usual: maximum likelihood and KS)."""
+    if data.censored is None:
+        return ""
+    return (f"maximum likelihood with right-censored times (scipy.stats.CensoredData), loc held at 0; "
+            f"D = {fit.statistic:.4g} from the Kaplan-Meier estimate, AIC = {fit.aic:.1f}")
+
+
+def _table(fits: list[Fit], data: Data, chosen: Fit, refused: dict[int, str], why: str) -> str:
+    import numpy as np
+
+    from cell.experiments.fit_output import DataMoments, format_table
+
+    x = np.asarray(data.values, dtype=float)
+    if data.censored is None:
+        row = DataMoments(x.size, float(x.mean()), float(x.std(ddof=1)))
+    else:
+        row = DataMoments(x.size, math.nan, math.nan, f"n = {x.size}, {int(data.censored.sum())} censored")
+    table = format_table(fits, row, lambda f: refused[id(f)] or ("written" if f is chosen else ""),
+                         censored=data.censored is not None)
+    if any(refused.values()):
+        table += "\nA fit with a note other than 'written' is not written: a scenario would refuse it."
+    return "\n".join([table, *data.notes, *([why] if why else [])])
+
+
+def fitted_block(args: argparse.Namespace, trace: Path, out: Path | None, data: Data,
+                 families: list[str], replay: str) -> Result:
+    """Fit, choose the fit to write, and make its block (with its caution and notes) and the
+    table; ``replay`` is how to replay the data instead (for the caution; "" for none)."""
+    from cell.experiments.fit_choice import caution, choose, first_accepted
+    from cell.experiments.fit_output import block_yaml
+
+    fits = _fits(args, trace, data, families)
+    key = args.block
+    refused = refusals(fits, key, out if out is not None else "the printed block")
+    try:
+        chosen, why = choose(fits, data.values, lambda f: refused[id(f)]) if data.censored is None \
+            else first_accepted(fits, lambda f: refused[id(f)])
+    except ValueError as exc:
+        raise ScenarioError(trace, "--families", ",".join(families), str(exc)) from None
+    warning = caution(chosen, data.values) if data.censored is None else ""
+    if warning and replay:
+        warning += f". To run the data themselves, replay them: {replay}"
+    notes = list(data.notes)
+    if key != "arrivals":
+        notes.append(f"in seconds: put it under failures.EQUIPMENT ({EQUIPMENT}), with its "
+                     f"{'time_to_repair' if key == 'time_to_failure' else 'time_to_failure'}")
+    source = f"{trace}, column {args.column} ({data.what})"
+    block = block_yaml(chosen, key, source, caution=warning, notes=notes, method=_method(chosen, data))
+    return Result(fits, chosen, warning, block, _table(fits, data, chosen, refused, why))
+
+
+def write(args: argparse.Namespace, data: Data, result: Result, out: Path | None,
+          figure: Path | None) -> None:
+    """Write the figure and the block together (or print the block), then print the table."""
+    from cell.plumbing.output.atomic import atomic_paths
+
+    targets = [t for t in (figure, out) if t is not None]
+    with atomic_paths(*targets) as tmps:  # both written in full, then put in place together
+        staged = dict(zip(targets, tmps))
+        if figure is not None:
+            _draw(args, data, result, staged[figure])
+        if out is not None:
+            staged[out].write_text(result.block, encoding="utf-8")
+    comment = "# " if out is None else ""  # printed table and block together are valid YAML
+    print("\n".join(comment + line for line in result.table.splitlines()))
+    print(result.block.rstrip("\n") if out is None else f"wrote {out}")
+    if figure is not None:
+        print(f"{comment}wrote {figure}")
+
+
+def _draw(args: argparse.Namespace, data: Data, result: Result, path: Any) -> None:
+    from cell.experiments.fit_figure import draw, draw_censored
+
+    what = {"time_to_failure": "time to failure", "time_to_repair": "time to repair"}.get(args.block)
+    if data.censored is not None:
+        draw_censored(data.values, data.censored, result.fits, path, best=result.chosen,
+                      xlabel=f"{what}, column {args.column} (s)")
+        return
+    label = (f"{what}, column {args.column} (s)" if what else
+             f"gap between the arrival times in {args.column} (s)" if args.times else
+             f"inter-arrival time, column {args.column} (s)")
+    draw(data.values, result.fits, path, best=result.chosen, xlabel=label)

@@ -1,0 +1,145 @@
+"""``cell run SCENARIO --out DIR``: one run; DIR/parts.csv, summary.csv and belts.csv.
+
+Part rows and belt changes are streamed to their files while the simulation
+runs, so a long run needs little memory; the three files appear together.  A
+long run shows its progress on stderr.  A DIR that holds another run's files is
+refused (exit 2, its files untouched) unless ``--force``; ``--format parquet``
+writes the three as Parquet (:mod:`cell.plumbing.output.parquet`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable
+from typing import Any
+
+from cell.cli.common import scenario_arguments, scenario_of
+
+HELP = "simulate one scenario; write parts.csv, summary.csv and belts.csv"
+DESCRIPTION = "Run the cell in simulated time under the scenario's policy."
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    scenario_arguments(p)
+    p.add_argument("--out", required=True,
+                   help="directory for parts.csv, summary.csv and belts.csv")
+    p.add_argument("--force", action="store_true",
+                   help="replace the files of a run already in --out")
+    p.add_argument("--format", choices=("csv", "parquet"), default="csv",
+                   help="write the three files as CSV (default) or Parquet")
+
+
+#: The files of a run, written as one set.
+RUN_FILES = ("parts.csv", "summary.csv", "belts.csv")
+#: Written as well when the scenario has a ``failures:`` section.
+FAILURE_FILES = ("states.csv", "failures.csv")
+#: The same, as ``--format parquet`` writes them.
+PARQUET_FILES = ("parts.parquet", "summary.parquet", "belts.parquet")
+#: Runs of at least this many parts show their progress on stderr (a bar on a terminal,
+#: a line every tenth of the run in a log).
+PROGRESS_FROM_PARTS = 50_000
+
+
+def main(args: argparse.Namespace) -> int:
+    from cell.plumbing.csvfile import RowWriter
+    from cell.plumbing.output.atomic import OutputDir
+    from cell.plumbing.progress import Progress
+    from cell.reporting.run_summary import format_summary, run_heading, thesis_figures
+    from cell.reporting.unit_slips import run_warnings
+    from cell.scenario.schema import inert_settings
+    from cell.sim.assembly import assemble
+    from cell.sim.records import BELT_COLUMNS, PART_COLUMNS, SUMMARY_COLUMNS
+    from cell.sim.simulation import simulate
+
+    names = RUN_FILES + FAILURE_FILES + PARQUET_FILES
+    OutputDir.check(args.out, names)  # before any work
+    _refuse_a_run(args)
+    scenario = scenario_of(args)
+    cell = assemble(scenario)  # every error is raised before anything is written
+    print(run_heading(cell))
+    timed = scenario.robot.timing == "minimum-time"  # the planner's settings matter
+    if timed:
+        from cell.reporting.planner_report import planner_line
+        print(planner_line(scenario))
+    for line in [*run_warnings(cell), *(inert_settings(scenario) if timed else [])]:
+        print(f"cell: warning: {line}", file=sys.stderr)
+    n = scenario.run.parts
+    with OutputDir(args.out, names) as out, \
+            Progress(n, "cell run", "parts", enabled=n >= PROGRESS_FROM_PARTS) as progress:
+        with out.open("parts.csv", newline="") as pf, out.open("belts.csv", newline="") as bf:
+            parts, belts = RowWriter(pf, PART_COLUMNS), RowWriter(bf, BELT_COLUMNS)
+            on_part: Callable[[Any], None] = parts.record
+            if progress.enabled:  # counted in chunks: a call per part would show in the run's time
+                step, write = max(1, n // 200), parts.record
+
+                def counted(record: Any) -> None:
+                    write(record)
+                    if record.part % step == 0:
+                        progress.update(step)
+
+                on_part = counted
+
+            result = simulate(cell, keep_parts=False, on_part=on_part,
+                              on_belt=belts.record, keep_belts=False)
+            progress.update(n - progress.n)
+        with out.open("summary.csv", newline="") as sf:
+            RowWriter(sf, SUMMARY_COLUMNS).record(result.summary)
+        if scenario.failures is not None:
+            _write_failures(out, result)
+        if args.format == "parquet":
+            _as_parquet(out)
+    print(format_summary(result.summary, thesis_figures(scenario)))
+    r = result.summary
+    print(f"robot busy (in motion) {r.robot_busy_fraction:.3f} of the run, beside its offered "
+          f"load (fastest cycle / mean inter-arrival) {r.offered_load:.3f}")
+    shown = out.target
+    written = RUN_FILES if args.format == "csv" else PARQUET_FILES
+    if scenario.failures is None:
+        print(f"wrote {shown}/{written[0]}, {written[1]} and {written[2]}")
+        return 0
+    print(f"availability {r.availability:.4f}, performance {r.performance:.4f}, quality "
+          f"{r.quality:.4f}: OEE {r.oee:.4f}; robot failures {r.robot_failures}, parts lost to "
+          f"downtime {r.parts_lost_downtime}, scrapped {r.parts_scrapped}")
+    print(f"wrote {shown}/{written[0]}, {written[1]}, {written[2]}, states.csv and failures.csv")
+    return 0
+
+
+def _write_failures(out: Any, result: Any) -> None:
+    """states.csv and failures.csv of a run with failures."""
+    from cell.plumbing.csvfile import RowWriter
+    from cell.sim.records import STATE_COLUMNS, STOP_COLUMNS
+
+    with out.open("states.csv", newline="") as f:
+        write = RowWriter(f, STATE_COLUMNS).record
+        for span in result.state_spans():
+            write(span)
+    with out.open("failures.csv", newline="") as f:
+        write = RowWriter(f, STOP_COLUMNS).record
+        for stop in result.stops():
+            write(stop)
+
+
+def _refuse_a_run(args: argparse.Namespace) -> None:
+    """A DIR holding a run's files (either format) is refused unless ``--force``."""
+    import os
+
+    from cell.plumbing.errors import CellError
+
+    if args.force:
+        return
+    found = [n for n in RUN_FILES + PARQUET_FILES if os.path.lexists(os.path.join(args.out, n))]
+    if found:
+        raise CellError(f"{args.out}: holds another run's files ({', '.join(found)}); "
+                        "--force replaces them, or choose another --out")
+
+
+def _as_parquet(out: Any) -> None:
+    """The staged CSV files as Parquet, in their place (:mod:`cell.plumbing.output.parquet`)."""
+    import os
+
+    from cell.plumbing.output.parquet import csv_to_parquet, parquet_name
+
+    for name in RUN_FILES:
+        csv_to_parquet(out.path(name), out.path(parquet_name(name)))
+        os.remove(out.path(name))

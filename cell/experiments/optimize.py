@@ -1,0 +1,234 @@
+"""``cell optimize``: search a study's keys with Optuna, over common random numbers.
+
+One objective: TPE (Bergstra et al. 2011); several: NSGA-II (Deb et al. 2002); constraints
+through Optuna's ``constraints_func`` (a trial is feasible when every value it returns is
+<= 0).  The study lives in ``DIR/study.db`` (SQLite), so a killed run resumes from it and
+several workers (local processes, or dask workers on a shared disk) share it.
+
+Trial ``n`` samples with a sampler seeded from ``(seed, n)``, so with one worker a study's
+trials depend on the seed and on the trials before them only: a run resumed after a kill
+proposes what an unbroken one would.  Each trial runs ``replications`` replications of its
+point on streams ``SeedSequence(seed, spawn_key=(r,))``, the same for every trial.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cell.experiments.study import Param, Study, interval, replicate
+from cell.plumbing.errors import CellError
+
+DB_NAME = "study.db"
+#: Replications KN runs are drawn from these streams on: fresh ones, not the search's.
+SELECT_OFFSET = 1_000_000
+
+
+def storage_url(out: Path) -> str:
+    return f"sqlite:///{(out / DB_NAME).resolve()}"
+
+
+def fingerprint(study: Study) -> str:
+    from cell import __version__
+
+    doc = {"settings": study.settings.model_dump(mode="json", by_alias=True),
+           "base": study.base.to_dict(), "version": __version__}
+    return hashlib.sha256(json.dumps(doc, sort_keys=True, default=str).encode()).hexdigest()
+
+
+def directions(study: Study) -> list[Any]:
+    return [o.goal for o in study.settings.objectives]
+
+
+def _sampler(study: Study, number: int) -> Any:
+    import optuna
+
+    seed = int(np.random.SeedSequence([study.settings.seed, number]).generate_state(1)[0])
+    # Optuna 5 reads the constraints a trial sets itself (Trial.set_constraint); before it,
+    # a constraints_func gave them
+    given: dict[str, Any] = {} if _SET_CONSTRAINT else {"constraints_func": _constraints}
+    if len(study.settings.objectives) > 1:
+        return optuna.samplers.NSGAIISampler(seed=seed, **given)
+    return optuna.samplers.TPESampler(seed=seed, n_startup_trials=min(10, max(2, study.settings.trials // 4)),
+                                      **given)
+
+
+def _has_set_constraint() -> bool:
+    try:
+        import optuna
+    except ImportError:
+        return False
+    return hasattr(optuna.trial.Trial, "set_constraint")
+
+
+_SET_CONSTRAINT = _has_set_constraint()
+
+
+def _constraints(trial: Any) -> list[float]:
+    return list(trial.user_attrs.get("excess", []))
+
+
+def open_study(study: Study, out: Path, resume: bool) -> Any:
+    """The Optuna study in ``out``: new, or (``resume``) the one there, which must be this
+    study's; trials a killed run left running are marked failed (and run again)."""
+    import optuna
+
+    optuna.logging.set_verbosity(optuna.logging.ERROR)  # refused trials: in trials.csv, with the reason
+    url, exists = storage_url(out), (out / DB_NAME).exists()
+    if exists and not resume:
+        raise CellError(f"{out}: holds a study already; add --resume to continue it, or choose "
+                        "another --out")
+    o = optuna.create_study(study_name=study.name, storage=url, load_if_exists=True,
+                            directions=directions(study))
+    mark = fingerprint(study)
+    if o.user_attrs.get("fingerprint", mark) != mark:
+        raise CellError(f"{out}: holds another study (or this one changed, or another version "
+                        "of cell); choose another --out")
+    o.set_user_attr("fingerprint", mark)
+    for t in o.get_trials(deepcopy=False, states=(optuna.trial.TrialState.RUNNING,)):
+        o._storage.set_trial_state_values(t._trial_id, optuna.trial.TrialState.FAIL)
+    return o
+
+
+def suggest(trial: Any, p: Param) -> Any:
+    if p.is_choice:
+        return p.choices[trial.suggest_categorical(p.key, list(range(len(p.choices))))]
+    if p.whole:
+        return trial.suggest_int(p.key, int(round(p.low)), int(round(p.high)), log=p.log,
+                                 step=int(p.step or 1))
+    return trial.suggest_float(p.key, p.low, p.high, log=p.log, step=p.step)
+
+
+def measured(study: Study) -> list[str]:
+    """The measures a trial records: the objectives', the constraints', the selection's and
+    the headline ones."""
+    keys = {p.key for p in study.params}
+    names = [o.measure for o in study.settings.objectives if o.measure not in keys]
+    names += [c.measure for c in study.constraints]
+    if study.settings.select is not None and study.settings.select.measure:
+        names.append(study.settings.select.measure)
+    names += ["parts_missed", "spacing_outside_pct", "parts_per_hr_wallclock"]
+    return list(dict.fromkeys(names))
+
+
+def evaluate(study: Study, trial: Any) -> tuple[float, ...]:
+    """One trial: its point's replications; the objectives' means (a varied key: its value)."""
+    from cell.plumbing.errors import ScenarioError
+
+    values = {p.key: suggest(trial, p) for p in study.params}
+    trial.set_user_attr("values", {k: _plain(v) for k, v in values.items()})
+    try:
+        rows = replicate(study, values, range(study.settings.replications))
+    except ScenarioError as exc:
+        trial.set_user_attr("refused", f"{exc.key} = {exc.value}: {exc.why}")
+        raise
+    names = measured(study)
+    summary = {}
+    for m in names:
+        mean, half = interval([r[m] for r in rows])
+        summary[m] = [mean, half]
+    trial.set_user_attr("measures", summary)
+    trial.set_user_attr("reps", {m: [r[m] for r in rows] for m in names})
+    excess = [c.excess(summary[c.measure][0]) for c in study.constraints]
+    trial.set_user_attr("excess", excess)
+    if _SET_CONSTRAINT:
+        for c, e in zip(study.constraints, excess):
+            trial.set_constraint(str(c), e)
+    out = []
+    for o in study.settings.objectives:
+        x = values[o.measure] if o.measure in values else summary[o.measure][0]
+        out.append(float(x) if not math.isnan(float(x)) else math.inf)
+    return tuple(out)
+
+
+def _plain(v: Any) -> Any:
+    return v.item() if isinstance(v, np.generic) else v
+
+
+def counted(o: Any, running: bool = True) -> int:
+    """Trials that count towards ``trials``: complete, refused (a point whose scenario is
+    refused is a finished trial), and with ``running`` those under way; not a trial a
+    killed run left behind (marked failed on resume, and run again)."""
+    import optuna
+
+    states = optuna.trial.TrialState
+    n = 0
+    for t in o.get_trials(deepcopy=False):
+        n += t.state == states.COMPLETE or running and t.state == states.RUNNING \
+            or t.state == states.FAIL and "refused" in t.user_attrs
+    return n
+
+
+def work(study: Study, o: Any, on_trial: Callable[[], None] | None = None) -> int:
+    """Run trials in this process until the study has its ``trials`` (counting every
+    worker's, finished or running); returns how many this process ran."""
+    from cell.plumbing.errors import ScenarioError
+
+    ran = 0
+    while (number := counted(o)) < study.settings.trials:
+        o.sampler = _sampler(study, number)
+        o.optimize(lambda t: evaluate(study, t), n_trials=1, catch=(ScenarioError,),
+                   gc_after_trial=False)
+        ran += 1
+        if on_trial is not None:
+            on_trial()
+    return ran
+
+
+def worker(source: str, out: str) -> int:
+    """A worker process (local or on a dask cluster): load the study file and the study
+    from the shared database, and run trials until there are enough."""
+    import optuna
+
+    from cell.experiments.study import load_study
+
+    optuna.logging.set_verbosity(optuna.logging.ERROR)  # refused trials: in trials.csv, with the reason
+    study = load_study(source, corners=False)
+    o = optuna.load_study(study_name=study.name, storage=storage_url(Path(out)))
+    return work(study, o)
+
+
+def run_workers(study: Study, out: Path, o: Any, workers: int, scheduler: str | None,
+                progress: Any) -> None:
+    """Run the trials: in this process (one worker), in local processes, or on dask."""
+    if scheduler is None and workers <= 1:
+        work(study, o, on_trial=progress.update)
+        return
+    import concurrent.futures as cf
+    import time
+
+    if scheduler is not None:
+        from distributed import Client
+
+        client = Client(scheduler, timeout="20s")
+        futures = [client.submit(worker, str(study.source.resolve()), str(out.resolve()),
+                                 pure=False) for _ in range(max(workers, 1))]
+        waiter: Callable[[], bool] = lambda: all(f.done() for f in futures)  # noqa: E731
+    else:
+        import multiprocessing
+
+        pool = cf.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
+        jobs = [pool.submit(worker, str(study.source.resolve()), str(out.resolve()))
+                for _ in range(workers)]
+        waiter = lambda: all(j.done() for j in jobs)  # noqa: E731
+    try:
+        seen = counted(o, running=False)
+        while not waiter():
+            time.sleep(0.5)
+            now = counted(o, running=False)
+            progress.update(now - seen)
+            seen = now
+        progress.update(counted(o, running=False) - seen)
+        for j in (futures if scheduler is not None else jobs):
+            j.result()
+    finally:
+        if scheduler is not None:
+            client.close()
+        else:
+            pool.shutdown(cancel_futures=True)

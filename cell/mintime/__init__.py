@@ -1,6 +1,0 @@
-"""Minimum-time motion along the transfer path (Shin & McKay 1983).
-
-``cell.mintime.planner`` is the phase-plane algorithm itself, on plain arrays;
-``cell.mintime.regimes`` applies it to the cell's freely moving regimes, R II
-and R IV, under a :class:`~cell.mintime.regimes.PlannerBounds`.
-"""

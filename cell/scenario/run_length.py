@@ -1,0 +1,29 @@
+"""How long a run may be: ``run.parts`` and ``run.hours`` are exclusive, and the parts an
+hours-long run would bring stay within the bound on parts (checked where a scenario is read;
+:mod:`cell.sim.horizon` draws the run's arrivals and runs it to its end)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from cell.plumbing.errors import ScenarioError
+from cell.scenario.arrivals import mean_interarrival
+
+SECONDS_PER_HOUR = 3600.0
+
+
+def check_hours(s: Any, default_parts: int, file: object) -> None:
+    """``run.hours`` and ``run.parts`` are exclusive; the parts an hours-long run brings
+    stay within the bound on parts."""
+    hours = s.run.hours
+    if hours is None:
+        return
+    if s.run.parts != default_parts:
+        raise ScenarioError(file, "run.hours", hours, f"give run.hours or run.parts "
+                            f"({s.run.parts}), not both")
+    from cell.scenario.sections import MAX_PARTS
+
+    expected = hours * SECONDS_PER_HOUR / mean_interarrival(s.arrivals, s.base_dir)
+    if expected > MAX_PARTS:
+        raise ScenarioError(file, "run.hours", hours, f"about {expected:.3g} parts would come; "
+                            f"at most {MAX_PARTS:g} a run")

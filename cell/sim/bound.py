@@ -1,0 +1,57 @@
+"""The bound on any controller: the most parts that could be delivered from given arrivals
+with the same robot and belts (SPEC §11; docs/model.md, "The bound").
+
+Part i comes at a_i, ``length`` inches before B.  Whatever the controller does, the
+input belt runs between its floor v_min and its ceiling v_max, so the part reaches
+B no earlier than a_i + L / v_max; the feeder drops it at a_i, or later if the belt
+has not cleared a part's size since the last drop, and never later than
+D_i = max(a_i, D_{i-1} + size / v_min), so it reaches B no later than D_i + L / v_min.
+The robot picks a part at B, and two picks are at least its fastest possible cycle
+c_min apart.  Each part then has a window [r_i, d_i]; both ends grow with i, so the
+greedy pass in order of arrival (pick i at max(r_i, last pick + c_min) if that is no
+later than d_i) fits the most picks into the windows (an exchange argument: any
+feasible choice can be turned, pick by pick, into the greedy one).  The windows
+ignore that the parts share one belt, so no controller can deliver more; it may not
+reach the bound.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from cell.sim.policies.base import CellConstants
+
+
+def fastest_possible_cycle(k: CellConstants) -> float:
+    """The shortest B → B cycle the robot can run: R II and R IV at the motors' peak, both
+    tracking regimes at the fastest belt speed the robot can follow (and the belt give)."""
+    t = k.timing
+    r1a, r1b = t.r1_time(min(t.input_track_max_in_s, k.input_max))
+    r3a, r3b = t.r3_time(min(t.output_track_max_in_s, k.output_max))
+    return r1a + r1b + t.r2_min_s + r3a + r3b + t.r4_min_s
+
+
+def greedy_picks(come_s: Iterable[float], length_in: float, v_min: float, v_max: float,
+                 part_size_in: float, cycle_min_s: float) -> int:
+    """The most parts, coming at ``come_s`` (in order), that fit their windows at B with
+    picks ``cycle_min_s`` apart (see the module's text)."""
+    early, late, clear = length_in / v_max, length_in / v_min, part_size_in / v_min
+    last_pick = latest_drop = -float("inf")
+    count = 0
+    for a in come_s:
+        latest_drop = a if a > latest_drop + clear else latest_drop + clear
+        pick = a + early
+        if pick < last_pick + cycle_min_s:
+            pick = last_pick + cycle_min_s
+        if pick <= latest_drop + late:
+            count += 1
+            last_pick = pick
+    return count
+
+
+def parts_bound(k: CellConstants, come_s: Iterable[float]) -> int:
+    """The bound for a run of the cell ``k`` whose parts come at ``come_s``."""
+    return greedy_picks(come_s, k.input_length, k.input_min, k.input_max, k.part_size,
+                        fastest_possible_cycle(k))

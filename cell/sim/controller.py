@@ -1,0 +1,169 @@
+"""The controller (thesis §5.3 step 1.0 and 6.0-7.0): a thin SimPy process.
+
+When a part reaches B it reads the cell's state, asks the scenario's
+:class:`~cell.sim.policies.Policy` for the part's cycle, hands the belt speeds to
+the conveyors and the order to the robot.  A part that reaches B while the
+robot is not back rides on and falls off at F (§6.3).  The decisions are the
+policy's; nothing here knows which policy runs.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Protocol
+
+import simpy
+
+from cell.sim.conveyors import EPS_S, InputConveyor, OutputConveyor
+from cell.sim.policies.base import CellConstants, Policy
+from cell.sim.records import PartRecord
+from cell.sim.robot import Robot
+from cell.sim.sensor import Sensor
+
+INF = math.inf
+
+
+class RunLog(Protocol):
+    """Where a part's limits are noted, and where a part lost at B goes."""
+
+    def flag(self, part: PartRecord, limits: int) -> None: ...
+
+    def missed(self, part: PartRecord) -> None: ...
+
+
+class View:
+    """What a policy may read of the cell when a part is at B (:class:`cell.sim.policies.CellView`).
+
+    The controller sets ``part`` and ``now`` before it asks the policy.
+    """
+
+    def __init__(self, k: CellConstants, fed_s: list[float], n_parts: int,
+                 conveyor: InputConveyor, output: OutputConveyor):
+        self.k, self.fed_s, self.n, self.output = k, fed_s, n_parts, output
+        self._input_speed, self._output_travel = conveyor.belt.speed, output.belt.travel
+        self._input_travel, self._x_fed = conveyor.belt.travel, conveyor.x_fed
+        self._length = k.input_length
+        self.part = 0
+        """Index of the part at B."""
+        self.now = 0.0
+        """The instant it reached B (the simulation's clock)."""
+        self.sensor_up = True
+        """False while the look-ahead sensor is down (a failure): it then reports nothing,
+        the ideal look-ahead included, and ``next_part`` is None."""
+
+    def input_speed(self) -> float:
+        return self._input_speed(self.now + EPS_S)
+
+    def output_gap(self) -> float | None:
+        """How far the last part set down has travelled since (None if none yet)."""
+        last = self.output.last_td_x
+        return None if last is None else self._output_travel(self.now) - last
+
+    def since_touchdown(self) -> float | None:
+        """Seconds since the last part was set down (None if none yet)."""
+        return None if self.output.last_td_x is None else self.now - self.output.last_td_s
+
+    def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
+        """(a, b) of the first part after this one that can still be caught: the ideal
+        look-ahead, which reads the feeder's schedule (``sensor.lookahead: ideal``)."""
+        if not self.sensor_up:
+            return None
+        now, fed_s, length = self.now, self.fed_s, self._length
+        x_now = None
+        for j in range(self.part + 1, self.n):
+            f = fed_s[j]
+            if f > now + lag:
+                return (f - now, length)
+            if x_now is None:
+                x_now = self._input_travel(now)
+            x_fed = self._x_fed.get(j)
+            if x_fed is None:  # dropped between now and LO (or held back): not on the belt yet
+                x_fed = x_now + v * (max(f, now) - now)
+            d = x_fed + length - (x_now + v * lag)
+            if d > 0:
+                return (lag, d)
+        return None
+
+
+class SensorView(View):
+    """The view with a physical look-ahead (``sensor.lookahead: sensor``): the next part is
+    the first the sensor has reported that can still be caught, where the report puts it;
+    the feeder's schedule is not given to it, so no arrival the sensor has not seen is read."""
+
+    def __init__(self, k: CellConstants, sensor: Sensor, n_parts: int,
+                 conveyor: InputConveyor, output: OutputConveyor):
+        super().__init__(k, [], n_parts, conveyor, output)
+        self.sensor = sensor
+
+    def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
+        """(lag, b) of the first reported part after this one still short of B at LO (its
+        reported distance less the belt's travel since the report); None if none."""
+        sensor, now = self.sensor, self.now
+        sensor.update(now, self.part)
+        if not self.sensor_up:
+            return None
+        ahead = self._input_travel(now) + v * lag  # the belt's travel at LO
+        for _, distance, x_told in sensor.reports:
+            d = distance - (ahead - x_told)
+            if d > 0:
+                return (lag, d)
+        return None
+
+
+class Controller:
+    """Decides each part's cycle when it reaches B (SimPy process)."""
+
+    def __init__(self, env: simpy.Environment, k: CellConstants, policy: Policy, view: View,
+                 conveyor: InputConveyor, output: OutputConveyor, robot: Robot, log: RunLog):
+        self.env, self.k, self.policy, self.view = env, k, policy, view
+        self.conveyor, self.output, self.robot, self.log = conveyor, output, robot, log
+        self.process = env.process(self.run())
+
+    def run(self):  # noqa: ANN201 (SimPy generator)
+        """Once per part, with locals bound."""
+        env, robot, view, plan_for = self.env, self.robot, self.view, self.policy.plan
+        replan_in, replan_out, u_nom = self.conveyor.replan, self.output.replan, self.k.u_nom
+        output_floor, u_min = self.output.belt.then, self.k.output_min
+        aim = self.k.lookahead_margin_s  # step 6.3 from when the next part is aimed at B
+        floor_after_td = math.nan  # the last planned TD (the spacing contract; nan: none)
+        get, flag, missed, order = self.conveyor.at_bot.get, self.log.flag, self.log.missed, \
+            robot.order
+        t = self.k.timing
+        l1, l2, l3, l4 = t.r1_length_in, t.r2.length_in, t.r3_length_in, t.r4.length_in
+        # the previous cycle's TD → K and R IV (step 5.0, 6.2); nominal before the first
+        residual = self.k.r3_post_nom + self.k.r4_nom
+        while True:
+            part: Any = yield get()
+            now = env.now
+            if not robot.free_at_s <= now + EPS_S:  # the robot is not back: the part rides on
+                part.missed = True
+                flag(part, robot.loss(now))  # let go, or lost to downtime
+                missed(part)
+                if floor_after_td == floor_after_td:  # a wait now foreseen: the output belt's
+                    replan_out(max(now, floor_after_td), u_min)  # floor from TD (or now)
+                continue
+            view.part, view.now = part.part - 1, now
+            plan = plan_for(view)
+            r1_pre, r3_pre, r3_post, to_g, cycle = \
+                plan.r1_pre, plan.r3_pre, plan.r3_post, plan.to_g, plan.cycle
+            output_to_g, r2, r4, limits = plan.output_to_g, plan.r2, plan.r4, plan.limits
+            if plan.steers_belts:
+                replan_in(now + r1_pre, plan.input_after_lo, now + cycle + aim, plan.input_next)
+                replan_out(now, output_to_g, now + to_g, u_nom)
+                if plan.output_floor_at < INF:  # the spacing contract: the belt's floor after TD
+                    output_floor(now + plan.output_floor_at, u_min)
+                    floor_after_td = now + to_g + r3_pre
+            r1, r3 = r1_pre + plan.r1_post, r3_pre + r3_post
+            part.picked = True
+            part.motion_cycle_s = cycle
+            part.input_speed_in_s, part.output_speed_in_s = plan.input_speed, output_to_g
+            part.r1_s, part.r2_s, part.r3_s, part.r4_s = r1, r2, r3, r4
+            part.v_r1_in_s, part.v_r2_in_s = l1 / r1, l2 / r2
+            part.v_r3_in_s, part.v_r4_in_s = l3 / r3, l4 / r4
+            if limits:
+                flag(part, limits)
+            # step 6.2: motion time to TD plus the previous cycle's residual
+            part.thesis_interval_s = to_g + r3_pre + residual
+            residual = r3_post + r4
+            # B → TD summed as LO + (LO → TD), the order the robot's legs are timed in
+            order(part, r1_pre, r1_pre + (to_g - r1_pre + r3_pre), cycle)

@@ -1,0 +1,367 @@
+"""The two belt conveyors (thesis §4.1, §5.2, §6.2 a).
+
+A belt is a speed schedule: piecewise-constant speeds from given instants, so
+its travel X(t) is piecewise linear and exact.  Speed changes take effect at
+once (§6.2 a: negligible lag).  The controller writes the schedule ahead of
+time (a change at LO, the step 6.3 decay at the end of the cycle, the output
+belt back to nominal at G); a part's arrival is the instant the belt has
+carried it the required distance, so the input conveyor's SimPy process only
+wakes when a part reaches B (the controller, which replans only then, having
+taken it first), and the output conveyor's when a part is set down.
+"""
+
+from __future__ import annotations
+
+import math
+from bisect import bisect_left, bisect_right
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+import simpy
+
+from cell.sim.mailbox import Mailbox
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from cell.plumbing.types import Array
+
+#: Two instants closer than this are the same instant (float rounding of planned times).
+EPS_S = 1e-6
+
+
+def speed_at(instants: Sequence[float] | Array, speeds: Sequence[float] | Array,
+             t: float) -> float:
+    """A piecewise-constant schedule's speed at t: the last change at or before t
+    (``instants`` in time order; lists or arrays alike, neither copied)."""
+    return speeds[max(bisect_right(instants, t) - 1, 0)]
+
+
+class Belt:
+    """A belt's speed schedule and travel X(t) (inches since t = 0).
+
+    Only the schedule from the present on is kept: a change whose successor has
+    started is final and is handed to ``on_change`` (e.g. a ``belts.csv``
+    writer) and dropped, so a long run keeps a few entries, not its history.
+    """
+
+    __slots__ = ("_t", "_x", "_v", "on_change", "max_speed_in_s", "min_speed_in_s", "_halted",
+                 "_anchor")
+
+    def __init__(self, speed_in_s: float,
+                 on_change: Callable[[float, float], Any] | None = None):
+        self._t: list[float] = [0.0]
+        """Instants at which a speed starts."""
+        self._x: list[float] = [0.0]
+        """Travel at those instants."""
+        self._v: list[float] = [speed_in_s]
+        """Speed from each instant on (the last one holds for ever)."""
+        self.on_change = on_change
+        """Told (instant, speed) of every change once it is final."""
+        self.max_speed_in_s = speed_in_s
+        """The fastest of the settled speeds (of all of them once closed)."""
+        self.min_speed_in_s = speed_in_s
+        """The slowest of them."""
+        self._halted: tuple[float, list[tuple[float, float]]] | None = None
+        """While stopped by a failure: the speed it ran at and the changes planned after."""
+        self._anchor: tuple[float, float, float] = (0.0, 0.0, speed_in_s)
+        """The last settled change (instant, travel, speed): still in force when a replan
+        from a later instant has settled past the present (a stop then starts from it)."""
+
+    @property
+    def held(self) -> int:
+        """Speed segments held in memory: the one in force and those planned ahead
+        (what is behind is told to ``on_change`` and dropped, so memory stays flat)."""
+        return len(self._t)
+
+    def speed(self, t: float) -> float:
+        """The speed at instant t (:func:`speed_at`, hand-written for speed: no ``max`` call)."""
+        k = bisect_right(self._t, t) - 1
+        return self._v[k if k > 0 else 0]
+
+    def travel(self, t: float) -> float:
+        """X(t): inches the belt has moved by time t (t ≥ the last settled change, or a
+        rounding before it: a replan within EPS_S of a change may settle up to it)."""
+        k = bisect_right(self._t, t) - 1
+        if k < 0:  # max(k, 0) without the builtin call; index -1 would be the last change
+            k = 0
+        return self._x[k] + self._v[k] * (t - self._t[k])
+
+    def time_at(self, x: float) -> float:
+        """First instant at which the belt's travel reaches x (speeds are > 0)."""
+        k = bisect_right(self._x, x) - 1
+        if k < 0:  # max(k, 0) without the builtin call (once a part)
+            k = 0
+        return self._t[k] + (x - self._x[k]) / self._v[k]
+
+    def plan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
+        """From instant t1 (now or later) run at v1, and from t2 > t1 at v2, dropping
+        later plans.
+
+        A new plan supersedes whatever was planned after t1 (the controller
+        replans every cycle); a change within EPS_S of the last one replaces it.
+        Changes before ``t1`` whose successors have started are settled.
+        (Called twice a part: the controller's case is unrolled first, for speed.)
+        """
+        if not v1 > 0 or (t2 is not None and not v2 > 0):
+            raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}")
+        ts, xs, vs = self._t, self._x, self._v
+        t0 = ts[-1]
+        if t0 > t1 + EPS_S and len(ts) > 1 and ts[-2] < t1:  # one change planned after t1
+            del ts[-1], xs[-1], vs[-1]  # (the output belt's floor): dropped, as below
+            t0 = ts[-1]
+        if t0 < t1 and t2 is not None and t1 < t2:
+            # the controller's every replan: both changes after the last one, which alone
+            # is kept (the general case below, unrolled)
+            n = len(ts) - 1
+            if n > 0:
+                self._settle(n)
+            x0, v0 = xs[-1], vs[-1]
+            x1 = x0 + v0 * (t1 - t0)
+            self._t, self._x, self._v = [t0, t1, t2], [x0, x1, x1 + v1 * (t2 - t1)], [v0, v1, v2]
+            return
+        k = bisect_right(ts, t1 + EPS_S)
+        if k == 0:  # would rewrite what is settled (and leave no schedule at all)
+            raise ValueError(f"a belt's plan cannot start at {t1!r}, before its earliest "
+                             f"held change ({ts[0]!r})")
+        if k < len(ts):
+            del ts[k:], xs[k:], vs[k:]
+        n = bisect_right(ts, t1) - 1
+        if n > 0:  # settle the changes whose successors have started
+            self._settle(n)
+            del ts[:n], xs[:n], vs[:n]
+        self._run_from(t1, v1)
+        if t2 is not None:
+            self._run_from(t2, v2)
+
+    def then(self, t: float, v: float) -> None:
+        """And from instant t, after every change planned, run at v (a third change)."""
+        ts, xs, vs = self._t, self._x, self._v
+        t0 = ts[-1]
+        if not v > 0 or not t > t0:
+            raise ValueError(f"a belt's further change must come after its last and be "
+                             f"positive, got {t!r}, {v!r}")
+        xs.append(xs[-1] + vs[-1] * (t - t0))  # _run_from's append, inline (once a part)
+        ts.append(t)
+        vs.append(v)
+
+    def _run_from(self, t: float, v: float) -> None:
+        """Run at v from instant t on (at or before the last change: that change's speed is v)."""
+        ts, xs, vs = self._t, self._x, self._v
+        t0 = ts[-1]
+        if t <= t0:
+            vs[-1] = v
+        else:
+            xs.append(xs[-1] + vs[-1] * (t - t0))
+            ts.append(t)
+            vs.append(v)
+
+    def _settle(self, n: int) -> None:
+        """The first ``n`` changes are final: note their speeds and tell ``on_change``."""
+        vs = self._v
+        hi, lo = self.max_speed_in_s, self.min_speed_in_s
+        for i in range(n):
+            v = vs[i]
+            if v > hi:
+                hi = v
+            if v < lo:
+                lo = v
+        self.max_speed_in_s, self.min_speed_in_s = hi, lo
+        if n:
+            self._anchor = (self._t[n - 1], self._x[n - 1], vs[n - 1])
+        told = self.on_change
+        if told is not None:
+            ts = self._t
+            for i in range(n):
+                told(ts[i], vs[i])
+
+    @property
+    def stopped(self) -> bool:
+        """Whether the belt stands (a failure, :meth:`stop`) until :meth:`restart`."""
+        return self._halted is not None
+
+    def stop(self, t: float) -> None:
+        """Stand from instant t (now) on: speed 0, parts stay where they are; what was
+        planned after t is kept for :meth:`restart` (docs/model.md, "When equipment fails")."""
+        ts, vs = self._t, self._v
+        if ts[0] > t:  # a replan from a later instant settled the change in force now: stop
+            t0, x0, v0 = self._anchor  # from it, every held change kept for the restart
+            self._halted = (v0, list(zip(ts, vs)))
+            self._t, self._x, self._v = [t], [x0 + v0 * (t - t0)], [0.0]
+            return
+        k = bisect_right(ts, t)
+        later = list(zip(ts[k:], vs[k:]))
+        running = vs[k - 1] if k > 0 else vs[0]
+        del ts[k:], self._x[k:], vs[k:]
+        self._run_from(t, 0.0)
+        self._halted = (running, later)
+
+    def plan_stopped(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
+        """:meth:`plan` while stopped: the plan takes effect from the restart on."""
+        assert self._halted is not None
+        running, later = self._halted
+        later = [(t, v) for t, v in later if t < t1 - EPS_S] + [(t1, v1)]
+        if t2 is not None:
+            later.append((t2, v2))
+        self._halted = (running, later)
+
+    def restart(self, t: float) -> None:
+        """Run again from instant t (now), at the speed the plan has for t."""
+        assert self._halted is not None
+        v, later = self._halted
+        self._halted = None
+        ahead = []
+        for tp, vp in later:
+            if tp <= t:
+                v = vp
+            else:
+                ahead.append((tp, vp))
+        self._run_from(t, v)
+        for tp, vp in ahead:
+            self._run_from(tp, vp)
+
+    def close(self, until: float | None = None) -> None:
+        """Hand every change still held (planned ones included) to ``on_change``; with
+        ``until`` (the end of the run), those planned to start then or later, which never
+        took effect, are dropped instead."""
+        if until is not None:
+            keep = max(bisect_left(self._t, until - EPS_S), 1)
+            del self._t[keep:], self._x[keep:], self._v[keep:]
+        self._settle(len(self._t))
+        del self._t[:], self._x[:], self._v[:]
+
+
+class InputConveyor:
+    """Carries parts from the feeder, ``length_in`` upstream of B, to B.
+
+    Its process takes each part the feeder drops (``loaded``), works out when
+    the belt will have carried it to B, and hands it to the controller (``at_bot``)
+    due at that instant: one event, which wakes the controller and then this
+    process, so the controller plans (and may replan the belt) before the next
+    part is timed.  A part nobody picks up rides on to F and falls off (§6.3).
+
+    The controller replans the belt only when a part reaches B, so a part on its
+    way to B never has its arrival moved; a replan at any other instant while a
+    part is due is refused (it would need the part timed again).
+    """
+
+    def __init__(self, env: simpy.Environment, speed_in_s: float, length_in: float,
+                 on_change: Callable[[float, float], Any] | None = None, stoppable: bool = False):
+        self.env = env
+        self.belt = Belt(speed_in_s, on_change)
+        self.length_in = length_in
+        """Feeder drop point to B (in)."""
+        self.loaded: Mailbox = Mailbox(env)
+        """Parts dropped on the belt by the feeder (their records)."""
+        self.at_bot: Mailbox = Mailbox(env)
+        """Parts as they reach B (the controller waits on it)."""
+        self.x_fed: dict[int, float] = {}
+        """Belt travel at the instant each part on the belt was dropped (by index)."""
+        self.due_s = -math.inf
+        """When the part on its way to B gets there (-inf: none is)."""
+        self.feeder: Any = None
+        """The feeder, told of a replan while it holds a part back."""
+        self.timing = False
+        """True while :meth:`run_stoppable` waits for a part to reach B (a stop re-times it)."""
+        self.process = env.process(self.run_stoppable() if stoppable else self.run())
+
+    def drop(self, part: Any, x: float) -> None:
+        """The feeder puts a part (its record) on the belt now, the belt's travel being x."""
+        self.x_fed[part.part - 1] = x
+        self.loaded.put(part)
+
+    def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
+        """New speed plan from the controller (see :meth:`Belt.plan`), made as a part
+        reaches B: before the next part is timed."""
+        if self.env.now < self.due_s:
+            raise RuntimeError("the input belt was replanned while a part was on its way to B")
+        self.belt.plan(t1, v1, t2, v2)
+        feeder = self.feeder
+        if feeder is not None and feeder.holding:
+            feeder.process.interrupt()
+
+    def run(self):  # noqa: ANN201 (SimPy generator)
+        env, get, hand_over = self.env, self.loaded.get, self.at_bot.put_after
+        time_at, x_fed, length = self.belt.time_at, self.x_fed, self.length_in
+        while True:
+            part = yield get()
+            i = part.part - 1
+            now = env.now
+            delay = time_at(x_fed[i] + length) - now
+            if delay < 0.0:  # max(delay, 0) without the builtin call
+                delay = 0.0
+            # the instant the part reaches B, as the event queue will have it
+            part.at_bot_s = self.due_s = now + delay
+            # the controller takes the part (and replans) before this process resumes
+            yield hand_over(part, delay)
+            del x_fed[i]
+
+    def run_stoppable(self):  # noqa: ANN201 (SimPy generator)
+        """:meth:`run` for a belt that can stop: the part's arrival at B is timed again
+        (the process interrupted) whenever the belt stops or starts."""
+        env, get, hand_over, belt = self.env, self.loaded.get, self.at_bot.put_after, self.belt
+        while True:
+            part = yield get()
+            i = part.part - 1
+            target = self.x_fed[i] + self.length_in
+            while True:
+                self.timing = True
+                try:
+                    if belt.stopped:
+                        yield env.event()  # until the restart interrupts
+                    delay = belt.time_at(target) - env.now
+                    self.due_s = env.now + max(delay, 0.0)
+                    if delay > 0.0:
+                        yield env.timeout(delay)
+                    break
+                except simpy.Interrupt:
+                    continue
+                finally:
+                    self.timing = False
+            part.at_bot_s = self.due_s = env.now
+            yield hand_over(part, 0.0)
+            del self.x_fed[i]
+
+    def retime(self) -> None:
+        """The belt stopped or started: time the part on its way to B again."""
+        if self.timing:
+            self.process.interrupt()
+
+
+class OutputConveyor:
+    """Takes parts from the robot at TD and records their spacing (thesis §4.3 f).
+
+    Spacing of a part = the output belt's travel between the previous part's
+    touch-down and its own: the distance between the two on the belt.  Each part
+    set down is handed on to ``delivered`` (the run's log).  The robot hands a part
+    over due at its touch-down (``placed``), so this process wakes once per part, at TD.
+    """
+
+    def __init__(self, env: simpy.Environment, speed_in_s: float,
+                 delivered: Callable[[Any], Any],
+                 on_change: Callable[[float, float], Any] | None = None):
+        self.env = env
+        self.belt = Belt(speed_in_s, on_change)
+        self.placed: Mailbox = Mailbox(env)
+        """Parts set down by the robot, each due at its touch-down."""
+        self.delivered = delivered
+        self.last_td_x: float | None = None
+        """Belt travel at the last touch-down (None before the first)."""
+        self.last_td_s = math.nan
+        """Instant of the last touch-down (read once ``last_td_x`` is set)."""
+        self.replan = self.belt.plan
+        """New speed plan from the controller (:meth:`Belt.plan`)."""
+        self.process = env.process(self.run())
+
+    def run(self):  # noqa: ANN201 (SimPy generator)
+        env, get, travel, delivered = self.env, self.placed.get, self.belt.travel, self.delivered
+        while True:
+            part = yield get()
+            td = part.touchdown_s = env.now
+            x = travel(td)
+            last_x = self.last_td_x
+            if last_x is not None:
+                part.spacing_in = x - last_x
+                part.delivery_interval_s = td - self.last_td_s
+            self.last_td_x, self.last_td_s = x, td
+            delivered(part)

@@ -1,0 +1,87 @@
+"""The feeder (thesis §6.2 d): drops part i on the input belt T_i after part i − 1.
+
+The times come from :mod:`cell.scenario.arrivals` (eq. 6.9 draws or a trace); the
+feeder is the SimPy process that makes each part's record and puts the part on
+the input conveyor when its time comes.  Parts are solid: a part is dropped
+only once the belt has carried the previous one at least a part's size away
+(centre to centre); until then the feeder holds it back, like an escapement,
+and the hold is recorded (``feed_delay_s``).  On the thesis's arrivals (at least
+17.6 s apart) no part is ever held.  While the input belt is stopped by a failure it
+carries nothing clear, so the feeder holds every part that comes until it runs again.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Protocol
+
+import numpy as np
+import simpy
+
+from cell.sim.conveyors import EPS_S
+from cell.sim.mailbox import Timer
+from cell.sim.records import HELD_AT_FEEDER, PartRecord
+
+#: Belt travel this close to clear counts as clear (the rounding of travel and its inverse).
+CLEAR_TOL_IN = 1e-9
+
+
+class Loadable(Protocol):
+    """Where the feeder drops parts: the input conveyor."""
+
+    belt: Any
+
+    def drop(self, part: Any, x: float) -> None: ...
+
+
+class Feeder:
+    """Drops part i on the input conveyor T_i after part i − 1, when the belt is clear
+    (SimPy process)."""
+
+    def __init__(self, env: simpy.Environment, interarrival_s: list[float],
+                 conveyor: Loadable, n_parts: int, part_size_in: float, flag: Any = None):
+        self.env = env
+        self.interarrival_s = interarrival_s
+        """All the run's draws; the one after the last part is the controller's look-ahead."""
+        self.fed_s: list[float] = np.cumsum(interarrival_s).tolist()
+        """When each part comes (is due to be dropped): the upstream process's schedule."""
+        self.n_parts = n_parts
+        self.conveyor = conveyor
+        self.part_size_in = part_size_in
+        self.flag = flag
+        """Told (record, limit bits) of a part held back."""
+        self.holding = False
+        """True while a part waits for the belt to clear (a replan interrupts the wait)."""
+        self.process = env.process(self.run())
+
+    def run(self):  # noqa: ANN201 (SimPy generator)
+        """Once per part, with locals bound."""
+        env, drop, fed, t = self.env, self.conveyor.drop, self.fed_s, self.interarrival_s
+        timeout, travel, flag = env.timeout, self.conveyor.belt.travel, self.flag
+        after = Timer(env).after  # env.timeout's schedule, without a new event a part
+        size = self.part_size_in
+        clear_at = -float("inf")
+        for i in range(self.n_parts):
+            f = fed[i]
+            delay = f - env.now
+            yield after(delay if delay > 0.0 else 0.0)  # max(delay, 0): after a hold it may be due
+            x = travel(env.now)
+            if x < clear_at - CLEAR_TOL_IN:
+                belt = self.conveyor.belt
+                self.holding = True
+                while x < clear_at - CLEAR_TOL_IN:
+                    try:
+                        if belt.stopped:  # a failure: wait for the restart to interrupt
+                            yield env.event()
+                        yield timeout(max(belt.time_at(clear_at) - env.now, EPS_S))
+                    except simpy.Interrupt:  # the belt was replanned: time the wait again
+                        pass
+                    x = travel(env.now)
+                self.holding = False
+                part = PartRecord(i + 1, env.now, t[i])
+                part.feed_delay_s = env.now - f
+                if flag is not None:
+                    flag(part, HELD_AT_FEEDER)
+            else:
+                part = PartRecord(i + 1, f, t[i])
+            drop(part, x)
+            clear_at = x + size

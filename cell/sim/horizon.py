@@ -1,0 +1,60 @@
+"""How long a run is: ``run.parts`` parts, or the parts that come in ``run.hours``.
+
+With ``run.hours`` the inter-arrival times are drawn (from the feeder's one stream, so the
+first k are the same whatever the length) until they pass the end; the run then stops at
+the end sharp, and the parts still in the cell are counted as such.  ``run.parts`` and
+``run.hours`` are exclusive (a scenario giving both is refused).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from cell.plumbing.errors import ScenarioError
+from cell.scenario.arrivals import interarrival_times, mean_interarrival
+from cell.scenario.run_length import SECONDS_PER_HOUR
+
+
+def run_arrivals(s: Any, seed: Any) -> tuple[np.ndarray, int, float | None]:
+    """(T_1 … T_{n+1}, n, horizon in s or None): ``run.parts`` parts, or with ``run.hours``
+    the parts that come before its end."""
+    if s.run.hours is None:
+        n = s.run.parts
+        return interarrival_times(s.arrivals, n + 1, seed, s.base_dir), n, None
+    horizon = s.run.hours * SECONDS_PER_HOUR
+
+    m = int(horizon / mean_interarrival(s.arrivals, s.base_dir) * 1.1) + 64
+    while True:
+        t = interarrival_times(s.arrivals, m, seed, s.base_dir)
+        fed = np.cumsum(t)
+        n = int(np.searchsorted(fed, horizon, side="left"))  # parts due before the end
+        if n < m:
+            break
+        m *= 2
+    if n == 0:
+        raise ScenarioError(s.source, "run.hours", s.run.hours,
+                            "no part comes in that time; make the run longer")
+    return t[:n + 1], n, horizon
+
+
+def run_until_done(env: Any, log: Any, n: int, horizon: float | None, output: Any) -> None:
+    """Run to the horizon, or (failure clocks never end) until the last part is done."""
+    if horizon is not None:
+        env.run(until=horizon)
+        log.flush()
+        return
+    finished = env.event()
+
+    def counting(done: Callable[[Any], None]) -> Callable[[Any], None]:
+        def counted(p: Any) -> None:
+            done(p)
+            if log.handed_on == n and not finished.triggered:
+                finished.succeed()
+        return counted
+
+    log.missed = counting(log.missed)
+    log.delivered_part = output.delivered = counting(log.delivered_part)
+    env.run(until=finished)

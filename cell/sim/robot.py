@@ -1,0 +1,196 @@
+"""The robot: regime times from the joint-step table, and its SimPy process.
+
+A regime's time for a tip velocity v is Σ max(ℓ/v, t_min) over its moves
+(thesis §6.1): each move takes its length over the velocity unless its slowest
+joint's maximum step rate makes it longer.  That total is piecewise linear in
+u = 1/v, so :class:`Segment` stores it once as sorted breakpoints and answers
+"time for this velocity" and "velocity for this time" with one bisection each,
+with no per-move work while the simulation runs.
+
+The tracking regimes (R I, R III) are timed against the belt, not along the
+path: a move's "length" there is the belt's travel during it (the path divides
+the belt equally, §4.2), so at belt speed v the robot keeps up with the part
+unless a joint cannot.  Before LO (and before TD) the robot must keep up; the
+grasp (release) move that ends at LO (TD) changes the hand's length (eq. 6.2)
+and may take longer than the belt's pace; after LO (TD) the hand is off the belt
+and the move times are only floored by the motors (§4.3 c).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import simpy
+
+from cell.arm.motors import Segment
+from cell.sim.mailbox import Mailbox
+from cell.sim.records import LET_GO
+
+if TYPE_CHECKING:
+    from cell.arm.steptable import StepTable
+
+
+@dataclass(frozen=True)
+class RobotTiming:
+    """Everything the controllers need about the robot's speed, built once per scenario.
+
+    Belt-tracking segments are in belt travel (in); R II and R IV in path length.
+    Motor floors are at the peak rates (the motors can always give them, §7.2);
+    ``r4_nominal_s`` is R IV with the base at its nominal 75 % (thesis 9.9855 s).
+    """
+
+    r1_pre: Segment
+    """B → LO, belt travel; the grasp move ending at LO included."""
+    r1_post: Segment
+    """LO → F, belt travel (hand off the belt: motors only)."""
+    r2: Segment
+    r3_pre: Segment
+    """G → TD, output belt travel; the release move ending at TD included."""
+    r3_post: Segment
+    """TD → K."""
+    r4: Segment
+    r4_nominal_s: float
+    """R IV at the nominal motor rates (the thesis's 9.9855 s; docs/model.md)."""
+    input_track_max_in_s: float
+    """Fastest input belt the robot can follow before LO (grasp move excluded)."""
+    output_track_max_in_s: float
+    """Fastest output belt the robot can follow before TD (release move excluded)."""
+    r1_length_in: float
+    r3_length_in: float
+    r2_min_s: float
+    r4_min_s: float
+    """Fastest R II / R IV: constant peak rates (§6.1) or the minimum-time planner."""
+
+    def r1_time(self, v: float) -> tuple[float, float]:
+        """(B → LO, LO → F) times tracking an input belt at v."""
+        return self.r1_pre.time(v), self.r1_post.time(v)
+
+    def r3_time(self, u: float) -> tuple[float, float]:
+        """(G → TD, TD → K) times tracking an output belt at u."""
+        return self.r3_pre.time(u), self.r3_post.time(u)
+
+
+def build_timing(t: StepTable, fastest: dict[str, float] | None = None) -> RobotTiming:
+    """Reduce a solved path to the regime segments (thesis §6.1).
+
+    ``fastest``: the planner's rest-to-rest R II and R IV times, which floor the
+    constant-rate ones (``robot.timing: minimum-time``); None for the thesis's model.
+    """
+    ell, tp = t.velocity_lengths, t.peak_min_times
+    rows = {name: np.flatnonzero(mask) for name, mask in t.segment_rows().items()}
+
+    def segment(name: str, drop_last: bool = False) -> Segment:
+        r = rows[name][:-1] if drop_last else rows[name]
+        return Segment(ell[r], tp[r])
+
+    # what the robot can follow on a belt: the grasp / release move excluded
+    track1, track3 = segment("r1_pre", drop_last=True), segment("r3_pre", drop_last=True)
+    r2seg, r4seg = segment("r2"), segment("r4")
+    r2_min, r4_min = r2seg.floor_s, r4seg.floor_s
+    if fastest is not None:
+        r2_min, r4_min = max(r2_min, float(fastest["R2"])), max(r4_min, float(fastest["R4"]))
+    return RobotTiming(
+        r1_pre=segment("r1_pre"), r1_post=segment("r1_post"), r2=r2seg,
+        r3_pre=segment("r3_pre"), r3_post=segment("r3_post"), r4=r4seg,
+        r4_nominal_s=t.regime_min_time("R4", nominal=True),
+        input_track_max_in_s=track1.max_tracking_velocity(),
+        output_track_max_in_s=track3.max_tracking_velocity(),
+        r1_length_in=t.regime_length("R1"), r3_length_in=t.regime_length("R3"),
+        r2_min_s=r2_min, r4_min_s=r4_min)
+
+
+def timing_to_plain(t: RobotTiming) -> dict[str, Any]:
+    """The timing as plain JSON data (for the disk cache); every float kept exactly.
+
+    Raises TypeError if a value is not a float or a list of floats (then it is not stored).
+    """
+    def plain(value: Any) -> Any:
+        if type(value) is float or (type(value) is list and all(type(v) is float for v in value)):
+            return value
+        raise TypeError(f"not plain: {type(value).__name__}")
+
+    out: dict[str, Any] = {}
+    for f in fields(t):
+        value = getattr(t, f.name)
+        if isinstance(value, Segment):
+            out[f.name] = {"segment": {slot: plain(getattr(value, slot))
+                                       for slot in Segment.__slots__}}
+        else:
+            out[f.name] = plain(value)
+    return out
+
+
+def timing_from_plain(data: dict[str, Any]) -> RobotTiming:
+    """The timing back from :func:`timing_to_plain`'s data."""
+    values: dict[str, Any] = {}
+    for f in fields(RobotTiming):
+        value = data[f.name]
+        if isinstance(value, dict):
+            segment = Segment.__new__(Segment)
+            for slot in Segment.__slots__:
+                setattr(segment, slot, value["segment"][slot])
+            value = segment
+        elif type(value) is not float:
+            raise TypeError(f"{f.name}: not a float")
+        values[f.name] = value
+    return RobotTiming(**values)
+
+
+# --------------------------------------------------------------------------- process
+class Robot:
+    """The arm as a SimPy process: told an order, runs it, hands the part over.
+
+    An order is one transfer cycle as the controller sends it (step 6.1): the
+    part's record (the robot writes its lift-off and touch-down instants), and
+    B → LO and B → TD in seconds from now; the robot is free again the cycle's
+    B → B later.
+
+    The robot owns its state: ``free_at_s``, when it will be back at B, is set the
+    moment it is told an order.  One event per order besides the order itself: a
+    regime's moves are summed, never simulated one by one; lift-off is written when
+    the order is taken, and the part is handed to the output conveyor due at
+    touch-down (:meth:`cell.sim.mailbox.Mailbox.put_after`), the set-down being the
+    event that wakes the conveyor.  The way back (TD → K → B) needs no event, since
+    no order comes before ``free_at_s``.
+    """
+
+    def __init__(self, env: simpy.Environment, output: Mailbox, cycle: Any = None):
+        self.env = env
+        self.orders: Mailbox = Mailbox(env)
+        """Cycles to run, from the controller: (part, B → LO, B → TD) tuples."""
+        self.output = output
+        """Where parts are set down (the output conveyor's mailbox)."""
+        self.free_at_s = 0.0
+        """When the robot is (or will be) back at B, ready for a part."""
+        self.cycle = cycle
+        """With failures (:mod:`cell.sim.failures`): runs each order's legs one by one, so that a
+        stop can interrupt them; None: the fast path, one event an order."""
+        self.process = env.process(self.run() if cycle is None else self.run_stoppable())
+
+    def loss(self, now: float) -> int:
+        """The limit bit of a part that reaches B while the robot is not back: let go
+        (with failures: lost to downtime, if a stop kept the robot away)."""
+        return LET_GO
+
+    def order(self, part: Any, to_lo_s: float, to_td_s: float, cycle_s: float) -> None:
+        """Start a cycle now (the robot must be free): lift-off ``to_lo_s``, touch-down
+        ``to_td_s`` and back at B ``cycle_s`` from now."""
+        self.free_at_s = self.env.now + cycle_s
+        self.orders.put((part, to_lo_s, to_td_s))
+
+    def run(self):  # noqa: ANN201 (SimPy generator)
+        env, set_down, get = self.env, self.output.put_after, self.orders.get
+        while True:
+            part, to_lo_s, to_td_s = yield get()
+            part.pick_s = env.now + to_lo_s
+            set_down(part, to_td_s)  # touch-down: B + (B → TD), as a timeout would fall
+
+    def run_stoppable(self):  # noqa: ANN201 (SimPy generator)
+        """Each order in a process of its own, which a stop interrupts (an interrupt that
+        comes once it is over is dropped, as SimPy drops them for a finished process)."""
+        env, get, cycle = self.env, self.orders.get, self.cycle
+        while True:
+            order = yield get()
+            yield env.process(cycle(*order))

@@ -1,0 +1,420 @@
+"""One run of the cell in simulated time (thesis §6).
+
+Five SimPy processes talk through :class:`~cell.sim.mailbox.Mailbox` hand-offs: the
+feeder drops parts on the input conveyor; the conveyor hands each to the
+controller due at the instant it reaches B; the controller asks the scenario's
+policy for the part's cycle, sets the belts and sends the robot an order; the
+robot hands the part to the output conveyor due at its touch-down, and the
+conveyor measures its spacing.  A part picked up costs about four SimPy events
+(its drop, its arrival at B, the order, the set-down), one fallen off at F two.
+Each part's :class:`~cell.sim.records.PartRecord` is filled in as these things
+happen; when a part is done (set down, or fallen off at F) the run's log
+completes its accounting and passes it on, in part order, to whoever asked for
+rows (a CSV writer, a list), keeping only a few numbers per part for the summary.
+
+Nothing per part outlives its part unless the run keeps the rows, and those are
+kept as tuples of plain values, which Python's cyclic garbage collector stops
+tracking: its full collections then cost the same at any run length, so the
+cost per part does not grow with the run.
+
+:func:`simulate` is what ``cell run`` and every sweep replication call.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import struct
+from array import array
+from collections.abc import Callable
+from operator import attrgetter
+from typing import Any
+
+import numpy as np
+import simpy
+
+from cell.scenario.schema import Scenario
+from cell.sim import accounting, oee, wear_clock
+from cell.sim.assembly import AssembledCell, assemble
+from cell.sim.bound import parts_bound
+from cell.sim.controller import Controller, SensorView, View
+from cell.sim.conveyors import InputConveyor, OutputConveyor
+from cell.sim.failures import Downtime
+from cell.sim.feeder import Feeder
+from cell.sim.horizon import run_arrivals, run_until_done
+from cell.sim.policies.base import Accounting
+from cell.sim.records import (
+    LIMIT_BIT,
+    LIMIT_COUNTS,
+    LIMIT_NAMES,
+    PART_COLUMNS,
+    SPACING_OFF,
+    BeltChange,
+    PartRecord,
+    RunSummary,
+    StateSpan,
+    Stop,
+    limit_names,
+)
+from cell.sim.robot import Robot
+from cell.sim.sensor import Sensor, sensor_position
+
+PartSink = Callable[[PartRecord], Any]
+BeltSink = Callable[[BeltChange], Any]
+#: parts.csv's columns of a record, as a tuple.
+_row = attrgetter(*PART_COLUMNS)
+_BELTS = ("input", "output")
+#: What the run's log keeps of each part for the summary (flags and picked as floats).
+PER_PART = ("touchdown", "picked", "r4", "output_speed", "interval", "spacing", "limits",
+            "feed_delay", "part", "arrival", "at_bot", "cycle")
+_PACK_PER_PART = struct.Struct(f"={len(PER_PART)}d").pack
+
+
+class SimResult:
+    """A run: its summary, and its part records and belt changes if they were kept.
+
+    Kept parts are held as tuples of plain values (which the cyclic garbage collector
+    stops tracking), belt changes as flat arrays; the record objects are made when
+    first asked for.
+    """
+    wear: wear_clock.WearResult | None = None  # with wear.enabled: its measures and stops
+
+    def __init__(self, summary: RunSummary, rows: list[tuple[Any, ...]] | None = None,
+                 belt_log: BeltLog | None = None):
+        self.summary = summary
+        self._rows = rows
+        self._belt_log = belt_log
+        self.downtime: Downtime | None = None
+        """The run's failures (None without a ``failures:`` section)."""
+        self.timelines: dict[str, list[tuple[str, float, float]]] = {}
+        """Each piece of equipment's (state, from_s, to_s) over the run."""
+
+    def state_spans(self) -> list[StateSpan]:
+        """states.csv's rows."""
+        return oee.state_spans(self.timelines)
+
+    def stops(self) -> list[Stop]:
+        """failures.csv's rows: every failure and planned stop, in order of start."""
+        if self.downtime is None:
+            return []
+        return [Stop(*row) for row in self.downtime.all_stops(self.summary.sim_end_s)]
+
+    @functools.cached_property
+    def records(self) -> list[PartRecord] | None:
+        """Every part's record, in part order (None if the run did not keep them)."""
+        return None if self._rows is None else [PartRecord(*row) for row in self._rows]
+
+    @functools.cached_property
+    def belt_changes(self) -> list[BeltChange]:
+        """Every belt speed change, the input belt's first, each belt's in time order."""
+        log = self._belt_log
+        if log is None:
+            return []
+        changes = [BeltChange(_BELTS[b], t, v) for b, t, v in zip(log.belt, log.t, log.v)]
+        changes.sort(key=lambda c: (c.belt != "input", c.from_s))
+        return changes
+
+    @property
+    def parts(self) -> Any:
+        """The part records as a pandas DataFrame (the columns of parts.csv)."""
+        import pandas as pd
+
+        if "records" in self.__dict__ and self.records is not None:
+            rows: Any = [_row(r) for r in self.records]
+        else:
+            rows = self._rows or []
+        return pd.DataFrame(rows, columns=PART_COLUMNS)
+
+    def belt_histories(self) -> dict[str, np.ndarray]:
+        """Each belt's speed changes as (m, 2) rows (from_s, speed_in_s), in time order: the
+        flat arrays the run kept, with no object made per change (a long run has millions)."""
+        log = self._belt_log
+        if log is None:
+            return {name: np.empty((0, 2)) for name in _BELTS}
+        which, rows = np.frombuffer(log.belt, dtype=np.int8), np.column_stack(
+            [np.frombuffer(log.t), np.frombuffer(log.v)]).reshape(-1, 2)
+        out = {}
+        for b, name in enumerate(_BELTS):
+            own = rows[which == b]
+            out[name] = own[np.argsort(own[:, 0], kind="stable")]
+        return out
+
+    @property
+    def belts(self) -> dict[str, list[tuple[float, float]]]:
+        """(instant, speed) of every speed change of the ``input`` and ``output`` belts."""
+        out: dict[str, list[tuple[float, float]]] = {"input": [], "output": []}
+        for c in self.belt_changes:
+            out[c.belt].append((c.from_s, c.speed_in_s))
+        return out
+
+
+class BeltLog:
+    """Belt speed changes as they become final: kept in flat arrays, and/or handed on."""
+
+    def __init__(self, keep: bool, sink: BeltSink | None):
+        self.belt, self.t, self.v = array("b"), array("d"), array("d")
+        self.keep, self.sink = keep, sink
+
+    def told(self, belt: int) -> Callable[[float, float], None] | None:
+        """What a belt calls with (instant, speed) of each final change (None: nobody asks)."""
+        if not self.keep and self.sink is None:
+            return None
+        mark, times, speeds, sink = self.belt.append, self.t.append, self.v.append, self.sink
+        last = [math.nan]  # the belt's speed so far: a "change" to the same speed is none
+
+        def keep(t: float, v: float) -> None:
+            mark(belt)
+            times(t)
+            speeds(v)
+        if sink is None:
+            told = keep
+        else:
+            name = _BELTS[belt]
+
+            def told(t: float, v: float) -> None:
+                if self.keep:
+                    keep(t, v)
+                sink(BeltChange(name, t, v))
+
+        def changed(t: float, v: float) -> None:
+            if v != last[0]:
+                last[0] = v
+                told(t, v)
+        return changed
+
+
+class RunLog:
+    """Completes each part's record and hands the records on in part order.
+
+    Parts finish out of order (a part can fall off at F while the one before it
+    is still in the hand), so a finished part waits here until those before it
+    are done; at most a few do.  What the summary needs is kept per part in flat
+    arrays (a few dozen bytes a part), so a warm-up can be cut off at the end;
+    no per-part object outlives its part unless the run keeps the rows.
+    """
+
+    def __init__(self, t: list[float], acct: Accounting, sink: PartSink | None,
+                 spacing_in: float, tol_in: float, rows: list[tuple[Any, ...]] | None = None):
+        self.t = t
+        """T_1 … T_{n+1}: the last is only part n's "next arrival"."""
+        self.acct, self.sink = acct, sink
+        """Told of every completed record, in part order (None: nobody asks)."""
+        self.spacing_in, self.tol_in = spacing_in, tol_in
+        self.rows = rows
+        """The kept rows (parts.csv's columns), if the run keeps them."""
+        self.waiting: dict[int, PartRecord] = {}
+        """Parts done but not yet handed on (a part before them is not done)."""
+        self.flags: dict[int, int] = {}
+        """Limit bits of parts not yet handed on."""
+        self.per_part = bytearray()
+        """What the summary needs of each part, :data:`PER_PART` values a part in that order,
+        as packed doubles (``struct``'s pack is a third of ``array.extend``'s cost a part)."""
+        self.missed = self.delivered_part = self._logger()
+        """A part fell off at F / was set down: see :meth:`_logger`."""
+
+    def flag(self, part: PartRecord, limits: int) -> None:
+        self.flags[part.part] = self.flags.get(part.part, 0) | limits
+
+    def _logger(self) -> Callable[[PartRecord], None]:
+        """``done(part)``: a part is done; it is completed and handed on now if every part
+        before it is, else kept till then.  The log's hot path, hand-written for speed
+        (locals bound, the in-order part completed in the same call)."""
+        t, acct_part, flags_of = self.t, self.acct.part, self.flags.pop
+        spacing_in, tol = self.spacing_in, self.tol_in + 1e-9
+        note, pack = self.per_part.extend, _PACK_PER_PART
+        sink = self.sink
+        keep = self.rows.append if self.rows is not None else None
+        names_of = LIMIT_NAMES.get  # limit_names' cache, read first
+        waiting = self.waiting
+        following = 1  # the part to hand on next
+
+        def done(p: PartRecord) -> None:
+            nonlocal following
+            i = p.part
+            if i != following:
+                waiting[i] = p
+                return
+            while True:  # complete p (part i) and hand it on, then any waiting after it
+                t_next = t[i]
+                d = p.delivery_interval_s
+                p.ip_wallclock = t_next / d
+                acct_part(p, t_next)
+                flags = flags_of(i, 0)
+                sp = p.spacing_in
+                if sp == sp and abs(sp - spacing_in) > tol:
+                    flags |= SPACING_OFF
+                p.limits = (names_of(flags) or limit_names(flags)) if flags else ""
+                note(pack(p.touchdown_s, p.picked, p.r4_s, p.output_speed_in_s, d, sp, flags,
+                          p.feed_delay_s, i, p.arrival_s, p.at_bot_s, p.motion_cycle_s))
+                if keep is not None:
+                    keep(_row(p))
+                if sink is not None:
+                    sink(p)
+                i += 1
+                if not waiting or i not in waiting:
+                    following = i
+                    return
+                p = waiting.pop(i)
+
+        def skip_to(i: int) -> None:  # the parts before i will never be done (:meth:`flush`)
+            nonlocal following
+            following = i
+        self._skip_to = skip_to
+        return done
+
+    @property
+    def handed_on(self) -> int:
+        """Parts completed and handed on so far."""
+        return len(self.per_part) // (8 * len(PER_PART))
+
+    def flush(self) -> None:
+        """The run stopped with parts still in the cell: hand on those done after them."""
+        waiting = self.waiting
+        while waiting:
+            first = min(waiting)
+            self._skip_to(first)
+            self.delivered_part(waiting.pop(first))
+
+    def column(self, name: str, start: int = 0) -> np.ndarray:
+        """One of :data:`PER_PART`'s values of every part from ``start`` on (a copy)."""
+        table = np.frombuffer(self.per_part, dtype=np.float64).reshape(-1, len(PER_PART))
+        return np.ascontiguousarray(table[start:, PER_PART.index(name)])
+
+    def warmup(self, setting: int | str) -> int:
+        """The number of leading parts to leave out: ``setting``, or for ``auto`` the
+        MSER-5 truncation point of the delivery intervals (White 1997)."""
+        if setting != "auto":
+            return int(setting)
+        from cell.sim.warmup import mser5
+
+        interval = self.column("interval")
+        delivered = np.flatnonzero(np.isfinite(interval))
+        if delivered.size < 10:
+            return 0
+        cut = mser5(interval[delivered])
+        return int(delivered[cut]) if cut < delivered.size else 0
+
+
+def _seed_value(seed: Any) -> Any:
+    if isinstance(seed, np.random.SeedSequence):
+        return str(seed.entropy) + ("/" + ".".join(map(str, seed.spawn_key))
+                                    if seed.spawn_key else "")
+    return seed
+
+
+def simulate(scenario: Scenario | AssembledCell,
+             seed: int | np.random.SeedSequence | None = None, *, keep_parts: bool = True,
+             on_part: PartSink | None = None, on_belt: BeltSink | None = None,
+             keep_belts: bool = True) -> SimResult:
+    """Run ``run.parts`` parts (or ``run.hours`` of parts) through the cell under its policy.
+
+    ``seed``: int or SeedSequence; None means ``run.seed``.  Policies given the
+    same seed see the same inter-arrival times (common random numbers).
+    ``keep_parts`` / ``keep_belts``: keep every part's record / belt speed change
+    in the result (off for long runs, which stream them to ``on_part`` /
+    ``on_belt`` instead, as each becomes final: memory then stays flat).
+    """
+    cell = scenario if isinstance(scenario, AssembledCell) else assemble(scenario)
+    s, k, policy = cell.scenario, cell.k, cell.policy
+    seed = s.run.seed if seed is None else seed
+    # T_1 .. T_{n+1}: the last is only the last part's "next arrival".
+    t_all, n, horizon = run_arrivals(s, seed)
+    t_list: list[float] = t_all.tolist()
+
+    rows: list[tuple[Any, ...]] | None = [] if keep_parts else None
+    belts = BeltLog(keep_belts, on_belt)
+
+    acct = policy.accounting()
+    env = simpy.Environment()
+    log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows)
+    downtime = None if s.failures is None else Downtime(env, s.failures, seed)
+    wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
+    conveyor = InputConveyor(env, k.v_nom, k.input_length, belts.told(0),
+                             stoppable=downtime is not None)
+    output = OutputConveyor(env, k.u_nom, log.delivered_part, belts.told(1))
+    robot = Robot(env, output.placed, None if downtime is None else downtime.robot.cycle)
+    feeder = Feeder(env, t_list, conveyor, n, k.part_size, log.flag)
+    conveyor.feeder = feeder
+    view = _view(cell, seed, n, feeder, conveyor, output)
+    Controller(env, k, policy, view, conveyor, output, robot, log)
+    wear = wear_clock.alone(cell, robot, seed, downtime)  # wear: without failures (or None)
+    if downtime is None and horizon is None:
+        env.run()
+    else:
+        if downtime is not None:
+            downtime.attach(robot, conveyor, output, feeder, view, log)
+            downtime.start()
+        run_until_done(env, log, n, horizon, output)
+    conveyor.belt.close()
+    output.belt.close(until=env.now)  # a floor planned after the last touch-down never ran
+
+    summary = _summary(cell, log, acct, t_all, n, env.now)
+    lines = oee.measure(summary, log.column, downtime, k.fastest_cycle_s, env.now)
+    summary.seed = _seed_value(seed)
+    summary.input_speed_max_in_s = conveyor.belt.max_speed_in_s
+    summary.input_speed_min_in_s = conveyor.belt.min_speed_in_s
+    summary.parts_bound = parts_bound(k, feeder.fed_s[summary.warmup_parts:n])
+    result = SimResult(summary, rows, belts if keep_belts else None)
+    result.downtime, result.timelines = downtime, lines
+    result.wear = wear_clock.measures(wear, downtime, env.now)
+    return result
+
+
+def _view(cell: AssembledCell, seed: Any, n: int, feeder: Feeder, conveyor: InputConveyor,
+          output: OutputConveyor) -> View:
+    """What the controller sees: the feeder's schedule (``sensor.lookahead: ideal``), or only
+    what a physical sensor has reported (``sensor``)."""
+    s, k = cell.scenario, cell.k
+    if s.sensor.lookahead == "ideal":
+        return View(k, feeder.fed_s, n, conveyor, output)
+    position = sensor_position(s.sensor, k.input_length, s.source)
+    return SensorView(k, Sensor(s.sensor, position, conveyor, n, seed), n, conveyor, output)
+
+
+def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, n: int,
+             end_s: float) -> RunSummary:
+    """The run's measures over the parts after the warm-up (all of them by default)."""
+    s, k = cell.scenario, cell.k
+    w = log.warmup(s.run.warmup_parts)
+    td = log.column("touchdown", w)
+    picked = log.column("picked", w) != 0
+    vout = log.column("output_speed", w)[picked]
+    # each part's IP, as its record has it (T_{i+1} over its interval)
+    ip_wall = t[log.column("part", w).astype(np.int_)] / log.column("interval", w)
+    sp = log.column("spacing", w)
+    sp = sp[np.isfinite(sp)]
+    limits = log.column("limits", w).astype(np.int_)
+    delay = log.column("feed_delay", w)
+    done = td[np.isfinite(td)]
+    d = done.size
+    missed = int((~picked).sum())
+
+    def count(name: str) -> int:
+        return int(np.count_nonzero(limits & LIMIT_BIT[name]))
+
+    held = limits & LIMIT_BIT["held_at_feeder"] != 0
+    r = RunSummary(
+        scenario=s.name, policy=cell.policy.name, ideal_cycle_s=cell.policy.ideal_cycle_s,
+        parts_arrived=n - w, parts_delivered=d, parts_missed=missed,
+        parts_in_cell=n - w - d - missed - count("scrapped"),
+        actual_cycle_wallclock_s=float((done[-1] - done[0]) / (d - 1)) if d > 1 else math.nan,
+        ip_wallclock=float(np.nanmean(ip_wall)) if np.isfinite(ip_wall).any() else math.nan,
+        spacing_min_in=float(sp.min()) if sp.size else math.nan,
+        spacing_max_in=float(sp.max()) if sp.size else math.nan,
+        spacing_outside_tol=count("spacing_off"),
+        feed_delay_max_s=float(delay[held].max()) if held.any() else 0.0,
+        output_speed_min_in_s=float(vout.min()) if vout.size else math.nan,
+        output_speed_max_in_s=float(vout.max()) if vout.size else math.nan,
+        r1_nominal_s=k.r1_nom, r2_nominal_s=k.r2_nom, nominal_cycle_s=k.cycle_nom,
+        nominal_from=k.nominal_from, mean_interarrival_s=k.mean_interarrival_s,
+        fastest_cycle_s=k.fastest_cycle_s, offered_load=k.offered_load, warmup_parts=w,
+        sim_end_s=end_s)
+    for name, counted in LIMIT_COUNTS.items():
+        setattr(r, counted.field, count(name))
+    # every handed-on part's next inter-arrival time (all of T_2 … T_{n+1} unless the run
+    # stopped with parts in the cell)
+    acct.finish(r, w, log.column("r4", w)[picked], t[log.column("part").astype(np.int_)])
+    r.parts_per_hr_wallclock = float(accounting.parts_per_hr(r.actual_cycle_wallclock_s))
+    r.parts_per_hr_thesis = float(accounting.parts_per_hr(r.actual_cycle_thesis_s))
+    r.vavg_r4_in_s = k.timing.r4.length_in / r.r4_s if r.r4_s == r.r4_s else math.nan
+    return r

@@ -1,0 +1,246 @@
+"""The wear model in a run: the robot's five motors worn cycle by cycle (:mod:`cell.sim.wear`).
+
+Two ways in.  With ``wear:`` alone, :func:`alone` wraps the robot's orders: each cycle's
+stretch times wear the motors (:class:`WearClock`) and, when one wears out, the robot stops
+``wear.repair_h`` once it is back at B.  With ``failures.robot`` as well, the failures'
+robot clock counts the wear instead of a drawn time to failure (:class:`WearExposure`,
+:func:`count_on`): the robot stops mid-move, waits for a crew and is repaired for a
+drawn ``failures.robot.time_to_repair``, and failures.csv says ``wear``.  Either way the
+run's measures come back as :class:`WearResult` (:func:`measures`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Protocol
+
+import numpy as np
+
+from cell.scenario.arrivals import stream
+from cell.sim.wear import (
+    HOUR_S,
+    STRETCHES,
+    CycleWear,
+    WearModel,
+    draw_thresholds,
+    mean_life_h,
+    series_life_h,
+)
+
+if TYPE_CHECKING:
+    from cell.arm.steptable import StepTable
+    from cell.sim.robot import RobotTiming
+
+
+#: The wear clock's child stream of the run's root SeedSequence (the feeder's is 0; the
+#: key is far from the few that other random draws of a run take).
+WEAR_STREAM = 21
+JOINTS = ("base", "shoulder", "elbow", "pitch", "roll")
+
+
+def model_of(settings: WearSettingsLike) -> WearModel:
+    return WearModel(float(settings.exponent), float(settings.rated_life_h),
+                     float(settings.reference_stress), float(settings.shape))
+
+
+class WearSettingsLike(Protocol):
+    """What the wear clock reads of the scenario's ``wear:`` section."""
+
+    @property
+    def exponent(self) -> float: ...
+    @property
+    def rated_life_h(self) -> float: ...
+    @property
+    def reference_stress(self) -> float: ...
+    @property
+    def shape(self) -> float: ...
+    @property
+    def repair_h(self) -> float: ...
+
+
+class WearLog:
+    """A run's wear: the clock (a :class:`WearClock` or a :class:`WearExposure`), and each
+    stop for a worn motor (from_s, to_s, joint; joint -1 where the failures' log keeps none)."""
+
+    def __init__(self, clock: WearClock | WearExposure, repair_s: float):
+        self.clock, self.repair_s = clock, repair_s
+        self.stops: list[tuple[float, float, int]] = []
+
+    def row(self, end_s: float) -> dict[str, float]:
+        """The run's wear measures, one row (wear_* columns)."""
+        model = self.clock.wear.model
+        hours = end_s / HOUR_S
+        down_h = sum(min(b, end_s) - a for a, b, _ in self.stops if a < end_s) / HOUR_S
+        lives = [hours / e if e > 0 else math.inf for e in self.clock.total]
+        robot = series_life_h(lives, model.shape)
+        mtbf = mean_life_h(robot, model.shape)
+        out: dict[str, float] = {
+            "wear_exponent": model.exponent, "wear_failures": float(len(self.stops)),
+            "wear_down_h": down_h, "wear_hours": hours,
+            "wear_robot_life_h": robot, "wear_mtbf_h": mtbf,
+            "wear_availability": mtbf / (mtbf + self.repair_s / HOUR_S)
+            if math.isfinite(mtbf) else 1.0}
+        for name, life in zip(JOINTS, lives):
+            out[f"wear_life_{name}_h"] = life
+        return out
+
+
+def attach(table: StepTable, timing: RobotTiming, settings: WearSettingsLike, robot: Any,
+           seed: int | np.random.SeedSequence) -> WearLog:
+    """Wear ``robot``'s motors by every cycle it is ordered to run (the stretch times read
+    from the part's record and the order); when a motor wears out, the robot stops for
+    ``repair_h`` once that cycle is done (back at B), and the motor is replaced."""
+    clock = WearClock(CycleWear(table, timing, model_of(settings)), stream(seed, WEAR_STREAM))
+    log = WearLog(clock, float(settings.repair_h) * HOUR_S)
+    run, stops, repair_s, original = clock.cycle, log.stops, log.repair_s, robot.order
+    env = robot.env
+
+    def order(part: Any, to_lo_s: float, to_td_s: float, cycle_s: float) -> None:
+        r1, r2, r3 = part.r1_s, part.r2_s, part.r3_s
+        r3_pre = round(to_td_s - (r1 + r2), 9)  # B → TD less R I and R II
+        joint = run((to_lo_s, r1 - to_lo_s, r2, r3_pre, r3 - r3_pre, part.r4_s))
+        if joint >= 0:
+            back = env.now + cycle_s
+            stops.append((back, back + repair_s, joint))
+            clock.replace(joint)
+            cycle_s += repair_s
+        original(part, to_lo_s, to_td_s, cycle_s)
+
+    robot.order = order
+    return log
+
+
+class WearClock:
+    """The robot's five motors, each worn by the cycles it runs until it fails.
+
+    :meth:`cycle` adds a cycle's exposure and answers the motor that wore out in it (the
+    first whose exposure crossed its drawn threshold), or -1; :meth:`replace` starts that
+    motor again from zero with a new threshold.
+    """
+
+    def __init__(self, wear: CycleWear, rng: np.random.Generator):
+        self.wear, self.rng = wear, rng
+        self.total = [0.0] * 5
+        """Each motor's exposure over the whole run (for its life at this duty)."""
+        self.since = [0.0] * 5
+        """Each motor's total exposure when it was fitted."""
+        self.threshold: list[float] = draw_thresholds(rng, 5, wear.model).tolist()
+        """The exposure since fitting at which each motor wears out."""
+        self._due = list(self.threshold)
+        self._first = min(self._due)
+
+    @property
+    def exposure(self) -> list[float]:
+        """Each motor's exposure since it was fitted."""
+        return [t - s for t, s in zip(self.total, self.since)]
+
+    def cycle(self, times_s: Sequence[float]) -> int:
+        """Add a cycle's exposure: the motor that wore out in it, or -1."""
+        e = self.wear.of_times(times_s)
+        before = self.total
+        self.total = now = [x + y for x, y in zip(before, e)]
+        if max(now) < self._first:
+            return -1
+        due = self._due
+        over = [j for j in range(5) if now[j] >= due[j]]
+        if not over:
+            return -1
+        # the motor whose threshold the cycle reached first (the smallest share of the cycle)
+        return min(over, key=lambda j: (due[j] - before[j]) / e[j] if e[j] else 0.0)
+
+    def replace(self, joint: int) -> None:
+        """A new motor at ``joint``: exposure 0, a new threshold."""
+        self.since[joint] = self.total[joint]
+        self.threshold[joint] = float(draw_thresholds(self.rng, 1, self.wear.model)[0])
+        self._due[joint] = self.since[joint] + self.threshold[joint]
+        self._first = min(self._due)
+
+
+class WearExposure:
+    """The robot's failure clock counting motor wear (:class:`cell.sim.failures.Exposure`):
+    five budgets, one a motor (the exposure at which it wears out), each used at its
+    exposure per second of the leg the robot is in, told of each cycle's leg times as it
+    starts.  Within a leg the rate is the leg's mean, so a motor wears out at the leg's
+    end exposure exactly and in between by linear interpolation."""
+
+    cause = "wear"
+
+    def __init__(self, wear: CycleWear, rng: np.random.Generator):
+        self.wear, self.rng = wear, rng
+        self._rates: list[list[float]] = [[0.0] * 5 for _ in STRETCHES]
+        self.total = [0.0] * 5
+        """Each motor's exposure over the run's cycles (for its life at this duty)."""
+
+    def thresholds(self) -> list[float]:
+        return draw_thresholds(self.rng, 5, self.wear.model).tolist()
+
+    def renew(self, component: int) -> float:
+        return float(draw_thresholds(self.rng, 1, self.wear.model)[0])
+
+    def rates(self, leg: int) -> Sequence[float]:
+        return self._rates[leg] if leg >= 0 else (0.0,) * 5
+
+    def cycle(self, legs_s: Sequence[float]) -> None:
+        rates = self._rates
+        total = self.total
+        for i, (w, t) in enumerate(zip(self.wear.stretches, legs_s, strict=True)):
+            e = w.at_time(t)
+            rates[i] = [x / t for x in e] if t > 0 else [0.0] * 5
+            total = [a + b for a, b in zip(total, e)]
+        self.total = total
+
+
+def _exposure(table: StepTable, timing: RobotTiming, settings: WearSettingsLike,
+                      seed: int | np.random.SeedSequence) -> WearExposure:
+    """The robot's failure clock counting motor wear (``wear:`` with ``failures.robot``)."""
+    return WearExposure(CycleWear(table, timing, model_of(settings)), stream(seed, WEAR_STREAM))
+
+
+def failures_log(exposure: WearExposure, downtime: Any, failures: Any, end_s: float) -> WearLog:
+    """The wear measures of a run whose failures' robot clock counted ``exposure``: the stops
+    with cause ``wear`` from its log, the repair time's mean for the expected availability."""
+    from cell.scenario.failure_spec import frozen
+
+    log = WearLog(exposure, float(frozen(failures.robot.time_to_repair).mean()))
+    log.stops = [(a, b, -1) for name, cause, a, b, _ in downtime.all_stops(end_s)
+                 if name == "robot" and cause == "wear"]
+    return log
+
+
+@dataclass(frozen=True)
+class WearResult:
+    """A run's wear: its measures (wear_* columns) and its stops for a worn motor."""
+
+    measures: dict[str, float]
+    stops: list[tuple[float, float, int]] = field(default_factory=list)
+    """(from_s, to_s, joint) of each stop; joint -1 where the failures' log keeps none."""
+
+    def __getitem__(self, key: str) -> float:
+        return self.measures[key]
+
+
+def count_on(downtime: Any, cell: Any, seed: int | np.random.SeedSequence) -> None:
+    """Have the failures' robot clock count wear (before the failures are attached), if the
+    scenario asks for wear and the robot can fail."""
+    s = cell.scenario
+    if downtime is None or not s.wear.enabled or s.failures.robot is None:
+        return
+    downtime.robot_exposure = _exposure(cell.table, cell.timing, s.wear, seed)
+
+
+def alone(cell: Any, robot: Any, seed: int | np.random.SeedSequence,
+          downtime: Any) -> WearLog | None:
+    """``wear:`` without failures: the robot's orders wrapped (:func:`attach`); else None."""
+    if not cell.scenario.wear.enabled or downtime is not None:
+        return None
+    return attach(cell.table, cell.timing, cell.scenario.wear, robot, seed)
+
+
+def measures(wear: WearLog | None, downtime: Any, end_s: float) -> WearResult | None:
+    """The run's wear measures, whichever way the wear was counted (None: no wear)."""
+    exposure = getattr(downtime, "robot_exposure", None)
+    if isinstance(exposure, WearExposure):
+        wear = failures_log(exposure, downtime, downtime.spec, end_s)
+    return None if wear is None else WearResult(wear.row(end_s), wear.stops)

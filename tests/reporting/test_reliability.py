@@ -1,0 +1,71 @@
+"""The reliability study's report (cell.reporting.reliability; reports/reliability/)."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from cell.reporting import reliability as rel
+
+ROOT = Path(__file__).resolve().parents[2]
+REPORT = ROOT / "reports" / "reliability"
+
+
+def _table(mtbf_fixed: dict[float, float], mtbf_adaptive: float = 1000.0) -> pd.DataFrame:
+    """A made-up study table: the fixed robot's MTBF at its shortest cycle per exponent."""
+    rows = []
+    for p, short in mtbf_fixed.items():
+        for policy, cycle, mtbf in (("non-adaptive", 22.5872, 1500.0),
+                                    ("non-adaptive", 20.0907, short),
+                                    ("adaptive", np.nan, mtbf_adaptive)):
+            down = 4.0 * rel.YEAR_H / (mtbf + 4.0)
+            rows.append({"wear_exponent": p, "policy": policy, "cycle_s": cycle,
+                         "robot_mtbf_h": mtbf, "expected_down_h_per_year": down,
+                         "parts_per_h": 150.0 if policy == "adaptive" else 140.0,
+                         "oee": 0.9})
+    return pd.DataFrame(rows)
+
+
+def test_the_verdict_and_where_it_flips() -> None:
+    """log(MTBF ratio) −0.1 at p = 1 and +0.1 at p = 2 (ratio e^±0.1) crosses 0 at p = 1.5."""
+    t = _table({0.0: 1000 * np.exp(0.3), 1.0: 1000 * np.exp(0.1), 2.0: 1000 * np.exp(-0.1),
+                3.0: 1000 * np.exp(-0.3)})
+    v = rel.verdicts(t)
+    assert v["holds"].tolist() == [False, False, True, True]
+    assert v["mtbf_ratio"].iloc[3] == pytest.approx(np.exp(-0.3))
+    assert rel.flip_exponent(v) == pytest.approx(1.5)
+    text = rel.headline(t)
+    assert "only for exponents 2, 3 (it flips at p ≈ 1.50)" in text
+    assert f"{100 * (1 - np.exp(-0.3)):.0f} % shorter" in text
+
+
+def test_no_flip_when_the_fixed_robot_always_wears_faster() -> None:
+    t = _table({0.0: 900.0, 3.0: 500.0})
+    assert rel.flip_exponent(rel.verdicts(t)) is None
+    assert "holds for every exponent swept:" in rel.headline(t)
+
+
+def test_the_committed_report_says_what_its_numbers_say() -> None:
+    """README.md's headline and reading are those of reliability.csv, the table it was made from;
+    the repository's README quotes the headline's figures."""
+    t = pd.read_csv(REPORT / "reliability.csv")
+    assert set(t["wear_exponent"]) >= {0.0, 1.0}  # the exponent swept, 0 included
+    assert set(t["cycle_s"].dropna()) == {22.5872, 22.0, 21.5, 21.0, 20.5, 20.0907}
+    text = (REPORT / "README.md").read_text(encoding="utf-8")
+    for sentence in rel.reading(t):
+        assert sentence in text
+    assert (REPORT / "reliability.png").stat().st_size > 10_000
+    v = rel.verdicts(t)
+    worst = v.iloc[-1]
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    bullet = re.search(r"\*\*Motor wear\*\*.*?(?=\n- |\n\n)", readme, re.S)
+    assert bullet is not None
+    quoted = " ".join(bullet.group(0).split())
+    flip = rel.flip_exponent(v)
+    assert (f"p ≈ {flip:.2f}" in quoted) if flip is not None else ("no flip" in quoted)
+    assert f"{abs(100 * (1 - worst['mtbf_ratio'])):.0f} %" in quoted
+    assert f"{worst['down_fixed_h']:.1f} against {worst['down_adaptive_h']:.1f} h" in quoted

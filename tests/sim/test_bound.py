@@ -1,0 +1,84 @@
+"""The bound on any controller (cell/sim/bound.py, SPEC §11): a greedy pass over each part's
+window at B, worked by hand here, and never below what either policy delivers."""
+
+from __future__ import annotations
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from cell.scenario.schema import Scenario
+from cell.sim.assembly import assemble
+from cell.sim.bound import fastest_possible_cycle, greedy_picks
+from cell.sim.simulation import simulate
+from tests.sim.test_sensor import run_trace
+
+
+def test_the_greedy_pass_worked_by_hand() -> None:
+    """L = 12 in, belt 1..4 in/s, 1 in parts, picks 10 s apart: a part reaches B 3 to 12 s
+    after it is dropped.  Parts at 0, 1, 2, 3 and 50 s have windows [3, 12], [4, 13], [5, 14],
+    [6, 15], [53, 62]: picks at 3 and 13 take parts 1 and 2; 23 s is past the windows of 3
+    and 4; part 5 is picked at 53.  Three parts."""
+    assert greedy_picks([0, 1, 2, 3, 50], 12.0, 1.0, 4.0, 1.0, 10.0) == 3
+    # three parts at once: the feeder drops them 1 s apart (1 in at the floor), so the
+    # windows are [3, 12], [3, 13], [3, 14]: picks at 3 and 13; 23 is too late.
+    assert greedy_picks([0, 0, 0], 12.0, 1.0, 4.0, 1.0, 10.0) == 2
+    assert greedy_picks([], 12.0, 1.0, 4.0, 1.0, 10.0) == 0
+
+
+def test_the_fastest_cycle_is_below_every_cycle_the_robot_runs(thesis_cell: Scenario) -> None:
+    k = assemble(thesis_cell).k
+    c = fastest_possible_cycle(k)
+    assert c <= k.fastest_cycle_s
+    r = simulate(thesis_cell.with_overrides({"run.parts": 200}), seed=1)
+    assert r.parts["motion_cycle_s"].min() >= c
+
+
+def test_the_bound_is_the_deliveries_where_every_part_can_be_taken(thesis_cell: Scenario) -> None:
+    """Parts 25 s apart, longer than either robot's cycle: by hand, every part is picked by
+    both policies and no controller can deliver more than the 60 parts that came."""
+    s = thesis_cell.with_overrides({"run.parts": 60})
+    for policy in ("adaptive", "non-adaptive"):
+        r = run_trace(s.with_overrides({"controller.policy": policy}), [25.0] * 61).summary
+        assert r.parts_delivered == r.parts_bound == 60
+
+
+def test_the_bound_counts_a_burst_by_hand(thesis_cell: Scenario) -> None:
+    """Ten parts 0.1 s apart: the feeder spaces their drops by a part's size at the belt's
+    speed, and each has the window [drop + L / v_max, drop + L / v_min]; the picks, a fastest
+    cycle c apart from the first part's earliest, fit while r_1 + (j - 1) c <= d_j."""
+    s = thesis_cell.with_overrides({"run.parts": 10})
+    k = assemble(s).k
+    c = fastest_possible_cycle(k)
+    early, late, clear = k.input_length / k.input_max, k.input_length / k.input_min, \
+        k.part_size / k.input_min
+    come = [0.1 * i for i in range(10)]
+    drops = [come[0]]
+    for a in come[1:]:
+        drops.append(max(a, drops[-1] + clear))
+    by_hand = sum(1 for j in range(10) if early + j * c <= drops[j] + late)
+    assert 2 < by_hand < 10
+    r = run_trace(s, [0.1] * 11).summary
+    assert r.parts_bound == by_hand >= r.parts_delivered
+
+
+@settings(max_examples=12, deadline=None)
+@given(family=st.sampled_from(["gamma", "lognorm", "weibull_min"]),
+       cv=st.sampled_from([0.05, 0.5, 1.0]), load=st.floats(0.8, 1.4),
+       seed=st.integers(0, 10_000), sensor=st.booleans())
+def test_no_policy_delivers_more_than_the_bound(thesis_cell: Scenario, family: str, cv: float,
+                                                load: float, seed: int, sensor: bool) -> None:
+    s = thesis_cell.with_overrides({
+        "run.parts": 120, "arrivals.distribution": family, "arrivals.cv": cv,
+        "arrivals.mean_s": 18.0841 * load, "controller.nominal_cycle_s": None,
+        "sensor.lookahead": "sensor" if sensor else "ideal"})
+    for policy in ("adaptive", "non-adaptive"):
+        r = simulate(s.with_overrides({"controller.policy": policy}), seed=seed).summary
+        assert r.parts_delivered <= r.parts_bound <= r.parts_arrived
+
+
+@pytest.mark.parametrize("warmup", [0, 40])
+def test_the_bound_covers_the_parts_measured(thesis_cell: Scenario, warmup: int) -> None:
+    r = simulate(thesis_cell.with_overrides({"run.parts": 100, "run.warmup_parts": warmup}),
+                 seed=3).summary
+    assert r.parts_bound == r.parts_arrived == 100 - warmup

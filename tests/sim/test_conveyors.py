@@ -1,0 +1,84 @@
+"""Belts as speed schedules (cell.sim.conveyors): travel is the integral of speed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from cell.sim.conveyors import Belt
+
+
+def test_travel_integrates_piecewise_speeds():
+    b = Belt(3.0)
+    b.plan(10.0, 6.0, 20.0, 1.5)
+    assert b.travel(10.0) == pytest.approx(30.0)
+    assert b.travel(15.0) == pytest.approx(60.0)
+    assert b.travel(30.0) == pytest.approx(30.0 + 60.0 + 15.0)
+    assert b.speed(12.0) == 6.0 and b.speed(25.0) == 1.5
+
+
+def test_new_plan_supersedes_later_changes():
+    b = Belt(3.0)
+    b.plan(10.0, 6.0, 20.0, 1.5)
+    b.plan(15.0, 2.0)                   # replans from 15 s: the change at 20 s is gone
+    assert b.speed(25.0) == 2.0
+    assert b.travel(25.0) == pytest.approx(30.0 + 30.0 + 20.0)
+
+
+def test_a_plan_cannot_start_before_what_the_belt_holds():
+    b = Belt(3.0)
+    b.plan(10.0, 6.0, 20.0, 1.5)
+    b.plan(30.0, 2.0)                   # settles the changes before 20 s
+    with pytest.raises(ValueError, match="before its earliest held change"):
+        b.plan(5.0, 4.0)
+    assert b.speed(25.0) == 1.5 and b.speed(35.0) == 2.0  # the schedule is as it was
+    with pytest.raises(ValueError, match="before its earliest held change"):
+        Belt(3.0).plan(-1.0, 4.0)
+
+
+def test_travel_a_rounding_before_the_earliest_held_change():
+    """The controller may replan up to EPS_S before the robot's cycle ends, where the belt
+    changes speed; a replan then keeps only that change, and the belt's travel just before
+    it is still the travel there (it read the last change's line, far off)."""
+    b = Belt(3.0)
+    b.plan(10.0, 6.0, 20.0, 1.5)
+    b.plan(21.0, 4.0, 30.0, 2.0)        # settles the changes before 20 s
+    assert b.travel(20.0 - 3e-13) == pytest.approx(90.0, abs=1e-9)  # 3 x 10 + 6 x 10
+    assert b.speed(20.0 - 3e-13) == 1.5
+
+
+def test_speed_must_be_positive():
+    with pytest.raises(ValueError):
+        Belt(3.0).plan(1.0, 0.0)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(st.floats(0.1, 50.0), st.floats(0.05, 12.0)), min_size=1,
+                max_size=8),
+       st.floats(0.0, 400.0))
+def test_travel_is_the_integral_of_the_schedule_and_every_change_is_told(changes, later):
+    told: list[tuple[float, float]] = []
+    b = Belt(3.0, on_change=lambda t, v: told.append((t, v)))
+    now = 0.0
+    for dt, v in changes:
+        now += dt
+        b.plan(now, v)
+    t = now + later                       # a belt is asked about the present and the future
+    knots = [0.0] + list(np.cumsum([dt for dt, _ in changes]))
+    speeds = [3.0] + [v for _, v in changes]
+    x = sum(s * (min(t, hi) - lo) for lo, hi, s in zip(knots, knots[1:] + [np.inf], speeds)
+            if t > lo)
+    assert b.travel(t) == pytest.approx(x, rel=1e-9, abs=1e-9)
+    assert b.time_at(b.travel(t)) == pytest.approx(t, rel=1e-9, abs=1e-7)
+    b.close()
+    assert told == list(zip(knots, speeds))
+    assert b.max_speed_in_s == max(speeds)
+
+
+def test_only_the_schedule_ahead_is_kept():
+    b = Belt(3.0)
+    for i in range(1, 1000):
+        b.plan(float(i), 3.0 + i % 2)
+    assert b.held <= 2

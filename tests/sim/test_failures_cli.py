@@ -1,0 +1,64 @@
+"""``cell run`` with failures: states.csv, failures.csv and a summary with OEE (issue 21)."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from cell.cli.main import main
+
+FAILURES = ("failures={robot: {time_to_failure: {distribution: expon, params: {scale: 7200}}, "
+            "time_to_repair: {distribution: expon, params: {scale: 600}}, clock: calendar}}")
+
+
+def run(*argv: str) -> tuple[int, str]:
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+        code = main(list(argv))
+    return code, out.getvalue()
+
+
+def test_an_eight_hour_run_with_robot_failures_writes_where_the_time_went(tmp_path: Path):
+    out = tmp_path / "run"
+    code, text = run("run", "baseline", "--set", "run.hours=8", "--set", FAILURES,
+                     "--out", str(out))
+    assert code == 0
+    assert sorted(p.name for p in out.iterdir()) == [
+        "belts.csv", "failures.csv", "parts.csv", "states.csv", "summary.csv"]
+    summary = pd.read_csv(out / "summary.csv").iloc[0]
+    assert summary.sim_end_s == 8 * 3600.0
+    assert 0 < summary.availability < 1 and 0 < summary.oee < summary.availability
+    assert summary.oee == pytest.approx(summary.availability * summary.performance
+                                        * summary.quality, rel=1e-8)  # CSV keeps ten digits
+    assert summary.parts_arrived == summary.parts_delivered + summary.parts_missed + \
+        summary.parts_scrapped + summary.parts_in_cell
+    stops = pd.read_csv(out / "failures.csv")
+    assert list(stops.columns) == ["equipment", "cause", "from_s", "to_s", "part"]
+    assert (stops.equipment == "robot").all() and (stops.cause == "failure").all()
+    assert len(stops) == summary.robot_failures > 0
+    states = pd.read_csv(out / "states.csv")
+    assert list(states.columns) == ["equipment", "state", "from_s", "to_s"]
+    robot = states[states.equipment == "robot"]
+    # the robot's states tile the run: each begins where the last ended
+    assert robot.from_s.iloc[0] == 0 and robot.to_s.iloc[-1] == 8 * 3600.0
+    assert (robot.from_s.iloc[1:].to_numpy() == robot.to_s.iloc[:-1].to_numpy()).all()
+    assert set(robot.state) <= {"busy", "waiting", "idle", "down", "maintenance"}
+    down = robot[robot.state == "down"]
+    assert (down.to_s - down.from_s).sum() / (8 * 3600.0) == \
+        pytest.approx(summary.robot_down_fraction)
+    assert "availability" in text and "robot busy (in motion)" in text
+
+
+def test_without_failures_a_run_writes_its_three_files_and_the_busy_fraction(tmp_path: Path):
+    out = tmp_path / "run"
+    code, text = run("run", "baseline", "--set", "run.parts=30", "--out", str(out))
+    assert code == 0
+    assert sorted(p.name for p in out.iterdir()) == ["belts.csv", "parts.csv", "summary.csv"]
+    summary = pd.read_csv(out / "summary.csv").iloc[0]
+    assert summary.robot_down_fraction == 0 and summary.availability == 1
+    assert f"robot busy (in motion) {summary.robot_busy_fraction:.3f}" in text
+    assert f"offered load (fastest cycle / mean inter-arrival) {summary.offered_load:.3f}" in text

@@ -1,0 +1,178 @@
+"""The wear model (cell.sim.wear) against closed forms and scipy (SPEC §10; Nelson 1990)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from cell.arm.motors import max_rates
+from cell.plumbing.errors import ScenarioError
+from cell.scenario.schema import default_scenario
+from cell.sim.assembly import assemble
+from cell.sim.simulation import simulate
+from cell.sim.wear import (
+    STRETCHES,
+    CycleWear,
+    WearModel,
+    draw_thresholds,
+    exposure,
+    failure_probability,
+    series_life_h,
+)
+
+EXPONENTS = (0.0, 0.5, 1.0, 2.0, 3.0)
+
+
+@pytest.fixture(scope="module")
+def cell():
+    return assemble(default_scenario())
+
+
+@pytest.mark.parametrize("p", EXPONENTS)
+def test_constant_stress_integrates_to_time_over_life(p: float) -> None:
+    """ε = T / η(S) for a constant stress, η(S) = η0 (S0/S)^p."""
+    m = WearModel(exponent=p, rated_life_h=1000.0, reference_stress=0.75)
+    eps = exposure([3600.0 * 40], [0.9], m)
+    assert eps == pytest.approx(40 / (1000.0 * (0.75 / 0.9) ** p), rel=1e-12)
+    assert m.life_h(0.9) == pytest.approx(1000.0 * (0.75 / 0.9) ** p, rel=1e-12)
+
+
+@pytest.mark.parametrize("p", EXPONENTS)
+def test_linear_ramp_integrates_to_its_closed_form(p: float) -> None:
+    """S(t) = a + b t over [0, T]: ∫ (S/S0)^p / η0 dt = ((a+bT)^(p+1) − a^(p+1)) / (b (p+1) S0^p η0),
+    reached by the piecewise-constant sum as the moves get shorter (midpoint rule, O(1/N²))."""
+    a, b, hours, s0, eta0 = 0.2, 0.7 / 10.0, 10.0, 0.75, 500.0   # 0.2 → 0.9 over 10 h
+    m = WearModel(exponent=p, rated_life_h=eta0, reference_stress=s0)
+    closed = ((a + b * hours) ** (p + 1) - a ** (p + 1)) / (b * (p + 1) * s0 ** p * eta0)
+    errors = []
+    for n in (100, 1000):
+        edges = np.linspace(0.0, hours, n + 1)
+        mid = 0.5 * (edges[1:] + edges[:-1])
+        errors.append(abs(float(exposure(np.diff(edges) * 3600.0, a + b * mid, m)) - closed))
+    assert errors[1] <= 1e-6 * closed
+    if p not in (0.0, 1.0):  # the rule is exact for a linear integrand
+        assert errors[0] / errors[1] == pytest.approx(100.0, rel=0.05)
+
+
+@pytest.mark.parametrize("p", (0.0, 1.0, 2.5))
+def test_stretch_exposure_is_the_sum_over_its_moves(cell, p: float) -> None:
+    """The breakpoint form of each stretch equals Σ over its moves of t_k/η(S_jk), at
+    velocities from free to every move at its motor floor."""
+    t, timing = cell.table, cell.timing
+    m = WearModel(exponent=p)
+    wear = CycleWear(t, timing, m)
+    rows = t.segment_rows()
+    rated = max_rates(t.path.load_oz, t.motors, 1.0)
+    for name, w in zip(STRETCHES, wear.stretches, strict=True):
+        r = rows[name]
+        seg = getattr(timing, name)
+        for scale in (1.0, 1.3, 2.0, 4.0):
+            time_s = seg.floor_s * scale
+            v = seg.velocity(time_s)
+            tk = np.maximum(t.velocity_lengths[r] / v, t.peak_min_times[r])
+            stress = np.abs(t.steps[r]) / tk[:, None] / rated[r]
+            assert np.allclose(w.at_time(time_s), exposure(tk, stress, m), rtol=1e-10, atol=0)
+
+
+def test_r4_exposure_against_its_time_per_exponent(cell) -> None:
+    """R IV is base moves only, at one step rate up to the rounding of each chord's steps (23
+    or 24): its exposure scales as (time)^(1−p), to that rounding (0.1 %).
+    The fixed robot's shortest cycle (R IV at the peak, Table 7.1) against the nominal R IV:
+    p = 0 wears less (less time moving), p = 1 the same (life in steps), p = 2 more."""
+    r4 = STRETCHES.index("r4")
+    nominal, peak = cell.k.r4_nom, cell.timing.r4_min_s
+    for p in (0.0, 1.0, 2.0, 3.0):
+        w = CycleWear(cell.table, cell.timing, WearModel(exponent=p)).stretches[r4]
+        ratio = w.at_time(peak)[0] / w.at_time(nominal)[0]
+        assert ratio == pytest.approx((peak / nominal) ** (1 - p), rel=2e-3)
+        if p != 1.0:
+            assert (ratio < 1) == (p < 1)
+
+
+def test_weibull_in_exposure_at_constant_stress_is_scipy_weibull_min() -> None:
+    """At a constant stress, ε = t/η(S): failing at ε = E^(1/β) is Weibull(β, η(S)) in time."""
+    m = WearModel(exponent=2.0, rated_life_h=800.0, reference_stress=0.75, shape=1.7)
+    stress = 1.0
+    eta = m.life_h(stress)
+    lives = draw_thresholds(np.random.default_rng(7), 4000, m) * eta
+    assert stats.kstest(lives, stats.weibull_min(m.shape, scale=eta).cdf).pvalue > 0.01
+    hours = np.array([10.0, 200.0, 450.0, 2000.0])
+    eps = exposure(np.broadcast_to(hours * 3600.0, (1, 4)), np.full((1, 4), stress), m)
+    assert np.allclose(failure_probability(eps, m),
+                       stats.weibull_min.cdf(hours, m.shape, scale=eta), rtol=1e-12)
+
+
+def test_motors_in_series_are_weibull_of_the_combined_life() -> None:
+    lives, beta = [1000.0, 2500.0, 4000.0, math.inf], 2.0
+    eta = series_life_h(lives, beta)
+    t = np.array([100.0, 700.0, 1500.0])
+    product = np.prod([stats.weibull_min.sf(t, beta, scale=x) for x in lives[:3]], axis=0)
+    assert np.allclose(stats.weibull_min.sf(t, beta, scale=eta), product, rtol=1e-12)
+
+
+def test_wear_off_or_never_failing_leaves_the_run_unchanged() -> None:
+    base = default_scenario().with_overrides({"run.parts": 300})
+    off = simulate(base, keep_parts=False, keep_belts=False)
+    assert off.wear is None
+    never = simulate(base.with_overrides({"wear.enabled": True, "wear.rated_life_h": 1e7}),
+                     keep_parts=False, keep_belts=False)
+    assert never.summary == off.summary
+    assert never.wear is not None and never.wear["wear_failures"] == 0
+
+
+@pytest.mark.parametrize("policy", ("adaptive", "non-adaptive"))
+def test_a_worn_motor_stops_the_robot_for_its_repair(policy: str) -> None:
+    """Short lives: the robot stops; no part is picked while it is down, the parts that come
+    then ride off, and every part is still accounted for."""
+    s = default_scenario().with_overrides({
+        "run.parts": 1500, "controller.policy": policy, "wear.enabled": True,
+        "wear.rated_life_h": 0.5, "wear.repair_h": 0.1})
+    worn = simulate(s)
+    clean = simulate(s.with_overrides({"wear.enabled": False}))
+    assert worn.wear is not None and worn.wear["wear_failures"] == len(worn.wear.stops) > 2
+    picks = np.array([r.pick_s for r in worn.records if r.picked])
+    for start, end, joint in worn.wear.stops:
+        assert end - start == pytest.approx(360.0) and 0 <= joint < 5
+        assert not np.any((picks > start + 1e-9) & (picks < end - 1e-9))
+    w, c = worn.summary, clean.summary
+    assert w.parts_missed > c.parts_missed
+    assert w.parts_delivered + w.parts_missed + w.parts_in_cell == w.parts_arrived
+
+
+@pytest.mark.parametrize("key, value", (("wear.exponent", -1.0), ("wear.rated_life_h", 0.0),
+                                        ("wear.shape", 0.0), ("wear.repair_h", -2.0)))
+def test_bad_wear_values_name_the_key(key: str, value: float) -> None:
+    with pytest.raises(ScenarioError, match=key.replace(".", r"\.")):
+        default_scenario().with_overrides({key: value})
+
+
+def test_with_failures_the_robot_clock_counts_wear_and_logs_it() -> None:
+    """wear: with failures.robot: the failures' robot clock counts the motors' exposure
+    instead of its drawn time to failure; failures.csv's stops say ``wear``, each repaired for
+    the drawn time to repair, and the run's wear measures count them."""
+    s = default_scenario().with_overrides({
+        "run.parts": 800, "wear.enabled": True, "wear.rated_life_h": 0.5,
+        "failures": {"robot": {"time_to_failure": {"distribution": "expon",
+                                                   "params": {"scale": 1e9}},
+                               "time_to_repair": {"distribution": "uniform",
+                                                  "params": {"loc": 100.0, "scale": 100.0}}}}})
+    run = simulate(s, keep_parts=False, keep_belts=False)
+    stops = [x for x in run.stops() if x.equipment == "robot"]
+    assert len(stops) > 2 and {x.cause for x in stops} == {"wear"}
+    assert all(100.0 - 1e-9 <= x.to_s - x.from_s <= 200.0 + 1e-9 for x in stops[:-1])
+    assert run.wear is not None and run.wear["wear_failures"] == len(stops)
+    assert run.wear["wear_availability"] == pytest.approx(
+        run.wear["wear_mtbf_h"] / (run.wear["wear_mtbf_h"] + 150.0 / 3600.0))
+
+
+def test_wear_with_failures_but_no_robot_entry_is_refused() -> None:
+    with pytest.raises(ScenarioError, match=r"wear\.enabled.*failures\.robot"):
+        default_scenario().with_overrides({
+            "wear.enabled": True,
+            "failures": {"sensor": {"time_to_failure": {"distribution": "expon",
+                                                        "params": {"scale": 100.0}},
+                                    "time_to_repair": {"distribution": "expon",
+                                                       "params": {"scale": 10.0}}}}})
