@@ -22,12 +22,9 @@ cost per part does not grow with the run.
 
 from __future__ import annotations
 
-import functools
 import math
 import struct
-from array import array
 from collections.abc import Callable
-from operator import attrgetter
 from typing import Any
 
 import numpy as np
@@ -47,140 +44,22 @@ from cell.sim.records import (
     LIMIT_BIT,
     LIMIT_COUNTS,
     LIMIT_NAMES,
-    PART_COLUMNS,
     SPACING_OFF,
-    BeltChange,
     PartRecord,
     RunSummary,
-    StateSpan,
-    Stop,
     limit_names,
 )
 from cell.sim.robot import Robot
 from cell.sim.sensor import Sensor, sensor_position
+from cell.sim.sim_result import BeltLog, BeltSink, SimResult, part_row
+
+__all__ = ["PER_PART", "BeltLog", "BeltSink", "PartSink", "RunLog", "SimResult", "simulate"]
 
 PartSink = Callable[[PartRecord], Any]
-BeltSink = Callable[[BeltChange], Any]
-#: parts.csv's columns of a record, as a tuple.
-_row = attrgetter(*PART_COLUMNS)
-_BELTS = ("input", "output")
 #: What the run's log keeps of each part for the summary (flags and picked as floats).
 PER_PART = ("touchdown", "picked", "r4", "output_speed", "interval", "spacing", "limits",
             "feed_delay", "part", "arrival", "at_bot", "cycle")
 _PACK_PER_PART = struct.Struct(f"={len(PER_PART)}d").pack
-
-
-class SimResult:
-    """A run: its summary, and its part records and belt changes if they were kept.
-
-    Kept parts are held as tuples of plain values (which the cyclic garbage collector
-    stops tracking), belt changes as flat arrays; the record objects are made when
-    first asked for.
-    """
-    wear: wear_clock.WearResult | None = None  # with wear.enabled: its measures and stops
-
-    def __init__(self, summary: RunSummary, rows: list[tuple[Any, ...]] | None = None,
-                 belt_log: BeltLog | None = None):
-        self.summary = summary
-        self._rows = rows
-        self._belt_log = belt_log
-        self.downtime: Downtime | None = None
-        """The run's failures (None without a ``failures:`` section)."""
-        self.timelines: dict[str, list[tuple[str, float, float]]] = {}
-        """Each piece of equipment's (state, from_s, to_s) over the run."""
-
-    def state_spans(self) -> list[StateSpan]:
-        """states.csv's rows."""
-        return oee.state_spans(self.timelines)
-
-    def stops(self) -> list[Stop]:
-        """failures.csv's rows: every failure and planned stop, in order of start."""
-        if self.downtime is None:
-            return []
-        return [Stop(*row) for row in self.downtime.all_stops(self.summary.sim_end_s)]
-
-    @functools.cached_property
-    def records(self) -> list[PartRecord] | None:
-        """Every part's record, in part order (None if the run did not keep them)."""
-        return None if self._rows is None else [PartRecord(*row) for row in self._rows]
-
-    @functools.cached_property
-    def belt_changes(self) -> list[BeltChange]:
-        """Every belt speed change, the input belt's first, each belt's in time order."""
-        log = self._belt_log
-        if log is None:
-            return []
-        changes = [BeltChange(_BELTS[b], t, v) for b, t, v in zip(log.belt, log.t, log.v)]
-        changes.sort(key=lambda c: (c.belt != "input", c.from_s))
-        return changes
-
-    @property
-    def parts(self) -> Any:
-        """The part records as a pandas DataFrame (the columns of parts.csv)."""
-        import pandas as pd
-
-        if "records" in self.__dict__ and self.records is not None:
-            rows: Any = [_row(r) for r in self.records]
-        else:
-            rows = self._rows or []
-        return pd.DataFrame(rows, columns=PART_COLUMNS)
-
-    def belt_histories(self) -> dict[str, np.ndarray]:
-        """Each belt's speed changes as (m, 2) rows (from_s, speed_in_s), in time order: the
-        flat arrays the run kept, with no object made per change (a long run has millions)."""
-        log = self._belt_log
-        if log is None:
-            return {name: np.empty((0, 2)) for name in _BELTS}
-        which, rows = np.frombuffer(log.belt, dtype=np.int8), np.column_stack(
-            [np.frombuffer(log.t), np.frombuffer(log.v)]).reshape(-1, 2)
-        out = {}
-        for b, name in enumerate(_BELTS):
-            own = rows[which == b]
-            out[name] = own[np.argsort(own[:, 0], kind="stable")]
-        return out
-
-    @property
-    def belts(self) -> dict[str, list[tuple[float, float]]]:
-        """(instant, speed) of every speed change of the ``input`` and ``output`` belts."""
-        out: dict[str, list[tuple[float, float]]] = {"input": [], "output": []}
-        for c in self.belt_changes:
-            out[c.belt].append((c.from_s, c.speed_in_s))
-        return out
-
-
-class BeltLog:
-    """Belt speed changes as they become final: kept in flat arrays, and/or handed on."""
-
-    def __init__(self, keep: bool, sink: BeltSink | None):
-        self.belt, self.t, self.v = array("b"), array("d"), array("d")
-        self.keep, self.sink = keep, sink
-
-    def told(self, belt: int) -> Callable[[float, float], None] | None:
-        """What a belt calls with (instant, speed) of each final change (None: nobody asks)."""
-        if not self.keep and self.sink is None:
-            return None
-        mark, times, speeds, sink = self.belt.append, self.t.append, self.v.append, self.sink
-        last = [math.nan]  # the belt's speed so far: a "change" to the same speed is none
-
-        def keep(t: float, v: float) -> None:
-            mark(belt)
-            times(t)
-            speeds(v)
-        if sink is None:
-            told = keep
-        else:
-            name = _BELTS[belt]
-
-            def told(t: float, v: float) -> None:
-                if self.keep:
-                    keep(t, v)
-                sink(BeltChange(name, t, v))
-
-        def changed(t: float, v: float) -> None:
-            if v != last[0]:
-                last[0] = v
-                told(t, v)
-        return changed
 
 
 class RunLog:
@@ -247,7 +126,7 @@ class RunLog:
                 note(pack(p.touchdown_s, p.picked, p.r4_s, p.output_speed_in_s, d, sp, flags,
                           p.feed_delay_s, i, p.arrival_s, p.at_bot_s, p.motion_cycle_s))
                 if keep is not None:
-                    keep(_row(p))
+                    keep(part_row(p))
                 if sink is not None:
                     sink(p)
                 i += 1

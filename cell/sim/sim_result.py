@@ -1,0 +1,141 @@
+"""A run's result: its summary, and its part records and belt changes if they were kept
+(:class:`SimResult`), with the log the belt changes are kept in as they become final
+(:class:`BeltLog`).
+
+Kept parts are held as tuples of plain values, belt changes as flat arrays; the record
+objects are made when first asked for.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from array import array
+from collections.abc import Callable
+from operator import attrgetter
+from typing import Any
+
+import numpy as np
+
+from cell.sim import oee, wear_clock
+from cell.sim.failures import Downtime
+from cell.sim.records import PART_COLUMNS, BeltChange, PartRecord, RunSummary, StateSpan, Stop
+
+BeltSink = Callable[[BeltChange], Any]
+#: parts.csv's columns of a record, as a tuple.
+part_row = attrgetter(*PART_COLUMNS)
+_BELTS = ("input", "output")
+
+
+class SimResult:
+    """A run: its summary, and its part records and belt changes if they were kept.
+
+    Kept parts are held as tuples of plain values (which the cyclic garbage collector
+    stops tracking), belt changes as flat arrays; the record objects are made when
+    first asked for.
+    """
+    wear: wear_clock.WearResult | None = None  # with wear.enabled: its measures and stops
+
+    def __init__(self, summary: RunSummary, rows: list[tuple[Any, ...]] | None = None,
+                 belt_log: BeltLog | None = None):
+        self.summary = summary
+        self._rows = rows
+        self._belt_log = belt_log
+        self.downtime: Downtime | None = None
+        """The run's failures (None without a ``failures:`` section)."""
+        self.timelines: dict[str, list[tuple[str, float, float]]] = {}
+        """Each piece of equipment's (state, from_s, to_s) over the run."""
+
+    def state_spans(self) -> list[StateSpan]:
+        """states.csv's rows."""
+        return oee.state_spans(self.timelines)
+
+    def stops(self) -> list[Stop]:
+        """failures.csv's rows: every failure and planned stop, in order of start."""
+        if self.downtime is None:
+            return []
+        return [Stop(*row) for row in self.downtime.all_stops(self.summary.sim_end_s)]
+
+    @functools.cached_property
+    def records(self) -> list[PartRecord] | None:
+        """Every part's record, in part order (None if the run did not keep them)."""
+        return None if self._rows is None else [PartRecord(*row) for row in self._rows]
+
+    @functools.cached_property
+    def belt_changes(self) -> list[BeltChange]:
+        """Every belt speed change, the input belt's first, each belt's in time order."""
+        log = self._belt_log
+        if log is None:
+            return []
+        changes = [BeltChange(_BELTS[b], t, v) for b, t, v in zip(log.belt, log.t, log.v)]
+        changes.sort(key=lambda c: (c.belt != "input", c.from_s))
+        return changes
+
+    @property
+    def parts(self) -> Any:
+        """The part records as a pandas DataFrame (the columns of parts.csv)."""
+        import pandas as pd
+
+        if "records" in self.__dict__ and self.records is not None:
+            rows: Any = [part_row(r) for r in self.records]
+        else:
+            rows = self._rows or []
+        return pd.DataFrame(rows, columns=PART_COLUMNS)
+
+    def belt_histories(self) -> dict[str, np.ndarray]:
+        """Each belt's speed changes as (m, 2) rows (from_s, speed_in_s), in time order: the
+        flat arrays the run kept, with no object made per change (a long run has millions)."""
+        log = self._belt_log
+        if log is None:
+            return {name: np.empty((0, 2)) for name in _BELTS}
+        which, rows = np.frombuffer(log.belt, dtype=np.int8), np.column_stack(
+            [np.frombuffer(log.t), np.frombuffer(log.v)]).reshape(-1, 2)
+        out = {}
+        for b, name in enumerate(_BELTS):
+            own = rows[which == b]
+            out[name] = own[np.argsort(own[:, 0], kind="stable")]
+        return out
+
+    @property
+    def belts(self) -> dict[str, list[tuple[float, float]]]:
+        """(instant, speed) of every speed change of the ``input`` and ``output`` belts."""
+        out: dict[str, list[tuple[float, float]]] = {"input": [], "output": []}
+        for c in self.belt_changes:
+            out[c.belt].append((c.from_s, c.speed_in_s))
+        return out
+
+
+class BeltLog:
+    """Belt speed changes as they become final: kept in flat arrays, and/or handed on."""
+
+    def __init__(self, keep: bool, sink: BeltSink | None):
+        self.belt, self.t, self.v = array("b"), array("d"), array("d")
+        self.keep, self.sink = keep, sink
+
+    def told(self, belt: int) -> Callable[[float, float], None] | None:
+        """What a belt calls with (instant, speed) of each final change (None: nobody asks)."""
+        if not self.keep and self.sink is None:
+            return None
+        mark, times, speeds, sink = self.belt.append, self.t.append, self.v.append, self.sink
+        last = [math.nan]  # the belt's speed so far: a "change" to the same speed is none
+
+        def keep(t: float, v: float) -> None:
+            mark(belt)
+            times(t)
+            speeds(v)
+        if sink is None:
+            told = keep
+        else:
+            name = _BELTS[belt]
+
+            def told(t: float, v: float) -> None:
+                if self.keep:
+                    keep(t, v)
+                sink(BeltChange(name, t, v))
+
+        def changed(t: float, v: float) -> None:
+            if v != last[0]:
+                last[0] = v
+                told(t, v)
+        return changed
+
