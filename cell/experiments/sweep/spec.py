@@ -41,7 +41,7 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -56,18 +56,15 @@ from cell.experiments.sweep.options import (
     read_baseline,
     read_replications,
     reserved,
-    show,
     summary_measures,
 )
+from cell.experiments.sweep.overload import nominal_gap, overload_warning, overloaded
 from cell.experiments.sweep.policy_names import check_policy_names
 from cell.experiments.sweep.sweep_schema import SweepFile, read
 from cell.plumbing.errors import ScenarioError
 from cell.plumbing.progress import Progress
 from cell.scenario import registry
 from cell.scenario.schema import Scenario, known_key, load_scenario
-
-if TYPE_CHECKING:
-    from cell.sim.policies.base import CellConstants
 
 #: At most this many grid points, and this many runs (points x replications), in a sweep.
 MAX_POINTS = 100_000
@@ -77,7 +74,7 @@ SHOW_CHECKING = 1_000
 
 SWEEP_KEYS = tuple(SweepFile.model_fields)
 __all__ = ["RESERVED", "SWEEP_KEYS", "Baseline", "Pair", "Point", "Precision", "Sweep", "Task",
-           "load_sweep", "summary_measures"]
+           "load_sweep", "nominal_gap", "overload_warning", "overloaded", "summary_measures"]
 
 
 @dataclass(frozen=True)
@@ -341,31 +338,6 @@ def _points(path: Path, base: Scenario, fixed: dict[Any, Any], shared: dict[str,
     return points
 
 
-def overload_warning(sweep: Sweep) -> str | None:
-    """One line if some points' cells cannot keep up on average (offered load 1 or more,
-    as ``cell run`` warns of a run), naming the worst; else None."""
-    over = [p for p in sweep.points if p.offered_load >= 1]
-    if not over:
-        return None
-    worst = max(over, key=lambda p: p.offered_load)
-    where = ", ".join(f"{k} {worst.name_of(k) or show(v)}" for k, v in worst.values) \
-        or worst.policy
-    return overloaded(f"{len(over)} of {len(sweep.points)} points have offered load 1 or more "
-                      f"(up to {worst.offered_load:.3f}, at {where})")
-
-
-def overloaded(how_much: str, times_s: tuple[float, float] | None = None) -> str:
-    """The one line saying a cell cannot keep up on average (offered load 1 or more), opened
-    by ``how_much``: for a sweep's points (:func:`overload_warning`) and for a run
-    (:func:`cell.reporting.run_summary.warnings`, with its fastest cycle and mean inter-arrival
-    time, s)."""
-    fastest, mean = (f" ({times_s[0]:.2f} s)", f" ({times_s[1]:.2f} s)") if times_s else \
-        ("", " there")
-    return (f"{how_much}: the robot's fastest cycle{fastest} is not shorter than the mean "
-            f"inter-arrival time{mean}; the cell cannot keep up on average and every policy "
-            "will lose parts")
-
-
 def _check_point(scenario: Scenario, file: object) -> dict[str, float]:
     """Assemble a grid point's cell now, so that no bad point is found after work began;
     an error names the sweep file, with the key and value it was about.  Returns the
@@ -377,13 +349,6 @@ def _check_point(scenario: Scenario, file: object) -> dict[str, float]:
     except ScenarioError as exc:
         raise ScenarioError(file, exc.key, exc.value, exc.why) from None
     return {"offered_load": k.offered_load, "nominal_gap": nominal_gap(k)}
-
-
-def nominal_gap(k: CellConstants) -> float:
-    """How far the nominal cycle a scenario states is off its arrivals' mean, relative and
-    signed; NaN where the cycle follows the arrivals (or the robot): for
-    :attr:`Point.nominal_gap` and :func:`cell.reporting.run_summary.warnings`."""
-    return k.cycle_nom / k.mean_interarrival_s - 1 if k.nominal_from == "scenario" else math.nan
 
 
 def comparison(a: Scenario, b: Scenario, labels: tuple[str, str], replications: int, seed: int,
