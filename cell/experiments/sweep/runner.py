@@ -267,17 +267,13 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
     """
     out = check_out(out)
     workers = check_workers(workers, scheduler)
-    for warning in (overload_warning(sweep), window_warning(sweep) if warn_windows else None):
-        if warning:
-            print(f"cell: warning: {warning}", file=sys.stderr)
+    _warn(sweep, warn_windows)
     executor, client = _open_executor(workers, scheduler, progress)
     window = CLUSTER_WINDOW if scheduler else 2 * workers
     columns = grid_columns(sweep)
     task_dir = out / TASK_DIR
     counts = dict.fromkeys(range(len(sweep.points)), 0)
-    values: dict[int, list[float]] = {p: [] for p in counts}
     run = reused = 0
-    rounds: list[dict[int, tuple[int, int]]] = []  # each round's replications, by point
     fresh = not (out / MANIFEST).exists()
     try:
         prepare(sweep, out, resume)
@@ -298,40 +294,68 @@ def run_sweep(sweep: Sweep, out: str | Path, *, workers: int | None = None,
                     run += 1
                     yield task
 
-        ranges = {p: (0, sweep.first_round) for p in counts}
         with bar:
-            while ranges:
-                rounds.append(ranges)
-                _run_tasks(sweep, todo(ranges), replicate, executor, window, done)
-                for p, (_, last) in ranges.items():
-                    counts[p] = last
-                if sweep.precision is None:
-                    break
-                from cell.experiments.stats import next_round, precision_reached
-
-                q = sweep.precision
-                for task in sweep.iter_tasks(ranges):
-                    values[task.point] += measure_values(sweep, task_dir, task, q.measure)
-                reached = precision_reached(values, q.precision, q.confidence, q.min_n)
-                more = next_round(counts, reached, sweep.batch, q.max_n)
-                ranges = {p: (counts[p], counts[p] + k) for p, k in more.items() if k}
-                bar.grow(sum(more.values()))
+            rounds = _run_rounds(sweep, counts, bar, task_dir,
+                                 lambda ranges: _run_tasks(sweep, todo(ranges), replicate,
+                                                           executor, window, done))
         _close(executor, client, wait=True)
     except BaseException as exc:
-        _close(executor, client, wait=False)
-        if fresh:
-            _unmade(out)
-        if scheduler:
-            from cell.experiments.sweep.cluster import lost
-
-            if (gone := lost(scheduler, exc, out)) is not None:
-                raise gone from None
+        _abandon(exc, executor, client, out, fresh, scheduler)
         raise
     # The files the rounds wrote, point by point: a round's tasks start where it does
     # (``min`` need not be a multiple of ``batch``), not where cutting from 0 would.
     tasks = (t for p in counts for r in rounds if p in r for t in sweep.iter_tasks({p: r[p]}))
     path = assemble_results(sweep, task_dir, tasks, out / RESULT_FILES[result_format])
     return Outcome(path, run, reused, counts)
+
+
+def _warn(sweep: Sweep, warn_windows: bool) -> None:
+    """On stderr: points that cannot keep up on average, and compared points that count over
+    different windows (with ``warn_windows``)."""
+    for warning in (overload_warning(sweep), window_warning(sweep) if warn_windows else None):
+        if warning:
+            print(f"cell: warning: {warning}", file=sys.stderr)
+
+
+def _run_rounds(sweep: Sweep, counts: dict[int, int], bar: Progress, task_dir: Path,
+                run_round: Callable[[dict[int, tuple[int, int]]], None],
+                ) -> list[dict[int, tuple[int, int]]]:
+    """Every round of the sweep, run by ``run_round``: one, or under a precision rule as many
+    as it takes (``counts`` kept up to date); each round's replications, by point."""
+    values: dict[int, list[float]] = {p: [] for p in counts}
+    rounds: list[dict[int, tuple[int, int]]] = []  # each round's replications, by point
+    ranges = {p: (0, sweep.first_round) for p in counts}
+    while ranges:
+        rounds.append(ranges)
+        run_round(ranges)
+        for p, (_, last) in ranges.items():
+            counts[p] = last
+        if sweep.precision is None:
+            break
+        from cell.experiments.stats import next_round, precision_reached
+
+        q = sweep.precision
+        for task in sweep.iter_tasks(ranges):
+            values[task.point] += measure_values(sweep, task_dir, task, q.measure)
+        reached = precision_reached(values, q.precision, q.confidence, q.min_n)
+        more = next_round(counts, reached, sweep.batch, q.max_n)
+        ranges = {p: (counts[p], counts[p] + k) for p, k in more.items() if k}
+        bar.grow(sum(more.values()))
+    return rounds
+
+
+def _abandon(exc: BaseException, executor: Any, client: Any, out: Path, fresh: bool,
+             scheduler: str | None) -> None:
+    """A sweep failed or was stopped: its workers closed, nothing left behind if nothing was
+    there before, and a lost cluster said as one line (raised here)."""
+    _close(executor, client, wait=False)
+    if fresh:
+        _unmade(out)
+    if scheduler:
+        from cell.experiments.sweep.cluster import lost
+
+        if (gone := lost(scheduler, exc, out)) is not None:
+            raise gone from None
 
 
 def _unmade(out: Path) -> None:
