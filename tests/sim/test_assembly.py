@@ -12,7 +12,7 @@ opened = []
 sys.addaudithook(lambda event, args: opened.append(str(args[0])) if event == "open" else None)
 import cell.sim.assembly
 print([p for p in opened if p.endswith((".yaml", ".yml"))])
-from cell import catalog
+from cell.scenario import catalog
 from cell.scenario.schema import load_scenario
 load_scenario(catalog.path("baseline"))
 print([p for p in opened if p.endswith((".yaml", ".yml"))][:1])
