@@ -191,6 +191,12 @@ def format_summary(r: RunSummary, thesis: dict[str, str] | None = None) -> str:
     hit = [f"{label} {getattr(r, field)}" for field, label in LIMIT_COUNTS.values()
            if getattr(r, field)]
     add("limits hit (parts)", "; ".join(hit) if hit else "none", "{}")
+    if r.availability < 1.0:  # something stopped: where the planned time went (OEE)
+        from cell.sim.oee import loss_waterfall
+
+        steps = loss_waterfall(r.availability, r.performance, r.quality)
+        add("planned time lost to", "; ".join(f"{name} {share:.1%}" for name, share in steps[:-1])
+            + f"; left: OEE {steps[-1][1]:.1%}", "{}")
     if r.warmup_parts:
         add("warm-up left out, parts", r.warmup_parts, "{:d}")
     width = max(len(label) for label, _ in rows)

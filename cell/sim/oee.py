@@ -142,3 +142,20 @@ def measure(r: RunSummary, column: Callable[[str], np.ndarray], downtime: Any,
     r.mtbf_observed_s = robot_up_s / failures if failures else math.nan
     r.mttr_observed_s = share["down"] * end_s / failures if failures else math.nan
     return lines
+
+
+#: The steps of OEE's loss waterfall (Nakajima), in order.
+WATERFALL = ("downtime (availability)", "speed and waiting (performance)",
+             "spacing off (quality)")
+
+
+def loss_waterfall(availability: float, performance: float, quality: float
+                   ) -> list[tuple[str, float]]:
+    """OEE's loss waterfall: the share of the planned time lost at each step, then OEE.
+
+    Downtime costs 1 − A of the planned time, the robot's pace costs A (1 − P) of it, parts
+    set down off spacing A P (1 − Q); what is left is OEE = A P Q, so the four shares sum
+    to 1."""
+    a, p, q = availability, performance, quality
+    return [(WATERFALL[0], 1.0 - a), (WATERFALL[1], a * (1.0 - p)),
+            (WATERFALL[2], a * p * (1.0 - q)), ("OEE", a * p * q)]

@@ -308,3 +308,17 @@ def test_planned_stops_come_back_and_cost_the_parts_they_cover():
     busy_after = [x for x in res.state_spans() if x.equipment == "robot" and x.state == "busy"
                   and x.from_s > stops[-1].to_s]
     assert busy_after  # the robot works again after its last stop
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.floats(0, 1), st.floats(0, 1), st.floats(0, 1))
+def test_the_oee_loss_waterfall_adds_up_to_the_planned_time(a: float, p: float, q: float) -> None:
+    """Each step's loss is taken from what the step before left: the shares sum to 1 and
+    the last is A × P × Q (Nakajima)."""
+    from cell.sim.oee import loss_waterfall
+
+    steps = loss_waterfall(a, p, q)
+    assert [name for name, _ in steps][-1] == "OEE"
+    assert sum(share for _, share in steps) == pytest.approx(1.0, abs=1e-12)
+    assert steps[-1][1] == pytest.approx(a * p * q, abs=1e-15)
+    assert all(share >= -1e-15 for _, share in steps)
