@@ -26,6 +26,7 @@ if TYPE_CHECKING:
 
     from cell.experiments.sweep import Sweep
     from cell.experiments.sweep.spec import Point
+    from cell.reporting.formatting import Headline
     from cell.scenario.schema import Scenario
 
 HELP = "compare two scenarios, paired over common random numbers"
@@ -194,71 +195,26 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
     as a sentence with A its subject (``b better: a delivers 3.1 ± 0.4 parts fewer than b
     ...``).  Counts and extremes are not compared if A and B take them over different
     windows (run length, warm-up)."""
-    from cell.cli.compare_rates import overall, rate_free, rates_differ, still_sides
-    from cell.experiments.sweep.windows import window_kind, windows_apart
-    from cell.reporting.formatting import (
-        HEADLINES,
-        better,
-        half_width,
-        number,
-        plus_minus,
-        too_few,
-    )
+    from cell.cli.compare_rates import RATE_FREE, overall, rate_free, rates_differ, still_sides
+    from cell.experiments.sweep.windows import windows_apart
+    from cell.reporting.formatting import HEADLINES
 
     (la, a), (lb, b) = _sides(sweep)
     differ = windows_apart(a.scenario, b.scenario)
     demand = rates_differ(summary, la, lb)
     parts = a.scenario.run.parts if a.scenario.run.parts == b.scenario.run.parts else None
-    level = f"{sweep.confidence * 100:g} %"
-    length = (f" of {parts} part{'s' if parts != 1 else ''}" if parts else
-              f" of {a.scenario.run.parts} and {b.scenario.run.parts} parts")
-    lines = [f"{la} ({a.policy}) against {lb} ({b.policy}): {sweep.replications} replications"
-             f"{length}, seed {sweep.seed}, common random numbers; A - B with its paired "
-             f"{level} confidence interval"]
+    lines = [_verdict_header(sweep, la, a, lb, b, parts)]
     if demand:
         lines.append(f"  {demand}")
     lines += [f"  {w}" for w in still_sides(summary, la, lb)]
     apart = ", ".join(f"run.{k} {va} against {vb}" for k, va, vb in differ)
     sides: list[tuple[str, int]] = []
-    from cell.cli.compare_rates import RATE_FREE
-
     width = max(len(t) for t in [*(h.title for h in HEADLINES), *(r[0] for r in RATE_FREE)])
     for h in HEADLINES:
-        d = differences[differences["measure"] == h.column]
-        windowed = window_kind(h.column)
-        if windowed and differ and h.column in set(summary["measure"]):
-            lines.append(f"  {h.title:<{width}}  not compared: {windowed}, over different "
-                         f"windows ({apart}); compare the rates")
-            continue
-        if d.empty:
-            continue
-        row = d.iloc[0]
-        means = summary[summary["measure"] == h.column].set_index("scenario")["mean"]
-        mean, sd, lo, hi = (float(row[k]) for k in ("mean", "sd", "ci_low", "ci_high"))
-        if int(row["n"]) < 2:
-            lines.append(f"  {h.title:<{width}}  not compared: "
-                         f"{too_few(int(row['n']), sides='both A and B')}")
-            continue
-        if sd == 0.0:
-            what = (f"{la} and {lb} equal in every replication" if mean == 0 else
-                    f"{h.says(la, number(abs(mean)), mean, lb, parts)} in every replication")
-            judged = bool(mean != 0)
-        else:
-            judged = not (lo <= 0.0 <= hi)
-            what = (f"{h.says(la, plus_minus(abs(mean), half_width(row)), mean, lb, parts)} "
-                    + ("(interval excludes 0)" if judged else
-                       "(interval includes 0: no difference shown)"))
-        side = better(h, float(means[la]), float(means[lb])) if judged else 0
-        who = {1: f"{la} better", -1: f"{lb} better", 0: "neither"}[side]
-        if h.better == "one" and side:
-            who += " (nearer 1 is better)"
-        if demand and h.column in DEMAND_BOUND:
-            who = "not judged (arrival rates differ)"
-            side = 0
-        elif not (demand and h.column in DEMAND_BOUND):
-            sides.append((h.title, side))
-        shown = f"{number(float(means[la]))} against {number(float(means[lb]))}"
-        lines.append(f"  {h.title:<{width}}  {who}: {what}; means {shown}")
+        line = _headline_verdict(h, summary, differences, la, lb, parts, width,
+                                 apart if differ else None, bool(demand), sides)
+        if line is not None:
+            lines.append(line)
     if replications is not None:
         for title, side, line in rate_free(replications, sweep, la, lb, width):
             lines.append(line)
@@ -266,6 +222,70 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
                 sides.append((title, side))
     lines.append(overall(sides, la, lb, bool(demand)))
     return "\n".join(lines)
+
+
+def _verdict_header(sweep: Sweep, la: str, a: Point, lb: str, b: Point,
+                    parts: int | None) -> str:
+    """The verdict's first line: the two sides, the replications, run length and seed."""
+    level = f"{sweep.confidence * 100:g} %"
+    length = (f" of {parts} part{'s' if parts != 1 else ''}" if parts else
+              f" of {a.scenario.run.parts} and {b.scenario.run.parts} parts")
+    return (f"{la} ({a.policy}) against {lb} ({b.policy}): {sweep.replications} replications"
+            f"{length}, seed {sweep.seed}, common random numbers; A - B with its paired "
+            f"{level} confidence interval")
+
+
+def _headline_verdict(h: Headline, summary: pd.DataFrame, differences: pd.DataFrame, la: str,
+                      lb: str, parts: int | None, width: int, apart: str | None,
+                      demand: bool, sides: list[tuple[str, int]]) -> str | None:
+    """One headline measure's verdict line (None if it was not measured); its side (1: A
+    better, -1: B better, 0: neither) is appended to ``sides`` unless the arrival rates
+    differ and the measure grows with the demand.  ``apart``: how the runs' windows differ,
+    None if they do not."""
+    from cell.experiments.sweep.windows import window_kind
+    from cell.reporting.formatting import better, number, too_few
+
+    d = differences[differences["measure"] == h.column]
+    windowed = window_kind(h.column)
+    if windowed and apart is not None and h.column in set(summary["measure"]):
+        return (f"  {h.title:<{width}}  not compared: {windowed}, over different "
+                f"windows ({apart}); compare the rates")
+    if d.empty:
+        return None
+    row = d.iloc[0]
+    means = summary[summary["measure"] == h.column].set_index("scenario")["mean"]
+    if int(row["n"]) < 2:
+        return (f"  {h.title:<{width}}  not compared: "
+                f"{too_few(int(row['n']), sides='both A and B')}")
+    what, judged = _difference_said(h, row, la, lb, parts)
+    side = better(h, float(means[la]), float(means[lb])) if judged else 0
+    who = {1: f"{la} better", -1: f"{lb} better", 0: "neither"}[side]
+    if h.better == "one" and side:
+        who += " (nearer 1 is better)"
+    if demand and h.column in DEMAND_BOUND:
+        who = "not judged (arrival rates differ)"
+    else:
+        sides.append((h.title, side))
+    shown = f"{number(float(means[la]))} against {number(float(means[lb]))}"
+    return f"  {h.title:<{width}}  {who}: {what}; means {shown}"
+
+
+def _difference_said(h: Headline, row: pd.Series, la: str, lb: str,
+                     parts: int | None) -> tuple[str, bool]:
+    """A - B for one measure as a sentence with A its subject, and whether it is judged (the
+    paired interval excludes 0, or A and B differ by the same in every replication)."""
+    from cell.reporting.formatting import half_width, number, plus_minus
+
+    mean, sd, lo, hi = (float(row[k]) for k in ("mean", "sd", "ci_low", "ci_high"))
+    if sd == 0.0:
+        what = (f"{la} and {lb} equal in every replication" if mean == 0 else
+                f"{h.says(la, number(abs(mean)), mean, lb, parts)} in every replication")
+        return what, bool(mean != 0)
+    judged = not (lo <= 0.0 <= hi)
+    what = (f"{h.says(la, plus_minus(abs(mean), half_width(row)), mean, lb, parts)} "
+            + ("(interval excludes 0)" if judged else
+               "(interval includes 0: no difference shown)"))
+    return what, judged
 
 
 #: Measures that grow with the demand: with different arrival rates they say more parts

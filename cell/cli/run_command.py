@@ -45,7 +45,7 @@ def main(args: argparse.Namespace) -> int:
     from cell.plumbing.csvfile import RowWriter
     from cell.plumbing.output.atomic import OutputDir
     from cell.plumbing.progress import Progress
-    from cell.reporting.run_summary import format_summary, run_heading, thesis_figures
+    from cell.reporting.run_summary import run_heading
     from cell.reporting.unit_slips import run_warnings
     from cell.scenario.schema import inert_settings
     from cell.sim.assembly import assemble
@@ -69,18 +69,7 @@ def main(args: argparse.Namespace) -> int:
             Progress(n, "cell run", "parts", enabled=n >= PROGRESS_FROM_PARTS) as progress:
         with out.open("parts.csv", newline="") as pf, out.open("belts.csv", newline="") as bf:
             parts, belts = RowWriter(pf, PART_COLUMNS), RowWriter(bf, BELT_COLUMNS)
-            on_part: Callable[[Any], None] = parts.record
-            if progress.enabled:  # counted in chunks: a call per part would show in the run's time
-                step, write = max(1, n // 200), parts.record
-
-                def counted(record: Any) -> None:
-                    write(record)
-                    if record.part % step == 0:
-                        progress.update(step)
-
-                on_part = counted
-
-            result = simulate(cell, keep_parts=False, on_part=on_part,
+            result = simulate(cell, keep_parts=False, on_part=_on_part(parts, progress, n),
                               on_belt=belts.record, keep_belts=False)
             progress.update(n - progress.n)
         with out.open("summary.csv", newline="") as sf:
@@ -89,20 +78,41 @@ def main(args: argparse.Namespace) -> int:
             _write_failures(out, result)
         if args.format == "parquet":
             _as_parquet(out)
+    _report(args, scenario, result, out.target)
+    return 0
+
+
+def _on_part(parts: Any, progress: Any, n: int) -> Callable[[Any], None]:
+    """What each part's record goes to: its row in parts.csv and, on a run that shows its
+    progress, the count (in chunks: a call per part would show in the run's time)."""
+    if not progress.enabled:
+        return parts.record
+    step, write = max(1, n // 200), parts.record
+
+    def counted(record: Any) -> None:
+        write(record)
+        if record.part % step == 0:
+            progress.update(step)
+
+    return counted
+
+
+def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) -> None:
+    """The run's summary on stdout, OEE with failures, and the files written."""
+    from cell.reporting.run_summary import format_summary, thesis_figures
+
     print(format_summary(result.summary, thesis_figures(scenario)))
     r = result.summary
     print(f"robot busy (in motion) {r.robot_busy_fraction:.3f} of the run, beside its offered "
           f"load (fastest cycle / mean inter-arrival) {r.offered_load:.3f}")
-    shown = out.target
     written = RUN_FILES if args.format == "csv" else PARQUET_FILES
     if scenario.failures is None:
         print(f"wrote {shown}/{written[0]}, {written[1]} and {written[2]}")
-        return 0
+        return
     print(f"availability {r.availability:.4f}, performance {r.performance:.4f}, quality "
           f"{r.quality:.4f}: OEE {r.oee:.4f}; robot failures {r.robot_failures}, parts lost to "
           f"downtime {r.parts_lost_downtime}, scrapped {r.parts_scrapped}")
     print(f"wrote {shown}/{written[0]}, {written[1]}, {written[2]}, states.csv and failures.csv")
-    return 0
 
 
 def _write_failures(out: Any, result: Any) -> None:

@@ -109,6 +109,13 @@ def reading(t: pd.DataFrame) -> list[str]:
     ad = t[t["policy"] == "adaptive"].copy()
     fx = t[t["policy"] == "non-adaptive"].set_index(["family", "cv", "mean_s"])
     ad["verdict"] = ad.apply(verdict, axis=1)
+    return [*_claim(ad), *_regular(ad, fx), *_overloaded(ad, fx), *_spread(ad), *_slack(ad),
+            *promises(ad, fx)]
+
+
+def _claim(ad: pd.DataFrame) -> list[str]:
+    """The thesis's claim on the map (``ad``: the adaptive robot's points, with their
+    verdicts), and whether the property tests' margin is used."""
     n, counts = len(ad), ad["verdict"].value_counts()
     better, same, worse = (int(counts.get(v, 0)) for v in ("better", "same", "worse"))
     out = [
@@ -127,6 +134,12 @@ def reading(t: pd.DataFrame) -> list[str]:
     else:
         out.append("Its mean is nowhere below the fixed-cycle robot's, so the property tests' "
                    f"margin of {MARGIN_PARTS} parts is never used on this map.")
+    return out
+
+
+def _regular(ad: pd.DataFrame, fx: pd.DataFrame) -> list[str]:
+    """Regular parts with the robot fast enough: what each robot loses."""
+    out = []
     regular = ad[(ad["cv"] <= 0.1) & (ad["load"] >= 1.0)]
     if len(regular):
         lost_ad = regular["parts_lost"].max()
@@ -138,6 +151,12 @@ def reading(t: pd.DataFrame) -> list[str]:
             f"whose cycle is the arrivals' mean, loses {min(lost_fx):.1f}-{max(lost_fx):.1f}: every "
             "part that comes even slightly early reaches B while it is busy, and falls, whatever "
             "the mean (its losses do not change with the load, since its cycle scales with it).")
+    return out
+
+
+def _overloaded(ad: pd.DataFrame, fx: pd.DataFrame) -> list[str]:
+    """Offered load 1 or more: both lose parts; the throughput against the ceiling."""
+    out = []
     over = ad[ad["offered_load"] >= 1.0]
     if len(over):
         ceiling = 3600.0 * over.iloc[0]["load"] / over.iloc[0]["mean_s"]   # 3600 / fastest cycle
@@ -153,6 +172,12 @@ def reading(t: pd.DataFrame) -> list[str]:
             f"{over['limit_input_floor'].mean():.0f} reach B before it is back even though it "
             "slowed the input belt to its floor for them (limit_input_floor, counted on the part "
             "picked before each).")
+    return out
+
+
+def _spread(ad: pd.DataFrame) -> list[str]:
+    """Widely spread parts: the advantage shrinks, and why."""
+    out = []
     wide = ad[ad["cv"] >= 0.75]
     narrow = ad[(ad["cv"] <= 0.25) & (ad["load"] >= 1.0)]
     if len(wide) and len(narrow):
@@ -166,6 +191,12 @@ def reading(t: pd.DataFrame) -> list[str]:
             f"({wide['limit_input_floor'].mean():.0f} of the {wide['parts_lost'].mean():.0f} "
             "parts a run it loses), and some parts come so close that the feeder must hold them "
             f"back ({wide['parts_held'].mean():.1f} a run).")
+    return out
+
+
+def _slack(ad: pd.DataFrame) -> list[str]:
+    """More slack losing more parts than less, where it does."""
+    out = []
     slack = ad[ad["load"] >= 1.2]
     mid = ad[(ad["load"] > 1.0) & (ad["load"] < 1.2)]
     if len(slack) and len(mid) and slack["parts_lost"].mean() > mid["parts_lost"].mean():
@@ -175,7 +206,7 @@ def reading(t: pd.DataFrame) -> list[str]:
             f"{mid['parts_lost'].mean():.1f} at 1.05-1.1: it aims at the longer mean cycle, "
             "and the spread (proportional to the mean) gives more parts early by more than "
             "R IV and R II can give back before the belt reaches its floor.")
-    return out + promises(ad, fx)
+    return out
 
 
 def promises(ad: pd.DataFrame, fx: pd.DataFrame) -> list[str]:

@@ -180,8 +180,7 @@ def _parts_collection(linewidth: float, zorder: float) -> PolyCollection:
 
 def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene,
            span: tuple[float, float] | None) -> Panel:
-    s, p = scene.scenario, scene.table.path
-    w = s.cell.belt_width_in
+    """One run's column: title, header, the close-up and the belt strips, and what moves."""
     policy = scene.data.policy
     centre = (left_in + column_in / 2) / fig.get_size_inches()[0]
     fig.text(centre, 1 - 0.13 / HEIGHT_IN, POLICY_TITLES.get(policy, policy), ha="center",
@@ -194,7 +193,17 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene,
     in_bottom = close_bottom - GAP_IN - STRIP_IN
     strip_in = _axes(fig, left_in + 0.25, in_bottom, strip_w, STRIP_IN)
     strip_out = _axes(fig, left_in + 0.25, in_bottom - GAP_IN - STRIP_IN, strip_w, STRIP_IN)
-    # the close-up: Fig. 8's plan view
+    arm, parts, labels, texts = _close_up(fig, close, scene, span)
+    parts_in, parts_out, gaps, in_stretch = _strips(strip_in, strip_out, scene, strip_w)
+    return Panel(scene, parts, parts_in, parts_out, labels, arm, texts, gaps, in_stretch)
+
+
+def _close_up(fig: Figure, close: Axes, scene: Scene, span: tuple[float, float] | None
+              ) -> tuple[list[Any], PolyCollection, dict[int, Any], dict[str, Any]]:
+    """The close-up, Fig. 8's plan view, and what moves in it: the arm's three lines, the
+    parts, their labels (the parts shown in ``span``) and the clock, tally and state texts."""
+    s, p = scene.scenario, scene.table.path
+    w = s.cell.belt_width_in
     b, f = scene.b_xy, scene.f_xy
     close.add_patch(Rectangle((CLOSE_X[0] - 1, b[1] - w / 2), f[0] - CLOSE_X[0] + 1, w,
                               color=BELT_COLOUR, zorder=0))
@@ -235,7 +244,15 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene,
              "lost": close.text(0.02, 0.895, "", **mono),
              "belts": close.text(0.02, 0.845, "", **mono),
              "robot": close.text(0.02, 0.755, "", fontweight="bold", **mono)}
-    # the whole input belt, drop point to its end at F; the close-up's stretch dotted
+    return arm, parts, labels, texts
+
+
+def _strips(strip_in: Axes, strip_out: Axes, scene: Scene, strip_w: float
+            ) -> tuple[PolyCollection, PolyCollection, list[Any], float]:
+    """The whole input belt, drop point to F (the close-up's stretch dotted), and the output
+    belt unrolled along its y: parts, gap labels and the input strip's parts' stretch."""
+    s, b, f = scene.scenario, scene.b_xy, scene.f_xy
+    w = s.cell.belt_width_in
     drop = b[0] - scene.data.input_length_in
     x0, x1 = drop - 3, f[0] + 3
     _strip(strip_in, x0, x1, w, strip_w, {"drop": drop, "B": b[0], "F": f[0]},
@@ -244,7 +261,6 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene,
                                  lw=0.6, ls=":", zorder=1))
     parts_in = _parts_collection(0.4, 2)
     strip_in.add_collection(parts_in)
-    # the output belt unrolled along its y
     y_end = scene.output_end_y
     _strip(strip_out, w / 2, y_end, w, strip_w, {"TD": scene.td_xy[1], "K": s.path.eot_in[1]},
            "output belt, unrolled (y) →", y_end, "right")
@@ -253,7 +269,7 @@ def _panel(fig: Figure, left_in: float, column_in: float, scene: Scene,
     gaps = [strip_out.text(0, 0, "", fontsize=6.5, ha="center", va="center", color="0.1",
                            clip_on=True, zorder=3) for _ in range(4)]
     in_stretch = max(1.0, STRIP_MIN_PART * (x1 - x0) / s.part.size_in)
-    return Panel(scene, parts, parts_in, parts_out, labels, arm, texts, gaps, in_stretch)
+    return parts_in, parts_out, gaps, in_stretch
 
 
 def _figure_in(columns: int) -> tuple[float, float]:

@@ -89,36 +89,8 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
     r3a, r3b, r4 = k.r3_pre_nom, k.r3_post_nom, k.r4_nom
     cycle = r1a + r1b + r2 + r3a + r3b + r4
     w = v
-    m = k.lookahead_margin_s  # the next part aimed at B this long after the robot is back
     if nxt is not None:
-        a, b = nxt
-        eta = a + b / v                       # 3.0: next arrival at the current speed
-        if eta > cycle + m:                       # 3.1: late; speed the belt up after the lag
-            w = b / (cycle + m - a) if cycle + m > a else math.inf
-            if w > k.input_max:
-                w = k.input_max
-                flags |= INPUT_CEILING
-        elif eta < cycle + m:                     # 3.2: early; R IV first, then the belt
-            need = cycle + m - eta
-            if r4 - need >= t.r4_min_s:
-                r4 -= need
-                cycle -= need
-            else:
-                cycle -= r4 - t.r4_min_s
-                r4 = t.r4_min_s
-                flags |= R4_PEAK
-                w = b / (cycle + m - a)
-                if w < k.input_min:           # departure: the belt's floor, R II first
-                    over = cycle + m - (a + b / k.input_min)  # the cycle past the floor's arrival
-                    spare = min(r2 - t.r2_min_s, over)
-                    if spare > 0:
-                        r2 -= spare
-                        cycle -= spare
-                        w = b / (cycle + m - a)
-                    if w < k.input_min:  # also by a rounding once R II took it all up
-                        w = k.input_min
-                        if spare < over:  # R II could not: the next part comes early
-                            flags |= INPUT_FLOOR
+        w, r2, r4, cycle, flags = aim_next(k, nxt, v, r2, r4, cycle, flags)
     # 6.3: decay toward nominal after the cycle; departure: never below what R II absorbs.
     v_next = 0.5 * (w + k.v_nom) if w > k.v_nom else \
         (k.input_absorb if k.input_absorb > w else w)  # max(w, absorb)
@@ -137,6 +109,51 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
         u, ttsot, cycle, flags, True
     plan.output_floor_at = floor_at(k, nxt, w, v_next, cycle, ttsot + r3a)
     return plan
+
+
+def aim_next(k: CellConstants, nxt: tuple[float, float], v: float, r2: float, r4: float,
+             cycle: float, flags: int) -> tuple[float, float, float, float, int]:
+    """Thesis §5.3 steps 3.0-3.2: aim the next part ``nxt = (a, b)`` (as in
+    :func:`adaptive_plan`) at B a look-ahead margin after the robot is back.
+
+    Late (3.1): the input belt speeds up after the lag, up to its ceiling.  Early (3.2):
+    the time is made up in R IV down to its fastest, then the input belt slows; departure
+    (docs/model.md): no further than its floor, R II (down to its fastest) taking time off
+    first, and a part still too early is let go.  Returns the input speed after LO ``w``,
+    R II, R IV, the cycle and ``flags`` with the limits hit added.
+    """
+    t = k.timing
+    w = v
+    m = k.lookahead_margin_s  # the next part aimed at B this long after the robot is back
+    a, b = nxt
+    eta = a + b / v                       # 3.0: next arrival at the current speed
+    if eta > cycle + m:                       # 3.1: late; speed the belt up after the lag
+        w = b / (cycle + m - a) if cycle + m > a else math.inf
+        if w > k.input_max:
+            w = k.input_max
+            flags |= INPUT_CEILING
+    elif eta < cycle + m:                     # 3.2: early; R IV first, then the belt
+        need = cycle + m - eta
+        if r4 - need >= t.r4_min_s:
+            r4 -= need
+            cycle -= need
+        else:
+            cycle -= r4 - t.r4_min_s
+            r4 = t.r4_min_s
+            flags |= R4_PEAK
+            w = b / (cycle + m - a)
+            if w < k.input_min:           # departure: the belt's floor, R II first
+                over = cycle + m - (a + b / k.input_min)  # the cycle past the floor's arrival
+                spare = min(r2 - t.r2_min_s, over)
+                if spare > 0:
+                    r2 -= spare
+                    cycle -= spare
+                    w = b / (cycle + m - a)
+                if w < k.input_min:  # also by a rounding once R II took it all up
+                    w = k.input_min
+                    if spare < over:  # R II could not: the next part comes early
+                        flags |= INPUT_FLOOR
+    return w, r2, r4, cycle, flags
 
 
 def output_speed(k: CellConstants, gap_in: float, ttsot: float, r3a: float,
