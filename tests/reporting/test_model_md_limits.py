@@ -57,17 +57,15 @@ def test_a_limit_that_binds_is_its_mean_per_run(adaptive: pd.DataFrame, addition
     assert adaptive.loc[measure, "mean"] > 0
 
 
-def test_the_output_floor_is_counted_over_all_runs(adaptive: pd.DataFrame) -> None:
-    cell = phrase("floor: {} parts in {} runs, each set down off the {} ± {} in spacing; "
-                  "ceiling never").search(column()["output belt floor and ceiling"])
-    assert cell is not None
-    assert float(cell[1]) == pytest.approx(n_times(adaptive, "limit_output_floor"))
-    assert float(cell[1]) == pytest.approx(n_times(adaptive, "spacing_outside_tol"))
-    assert int(cell[2]) == adaptive.loc["limit_output_floor", "n"]
-    assert adaptive.loc["limit_output_ceiling", "mean"] == 0
-    text = prose(MODEL)
-    said = phrase("R IV at its peak and, {} times in {} runs, the output belt's floor").search(text)
-    assert said is not None and said.groups() == cell.groups()[:2]
+def test_the_output_floor_never_binds_under_the_spacing_contract(adaptive: pd.DataFrame) -> None:
+    """With the output belt steered over the whole interval between touch-downs, Table 7.1's
+    adaptive runs never leave it at its floor or ceiling, and no part lands off spacing; the
+    table and the prose say so (before the contract: 3 parts in 200 runs)."""
+    cell = column()["output belt floor and ceiling"]
+    assert "with the spacing contract: never" in cell and "ceiling never" in cell
+    for measure in ("limit_output_floor", "limit_output_ceiling", "spacing_outside_tol"):
+        assert n_times(adaptive, measure) == 0, measure
+    assert "the output belt's floor (with the spacing contract)" in prose(MODEL)
 
 
 @pytest.mark.parametrize(("addition", "measures"), [
