@@ -26,7 +26,6 @@ reading uses the expected figures, which do not depend on how the few stops fell
 from __future__ import annotations
 
 import io
-import sys
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -35,8 +34,9 @@ import numpy as np
 import pandas as pd
 
 from cell.plumbing.output.atomic import OutputDir
+from cell.reporting import map_report
 
-FILES = ("reliability.csv", "reliability.png", "README.md")
+FILES = map_report.files("reliability")
 #: Hours of a year of two shifts (250 days × 16 h), what downtime is quoted per.
 YEAR_H = 4000.0
 FIXED, ADAPTIVE = "non-adaptive", "adaptive"
@@ -261,16 +261,10 @@ def overview(t: pd.DataFrame) -> list[str]:
 
 
 def write(replications: str | Path, out_dir: str | Path) -> Path:
-    OutputDir.check(out_dir, FILES, option="DIR")
+    map_report.check(out_dir, "reliability")
     reps = pd.read_csv(replications)
     t = table(reps)
-    text, png = markdown(t, reps), figure(t)
-    with OutputDir(out_dir, FILES, option="DIR") as out:
-        out.write_csv("reliability.csv", t)
-        with out.open("reliability.png", "wb") as fh:
-            fh.write(png)
-        out.write_text("README.md", text)
-    return Path(out_dir)
+    return map_report.write_set(out_dir, "reliability", t, figure(t), markdown(t, reps))
 
 
 def run(sweep_file: str | Path, build: str | Path, out_dir: str | Path,
@@ -285,10 +279,4 @@ def run(sweep_file: str | Path, build: str | Path, out_dir: str | Path,
 
 
 if __name__ == "__main__":  # pragma: no cover
-    from cell.plumbing.errors import CellError
-
-    try:
-        print(f"wrote {run(sys.argv[1], sys.argv[2], sys.argv[3])}")
-    except CellError as exc:
-        print(f"cell.reporting.reliability: error: {exc}", file=sys.stderr)
-        sys.exit(2)
+    map_report.command_line("cell.reporting.reliability", run, 3)

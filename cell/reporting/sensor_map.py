@@ -18,16 +18,15 @@ from __future__ import annotations
 
 import io
 import math
-import sys
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
 from cell.experiments.stats import paired_difference, summarise
-from cell.plumbing.output.atomic import OutputDir
+from cell.reporting import map_report
 
-FILES = ("sensor.csv", "sensor.png", "README.md")
+FILES = map_report.files("sensor")
 #: A sensor's qualities as the sweep names them (``range_70``, ``noise_1``, ...): the column,
 #: the figure's axis label and how the reading words a value.
 AXES = {"range": ("range_in", "range, in before B", "a range of {:.4g} in"),
@@ -240,24 +239,11 @@ def drop_point(reps: pd.DataFrame) -> float:
 
 
 def write(replications: str | Path, out_dir: str | Path) -> Path:
-    OutputDir.check(out_dir, FILES, option="DIR")
+    map_report.check(out_dir, "sensor")
     reps = pd.read_csv(replications)
     t = table(reps, drop_point(reps))
-    text = markdown(t, str(replications))
-    png = figure(t)
-    with OutputDir(out_dir, FILES, option="DIR") as out:
-        out.write_csv("sensor.csv", t)
-        with out.open("sensor.png", "wb") as fh:
-            fh.write(png)
-        out.write_text("README.md", text)
-    return Path(out_dir)
+    return map_report.write_set(out_dir, "sensor", t, figure(t), markdown(t, str(replications)))
 
 
 if __name__ == "__main__":  # pragma: no cover
-    from cell.plumbing.errors import CellError
-
-    try:
-        print(f"wrote {write(*sys.argv[1:3])}")
-    except CellError as exc:
-        print(f"cell.reporting.sensor_map: error: {exc}", file=sys.stderr)
-        sys.exit(2)
+    map_report.command_line("cell.reporting.sensor_map", write, 2)

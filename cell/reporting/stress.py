@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import io
 import math
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -27,11 +26,11 @@ import numpy as np
 import pandas as pd
 
 from cell.experiments.stats import paired_difference, summarise
-from cell.plumbing.output.atomic import OutputDir
+from cell.reporting import map_report
 from cell.sim.records import LIMIT_COUNTS
 
 KEYS = ("arrivals.distribution", "arrivals.cv", "arrivals.mean_s")
-FILES = ("stress.csv", "stress.png", "README.md")
+FILES = map_report.files("stress")
 POLICIES = ("non-adaptive", "adaptive")
 #: The limits counted in stress.csv (their summary columns, cell.sim.records.LIMIT_COUNTS).
 LIMITS = tuple(LIMIT_COUNTS[name].field for name in ("input_floor", "r4_peak", "r2_peak",
@@ -325,24 +324,11 @@ def markdown(t: pd.DataFrame, source: str) -> str:
 
 
 def write(replications: str | Path, out_dir: str | Path) -> Path:
-    OutputDir.check(out_dir, FILES, option="DIR")
+    map_report.check(out_dir, "stress")
     reps = pd.read_csv(replications)
     t = table(reps)
-    text = markdown(t, str(replications))
-    png = figure(t)
-    with OutputDir(out_dir, FILES, option="DIR") as out:
-        out.write_csv("stress.csv", t)
-        with out.open("stress.png", "wb") as fh:
-            fh.write(png)
-        out.write_text("README.md", text)
-    return Path(out_dir)
+    return map_report.write_set(out_dir, "stress", t, figure(t), markdown(t, str(replications)))
 
 
 if __name__ == "__main__":  # pragma: no cover
-    from cell.plumbing.errors import CellError
-
-    try:
-        print(f"wrote {write(*sys.argv[1:3])}")
-    except CellError as exc:
-        print(f"cell.reporting.stress: error: {exc}", file=sys.stderr)
-        sys.exit(2)
+    map_report.command_line("cell.reporting.stress", write, 2)

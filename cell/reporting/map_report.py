@@ -1,0 +1,45 @@
+"""A map's report folder, shared by the stress, sensor and reliability maps: its table as CSV,
+its figure as PNG and its README, written as one set, and the ``python -m`` entry that makes it
+(one line and exit 2 on bad input)."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+import pandas as pd
+
+from cell.plumbing.output.atomic import OutputDir
+
+
+def files(name: str) -> tuple[str, str, str]:
+    """The folder's files: NAME.csv, NAME.png and README.md."""
+    return f"{name}.csv", f"{name}.png", "README.md"
+
+
+def check(out_dir: str | Path, name: str) -> None:
+    """Refuse before any work a folder that cannot take the set."""
+    OutputDir.check(out_dir, files(name), option="DIR")
+
+
+def write_set(out_dir: str | Path, name: str, table: pd.DataFrame, png: bytes, text: str) -> Path:
+    """The table, figure and reading, appearing together or not at all."""
+    csv, figure, readme = files(name)
+    with OutputDir(out_dir, files(name), option="DIR") as out:
+        out.write_csv(csv, table)
+        with out.open(figure, "wb") as fh:
+            fh.write(png)
+        out.write_text(readme, text)
+    return Path(out_dir)
+
+
+def command_line(module: str, make: Callable[..., Path], count: int) -> None:
+    """``python -m MODULE ARG...``: make the report from the first ``count`` arguments."""
+    from cell.plumbing.errors import CellError
+
+    try:
+        print(f"wrote {make(*sys.argv[1:1 + count])}")
+    except (CellError, OSError) as exc:  # bad input, or a replications file not there
+        print(f"{module}: error: {exc}", file=sys.stderr)
+        sys.exit(2)
