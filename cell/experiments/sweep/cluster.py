@@ -169,13 +169,17 @@ def connect(address: str, timeout_s: float | None = None) -> Any:
                            f"{exc})") from None
 
 
-def lost(address: str, exc: BaseException, out: object) -> CellError | None:
+def lost(address: str, exc: BaseException, out: object, client: Any = None) -> CellError | None:
     """The one line for a sweep whose scheduler went away (``exc``, what the sweep met),
-    or None if ``exc`` is not that."""
+    or None if ``exc`` is not that.  With the ``client``: whatever error the sweep met once it
+    is no longer connected (dask's own bookkeeping can fail in any way as the scheduler goes:
+    a ValueError in its futures was seen) counts as the scheduler gone."""
     import concurrent.futures as cf
 
     names = {c.__name__ for c in type(exc).__mro__}
-    if not (isinstance(exc, (cf.CancelledError, OSError, TimeoutError))
+    gone = (client is not None and isinstance(exc, Exception) and not isinstance(exc, CellError)
+            and getattr(client, "status", "running") != "running")
+    if not (gone or isinstance(exc, (cf.CancelledError, OSError, TimeoutError))
             or names & {"CommClosedError", "FutureCancelledError", "CancelledError"}):
         return None
     return CellError(f"--scheduler {address}: the scheduler went away during the sweep "

@@ -348,14 +348,16 @@ def _abandon(exc: BaseException, executor: Any, client: Any, out: Path, fresh: b
              scheduler: str | None) -> None:
     """A sweep failed or was stopped: its workers closed, nothing left behind if nothing was
     there before, and a lost cluster said as one line (raised here)."""
+    gone = None
+    if scheduler:  # judged before our own close, which would make any client look gone
+        from cell.experiments.sweep.cluster import lost
+
+        gone = lost(scheduler, exc, out, client)
     _close(executor, client, wait=False)
     if fresh:
         _unmade(out)
-    if scheduler:
-        from cell.experiments.sweep.cluster import lost
-
-        if (gone := lost(scheduler, exc, out)) is not None:
-            raise gone from None
+    if gone is not None:
+        raise gone from None
 
 
 def _unmade(out: Path) -> None:
