@@ -64,7 +64,8 @@ def _completed(db: Path) -> int:
 
 
 def test_a_killed_optimize_resumes_without_losing_or_repeating_a_trial(tmp_path: Path) -> None:
-    text = FIXED.replace("TRIALS", "8").replace("run.parts: 60", "run.parts: 400")
+    # trials long enough (8,000 parts each) that the kill lands between the 3rd and the 8th
+    text = FIXED.replace("TRIALS", "8").replace("run.parts: 60", "run.parts: 4000")
     path = _study(tmp_path, text)
     out = tmp_path / "out"
     cmd = [sys.executable, "-m", "cell", "optimize", str(path), "--out", str(out)]
