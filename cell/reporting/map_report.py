@@ -4,9 +4,11 @@ its figure as PNG and its README, written as one set, and the ``python -m`` entr
 
 from __future__ import annotations
 
+import io
 import sys
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pandas as pd
 
@@ -21,6 +23,13 @@ def files(name: str) -> tuple[str, str, str]:
 def check(out_dir: str | Path, name: str) -> None:
     """Refuse before any work a folder that cannot take the set."""
     OutputDir.check(out_dir, files(name), option="DIR")
+
+
+def png_bytes(fig: Any) -> bytes:
+    """A figure as PNG bytes with no software stamp, so the same figure is the same file."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", metadata={"Software": None})
+    return buf.getvalue()
 
 
 def write_set(out_dir: str | Path, name: str, table: pd.DataFrame, png: bytes, text: str) -> Path:

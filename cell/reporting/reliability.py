@@ -25,7 +25,6 @@ reading uses the expected figures, which do not depend on how the few stops fell
 
 from __future__ import annotations
 
-import io
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -219,9 +218,7 @@ def figure(t: pd.DataFrame) -> bytes:
         ax.legend(fontsize=7)
     fig.suptitle("Throughput against downtime as the fixed cycle shortens "
                  "(scenarios/reliability.yaml; labels: the fixed cycle, s)", fontsize=11)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", metadata={"Software": None})
-    return buf.getvalue()
+    return map_report.png_bytes(fig)
 
 
 def markdown(t: pd.DataFrame, reps: pd.DataFrame) -> str:

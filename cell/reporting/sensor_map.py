@@ -16,7 +16,6 @@ robot once, on the thesis's arrivals and on widely spread ones) this writes, as 
 
 from __future__ import annotations
 
-import io
 import math
 from pathlib import Path
 from typing import Any
@@ -200,9 +199,7 @@ def figure(t: pd.DataFrame) -> bytes:
     axes[0].legend(fontsize=7)
     fig.suptitle("The adaptive robot's advantage against its sensor (scenarios/sensor.yaml; "
                  "95 % paired intervals)", fontsize=11)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", metadata={"Software": None})
-    return buf.getvalue()
+    return map_report.png_bytes(fig)
 
 
 def markdown(t: pd.DataFrame, source: str) -> str:

@@ -17,7 +17,6 @@ times, each given by its mean and coefficient of variation) this writes, as one 
 
 from __future__ import annotations
 
-import io
 import math
 from pathlib import Path
 from typing import Any
@@ -298,9 +297,7 @@ def figure(t: pd.DataFrame) -> bytes:
             fig.colorbar(im, ax=ax, shrink=0.8)
     fig.suptitle("The stress map: both policies, 500 parts a run, 20 replications a point "
                  "(scenarios/stress.yaml)", fontsize=12)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", metadata={"Software": None})
-    return buf.getvalue()
+    return map_report.png_bytes(fig)
 
 
 def markdown(t: pd.DataFrame, source: str) -> str:
