@@ -2,7 +2,8 @@
 
 In a cycle the joints move linearly in time between the path's points, as
 :func:`cell.reporting.animation.scene.build_scene` timed them (eq. 6.7); between cycles the
-robot waits at B.  The arm's pose is the forward kinematics of those joints.
+robot waits at B, and while it is stopped (``failures:``, ``wear:``) the arm stands still.
+The arm's pose is the forward kinematics of those joints.
 """
 
 from __future__ import annotations
@@ -44,14 +45,15 @@ def robot_state(scene: Scene, t: ArrayLike) -> RobotState:
     out = np.tile(values[0], (len(t), 1))
     regime = np.zeros(len(t), dtype=np.int64)
     part = np.full(len(t), -1, dtype=np.int64)
-    times = scene.cycle_t_s
+    times, clock = scene.cycle_t_s, scene.clock
     if len(times):
         k = np.searchsorted(times[:, 0], t, side="right") - 1
         active = (k >= 0) & (t <= times[np.maximum(k, 0), -1])
         for c in np.unique(k[active]):
             sel = active & (k == c)
             tc = t[sel]
-            out[sel] = np.column_stack([np.interp(tc, times[c], values[:, j])
+            run, at = clock.operating(tc), clock.operating(times[c])  # still while stopped
+            out[sel] = np.column_stack([np.interp(run, at, values[:, j])
                                         for j in range(values.shape[1])])
             move = np.clip(np.searchsorted(times[c], tc, side="left"), 1, p.n_points - 1)
             regime[sel] = p.regime[move]

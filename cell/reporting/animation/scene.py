@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -28,6 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cell.arm.steptable import StepTable
 from cell.reporting.animation.arm_pose import ArmPose, RobotState, robot_at
+from cell.reporting.animation.stops import OperatingClock
 from cell.scenario.schema import Scenario
 
 Floats = NDArray[np.float64]
@@ -163,6 +165,11 @@ class Scene:
     """(equipment, cause, from_s, to_s) of every stop of the run: a failure, a worn motor, a
     planned stop (failures.csv's rows)."""
 
+    @cached_property
+    def clock(self) -> OperatingClock:
+        """The robot's operating clock: its moves' time, its stops taken out."""
+        return OperatingClock.of(self.stops)
+
     def stopped_at(self, t: float) -> dict[str, tuple[str, float]]:
         """The equipment stopped at instant t: name -> (cause, seconds until it is back)."""
         return {name: (cause, end - t) for name, cause, start, end in self.stops
@@ -207,12 +214,14 @@ def build_scene(data: AnimationInput, table: StepTable, scenario: Scenario,
     every one before them)."""
     from cell.reporting.figures.motion import record_segments, timeline
 
-    ends = data.start_s + np.nansum(data.regime_s, axis=1)
+    clock = OperatingClock.of(stops)  # the regime times leave the robot's stops out
+    start, pick, td = (clock.operating(v) for v in (data.start_s, data.pick_s, data.touchdown_s))
+    ends = clock.wall(start + np.nansum(data.regime_s, axis=1))
     cycles = np.flatnonzero(data.picked & (ends >= from_s))
     t_s = np.empty((len(cycles), table.path.n_points))
     for row, i in enumerate(cycles):
-        seg = record_segments(data.start_s[i], data.pick_s[i], data.touchdown_s[i], data.regime_s[i])
-        t_s[row] = data.start_s[i] + timeline(table, seg).t_s
+        seg = record_segments(start[i], pick[i], td[i], data.regime_s[i])
+        t_s[row] = clock.wall(start[i] + timeline(table, seg).t_s)
     to_f = data.input_length_in + float(scenario.path.f_in[0] - scenario.path.bot_in[0])
     x_drop = travel(data.input_belt, data.arrival_s)
     fall = np.where(data.picked, np.nan, time_at(data.input_belt, x_drop + to_f))

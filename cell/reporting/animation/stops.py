@@ -1,14 +1,20 @@
 """A frame's stopped equipment (``failures:``, ``wear:``): marked, with its repair clock.
 
 The robot stopped is drawn in red with what stopped it and when it is back; a stopped belt
-says so beside its speed; a failed sensor under the robot's line.
+says so beside its speed; a failed sensor under the robot's line.  While the robot is stopped
+its arm stands where the stop caught it: :class:`OperatingClock` is the robot's clock with its
+stops taken out, the clock its moves are timed on (parts.csv's regime times leave the stops out).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
 from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 #: How a stop's cause reads on a frame.
 STOP_WORDS = {"failure": "breakdown", "wear": "worn motor", "maintenance": "maintenance"}
@@ -57,3 +63,55 @@ def mark_stops(down: Mapping[str, tuple[str, float]], texts: Mapping[str, Any],
             line.set_color(DOWN_COLOUR)
     if "sensor" in words:
         texts["robot"].set_text(texts["robot"].get_text() + "\n" + words["sensor"])
+
+
+@dataclass(frozen=True)
+class OperatingClock:
+    """The robot's operating time: wall time less the robot's stops before it.
+
+    ``operating`` is flat through a stop (the arm stands still) and ``wall`` is its inverse,
+    giving for an operating instant the earliest wall instant that reaches it (a stop's
+    start, not its end)."""
+
+    start_s: NDArray[np.float64]
+    """(k,) the stops' starts, sorted, overlapping stops merged."""
+    end_s: NDArray[np.float64]
+    """(k,) their ends."""
+
+    @classmethod
+    def of(cls, stops: Iterable[tuple[str, str, float, float]]) -> OperatingClock:
+        """The clock of a run's stops, (equipment, cause, from_s, to_s): the robot's only."""
+        spans = sorted((a, b) for name, _, a, b in stops if name == "robot" and b > a)
+        merged: list[list[float]] = []
+        for a, b in spans:
+            if merged and a <= merged[-1][1]:
+                merged[-1][1] = max(merged[-1][1], b)
+            else:
+                merged.append([a, b])
+        pair = np.asarray(merged, dtype=float).reshape(-1, 2)
+        return cls(pair[:, 0].copy(), pair[:, 1].copy())
+
+    @property
+    def _down_before(self) -> NDArray[np.float64]:
+        """(k + 1,) the stops' time before each stop, and in all."""
+        return np.concatenate([[0.0], np.cumsum(self.end_s - self.start_s)])
+
+    def operating(self, t: ArrayLike) -> NDArray[np.float64]:
+        """The operating instant of each wall instant t."""
+        t = np.asarray(t, dtype=float)
+        if not len(self.start_s):
+            return t
+        cum = self._down_before
+        k = np.searchsorted(self.start_s, t, side="right")
+        inside = (k > 0) & (t < self.end_s[np.maximum(k - 1, 0)])
+        frozen = self.start_s[np.maximum(k - 1, 0)] - cum[np.maximum(k - 1, 0)]
+        return np.where(inside, frozen, t - cum[k])
+
+    def wall(self, x: ArrayLike) -> NDArray[np.float64]:
+        """The earliest wall instant whose operating instant is x."""
+        x = np.asarray(x, dtype=float)
+        if not len(self.start_s):
+            return x
+        cum = self._down_before
+        k = np.searchsorted(self.start_s - cum[:-1], x, side="left")
+        return x + cum[k]
