@@ -36,8 +36,8 @@ RUN_FILES = ("parts.csv", "summary.csv", "belts.csv")
 FAILURE_FILES = ("states.csv", "failures.csv")
 #: The same, as ``--format parquet`` writes them.
 PARQUET_FILES = ("parts.parquet", "summary.parquet", "belts.parquet")
-#: Runs of at least this many parts show their progress on stderr (a bar on a terminal,
-#: a line every tenth of the run in a log).
+#: Runs of at least this many parts (or, with ``run.hours``, expected parts) show their
+#: progress on stderr (a bar on a terminal, a line every tenth of the run in a log).
 PROGRESS_FROM_PARTS = 50_000
 
 
@@ -47,6 +47,7 @@ def main(args: argparse.Namespace) -> int:
     from cell.plumbing.progress import Progress
     from cell.reporting.run_summary import run_heading
     from cell.reporting.unit_slips import run_warnings
+    from cell.scenario.run_length import expected_parts
     from cell.scenario.schema import inert_settings
     from cell.sim.assembly import assemble
     from cell.sim.records import BELT_COLUMNS, PART_COLUMNS, SUMMARY_COLUMNS
@@ -64,14 +65,16 @@ def main(args: argparse.Namespace) -> int:
         print(planner_line(scenario))
     for line in [*run_warnings(cell), *(inert_settings(scenario) if timed else [])]:
         print(f"cell: warning: {line}", file=sys.stderr)
-    n = scenario.run.parts
+    n = round(expected_parts(scenario))  # run.hours: about that many
     with OutputDir(args.out, names) as out, \
             Progress(n, "cell run", "parts", enabled=n >= PROGRESS_FROM_PARTS) as progress:
         with out.open("parts.csv", newline="") as pf, out.open("belts.csv", newline="") as bf:
             parts, belts = RowWriter(pf, PART_COLUMNS), RowWriter(bf, BELT_COLUMNS)
             result = simulate(cell, keep_parts=False, on_part=_on_part(parts, progress, n),
                               on_belt=belts.record, keep_belts=False)
-            progress.update(n - progress.n)
+            done = result.summary.parts_arrived if scenario.run.hours is not None else n
+            progress.grow(done - progress.total)
+            progress.update(done - progress.n)
         with out.open("summary.csv", newline="") as sf:
             RowWriter(sf, SUMMARY_COLUMNS).record(result.summary)
         if scenario.failures is not None:

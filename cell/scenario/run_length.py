@@ -23,7 +23,15 @@ def check_hours(s: Any, default_parts: int, file: object) -> None:
                             f"({s.run.parts}), not both")
     from cell.scenario.sections import MAX_PARTS
 
-    expected = hours * SECONDS_PER_HOUR / mean_interarrival(s.arrivals, s.base_dir)
+    expected = expected_parts(s)
     if expected > MAX_PARTS:
         raise ScenarioError(file, "run.hours", hours, f"about {expected:.3g} parts would come; "
                             f"at most {MAX_PARTS:g} a run")
+
+
+def expected_parts(s: Any) -> float:
+    """The parts a run brings: ``run.parts``, or about ``run.hours`` over the mean
+    inter-arrival time (what an hours-long run's progress counts towards)."""
+    if s.run.hours is None:
+        return float(s.run.parts)
+    return float(s.run.hours * SECONDS_PER_HOUR / mean_interarrival(s.arrivals, s.base_dir))

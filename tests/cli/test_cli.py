@@ -237,3 +237,19 @@ def test_cell_docs_reads_the_pages_its_output_refers_to(tmp_path, capsys):
     assert main(["docs", "nope"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "'nope'" in err[0] and "accounting" in err[0]
+
+
+def test_an_hours_long_run_shows_its_progress_towards_the_parts_expected(
+        tmp_path, monkeypatch, capsys):
+    """``run.hours`` gives no part count: the progress counts towards the parts expected
+    (hours over the mean inter-arrival time) and ends at the parts that came."""
+    from cell.cli import run_command
+
+    monkeypatch.setattr(run_command, "PROGRESS_FROM_PARTS", 50)
+    assert main(["run", "baseline", "--set", "run.hours=2", "--out", str(tmp_path / "o")]) == 0
+    arrived = int(pd.read_csv(tmp_path / "o" / "summary.csv")["parts_arrived"][0])
+    lines = [ln for ln in capsys.readouterr().err.splitlines() if ln.startswith("cell run: ")]
+    assert lines, "a log gets progress lines"
+    assert lines[-1].startswith(f"cell run: {arrived:,}/{arrived:,} parts (100 %), done in ")
+    first_total = int(lines[0].split("/")[1].split()[0].replace(",", ""))
+    assert abs(first_total - arrived) < 0.25 * arrived  # 2 h over the mean gap, about
