@@ -253,7 +253,3 @@ def next_round(counts: Mapping[K, int], reached: Mapping[K, bool], batch: int,
         raise ValueError(f"max_n must be at least 1, got {max_n!r}")
     return {key: 0 if reached.get(key, False) else max(0, min(batch, max_n - n))
             for key, n in counts.items()}
-
-
-# the warm-up rule, which a run applies itself, re-exported for experiments
-from cell.sim.warmup import mser, mser5, mser_statistic  # noqa: E402, F401

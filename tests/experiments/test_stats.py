@@ -12,9 +12,6 @@ from hypothesis import strategies as st
 from scipy import stats
 
 from cell.experiments.stats import (
-    mser,
-    mser5,
-    mser_statistic,
     next_round,
     no_variation,
     paired_difference,
@@ -22,6 +19,7 @@ from cell.experiments.stats import (
     relative_half_width,
     summarise,
 )
+from cell.sim.warmup import mser, mser5, mser_statistic
 
 
 # --------------------------------------------------------------------------- summarise
