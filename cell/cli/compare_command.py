@@ -129,9 +129,11 @@ def main(args: argparse.Namespace) -> int:
     from cell.experiments.sweep import run_sweep, simulate_summary
     from cell.experiments.sweep.spec import MAX_RUNS, comparison
     from cell.plumbing.errors import CellError
+    from cell.plumbing.output.paths import check_umask
     from cell.scenario.overrides import parse_sets
     from cell.scenario.schema import load_scenario
 
+    check_umask("cell compare's temporary folder")  # the runs go there, --out or not
     sets = parse_sets(args.sets)
     if args.policy is not None:
         sets["controller.policy"] = args.policy

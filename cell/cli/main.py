@@ -164,6 +164,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             import shutil
 
             shutil.rmtree(made[0], ignore_errors=True)
+            with contextlib.suppress(OSError):  # made, not yet opened to its owner (umask)
+                os.rmdir(made[0])
         stops.restore()
     if code in (INTERRUPTED, TERMINATED) and argv is None:
         exit_now(code)
@@ -232,7 +234,10 @@ def _matplotlib_home(made: list[str]) -> None:
         if not os.path.isabs(base):
             base = os.path.join(os.path.expanduser("~"), ".config")
         wanted = os.path.join(base, "matplotlib")
-    if os.path.isabs(wanted) and _usable(wanted):
+    from cell.plumbing.output.paths import umask_blocks
+
+    blocked = umask_blocks()  # what matplotlib would make, it could not write in
+    if os.path.isabs(wanted) and _usable(wanted) and not (blocked and not os.path.isdir(wanted)):
         return
     import tempfile
 
@@ -248,6 +253,12 @@ def _matplotlib_home(made: list[str]) -> None:
             made.clear()
             continue
         except OSError:
+            break
+        try:
+            os.chmod(made[0], 0o700)  # the owner's, whatever the umask took
+        except OSError:
+            with contextlib.suppress(OSError):
+                os.rmdir(made[0])
             break
         os.environ["MPLCONFIGDIR"] = made[0]
         return
