@@ -6,6 +6,8 @@ evenly spaced, on an output conveyor while parts arrive at random.  The maths
 processes are thin shells around them.
 """
 
+# First of all: Ctrl-C and kill said as ``cell`` says them, if this process is the command.
+from cell.plumbing import startup as _startup  # noqa: F401  (installs on import)
 from cell.plumbing.errors import CellError, ScenarioError, UnreachableError
 
 __all__ = ["CellError", "ScenarioError", "UnreachableError", "__version__"]

@@ -129,9 +129,11 @@ def main(args: argparse.Namespace) -> int:
     from cell.experiments.sweep import run_sweep, simulate_summary
     from cell.experiments.sweep.spec import MAX_RUNS, comparison
     from cell.plumbing.errors import CellError
+    from cell.plumbing.output.paths import check_umask
     from cell.scenario.overrides import parse_sets
     from cell.scenario.schema import load_scenario
 
+    check_umask("cell compare's temporary folder")  # the runs go there, --out or not
     sets = parse_sets(args.sets)
     if args.policy is not None:
         sets["controller.policy"] = args.policy
@@ -195,7 +197,14 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
     as a sentence with A its subject (``b better: a delivers 3.1 ± 0.4 parts fewer than b
     ...``).  Counts and extremes are not compared if A and B take them over different
     windows (run length, warm-up)."""
-    from cell.cli.compare_rates import RATE_FREE, overall, rate_free, rates_differ, still_sides
+    from cell.cli.compare_rates import (
+        RATE_FREE,
+        SHOWN_ONLY,
+        overall,
+        rate_free,
+        rates_differ,
+        still_sides,
+    )
     from cell.experiments.sweep.windows import windows_apart
     from cell.reporting.formatting import HEADLINES
 
@@ -218,7 +227,7 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
     if replications is not None:
         for title, side, line in rate_free(replications, sweep, la, lb, width):
             lines.append(line)
-            if demand:
+            if demand and title not in SHOWN_ONLY:
                 sides.append((title, side))
     lines.append(overall(sides, la, lb, bool(demand)))
     return "\n".join(lines)

@@ -12,6 +12,11 @@ each a paired difference, replication by replication (common random numbers), as
 headline measures are (:func:`cell.experiments.stats.paired_difference`).  A side that gives
 the same figures in every replication (a trace, say) leaves the paired interval resting on
 the other side's variation alone: said in a warning line.
+
+Each side's parts delivered as a share of its bound (``parts_bound``, :mod:`cell.sim.bound`:
+the most any controller could deliver from the same arrivals) is said after them, paired the
+same way, fed alike or not; it is not counted in the overall line (:data:`SHOWN_ONLY`): where
+every part could be delivered it is the service level again.
 """
 
 from __future__ import annotations
@@ -33,7 +38,10 @@ RATE_FREE = (
     ("Service level (delivered / arrived)", ("parts_delivered", "parts_arrived", 1.0), True),
     ("Parts lost per 100 arrivals", ("parts_missed", "parts_arrived", 100.0), False),
     ("Spacings off per 100 delivered", ("spacing_outside_tol", "parts_delivered", 100.0), False),
+    ("Delivered of the bound (%)", ("parts_delivered", "parts_bound", 100.0), True),
 )
+#: Rate-free measures said but not counted in the overall line.
+SHOWN_ONLY = frozenset({"Delivered of the bound (%)"})
 
 
 def _mean(summary: pd.DataFrame, measure: str, label: str) -> float:

@@ -145,12 +145,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     (:func:`cell.plumbing.interrupts.exit_now`), whatever Ctrl-C or kill met on its way."""
     global _stops
     _stops = stops = Stops().install()
-    mpl = None
+    made: list[str] = []  # the folder _matplotlib_home makes, named before it is made
     try:
         from cell.plumbing.streams import reader_may_leave, standard_streams
 
         standard_streams()
-        mpl = _matplotlib_home()
+        _matplotlib_home(made)
         with reader_may_leave():
             code = _where() or _main(argv)
         if stops.settled():  # stopped while it finished: said so, its outputs whole
@@ -160,11 +160,13 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise
         code = _said_stopped(exc, stops.signum)
     finally:
-        stops.restore()
-        if mpl is not None:
+        if made:  # before the handlers go back: a stop now could not leave it behind
             import shutil
 
-            shutil.rmtree(mpl, ignore_errors=True)
+            shutil.rmtree(made[0], ignore_errors=True)
+            with contextlib.suppress(OSError):  # made, not yet opened to its owner (umask)
+                os.rmdir(made[0])
+        stops.restore()
     if code in (INTERRUPTED, TERMINATED) and argv is None:
         exit_now(code)
     return code
@@ -218,11 +220,12 @@ def _usable(path: str) -> bool:
     return os.path.isdir(path) and os.access(path, os.W_OK | os.X_OK)
 
 
-def _matplotlib_home() -> str | None:
+def _matplotlib_home(made: list[str]) -> None:
     """A temporary folder for matplotlib's configuration and cache, made (and put in
     ``MPLCONFIGDIR``) only when the one it would use cannot be written (a read-only or
     file-valued ``HOME``, a bad ``MPLCONFIGDIR``): matplotlib would otherwise warn on stderr
-    and leave its own temporary folder behind.  The caller removes it at the end."""
+    and leave its own temporary folder behind.  Its name goes into ``made`` before the folder
+    is made, so that the caller removes it at the end even if a stop cut this short."""
     given = os.environ.get("MPLCONFIGDIR")
     if given:
         wanted = given
@@ -231,16 +234,35 @@ def _matplotlib_home() -> str | None:
         if not os.path.isabs(base):
             base = os.path.join(os.path.expanduser("~"), ".config")
         wanted = os.path.join(base, "matplotlib")
-    if os.path.isabs(wanted) and _usable(wanted):
-        return None
+    from cell.plumbing.output.paths import umask_blocks
+
+    blocked = umask_blocks()  # what matplotlib would make, it could not write in
+    if os.path.isabs(wanted) and _usable(wanted) and not (blocked and not os.path.isdir(wanted)):
+        return
     import tempfile
 
     try:
-        made = tempfile.mkdtemp(prefix="cell-matplotlib-")
-    except OSError:
-        return None
-    os.environ["MPLCONFIGDIR"] = made
-    return made
+        parent = tempfile.gettempdir()
+    except OSError:  # no temporary folder can be written: matplotlib's own warning stands
+        return
+    for _ in range(100):
+        made[:] = [os.path.join(parent, f"cell-matplotlib-{os.urandom(6).hex()}")]
+        try:
+            os.mkdir(made[0], 0o700)
+        except FileExistsError:  # (not ours: never to be removed)
+            made.clear()
+            continue
+        except OSError:
+            break
+        try:
+            os.chmod(made[0], 0o700)  # the owner's, whatever the umask took
+        except OSError:
+            with contextlib.suppress(OSError):
+                os.rmdir(made[0])
+            break
+        os.environ["MPLCONFIGDIR"] = made[0]
+        return
+    made.clear()
 
 
 def _where() -> int:

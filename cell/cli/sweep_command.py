@@ -96,7 +96,9 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
     from cell.experiments.sweep import load_sweep, run_sweep, simulate_summary
     from cell.experiments.sweep.checks import size_note
     from cell.experiments.sweep.outdir import check_out, check_owner, lock
+    from cell.plumbing.output.paths import check_umask
 
+    check_umask(args.out)  # its folders could not be written in
     out = check_out(args.out)  # before the sweep file's points are built and checked
     _check_select(args)
     check_workers(args.workers, args.scheduler)

@@ -275,8 +275,10 @@ def store(kind: str, key: Any, value: Any) -> None:
 
 
 def _store(kind: str, key_text: str, value: Any) -> None:
-    """:func:`store`, the key already text (:func:`_text`)."""
+    """:func:`store`, the key already text (:func:`_text`).  Folders it made for an entry
+    it could not write (a restrictive umask, a read-only place) are removed again."""
     tmp = None
+    made: list[Path] = []
     try:
         text, whole = _key_text(kind, key_text)
         path = _entry(text, kind)
@@ -284,14 +286,24 @@ def _store(kind: str, key_text: str, value: Any) -> None:
             return
         payload = json.dumps({"key": whole, "value": value}).encode()
         digest = hashlib.sha256(payload).hexdigest().encode()
-        path.parent.mkdir(parents=True, exist_ok=True)
+        for folder in [*reversed(path.parent.parents), path.parent]:
+            if not os.path.isdir(folder):
+                with contextlib.suppress(FileExistsError):  # (another process's, just made)
+                    os.mkdir(folder)
+                    made.append(folder)
         fd, tmp = tempfile.mkstemp(prefix=".tmp-", dir=path.parent)
         with os.fdopen(fd, "wb") as fh:
             fh.write(_MAGIC + digest + b"\n" + payload)
         os.replace(tmp, path)
         tmp = None
     except Exception:  # noqa: BLE001 - an unwritable cache is only a cache miss next time
-        pass
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+            tmp = None
+        for folder in reversed(made):
+            with contextlib.suppress(OSError):
+                os.rmdir(folder)
     finally:
         if tmp is not None:
             with contextlib.suppress(OSError):

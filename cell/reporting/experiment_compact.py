@@ -2,6 +2,10 @@
 values and its load), a column per policy (mean ± half-width), then a column per paired
 comparison (the policies against each other, and each against the named ``baseline:``),
 each a difference with its interval; a difference whose interval holds 0 is in italics.
+Parts delivered has, beside each policy's column, that policy's ``of bound %`` (said in a
+line above the table): its runs'
+deliveries as a share of their bound (:data:`cell.reporting.experiment_data.BOUND_SHARE`),
+mean ± half-width over the replications.
 
 Every figure is one of ``summary.csv``'s or ``differences.csv``'s rows
 (:mod:`cell.reporting.experiment_data`); single runs' ranges stay in ``summary.csv``.
@@ -16,12 +20,19 @@ from typing import Any
 import pandas as pd
 
 from cell.experiments.sweep.columns import NAME_SUFFIX
+from cell.reporting.experiment_data import BOUND_SHARE
 from cell.reporting.experiment_reading import against, show
 from cell.reporting.formatting import Headline, half_width, number, plus_minus, table_head, table_row
 
 #: The summary column that says how loaded a point's robot is (its fastest cycle over the
 #: mean inter-arrival time), under its new name first.
 LOAD_COLUMNS = ("offered_load", "load", "utilisation")  # today's name, then older sweeps'
+#: A headline measure shown with a share beside each policy's column: (the share's
+#: measure, its column's heading, the line under the table that says what it is).
+SHARES = {"parts_delivered": (BOUND_SHARE, "of bound %", (
+    "of bound %: each run's parts delivered over its `parts_bound`, the most any controller "
+    "could deliver from the same arrivals with the same robot and belts (docs/model.md, "
+    "\"The bound on any controller\"), mean ± half-width over the runs."))}
 
 
 def load_column(summary: pd.DataFrame) -> str | None:
@@ -86,11 +97,17 @@ def compact_table(h: Headline, summary: pd.DataFrame, differences: pd.DataFrame,
     ``summary``'s point order."""
     rows: dict[tuple[str, ...], dict[str, str]] = {}
     load_of: dict[tuple[str, ...], list[str]] = {}
+    share = SHARES.get(h.column)
+    beside = [name for p in policies for name in (p, *([f"{p} {share[1]}"] if share else ()))]
     mine = summary[summary["measure"] == h.column]
     for i, r in enumerate(mine.to_dict("records")):
         key = tuple(show(r[c]) for c in cols)
         rows.setdefault(key, {})[str(r["policy"])] = \
             mean_cell(r, runs[i] if runs is not None else None)
+    if share is not None:
+        for i, r in enumerate(summary[summary["measure"] == share[0]].to_dict("records")):
+            rows.setdefault(tuple(show(r[c]) for c in cols), {})[f"{r['policy']} {share[1]}"] = \
+                mean_cell(r, runs[i] if runs is not None else None)
     loaded = load_column(summary)
     if loaded is not None:
         for r in summary[summary["measure"] == loaded].to_dict("records"):
@@ -103,11 +120,14 @@ def compact_table(h: Headline, summary: pd.DataFrame, differences: pd.DataFrame,
             compared.append(name)
         rows.setdefault(tuple(show(d[c]) for c in cols), {})[name] = difference_cell(d)
     compared.sort(key=lambda name: name.endswith(" − baseline"))  # the policies' first
+    have = {name for cells in rows.values() for name in cells}
+    beside = [p for p in beside if p in policies or p in have]  # no share: no column
     head = [c.removesuffix(NAME_SUFFIX) for c in cols] + (["load"] if loaded else []) \
-        + list(policies) + compared
-    out = table_head(head)
+        + [p if share is None or p in policies else share[1] for p in beside] + compared
+    out = [share[2], ""] if share is not None and len(beside) > len(policies) else []
+    out += table_head(head)
     for key, cells in rows.items():
         load = " / ".join(dict.fromkeys(load_of.get(key, ["—"]))) if loaded else None
         out.append(table_row([*key, *([load] if load is not None else []),
-                              *(cells.get(p, "") for p in [*policies, *compared])]))
+                              *(cells.get(p, "") for p in [*beside, *compared])]))
     return out

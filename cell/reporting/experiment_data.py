@@ -22,6 +22,11 @@ from cell.experiments.sweep.windows import pair_apart, window_measures
 
 #: Columns of replications.csv that are not measures.
 NOT_MEASURES = {"policy", "point", "seed", "replication"}
+#: The share of the bound a run delivered, in percent: its ``parts_delivered`` over its
+#: ``parts_bound`` (:mod:`cell.sim.bound`, the most any controller could deliver from the same
+#: arrivals), run by run, so its mean has an interval over the replications and two policies'
+#: shares a paired difference; a run whose bound is 0 has none.
+BOUND_SHARE = "delivered_of_bound_pct"
 
 
 def measures(replications: pd.DataFrame, sweep: Sweep) -> list[str]:
@@ -30,6 +35,19 @@ def measures(replications: pd.DataFrame, sweep: Sweep) -> list[str]:
     return [c for c in replications.columns
             if c not in NOT_MEASURES and c not in grid
             and pd.api.types.is_numeric_dtype(replications[c])]
+
+
+def with_bound_share(replications: pd.DataFrame) -> pd.DataFrame:
+    """``replications`` with :data:`BOUND_SHARE` after its other columns, if its runs have a
+    bound (the frame itself otherwise, and if the share is already there)."""
+    have = replications.columns
+    if BOUND_SHARE in have or not {"parts_delivered", "parts_bound"} <= set(have):
+        return replications
+    bound = replications["parts_bound"].to_numpy(float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        share = np.where(bound > 0, 100.0 * replications["parts_delivered"].to_numpy(float)
+                         / bound, np.nan)
+    return replications.assign(**{BOUND_SHARE: share})
 
 
 def runs_of(replications: pd.DataFrame, sweep: Sweep, i: int) -> pd.DataFrame:
@@ -89,7 +107,9 @@ def run_counts(replications: pd.DataFrame, sweep: Sweep) -> list[int]:
 
 
 def summary_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
-    """``summary.csv``: every point, policy and measure with its statistics."""
+    """``summary.csv``: every point, policy and measure with its statistics (the runs'
+    measures and, last, :data:`BOUND_SHARE`)."""
+    replications = with_bound_share(replications)
     columns, names = grid_columns(sweep), measures(replications, sweep)
     rows = []
     found = _Rows(replications, sweep)
@@ -122,6 +142,7 @@ def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     only the partner varies.  A pair whose points run over different windows
     (:mod:`cell.experiments.sweep.windows`) has no rows for the counts and extremes.
     """
+    replications = with_bound_share(replications)
     columns, names = grid_columns(sweep), measures(replications, sweep)
     windowed = set(window_measures())
     rows: list[dict[str, object]] = []

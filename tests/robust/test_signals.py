@@ -2,8 +2,8 @@
 ``cell: terminated`` (143), its temporary folders removed, finished outputs intact.
 
 Each test waits for a readiness marker on disk (a temporary folder, a finished task) before
-it sends the signal: no fixed delays.  (A signal in the interpreter's own start, before any
-of cell's code runs, gets Python's default; from ``cell.cli.main.main`` on, these hold.)
+it sends the signal: no fixed delays.  The first milliseconds, before any command runs:
+tests/robust/test_signals_startup.py.
 """
 
 from __future__ import annotations

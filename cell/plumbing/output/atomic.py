@@ -35,6 +35,7 @@ from cell.plumbing.output.paths import (
     allowed,
     check_file,
     check_parent,
+    check_umask,
     failing,
     foreign_entries,
     fsync,
@@ -129,6 +130,7 @@ class OutputDir(contextlib.AbstractContextManager["OutputDir"]):
         shown, path, names = _show(target), absolute(target, "directory", option), tuple(names)
         if path == Path.cwd() or path in Path.cwd().parents:
             raise CellError(f"{shown}: holds the current directory; choose another {option}")
+        check_umask(shown)
         try:
             mode = os.stat(path).st_mode
         except OSError as exc:

@@ -84,6 +84,36 @@ def check_parent(shown: str, path: Path) -> None:
         raise CellError(f"{shown}: cannot write in {_show(ancestor)}: permission denied")
 
 
+def held_to_permissions() -> bool:
+    """Whether this process is held to permission bits: not root with CAP_DAC_OVERRIDE (read
+    from /proc where there is one; root elsewhere is taken to override them)."""
+    if os.geteuid() != 0:
+        return True
+    try:
+        with open("/proc/self/status", encoding="ascii", errors="replace") as status:
+            caps = next((x.split()[1] for x in status if x.startswith("CapEff:")), None)
+    except OSError:
+        return False
+    return caps is not None and not int(caps, 16) & (1 << 1)  # CAP_DAC_OVERRIDE
+
+
+def umask_blocks(files: bool = False) -> bool:
+    """Whether the umask takes the owner's write or search permission from new folders
+    (``umask 0777``: nothing could be written in a folder cell makes), or with ``files`` the
+    owner's read or write permission from new files (what is written could not be read back),
+    and this process is held to it."""
+    return bool(_UMASK & (0o600 if files else 0o300)) and held_to_permissions()
+
+
+def check_umask(shown: str, files: bool = False) -> None:
+    """Refuse, before any work, an output the umask would leave unusable (:func:`umask_blocks`)."""
+    if umask_blocks(files):
+        what = "a file cell writes could not be read back" if files else \
+            "a folder cell makes could not be written in"
+        raise CellError(f"{shown}: cannot write under umask {_UMASK:04o}: {what} (umask 022 is "
+                        "usual)")
+
+
 def make_parents(path: Path, made: list[Path]) -> None:
     """Create the missing directories above ``path``, outermost first, each added to ``made``."""
     for parent in [p for p in path.parents if not os.path.lexists(p)][::-1]:
@@ -150,6 +180,9 @@ def check_file(target: str | os.PathLike[str], option: str = "--out") -> Path:
     if os.path.isdir(path):
         raise CellError(f"{shown}: is a directory; name a file")
     check_parent(shown, path)
+    check_umask(shown, files=True)
+    if not os.path.isdir(path.parent):  # folders to make
+        check_umask(shown)
     return path
 
 

@@ -1,0 +1,147 @@
+"""SIGINT and SIGTERM in a command's first milliseconds (issue 25, item 6): from the first
+code of ``cell`` on (cell/plumbing/startup.py, imported first by the package), ``python -m
+cell`` and the ``cell`` script end with ``cell: interrupted`` (130) or ``cell: terminated``
+(143) and nothing else on stderr, leaving nothing behind.
+
+Whether cell's handlers were in place when a signal was sent is read from the kernel
+(``SigCgt`` in /proc/PID/status: the interpreter catches SIGINT itself, SIGTERM only once
+cell does, after SIGINT), not guessed from a delay, so the test holds on a loaded machine.
+A signal sent before that, in the interpreter's own start-up, gets Python's default (said in
+cell/plumbing/startup.py); each delay from 0 ms on is sent, and twice the signal goes the
+moment the handlers are seen.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from cell.scenario import catalog
+
+pytestmark = pytest.mark.skipif(not Path("/proc/self/status").is_file(),
+                                reason="reads the signal mask from /proc (Linux)")
+LINES = {signal.SIGINT: (130, "cell: interrupted"), signal.SIGTERM: (143, "cell: terminated")}
+DELAYS_S = (0.0, 0.01, 0.02, 0.035, 0.05)
+SCRIPT = Path(sys.executable).with_name("cell")
+COMMANDS = {"python -m cell": [sys.executable, "-m", "cell"], "cell script": [str(SCRIPT)]}
+
+
+def _caught_term(pid: int) -> bool:
+    """Whether process ``pid`` catches SIGTERM now (cell's handlers are installed)."""
+    try:
+        text = Path(f"/proc/{pid}/status").read_text()
+    except OSError:  # already gone
+        return False
+    mask = next(line.split()[1] for line in text.splitlines() if line.startswith("SigCgt:"))
+    return bool(int(mask, 16) & (1 << (signal.SIGTERM - 1)))
+
+
+def _python_default(number: int, code: int, err: str) -> bool:
+    """Python's own end for a signal before cell's handlers: killed by it, or, for SIGINT,
+    the KeyboardInterrupt traceback of the interpreter's start-up."""
+    if number == signal.SIGTERM:
+        return code == -signal.SIGTERM and err == ""
+    return code in (-signal.SIGINT, 1) and (err == "" or err.rstrip().endswith("KeyboardInterrupt"))
+
+
+def _one(command: list[str], number: int, delay: float | None, where: Path) -> None:
+    where.mkdir()
+    (where / "tmp").mkdir()
+    env = {**os.environ, "TMPDIR": str(where / "tmp"), "XDG_CACHE_HOME": str(where / ".cache")}
+    proc = subprocess.Popen([*command, "run", str(catalog.path("baseline")), "--set",
+                             "run.parts=100000", "--out", str(where / "out")], cwd=where, env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    if delay is None:  # the moment the handlers are in place
+        end = time.monotonic() + 60
+        while not _caught_term(proc.pid) and time.monotonic() < end and proc.poll() is None:
+            time.sleep(0.0005)
+    else:
+        time.sleep(delay)
+    ours = _caught_term(proc.pid)
+    proc.send_signal(number)
+    err = proc.stderr.read()
+    code = proc.wait(timeout=60)
+    said = (code, err) == (LINES[number][0], LINES[number][1] + "\n")
+    assert said or (not ours and _python_default(number, code, err)), (delay, ours, code, err)
+    assert ours or delay is not None, "the handlers never came"
+    left = sorted(p.name for p in where.iterdir() if p.name != ".cache")
+    assert left == ["tmp"] and list((where / "tmp").iterdir()) == [], (delay, left)
+
+
+@pytest.mark.parametrize("number", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("how", list(COMMANDS))
+def test_a_signal_from_the_first_millisecond_on(tmp_path, number, how):
+    if how == "cell script" and not SCRIPT.is_file():
+        pytest.skip(f"no console script beside {sys.executable}")
+    for i, delay in enumerate([*DELAYS_S, None, None]):
+        _one(COMMANDS[how], number, delay, tmp_path / f"r{i}")
+
+
+#: A ``sitecustomize`` (run by the interpreter before any code of cell) that holds the import
+#: of one module: it marks that it got there, then waits, so the signal lands in that import.
+HOLD = """
+import os, sys, time
+class Hold:
+    def find_spec(self, name, path=None, target=None):
+        if name == os.environ["HOLD_AT"]:
+            open(os.environ["HOLD_MARK"], "w").close()
+            time.sleep(30)
+        return None
+sys.meta_path.insert(0, Hold())
+"""
+
+
+@pytest.mark.parametrize("number", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("at", ["cell.plumbing.errors", "cell.cli", "cell.plumbing.streams"])
+def test_a_signal_while_cell_is_imported(tmp_path, number, at):
+    """Held in the package's first import after cell's handlers, in the import of
+    cell.cli.main (its package first), and in main() (the command's own handlers): the line
+    and the code each time (before cell/plumbing/startup.py, the first two got Python's
+    default)."""
+    (tmp_path / "hook").mkdir()
+    (tmp_path / "hook" / "sitecustomize.py").write_text(HOLD)
+    mark = tmp_path / "there"
+    env = {**os.environ, "PYTHONPATH": str(tmp_path / "hook"), "HOLD_AT": at,
+           "HOLD_MARK": str(mark), "TMPDIR": str(tmp_path)}
+    proc = subprocess.Popen([sys.executable, "-m", "cell", "scenarios"], cwd=tmp_path, env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    end = time.monotonic() + 60
+    while not mark.exists() and proc.poll() is None and time.monotonic() < end:
+        time.sleep(0.002)
+    assert mark.exists(), proc.stderr.read()
+    proc.send_signal(number)
+    err = proc.stderr.read()
+    assert (proc.wait(timeout=60), err) == (LINES[number][0], LINES[number][1] + "\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["hook", "there"]
+
+
+@pytest.mark.parametrize(("argv", "orig", "command"), [
+    (["-m", "run"], ["python", "-m", "cell", "run"], True),
+    (["-m", "run"], ["python", "-I", "-m", "cell.cli.main", "run"], True),
+    (["-m", "run"], ["python", "-m", "other", "run"], False),  # another module, found first
+    (["/v/bin/cell", "run"], ["/v/bin/python", "/v/bin/cell", "run"], True),
+    (["/v/bin/cell", "run"], ["/v/bin/python", "-s", "/v/bin/cell", "run"], True),
+    (["/v/bin/pytest", "-q"], ["/v/bin/python", "/v/bin/pytest", "-q"], False),
+    # a multiprocessing child (spawn) is given its parent's sys.argv
+    (["/v/bin/cell", "run"], ["/v/bin/python", "-c", "from multiprocessing.spawn import "
+                              "spawn_main; spawn_main()", "--multiprocessing-fork"], False),
+    ([], ["python"], False),
+])
+def test_only_the_command_itself_installs(argv, orig, command):
+    from cell.plumbing.startup import is_the_command
+
+    assert is_the_command(argv, orig) is command
+
+
+def test_importing_the_package_installs_nothing():
+    """A program (here pytest) that imports cell keeps its own handlers."""
+    from cell.plumbing import startup
+
+    assert not startup.INSTALLED
+    assert signal.getsignal(signal.SIGTERM) is not startup.stop_now
