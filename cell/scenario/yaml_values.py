@@ -46,10 +46,14 @@ KeyPath = list[str | int | None]  # mapping keys and list indices; None: the roo
 LOADER: Any = yaml.CSafeLoader if yaml.__with_libyaml__ else yaml.SafeLoader
 
 
+_KINDS = {cls: cls.__name__.removesuffix("Event") for cls in vars(yaml.events).values()
+          if isinstance(cls, type) and issubclass(cls, yaml.events.Event)}
+
+
 def _kind(event: Any) -> str:
     """``Scalar``, ``Alias``, ``SequenceStart``, ``MappingEnd``, ``DocumentStart`` ...: the
-    event's class name less ``Event`` (:mod:`yaml.events`)."""
-    return type(event).__name__.removesuffix("Event")
+    event's class name less ``Event`` (:mod:`yaml.events`, whichever parser made it)."""
+    return _KINDS[type(event)]
 
 
 def _tag_of(event: Any) -> str:
@@ -81,7 +85,7 @@ class _Open:
 
     @property
     def wants_value(self) -> bool:
-        return _kind(self.event) == "MappingStart" and self.children % 2 == 1
+        return self.children % 2 == 1 and _kind(self.event) == "MappingStart"
 
 
 def _dotted(path: Iterable[str | int | None], limit: int = 80) -> str:
@@ -198,31 +202,32 @@ class Walk:
         return node if node is not None and _kind(node) == "Scalar" else None
 
     def node(self, event: Any, kind: str) -> None:
-        path, index = self.where(node=True), self.child()
         known = self.anchors.get(event.anchor) if kind == "Alias" else None
         if known is not None:
             if known[1] is None:
-                self.src.fail_at(path, event.start_mark, "an alias refers to a collection that holds it")
+                self.src.fail_at(self.where(node=True), event.start_mark,
+                                 "an alias refers to a collection that holds it")
             size, levels = known[1]
         else:
             size, levels = 1, int(kind.endswith("Start"))
         too_many = self.nodes + size > MAX_NODES
         if too_many or self.depth + levels > MAX_DEPTH:
-            self.src.fail_at(path, event.start_mark, _TOO_MANY if too_many else _TOO_DEEP)
+            self.src.fail_at(self.where(node=True), event.start_mark, _TOO_MANY if too_many else _TOO_DEEP)
         before, outer_deepest = self.nodes, self.deepest
         self.nodes, self.depth = self.nodes + size, self.depth + levels
         self.deepest = self.depth
         if kind == "Alias" and known is None:
-            syntax_error(self.src, path, event.start_mark, f"found undefined alias {event.anchor!r}")
+            syntax_error(self.src, self.where(node=True), event.start_mark,
+                         f"found undefined alias {event.anchor!r}")
         if kind != "Alias" and event.anchor is not None:
             if event.anchor in self.anchors:
-                syntax_error(self.src, path, event.start_mark, "second occurrence",
+                syntax_error(self.src, self.where(node=True), event.start_mark, "second occurrence",
                              f"found duplicate anchor {event.anchor!r}; first occurrence",
                              self.anchors[event.anchor][0].start_mark)
             self.anchors[event.anchor] = event, None
         self.kept.append(event)
         if levels and kind != "Alias":
-            self.open.append(_Open(event, index, before, outer_deepest))
+            self.open.append(_Open(event, self.child(), before, outer_deepest))
         else:
             self.close(event, before, outer_deepest, levels)
 
