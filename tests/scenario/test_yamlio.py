@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from cell.plumbing.errors import ScenarioError, short
-from cell.scenario import yamlio
+from cell.scenario import yaml_values
 from cell.scenario.yamlio import MAX_BYTES, load_mapping, parse_value
 
 LOADERS = ["python"] + (["libyaml"] if yaml.__with_libyaml__ else [])
@@ -26,7 +26,7 @@ HANG_S = 10.0
 def loader(request, monkeypatch):
     """Every test runs with PyYAML's pure-Python parser and, when there, with libyaml's."""
     if request.param == "python":
-        monkeypatch.setattr(yamlio, "_Loader", yamlio._PyLoader)
+        monkeypatch.setattr(yaml_values, "LOADER", yaml.SafeLoader)
     return request.param
 
 
