@@ -116,6 +116,17 @@ def mt(model: str, *keys: str) -> list[float]:
     return [float(doc[model][k]) for k in keys or ("R2_s", "R4_s", "cycle_thesis_logic_s")]
 
 
+def opt() -> dict[str, pd.Series]:
+    """reports/optimize: the front's one point, the best at 1.10 in/s, the chosen trial and the
+    front's point as KN's selection saw them."""
+    front, trials = (pd.read_csv(REPORTS / "optimize" / f) for f in ("front.csv", "trials.csv"))
+    sel = pd.read_csv(REPORTS / "optimize" / "selection.csv").set_index("verdict", drop=False)
+    chosen = sel.loc["chosen"]
+    return {"front": front.iloc[0], "chosen": chosen, "at_front": sel.set_index("trial").loc[
+        front.iloc[0]["trial"]], "picked": trials.set_index("trial").loc[chosen["trial"]],
+        "at_110": trials[trials["belts.input_nominal_in_s"] == 1.10]["parts_missed"].min()}
+
+
 DYN, KIN, CONST = "minimum-time (dynamic)", "minimum-time (kinematic)", "constant-rate"
 #: (page, a phrase of it with its numbers as ``{}``, the values they must read, in order)
 NUMBERS: list[tuple[str, str, str]] = [
@@ -154,6 +165,15 @@ NUMBERS: list[tuple[str, str, str]] = [
      "wi('adaptive', 'parts_missed', 'both')['mean'], wd('adaptive', 'both')[1], "
      "*wi('adaptive', 'parts_missed', 'both')[['run_p2_5', 'run_p97_5']], "
      "wi('adaptive', 'parts_per_hr_wallclock', 'both')['mean']"),
+    # the worked optimisation
+    ("README.md", "as slowly as **{} in/s** with a nominal cycle as long as **{} s** at once (losses {} "
+     "parts of 500 on average, {} % of spacings off)", "*opt()['front'][['belts.input_nominal_in_s', "
+     "'controller.nominal_cycle_s', 'parts_missed', 'spacing_outside_pct']]"),
+    ("README.md", "(at 1.10 in/s already {} on average)", "opt()['at_110']"),
+    ("README.md", "**trial {}** ({} in/s, {} s, {} parts/hr), and finds that the longest cycle costs "
+     "about {} parts/hr ({})", "opt()['chosen']['trial'], *opt()['picked'][['belts.input_nominal_in_s', "
+     "'controller.nominal_cycle_s']], opt()['chosen']['mean'], "
+     "opt()['chosen']['mean'] - opt()['at_front']['mean'], opt()['at_front']['mean']"),
     # docs/model.md: the departures' table (adaptive Table 7.1 runs) and the planner's cycles
     ("docs/model.md", "on the thesis's arrivals (adaptive, {} runs of {} parts)",
      "ad('parts_arrived')['n'], ad('parts_arrived')['mean']"),

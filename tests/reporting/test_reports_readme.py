@@ -299,21 +299,17 @@ def test_every_number_in_the_readme_is_checked() -> None:
 
 
 def test_what_the_readings_rest_on_holds(src: dict[str, Any]) -> None:
-    """The shapes the prose describes: constant-radius arcs, R I and R III alike, y's peak at K,
-    the held wrist roll and shoulder, the flat base rate at its nominal fraction, the shoulder
-    within its limit, the Weibull's mode right of its mean, the two bands of thesis IP, no
-    wall-clock IP for a lost part, the summary's cycles the parts' own."""
-    t, p, deg, rates, lim, k, m = (src[n] for n in ("t", "p", "deg", "rates", "lim", "k", "m"))
-    assert np.ptp(src["radius"](2)) < 1e-9 and np.ptp(src["radius"](4)) < 1e-9
+    """The shapes the prose describes that no other test holds (the arcs' radii, R II's and R IV's
+    still joints and the rates' limits are tests/arm/test_path.py's and test_figures.py's): R I
+    and R III alike, y's peak at K, the base's flat rates (R IV at its nominal fraction), the
+    Weibull's mode right of its mean, two bands of thesis IP, no wall-clock IP for a lost part,
+    the summary's cycles the parts' own."""
+    t, p, rates, lim, k, m = (src[n] for n in ("t", "p", "rates", "lim", "k", "m"))
     assert m(1).sum() == m(3).sum() and t.regime_length(1) == pytest.approx(t.regime_length(3))
-    assert p.xyz_in[: k + 1, 1].max() == p.xyz_in[k, 1]
-    assert np.ptp(deg[t.regime_rows(2), 4]) < 1e-6 and np.ptp(deg[k:, 1]) < 1e-6
-    assert np.ptp(rates[m(2), 0]) < 1e-6 and np.ptp(rates[m(4), 0]) < 1e-6
-    assert -rates[m(4), 0][0] == pytest.approx(src["s"].robot.motors.nominal_fraction * lim[m(4), 0][0],
-                                               rel=1e-3)
-    assert np.all(np.abs(rates[:, 1]) <= lim[:, 1] * (1 + 1e-9))
-    assert rates[0, 2] == rates[m(1), 2].min()
-    assert np.abs(rates[m(2), 4]).max() < 1e-6 and np.ptp(rates[m(4), 4]) < 1e-6
+    assert p.xyz_in[: k + 1, 1].max() == p.xyz_in[k, 1] and rates[0, 2] == rates[m(1), 2].min()
+    assert np.ptp(rates[m(2), 0]) < 1e-6 and np.ptp(rates[m(4), 0]) < 1e-6 and np.ptp(rates[m(4), 4]) < 1e-6
+    fraction = src["s"].robot.motors.nominal_fraction
+    assert -rates[m(4), 0][0] == pytest.approx(fraction * lim[m(4), 0][0], rel=1e-3)
     assert src["mode"] > src["w"].mean()
     lost, ip = src["lost_ip"]("thesis")
     assert ip[~lost].min() > ip[lost].max()
