@@ -32,8 +32,10 @@ def prose(text: str) -> str:
 
 
 def phrase(template: str) -> re.Pattern[str]:
+    """A phrase with its numbers written ``{}`` and ``…`` for prose skipped (a few lines at most)."""
     parts = re.sub(r"\s+", " ", template).split("{}")
-    return re.compile(NUMBER.join(re.escape(p).replace(r"\ ", " ") for p in parts))
+    return re.compile(NUMBER.join(r".{0,160}?".join(re.escape(q).replace(r"\ ", " ")
+                                                       for q in p.split("…")) for p in parts))
 
 
 def value(printed: str) -> float:
@@ -130,37 +132,31 @@ CLAIMS: list[tuple[str, str]] = [
     ("all seven runs see the same {} inter-arrival times", "len(a)"),
     # Fig. 8, 9 and 12
     ("the {} in input belt along y = {} and the output belt along x = {}, the robot's base axis at "
-     "({}, {}), B ({}, {}) → F ({}, {}) on the input belt, G ({}, {}) → K ({}, {}) on the output "
-     "belt, LO at ({}, {}) and TD at ({}, {})",
+     "({}, {}), B ({}, {}) → F ({}, {}) … G ({}, {}) → K ({}, {}) … LO at ({}, {}) and TD at ({}, {})",
      "s.cell.belt_width_in, s.path.bot_in[1], s.path.g_in[0], *pt('base', 'B', 'F', 'G', 'K', 'LO', 'TD')"),
-    ("R II is the quarter arc of radius {} in; the R IV return arc (radius {} in) swings out over "
-     "the belts' corner to x = {} in and y = {} in",
+    ("quarter arc of radius {} in; the R IV return arc (radius {} in) … to x = {} in and y = {} in",
      "radius(2)[0], radius(4)[0], xyz[:, 0].max(), xyz[:, 1].min()"),
-    ("R I and R III are {} moves and {} in each ({} in of belt plus the clamped-spline dip from z = "
-     "{} in to {} in at LO and TD), R II {} moves and {} in at z = {} in, R IV {} moves and {} in "
-     "at z = {} in; {} points in all",
+    ("R I and R III are {} moves and {} in each ({} in of belt … from z = {} in to {} in at LO and TD), "
+     "R II {} moves and {} in at z = {} in, R IV {} moves and {} in at z = {} in; {} points in all",
      "m(1).sum(), t.regime_length(1), belt, s.path.bot_in[2], s.path.pick_height_in, m(2).sum(), "
      "t.regime_length(2), xyz[q(2), 2].max(), m(4).sum(), t.regime_length(4), xyz[q(4), 2].min(), "
      "p.n_points"),
     ("up to the shoulder at {} in", "s.cell.shoulder_height_in"),
     ("the hand is longest, {} in, at G = G0 = {} in; holding the {} in cube it is {} in; at the "
-     "assumed {} in open width {} in; it falls to L1 = {} in at G = {} in, where the square root "
-     "vanishes. The {} in between open and closed",
+     "assumed {} in open width {} in; it falls to L1 = {} in at G = {} in, … The {} in between",
      "w11(hand.g0_in), hand.g0_in, s.part.size_in, w11(s.part.size_in), hand.open_in, "
      "w11(hand.open_in), hand.l1_in, hand.g0_in + hand.l2_in * np.sqrt(2), "
      "w11(s.part.size_in) - w11(hand.open_in)"),
     # Fig. 13-14
     ("The run's own {} inter-arrival times", "len(x)"),
-    ("pdf mean {} s and sd {} s, the draws {} s and {} s, from {} to {} s; the mode sits a little "
-     "right of the mean, at {} s (the shape {} leaves a slight left skew). The thesis's mean {} s "
-     "is the distribution's {} s to rounding",
+    ("pdf mean {} s and sd {} s, the draws {} s and {} s, from {} to {} s; … at {} s (the shape {} "
+     "… The thesis's mean {} s is the distribution's {} s",
      "w.mean(), w.std(), x.mean(), x.std(ddof=1), x.min(), x.max(), mode, c, C, w.mean()"),
-    ("(Kolmogorov–Smirnov D = {}, p = {}); the dashed line shows eq. 6.9 at work, u = {} → T = {} s "
-     "(the median)", "ks.statistic, ks.pvalue, 0.5, w.median()"),
+    ("(Kolmogorov–Smirnov D = {}, p = {}); … u = {} → T = {} s (the median)",
+     "ks.statistic, ks.pvalue, 0.5, w.median()"),
     # Fig. 15-21
-    ("R I and R III locked to their belts ({} and {} in/s), R IV with the base at its nominal {} % "
-     "rate, R II the rest of the {} s ideal cycle. No move is shorter than its motors allow, so R I "
-     "takes {} s rather than {}/{} s",
+    ("locked to their belts ({} and {} in/s), R IV with the base at its nominal {} % rate, R II the "
+     "rest of the {} s ideal cycle. … R I takes {} s rather than {}/{} s",
      "b.input_nominal_in_s, b.output_nominal_in_s, 100 * s.robot.motors.nominal_fraction, C, "
      "tl.regime_s[1], belt, b.input_nominal_in_s"),
     ("R III {} s, R IV {} s (the calibrated nominal), and R II {} s, not the thesis's {} − {}/{} − "
@@ -169,65 +165,59 @@ CLAIMS: list[tuple[str, str]] = [
      "(s.path.eot_in[1] - s.path.g_in[1]) / b.output_nominal_in_s, tl.regime_s[4], "
      "n[3] - n[4] / n[5] - n[6] - n[7]"),
     ("x rises from {} to {} and y from {} to {} over the first {} s; z dips to {} in at LO ({} s) and "
-     "TD ({} s). As the thesis says, y has a sharp peak, {} in at K, {} s, where R IV turns back; "
-     "during R IV x swings out to {} in and y to {} in",
+     "TD ({} s). … {} in at K, {} s, … x swings out to {} in and y to {} in",
      "xyz[0, 0], xyz[k, 0], xyz[0, 1], xyz[k, 1], tl.t_s[k], xyz[:, 2].min(), tl.t_s[p.lo], "
      "tl.t_s[p.td], xyz[:, 1].max(), tl.t_s[k], xyz[:, 0].max(), xyz[:, 1].min()"),
-    ("θ1 (base) climbs from {}° to {}° over R I–R III and comes straight back in R IV, a sharp peak "
-     "at {} s; the wrist roll θ5 goes {}° → {}° in R I, holds {}° through R II",
+    ("θ1 (base) climbs from {}° to {}° … a sharp peak at {} s; the wrist roll θ5 goes {}° → {}° in "
+     "R I, holds {}° through R II",
      "deg[:, 0].min(), deg[k, 0], tl.t_s[k], deg[0, 4], deg[np.flatnonzero(p.regime == 1)[-1], 4], "
      "deg[q(2), 4].mean()"),
     ("reaches {}° at K and is turned back to {}° during R IV", "deg[k, 4], deg[-1, 4]"),
-    ("smooth bumps at the two dips ({}° to {}°) and is constant at {}° from K to B, because R IV "
-     "stays at z = {} in", "deg[:k + 1, 1].min(), deg[:k + 1, 1].max(), deg[k, 1], xyz[q(4), 2].max()"),
-    ("Base: {} steps/s through R II, rising to a peak of {} steps/s in R I after LO (below its {} "
-     "steps/s loaded maximum) and falling to {} steps/s at K; R IV is a flat {} steps/s, exactly "
-     "the nominal {} % line",
+    ("the two dips ({}° to {}°) and is constant at {}° from K to B, because R IV stays at z = {} in",
+     "deg[:k + 1, 1].min(), deg[:k + 1, 1].max(), deg[k, 1], xyz[q(4), 2].max()"),
+    ("Base: {} steps/s through R II, rising to a peak of {} steps/s …below its {} steps/s loaded "
+     "maximum) and falling to {} steps/s at K; R IV is a flat {} steps/s, exactly the nominal {} %",
      "rates[m(2), 0][0], rates[m(1) & (np.arange(len(rates)) >= p.lo), 0].max(), lim[p.lo, 0], "
      "rates[k - 1, 0], rates[m(4), 0][0], 100 * s.robot.motors.nominal_fraction"),
-    ("After LO it runs at its loaded maximum of {} steps/s (the red line drops from {} to {} "
-     "steps/s at LO, when the {} oz part is picked), and the two single-move spikes to ±{} steps/s "
-     "are the hand closing at LO and opening after TD",
+    ("loaded maximum of {} steps/s (the red line drops from {} to {} steps/s at LO, when the {} oz part "
+     "is picked), and the two single-move spikes to ±{} steps/s",
      "np.abs(rates[p.lo:p.td - 1, 1]).max(), lim[p.lo - 1, 1], lim[p.lo, 1], s.part.weight_oz, "
      "tuple(np.abs(rates[[p.lo - 1, p.td], 1]))"),
-    ("Elbow: {} steps/s leaving B, easing off towards F, up to {} steps/s in R III, far below its "
-     "{}–{} steps/s limits", "rates[0, 2], rates[m(3), 2].max(), lim[:, 2].min(), lim[:, 2].max()"),
+    ("Elbow: {} steps/s leaving B, … up to {} steps/s in R III, far below its {}–{} steps/s limits",
+     "rates[0, 2], rates[m(3), 2].max(), lim[:, 2].min(), lim[:, 2].max()"),
     ("Wrist pitch: never above {} steps/s against a maximum of {}–{} steps/s",
      "np.abs(rates[:, 3]).max(), lim[:, 3].min(), lim[:, 3].max()"),
-    ("Wrist roll: {}–{} steps/s in R I and {}–{} steps/s in R III, zero in R II (the part's {}° "
-     "turn is the base's), a steady {} steps/s in R IV",
+    ("Wrist roll: {}–{} steps/s in R I and {}–{} steps/s in R III, zero in R II (the part's {}° turn "
+     "… a steady {} steps/s in R IV",
      "rates[m(1), 4].min(), rates[m(1), 4].max(), rates[m(3), 4].min(), rates[m(3), 4].max(), "
      "np.degrees(p.phi_rad[p.td] - p.phi_rad[0]), rates[m(4), 4][0]"),
     # Fig. 22
     ("One adaptive transfer (part {}, the part with the longest lag", "row['part']"),
-    ("the look-ahead lag, {} s of tracking B → LO at the current belt speed {} in/s, before the "
-     "belt may change (here to {} in/s). The tip then averages {} (R I), {} (R II), {} (R III, the "
-     "belt's {} in/s plus the dip) and {} in/s (R IV)",
+    ("the look-ahead lag, {} s of tracking B → LO at the current belt speed {} in/s, … (here to {} "
+     "in/s). The tip then averages {} (R I), {} (R II), {} (R III, the belt's {} in/s plus the dip) "
+     "and {} in/s (R IV)",
      "row['pick_s'] - row['at_bot_s'], before, after, row['v_r1_in_s'], row['v_r2_in_s'], "
      "row['v_r3_in_s'], b.output_nominal_in_s, row['v_r4_in_s']"),
     ("so each lasts {} s at {} in/s", "grasp_dt, grasp_v"),
     ("its example lag is {} s", "thesis_lag"),
-    ("here the lag is B → LO ({} in) over the belt speed, {}–{} s over all {} parts. A {} s lag would "
-     "need LO about {} in from B at {} in/s",
+    ("the lag is B → LO ({} in) over the belt speed, {}–{} s over all {} parts. A {} s lag would need "
+     "LO about {} in from B at {} in/s",
      "s.path.lo_from_bot_in, lags.min(), lags.max(), len(a), None, n[4] * b.input_nominal_in_s, "
      "b.input_nominal_in_s"),
     # Fig. 23-24
     ("({}-part lot means {}–{} s; run mean {} s as counted by the thesis, {} %; {} s on the wall "
-     "clock, {} %), and the non-adaptive one (robot cycle {} s) is far above it (lot means {}–{} "
-     "s). Its mean as the thesis counted is {} s, **{} %**: this matches the thesis's \"{} percent "
-     "out of spec\"",
+     "clock, {} %), and the non-adaptive one (robot cycle {} s) … (lot means {}–{} s). Its mean as "
+     "the thesis counted is {} s, **{} %**: this matches the thesis's \"{} percent out of spec\"",
      "LOT, lots(a.thesis_interval_s).min(), lots(a.thesis_interval_s).max(), a.thesis_interval_s.mean(), "
      "100 * (a.thesis_interval_s.mean() / C - 1), a.delivery_interval_s.mean(), "
      "100 * (a.delivery_interval_s.mean() / C - 1), C, lots(na().thesis_interval_s).min(), "
      "lots(na().thesis_interval_s).max(), na().thesis_interval_s.mean(), "
      "*[100 * (na().thesis_interval_s.mean() / C - 1)] * 2"),
-    ("That mean is over all {} parts, a lost part booked as one more cycle (D = T + C); the run's "
-     "summary (CODE) divides the same total by the {} parts delivered and reads {} s",
+    ("That mean is over all {} parts, … by the {} parts delivered and reads {} s",
      "len(na()), len(na()) - na().missed_thesis.sum(), NA['actual_cycle_thesis_s']"),
     ("The thesis's \"{} percent reduction in throughput\" is {}/{} lost parts",
      "100 * pub('parts_missed') / s.run.parts, pub('parts_missed'), s.run.parts"),
-    ("On the wall clock the non-adaptive robot loses {} parts (the thesis's bookkeeping: {}) and "
-     "averages {} s, {} %",
+    ("the non-adaptive robot loses {} parts (the thesis's bookkeeping: {}) and averages {} s, {} %",
      "NA['parts_missed'], NA['parts_missed_thesis'], np.nanmean(na().delivery_interval_s), "
      "100 * (np.nanmean(na().delivery_interval_s) / C - 1)"),
     ("the adaptive one (thesis count) reads {} s after {} parts and {} s after {}",
@@ -246,12 +236,12 @@ CLAIMS: list[tuple[str, str]] = [
      "pub('ip', policy='adaptive')"),
     ("gives {} and a cycle {} % short, next to the thesis's \"within {} percent\"",
      "A['ip_thesis_memoryless'], -A['cycle_vs_nominal_memoryless_pct'], PCT"),
-    ("two bands, {}–{} for delivered parts (its doubled denominator) and {}–{} for the {} missed "
-     "parts (triangles), mean {} against Table 7.1's {}",
+    ("two bands, {}–{} for delivered parts … and {}–{} for the {} missed parts (triangles), mean {} "
+     "against Table 7.1's {}",
      "*(lambda lost, ip: [ip[~lost].min(), ip[~lost].max(), ip[lost].min(), ip[lost].max(), "
      "lost.sum(), ip.mean()])(*lost_ip('thesis')), pub('ip')"),
     ("a delivered part's IP averages {} when the part before it was delivered and {} when it was "
-     "lost, and the {} lost parts (no delivery, no IP) are marked on the floor; mean {}",
+     "lost, and the {} lost parts … mean {}",
      "*(lambda lost, ip, after: [np.nanmean(ip[~lost & ~after]), np.nanmean(ip[~lost & after]), "
      "lost.sum(), np.nanmean(ip)])(*lost_ip('wallclock'), np.r_[False, lost_ip('wallclock')[0][:-1]])"),
     ("Robot cycle {} s: {} parts missed as the thesis counted (Table 7.1: {}), mean IP {} (Table "
