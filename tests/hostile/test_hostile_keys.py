@@ -104,9 +104,8 @@ def number_values(b: Bounds, default: float, whole: bool) -> tuple[Values, Value
     step = 1 if whole else max(1.0, abs(b.lo or 0) * 0.01)
     if b.lo is not None:
         refuse.append(("below", b.lo - step if not b.lo_open else b.lo))
-        if b.lo_open:
-            either += [("1e-300 above", b.lo + 1e-300 if b.lo == 0 else b.lo * (1 + 1e-12)),
-                       ("1e-9 above", b.lo + 1e-9)]
+        if b.lo_open:  # just above an open bound (1e-9 above: the same rule)
+            either.append(("1e-300 above", b.lo + 1e-300 if b.lo == 0 else b.lo * (1 + 1e-12)))
         else:
             either.append(("lowest", int(b.lo) if whole else b.lo))
     if b.hi is not None:
