@@ -5,6 +5,16 @@ the value, exit code 2, and nothing written; accepted input runs sanely (exit 0,
 warning or traceback, parts conserved, every summary value finite where it is defined); outputs appear
 whole or not at all.  Each call of :func:`cli` is one case; the session's count is printed
 at the end of the run (``hostile inputs: N cases ...``), after pytest's own summary line.
+
+One case per rule.  A *rule* is one condition the code checks (a bound, finiteness, a type, a
+file's encoding, an output's parent being a directory, one step of the output protocol), as
+reached through one way in (a command's option, a scenario key, a file, ``--set``).  Two cases
+that meet the same condition through the same way in, with different values (``-3`` beside
+``0`` below a bound, ``EDQUOT`` beside ``ENOSPC`` in the same branch, a ``{`` beside a ``[``
+nested too deep), test the rule twice: one of them goes.  The same condition through another
+way in (a key of another section, ``--set`` beside a file, another command wiring a shared
+check) is another rule, kept with one case; a shared check's every condition is walked
+through one command only.
 """
 
 from __future__ import annotations

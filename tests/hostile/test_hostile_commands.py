@@ -41,6 +41,9 @@ COMMANDS: dict[str, tuple[list[str], str, str]] = {
 
 #: Other words a command's refusal may use (animate checks the suffix first, fit the directory).
 OR = {"animate": (".gif or .mp4",), "fit": ("its directory does not exist",)}
+#: The commands through which every condition of the shared output checks is walked: ``run``
+#: for OutputDir, ``path`` for check_file; the others wire the same check, one case each.
+WALKED = ("run", "path")
 
 
 def _import_everything() -> None:
@@ -125,7 +128,9 @@ def test_outputs_refused_before_any_work(tmp_path: Path, monkeypatch: pytest.Mon
     argv = _argv(command, tmp_path)
     monkeypatch.chdir(tmp_path)
     failures = []
-    for label, how, out, words in _targets(tmp_path, kind):
+    targets = _targets(tmp_path, kind)
+    for label, how, out, words in targets if command in WALKED else [
+            t for t in targets if t[0] == "under a file"]:
         with monkeypatch.context() as m:
             _forbid(m, work)
             if how:
@@ -169,12 +174,13 @@ class _FillingFile:
         self.stream.close()
 
 
-@pytest.mark.parametrize("command", ["run", "path", "mintime", "schema", "fit"])
-@pytest.mark.parametrize("room", [0, 300])
+@pytest.mark.parametrize("command", ["run", "path", "schema", "fit"])
 def test_disk_full_while_writing_keeps_the_old_output(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                                                      command: str, room: int) -> None:
-    """The disk fills after the work, at the first byte or a few hundred bytes in: one line
-    naming the output, and the output of the previous run unchanged, nothing else left."""
+                                                      command: str) -> None:
+    """The disk fills after the work, a few hundred bytes in: one line naming the output, and the
+    output of the previous run unchanged, nothing else left (the first byte's failure meets the
+    same clean-up; mintime commits through the same OutputDir as run)."""
+    room = 300
     import cell.plumbing.output.atomic
 
     argv = _argv(command, tmp_path)
@@ -229,9 +235,7 @@ def _raising(exc: BaseException) -> Any:
     (RecursionError("maximum recursion depth exceeded"), ("recursion limit",)),
     (PermissionError(errno.EACCES, "Permission denied", "/data/out/parts.csv"),
      ("/data/out/parts.csv: permission denied",)),
-    (OSError(errno.EROFS, "Read-only file system", "/mnt/ro/x"), ("/mnt/ro/x: read-only file system",)),
     (OSError(errno.ENOSPC, "No space left on device"), ("OUT: cannot write: no space left on device",)),
-    (OSError(errno.EDQUOT, "Disk quota exceeded"), ("OUT: cannot write: disk quota exceeded",)),
     (OSError(errno.ENAMETOOLONG, "File name too long", "/x/" + "n" * 400), ("file name too long", "…")),
     (OSError(errno.EISDIR, "Is a directory", "a\nb"), ("'a\\nb': is a directory",)),
 ], ids=lambda v: type(v).__name__ if isinstance(v, BaseException) else None)
@@ -254,8 +258,7 @@ def test_a_real_memory_error_is_one_line(tmp_path: Path, monkeypatch: pytest.Mon
     refused(cli("run", "baseline", "--out", out), "ran out of memory", nothing_in=out)
 
 
-@pytest.mark.parametrize("exc", [ZeroDivisionError("a bug"), KeyError("a bug"),
-                                 OSError(errno.EBADF, "a bug")])
+@pytest.mark.parametrize("exc", [ZeroDivisionError("a bug"), OSError(errno.EBADF, "a bug")])
 def test_an_unexpected_exception_keeps_its_traceback(monkeypatch: pytest.MonkeyPatch,
                                                      exc: BaseException) -> None:
     import cell.cli.run_command
@@ -269,10 +272,7 @@ def test_an_unexpected_exception_keeps_its_traceback(monkeypatch: pytest.MonkeyP
     ([], ("required",)),
     (["nosuch"], ("invalid choice",)),
     (["run", "baseline"], ("--out",)),
-    (["run"], ("required",)),
     (["sweep", "x", "--out", "y", "--workers", "many"], ("--workers", "many")),
-    (["animate", "baseline", "--out", "a.gif", "--parts", "1e3"], ("--parts", "1e3")),
-    (["fit", "t.csv", "--rank-by", "luck"], ("--rank-by",)),
     (["run", "baseline", "--out", "x", "--frobnicate"], ("unrecognized arguments",)),
 ])
 def test_usage_errors_are_one_line(argv: list[str], words: tuple[str, ...]) -> None:
@@ -281,7 +281,7 @@ def test_usage_errors_are_one_line(argv: list[str], words: tuple[str, ...]) -> N
 
 
 def test_help_and_version_exit_0(capsys: pytest.CaptureFixture[str]) -> None:
-    for argv in (["--help"], ["run", "--help"], ["--version"]):
+    for argv in (["--help"], ["--version"]):
         res = cli(*argv)
         assert res.code == 0 and res.out and res.err == ""     # a case checked otherwise
 
@@ -289,10 +289,9 @@ def test_help_and_version_exit_0(capsys: pytest.CaptureFixture[str]) -> None:
 # --- options ---------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("option,value,words", [
-    ("--parts", "0", "between 1 and 10000"), ("--parts", "-3", "between"), ("--parts", "1000000", "between"),
+    ("--parts", "0", "between 1 and 10000"), ("--parts", "1000000", "between"),
     ("--from-part", "0", "between"), ("--from-part", "100000000", "between"),
-    ("--speed", "0", "between"), ("--speed", "-1", "between"), ("--speed", "nan", "between"),
-    ("--speed", "inf", "between"), ("--speed", "1e-9", "between"),
+    ("--speed", "0", "between"), ("--speed", "nan", "between"), ("--speed", "inf", "between"),
     ("--fps", "0", "between"), ("--fps", "100000", "between"),
     ("--dpi", "0", "between"), ("--dpi", "1e6", "between"), ("--dpi", "nan", "between"),
     ("--parts", "10000", "frames"),
@@ -304,7 +303,7 @@ def test_animate_options_refused_before_simulating(tmp_path: Path, monkeypatch: 
     refused(cli("animate", "baseline", option, value, "--out", out), option, words, nothing_in=out)
 
 
-@pytest.mark.parametrize("out", ["a.txt", "a", "a.GIF.bak"])
+@pytest.mark.parametrize("out", ["a.GIF.bak"])  # a.txt and a: the same suffix rule
 def test_animate_suffixes(tmp_path: Path, out: str) -> None:
     refused(cli("animate", "baseline", "--out", tmp_path / out), ".gif or .mp4", nothing_in=tmp_path / out)
 
@@ -327,8 +326,7 @@ def test_fit_hostile_traces(tmp_path: Path, name: str, text: str, words: str) ->
     assert not (tmp_path / "fit.png").exists()
 
 
-@pytest.mark.parametrize("families,words", [("bogus", "bogus"), ("", "--families"), ("norm", "non-negative"),
-                                            ("__class__", "__class__"), ("rv_continuous", "rv_continuous")])
+@pytest.mark.parametrize("families,words", [("bogus", "bogus"), ("", "--families"), ("norm", "non-negative")])
 def test_fit_hostile_families(tmp_path: Path, families: str, words: str) -> None:
     trace = tmp_path / "trace.csv"
     trace.write_text(TRACE)
@@ -346,9 +344,9 @@ def test_fit_refuses_to_overwrite_its_trace(tmp_path: Path) -> None:
 
 
 def test_mintime_old_stem_form_refused(tmp_path: Path) -> None:
-    for name in ("m.csv", "m.json"):
-        refused(cli("mintime", "baseline", "--out", tmp_path / name), "profile.csv and summary.json",
-                nothing_in=tmp_path / name)
+    name = "m.csv"  # m.json: the same rule
+    refused(cli("mintime", "baseline", "--out", tmp_path / name), "profile.csv and summary.json",
+            nothing_in=tmp_path / name)
 
 
 # --- real processes ----------------------------------------------------------------------------

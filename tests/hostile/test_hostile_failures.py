@@ -16,12 +16,10 @@ def robot(ttf: str, extra: str = "") -> str:
     return f"{{robot: {{time_to_failure: {ttf}, time_to_repair: {R}}}{extra}}}"
 
 
-#: (id, the failures value, words the refusal must hold)
+#: (id, the failures value, words the refusal must hold); a negative scale is a zero scale's rule
 CASES = [
     ("zero mean time to failure", robot("{distribution: expon, params: {scale: 0}}"),
      ("failures.robot.time_to_failure.params", "scale", "zero or negative")),
-    ("negative scale", robot("{distribution: expon, params: {scale: -600}}"),
-     ("failures.robot.time_to_failure.params", "-600")),
     ("negative mean", robot("{distribution: norm, params: {loc: -600, scale: 10}}"),
      ("failures.robot.time_to_failure.params", "non-negative")),
     ("no finite mean", robot("{distribution: pareto, params: {b: 0.8}}"),
@@ -47,10 +45,14 @@ CASES = [
 
 @pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
 def test_a_bad_failures_section_is_refused_in_one_line(tmp_path: Path, case: tuple) -> None:
+    """Each through ``--set``; the first in a scenario file too (the file is named by the same
+    rule whichever check of the section refuses it)."""
     _, value, words = case
     out = tmp_path / "out"
     refused(cli("run", "baseline", "--set", "run.parts=5", "--set", f"failures={value}",
                 "--out", out), "baseline.yaml", *words, nothing_in=out)
+    if case is not CASES[0]:
+        return
     scenario = tmp_path / "bad.yaml"
     scenario.write_text(f"run: {{parts: 5}}\nfailures: {value}\n", encoding="utf-8")
     refused(cli("run", scenario, "--out", out), str(scenario), *words, nothing_in=out)

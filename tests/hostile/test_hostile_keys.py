@@ -104,9 +104,8 @@ def number_values(b: Bounds, default: float, whole: bool) -> tuple[Values, Value
     step = 1 if whole else max(1.0, abs(b.lo or 0) * 0.01)
     if b.lo is not None:
         refuse.append(("below", b.lo - step if not b.lo_open else b.lo))
-        if b.lo_open:
-            either += [("1e-300 above", b.lo + 1e-300 if b.lo == 0 else b.lo * (1 + 1e-12)),
-                       ("1e-9 above", b.lo + 1e-9)]
+        if b.lo_open:  # just above an open bound (1e-9 above: the same rule)
+            either.append(("1e-300 above", b.lo + 1e-300 if b.lo == 0 else b.lo * (1 + 1e-12)))
         else:
             either.append(("lowest", int(b.lo) if whole else b.lo))
     if b.hi is not None:
@@ -142,8 +141,8 @@ def cases() -> Iterator[Any]:
             else:
                 refuse.append(("null", None))
         elif ann is bool:
-            refuse = [("1", 1), ("0", 0), ("yes", "yes"), ("quoted", "true"), ("null", None),
-                      ("list", [True])]
+            # an integer is not a boolean (0 is 1's rule), nor a word (a quoted "true" is yes's)
+            refuse = [("1", 1), ("null", None), ("yes", "yes"), ("list", [True])]
             either = [("true", True), ("false", False)]
         elif origin is tuple:
             n = len(args)
@@ -167,11 +166,13 @@ def cases() -> Iterator[Any]:
             either = [(label, v) for label, v in either if label != "highest"]
             either += [(w, w) for w in typing.get_args(word)] + [("some", 3)]
         elif origin is typing.Literal:
-            refuse = [("bogus", "bogus"), ("empty", ""), ("number", 1), ("null", None), ("list", list(args))]
+            # a word not among the choices ("" is bogus's rule), a number, null, a list
+            refuse = [("bogus", "bogus"), ("null", None), ("number", 1), ("list", list(args))]
             either = [(v, v) for v in args if v != default]
         elif ann is str:
-            refuse = [("number", 1), ("float", 1.5), ("true", True), ("null", None), ("list", ["a"]),
-                      ("mapping", {"a": "b"})]
+            # a number is not text (1.5 is 1's rule), nor a boolean, null, a list, a mapping
+            refuse = [("number", 1), ("null", None), ("true", True), ("mapping", {"a": "b"}),
+                      ("list", ["a"])]
             if key in ("name", "description"):
                 either = [("empty", ""), ("long", "n" * 5000), ("unicode", "ünïcødé ✓ 工作单元"),
                           ("tab", "a\tb"), ("quote and comma", 'a "b", c')]
@@ -257,7 +258,8 @@ def test_set_on_the_command_line(tmp_path: Path, key: str) -> None:
 
 @pytest.mark.parametrize("key", KEYS)
 def test_in_a_scenario_file(tmp_path: Path, key: str) -> None:
-    """Each key's forbidden values (every other one) written in a scenario file."""
+    """Each key's forbidden values (every other one, in the order listed) written in a scenario
+    file."""
     _all(tmp_path, _check_file, [c for c in CASES if c.key == key and c.must_refuse][::2])
 
 

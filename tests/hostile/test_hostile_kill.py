@@ -1,5 +1,7 @@
-"""Kill tests through the real commands: SIGKILL at every file-system step of ``cell run`` and of
-the planner's report directory leaves the old set or the new one, never a mixed or partial one.
+"""Kill tests through the real commands: SIGKILL at every file-system step of ``cell run`` leaves
+the old set or the new one, never a mixed or partial one, by exchange and by the fallback (each
+step of the output protocol is a rule: the planner's report and every other set commit through
+the same OutputDir, so ``cell run`` walks its steps for them).
 
 Each child is a fork of this process running the command's ``main`` (the planner's results,
 already solved here, are shared), with every open, mkdir, fsync, rename, exchange, unlink,
@@ -11,7 +13,6 @@ from __future__ import annotations
 import contextlib
 import io
 import os
-import shutil
 from pathlib import Path
 
 import pytest
@@ -89,24 +90,6 @@ def test_cell_run_killed_at_any_step_leaves_the_old_set_or_the_new(tmp_path, fal
     seen = _every_kill(tmp_path, target, lambda: _quiet(main, argv + ["--set", "run.seed=1"]),
                        lambda: _quiet(main, argv + ["--set", "run.seed=2"]), NAMES, fallback)
     assert seen <= {"old", "new", "absent"}
-
-
-def test_mintime_report_killed_at_any_step_leaves_the_old_set_or_the_new(tmp_path):
-    """``reports/mintime`` written by the planner's report, killed at each step: its files are the
-    old set or the new, never a mix."""
-    from cell.reporting import planner_report as report
-
-    target = tmp_path / "mintime"
-
-    def write_old():
-        shutil.rmtree(target, ignore_errors=True)
-        target.mkdir()
-        for name in report.FILES:
-            (target / name).write_text(f"old {name}\n")
-
-    seen = _every_kill(tmp_path, target, write_old, lambda: report.write(target), report.FILES,
-                       fallback=False)
-    assert seen <= {"old", "new"}
 
 
 def _quiet(main, argv):

@@ -35,9 +35,11 @@ def _trace(tmp: Path, values: list[str]) -> Path:
     return path
 
 
-#: (id, --set values, words the refusal must hold); a trace file is written when a value says {trace:...}
+#: (id, --set values, words the refusal must hold); a trace file is written when a value says {trace:...}.
+#: One case per rule (tests/hostile/harness.py): a trace's -inf is nan's rule, 1e308 is 2e6's (too
+#: long a gap), arrivals 1e300 s apart 1e9's, rv_continuous any name that is no distribution's
 REFUSE = [
-    ("heavy part", ["part.weight_oz=30"], ("part.weight_oz", "27.43 oz")),
+    ("a part too heavy for the shoulder", ["part.weight_oz=30"], ("part.weight_oz", "27.43 oz", "shoulder")),
     ("part wider than the hand opens", ["part.size_in=9"], ("part.size_in",)),
     ("window B-F shorter than LO", ["path.lo_from_bot_in=9"], ("path.lo_from_bot_in",)),
     ("max below nominal", ["belts.input_max_in_s=1"], ("belts.input_max_in_s",)),
@@ -50,13 +52,11 @@ REFUSE = [
     ("no finite mean", ["arrivals.distribution=cauchy", "arrivals.params={loc: 22, scale: 3}"],
      ("arrivals.params",)),
     ("a distribution scipy lacks", ["arrivals.distribution=bogus"], ("arrivals.distribution",)),
-    ("not a distribution", ["arrivals.distribution=rv_continuous"], ("arrivals.distribution",)),
     ("bogus distribution beside a trace", ["arrivals.distribution=bogus", "arrivals.trace_csv={trace:22}"],
      ("arrivals.distribution",)),
     ("trace value True", ["arrivals.trace_csv={trace:True}"], ("arrivals.trace_csv", "True")),
     ("trace value -0.5", ["arrivals.trace_csv={trace:-0.5}"], ("arrivals.trace_csv", "line 3")),
     ("trace value nan", ["arrivals.trace_csv={trace:nan}"], ("arrivals.trace_csv",)),
-    ("trace value -inf", ["arrivals.trace_csv={trace:-inf}"], ("arrivals.trace_csv",)),
     ("trace missing", ["arrivals.trace_csv=nowhere.csv"], ("arrivals.trace_csv", "no such file")),
     ("trace is a directory", ["arrivals.trace_csv=."], ("arrivals.trace_csv",)),
     ("minimum-time without any bound", ["robot.timing=minimum-time", "mintime.dynamics_file=null",
@@ -65,9 +65,7 @@ REFUSE = [
      ("mintime.dynamics_file", "no such file")),
     ("minimum-time, planner too slow", ["robot.timing=minimum-time", "mintime.rate_fraction=1e-9"],
      ("mintime.rate_fraction", "at most")),
-    ("arrivals 1e300 s apart", ["arrivals.params={c: 4.9, loc: 1e300, scale: 5.4}"], ("arrivals.params",)),
     ("arrivals 1e9 s apart", ["arrivals.params={c: 4.9, loc: 1e9, scale: 5.4}"], ("arrivals.params",)),
-    ("trace value 1e308", ["arrivals.trace_csv={trace:1e308}"], ("arrivals.trace_csv", "line 3")),
     ("trace value 2e6", ["arrivals.trace_csv={trace:2e6}"], ("arrivals.trace_csv", "line 3")),
     ("spacing smaller than a part", ["belts.spacing_in=1.0"], ("belts.spacing_in", "overlap")),
     ("tolerance wider than the spacing", ["belts.spacing_tol_in=250"],
@@ -75,7 +73,6 @@ REFUSE = [
     ("base motor too coarse for the path", ["robot.motors.steps_per_rad=[1e-9, 1125, 672, 241, 241]"],
      ("robot.motors.steps_per_rad",)),
     ("a part too heavy to track the output belt", ["part.weight_oz=10"], ("part.weight_oz", "TD")),
-    ("a part too heavy for the shoulder", ["part.weight_oz=30"], ("part.weight_oz", "shoulder")),
     ("LO at B", ["path.lo_from_bot_in=1e-300"], ("path.lo_from_bot_in", "one move")),
     ("B on F", ["path.bot_in=[-8.0, 0.0, 3.0]"], ("path.bot_in", "window")),
     ("drives too weak for the rates",
@@ -105,7 +102,6 @@ def test_physics_refused(tmp_path: Path, label: str, sets: list[str], words: tup
     ["arrivals.distribution=expon", "arrivals.params={loc: 17, scale: 5.6}"],
     ["arrivals.params={c: 1e300}"],  # every part 1 s after the last: parts are lost, the books balance
     ["controller.policy=non-adaptive", "controller.ideal_cycle_s=21e0"],
-    ["controller.policy=non-adaptive", "controller.ideal_cycle_s=2.25872e1"],
     ["part.weight_oz=0"], ["part.weight_oz=6"],
     ["run.seed=340282366920938463463374607431768211455"],
     ["controller.nominal_cycle_s=1e6"], ["controller.nominal_cycle_s=5"], ["controller.nominal_cycle_s=null"],

@@ -31,10 +31,12 @@ def _bomb_as(key: str) -> str:
     return text + f"{indent}{leaf}: *i\n"
 
 
-#: (id, bytes of the file, words the one line must hold)
+#: (id, bytes of the file, words the one line must hold): one case per rule of the reader
+#: (tests/hostile/harness.py), e.g. one syntax error for the parser's one way of reporting it,
+#: one alias bomb (a bomb as the value of a key is counted by the same rule), one non-name key
+#: (a boolean or null key meets the same check as a number)
 FILES: list[tuple[str, bytes, tuple[str, ...]]] = [
     ("latin-1", "name: caf\xe9\n".encode("latin-1"), ("not UTF-8", "line 1")),
-    ("lone 0xff", b"name: \xff\n", ("not UTF-8",)),
     ("binary", bytes(range(256)) * 8, ("(file)",)),
     ("NUL in text", b"name: a\x00b\n", ("NUL",)),
     ("control character", b"name: a\x07b\n", ("U+0007",)),
@@ -42,16 +44,12 @@ FILES: list[tuple[str, bytes, tuple[str, ...]]] = [
     ("UTF-8 BOM then latin-1", codecs.BOM_UTF8 + "name: \xe9\n".encode("latin-1"), ("not UTF-8",)),
     ("too big", b"# " + b"x" * (1 << 20) + b"\n", ("KiB",)),
     ("top-level list", b"- run\n- path\n", ("top level", "not a list")),
-    ("top-level scalar", b"just words\n", ("top level",)),
     ("unclosed flow", b"run: {parts: 5\n", ("invalid YAML", "line 1")),
     ("bad indent", b"run:\n  parts: 5\n seed: 3\n", ("invalid YAML", "line 3")),
     ("tab indent", b"run:\n\tparts: 5\n", ("invalid YAML", "line 2")),
-    ("mapping in scalar", b"a: b: c\n", ("invalid YAML",)),
-    ("unterminated quote", b'name: "abc\n', ("invalid YAML",)),
     ("two documents", b"name: a\n---\nname: b\n", ("single document",)),
     ("duplicate top key", b"run: {parts: 5}\nrun: {parts: 6}\n", ("duplicate key", "line 2")),
     ("duplicate nested key", b"run:\n  parts: 5\n  parts: 6\n", ("run.parts", "duplicate key")),
-    ("duplicate in flow", b"run: {parts: 5, parts: 6}\n", ("duplicate key",)),
     ("merge key", b"base: &b {parts: 5}\nrun:\n  <<: *b\n", ("merge keys",)),
     ("python tag", b"run: !!python/object/apply:os.system [ls]\n", ("tag", "not supported")),
     ("binary tag", b"name: !!binary aGVsbG8=\n", ("tag",)),
@@ -60,22 +58,15 @@ FILES: list[tuple[str, bytes, tuple[str, ...]]] = [
     ("self-referencing alias", b"a: &a [*a]\n", ("alias",)),
     ("undefined alias", b"name: *nowhere\n", ("invalid YAML",)),
     ("20,000 [", b"name: " + b"[" * 20000 + b"\n", ("nested deeper",)),
-    ("20,000 {", b"name: " + b"{a: " * 20000 + b"\n", ("nested deeper",)),
     ("200 levels of block lists", b"name:\n" + b"".join(b"  " * i + b"-\n" for i in range(1, 200)),
      ("nested deeper",)),
     ("alias bomb at the top", BOMB.encode(), ("more than 10,000 values",)),
-    ("alias bomb as run.parts", _bomb_as("run.parts").encode(), ("more than 10,000 values",)),
-    ("alias bomb as name", _bomb_as("name").encode(), ("more than 10,000 values",)),
-    ("alias bomb as a point", _bomb_as("path.bot_in").encode(), ("more than 10,000 values",)),
     ("40,000 keys", b"".join(b"k%d: 1\n" % i for i in range(40000)), ("more than 10,000 values",)),
     ("a 200,000-character key", b"k" * 200000 + b": 1\n", ("(syntax)", "1024 characters")),
     ("unknown section", b"robt: {}\n", ("robt", "unknown key")),
     ("unknown key", b"run: {prts: 5}\n", ("run.prts", "unknown key")),
     ("section as list", b"run: [1, 2]\n", ("run",)),
-    ("section as scalar", b"run: 5\n", ("run",)),
     ("integer key", b"1: x\n", ("a key must be a name, not a number (1)",)),
-    ("boolean key", b"true: x\n", ("a key must be a name, not a boolean (true)",)),
-    ("null key", b"~: x\n", ("a key must be a name, not null (~)",)),
     ("float key in a section", b"run: {1.5: x}\n", ("run.1.5", "not a number")),
     ("sexagesimal parts", b"run: {parts: 1:30}\n", ("run.parts", "'1:30'")),
     ("YAML 1.1 yes", b"mintime: {acceleration_bounds: yes}\n", ("mintime.acceleration_bounds",)),
@@ -88,9 +79,11 @@ FILES: list[tuple[str, bytes, tuple[str, ...]]] = [
 
 @pytest.mark.parametrize("command", ["run", "path", "mintime"])
 def test_hostile_files(tmp_path: Path, command: str) -> None:
-    """Every file above, refused in one line naming the file, fast, nothing written."""
+    """Every file above, refused in one line naming the file, fast, nothing written; ``path`` and
+    ``mintime`` read their scenario with the same reader as ``run``, so one file each shows
+    they use it."""
     failures = []
-    for i, (label, data, words) in enumerate(FILES):
+    for i, (label, data, words) in enumerate(FILES if command == "run" else FILES[:1]):
         scenario = tmp_path / f"case{i}.yaml"
         scenario.write_bytes(data)
         out = tmp_path / f"out{i}"
@@ -127,12 +120,13 @@ def test_yaml_12_numbers_are_read(tmp_path: Path) -> None:
 
 
 def test_files_that_are_not_files(tmp_path: Path) -> None:
-    """A directory, a missing file, a FIFO (which would block a reader forever), a device."""
+    """A directory, a missing file, a FIFO (which would block a reader forever; a device is the
+    same rule)."""
     fifo = tmp_path / "fifo.yaml"
     os.mkfifo(fifo)
     (tmp_path / "dir.yaml").mkdir()
     cases = [(tmp_path / "dir.yaml", "is a directory"), (tmp_path / "missing.yaml", "no such scenario file"),
-             (fifo, "not a regular file"), (Path("/dev/zero"), "not a regular file")]
+             (fifo, "not a regular file")]  # /dev/zero: the same rule as the FIFO
     for path, words in cases:
         out = tmp_path / "out"
         refused(cli("run", path, "--out", out), str(path), words, nothing_in=out)
@@ -157,17 +151,13 @@ def test_unreadable_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Non
 #: (id, --set arguments, words)
 SETS: list[tuple[str, list[str], tuple[str, ...]]] = [
     ("no =", ["run.parts"], ("KEY=VALUE",)),
-    ("empty key", ["=5"], ("KEY=VALUE",)),
     ("unclosed list", ["run.parts=[1,"], ("--set run.parts", "invalid YAML")),
-    ("unclosed mapping", ["run={parts: 5"], ("--set run", "invalid YAML")),
     ("two documents", ["name=a\n---\nb"], ("--set name",)),
     ("empty part", ["run..parts=5"], ("empty part",)),
-    ("leading dot", [".run=5"], ("empty part",)),
     ("unknown section", ["nosuch.key=5"], ("nosuch",)),
     ("unknown key", ["run.prts=5"], ("run.prts", "unknown key")),
     ("into a value", ["run.parts.x=5"], ("run.parts",)),
     ("section as scalar", ["run=5"], ("run",)),
-    ("section as list", ["run=[1]"], ("run",)),
     ("section to null", ["run=~", "run.parts=3"], ()),
     ("alias bomb", ["name=" + "{" + BOMB.replace("\n", ", ").rstrip(", ") + "}"], ("more than 10,000",)),
     ("deep nesting", ["name=" + "[" * 5000], ("nested deeper",)),

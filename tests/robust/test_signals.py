@@ -112,10 +112,12 @@ def _swallowed_then(number: int, error: BaseException):
     return main
 
 
-@pytest.mark.parametrize("number", [signal.SIGINT, signal.SIGTERM])
-@pytest.mark.parametrize("error", [BrokenPipeError(32, "Broken pipe"),
-                                   RuntimeError("ffmpeg stopped with exit status 255")],
-                         ids=["broken pipe", "another error"])
+# each signal once and each kind of error once (the signal's line and the error's kind are
+# separate rules: two cases walk both)
+@pytest.mark.parametrize("number,error", [
+    (signal.SIGINT, BrokenPipeError(32, "Broken pipe")),
+    (signal.SIGTERM, RuntimeError("ffmpeg stopped with exit status 255"))],
+    ids=["SIGINT, broken pipe", "SIGTERM, another error"])
 def test_a_stop_that_became_another_error_is_still_the_stop(monkeypatch, capsys, number, error):
     from cell.cli.main import main
 

@@ -1,0 +1,28 @@
+"""Figures laid out but not rasterised, for tests of what a figure says or which are drawn."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+from matplotlib.figure import Figure
+
+#: A PNG signature: what an unrendered figure's file holds (tests/reporting/test_figures.py reads
+#: every figure as a real PNG).
+STUB = b"\x89PNG\r\n\x1a\n"
+
+
+def unrendered_savefig(fig: Figure, fname: Any, *args: Any, **kwargs: Any) -> None:
+    """Everything a save does but the pixels: the layout, the texts and ticks, and any warning
+    they raise are met; the file holds :data:`STUB`."""
+    fig.draw_without_rendering()
+    if hasattr(fname, "write"):
+        fname.write(STUB)
+    else:
+        Path(fname).write_bytes(STUB)
+
+
+@pytest.fixture
+def unrendered(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(Figure, "savefig", unrendered_savefig)
