@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from collections import Counter
 from pathlib import Path
 from types import SimpleNamespace
@@ -13,6 +14,12 @@ import yaml
 from cell.scenario import catalog
 from cell.scenario.schema import Scenario, default_scenario, load_scenario
 from cell.sim.assembly import constants, robot_timing, step_table
+
+# The suite's own disk cache (cell.plumbing.cache), in this checkout's .pytest_cache: other
+# checkouts' code (another fingerprint) cannot replace its entries mid-run, and a user's
+# ~/.cache is left alone.  Subprocesses inherit it; tests of the cache set their own.
+os.environ["XDG_CACHE_HOME"] = str(Path(__file__).resolve().parent.parent / ".pytest_cache"
+                                   / "xdg")
 
 
 @pytest.fixture(scope="session")
