@@ -12,7 +12,9 @@ import yaml
 
 from cell.scenario import catalog
 from cell.scenario.schema import Scenario, default_scenario, load_scenario
-from cell.sim.assembly import constants, robot_timing, step_table
+from cell.sim.physics_checks import step_table
+from cell.sim.policy_setup import constants
+from cell.sim.timing_cache import robot_timing
 
 
 @pytest.fixture(scope="session")

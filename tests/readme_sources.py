@@ -58,7 +58,7 @@ class Sources:
 
     @cached_property
     def table(self) -> Any:
-        from cell.sim.assembly import step_table
+        from cell.sim.physics_checks import step_table
 
         return step_table(self.s)
 

@@ -10,13 +10,13 @@ policy's; nothing here knows which policy runs.
 from __future__ import annotations
 
 import math
-from typing import Any, Protocol
+from typing import Protocol
 
 import simpy
 
 from cell.sim.conveyors import EPS_S, InputConveyor, OutputConveyor
 from cell.sim.policies.base import CellConstants, Policy
-from cell.sim.records import PartRecord
+from cell.sim.records import Part
 from cell.sim.robot import Robot
 from cell.sim.sensor import Sensor
 
@@ -26,9 +26,9 @@ INF = math.inf
 class RunLog(Protocol):
     """Where a part's limits are noted, and where a part lost at B goes."""
 
-    def flag(self, part: PartRecord, limits: int) -> None: ...
+    def flag(self, part: Part, limits: int) -> None: ...
 
-    def missed(self, part: PartRecord) -> None: ...
+    def missed(self, part: Part) -> None: ...
 
 
 class View:
@@ -128,42 +128,28 @@ class Controller:
         floor_after_td = math.nan  # the last planned TD (the spacing contract; nan: none)
         get, flag, missed, order = self.conveyor.at_bot.get, self.log.flag, self.log.missed, \
             robot.order
-        t = self.k.timing
-        l1, l2, l3, l4 = t.r1_length_in, t.r2.length_in, t.r3_length_in, t.r4.length_in
-        # the previous cycle's TD → K and R IV (step 5.0, 6.2); nominal before the first
-        residual = self.k.r3_post_nom + self.k.r4_nom
         while True:
-            part: Any = yield get()
+            part: Part = yield get()
             now = env.now
             if not robot.free_at_s <= now + EPS_S:  # the robot is not back: the part rides on
-                part.missed = True
-                flag(part, robot.loss(now))  # let go, or lost to downtime
+                flag(part, robot.loss(now))  # let go, or lost to downtime (RODE_OFF)
                 missed(part)
                 if floor_after_td == floor_after_td:  # a wait now foreseen: the output belt's
                     replan_out(max(now, floor_after_td), u_min)  # floor from TD (or now)
                 continue
-            view.part, view.now = part.part - 1, now
+            view.part, view.now = part.index, now
             plan = plan_for(view)
-            r1_pre, r3_pre, r3_post, to_g, cycle = \
-                plan.r1_pre, plan.r3_pre, plan.r3_post, plan.to_g, plan.cycle
-            output_to_g, r2, r4, limits = plan.output_to_g, plan.r2, plan.r4, plan.limits
+            r1_pre, r3_pre, to_g = plan.r1_pre, plan.r3_pre, plan.to_g
             if plan.steers_belts:
+                cycle = plan.cycle
                 replan_in(now + r1_pre, plan.input_after_lo, now + cycle + aim, plan.input_next)
-                replan_out(now, output_to_g, now + to_g, u_nom)
+                replan_out(now, plan.output_to_g, now + to_g, u_nom)
                 if plan.output_floor_at < INF:  # the spacing contract: the belt's floor after TD
                     output_floor(now + plan.output_floor_at, u_min)
                     floor_after_td = now + to_g + r3_pre
-            r1, r3 = r1_pre + plan.r1_post, r3_pre + r3_post
-            part.picked = True
-            part.motion_cycle_s = cycle
-            part.input_speed_in_s, part.output_speed_in_s = plan.input_speed, output_to_g
-            part.r1_s, part.r2_s, part.r3_s, part.r4_s = r1, r2, r3, r4
-            part.v_r1_in_s, part.v_r2_in_s = l1 / r1, l2 / r2
-            part.v_r3_in_s, part.v_r4_in_s = l3 / r3, l4 / r4
+            part.plan = plan  # the part's regime times and belt speeds (read as its row is made)
+            limits = plan.limits
             if limits:
                 flag(part, limits)
-            # step 6.2: motion time to TD plus the previous cycle's residual
-            part.thesis_interval_s = to_g + r3_pre + residual
-            residual = r3_post + r4
             # B → TD summed as LO + (LO → TD), the order the robot's legs are timed in
-            order(part, r1_pre, r1_pre + (to_g - r1_pre + r3_pre), cycle)
+            order(part, r1_pre, r1_pre + (to_g - r1_pre + r3_pre), plan.cycle)

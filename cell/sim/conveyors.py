@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 import simpy
 
 from cell.sim.mailbox import Mailbox
+from cell.sim.records import Part
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -252,22 +253,22 @@ class InputConveyor:
         self.length_in = length_in
         """Feeder drop point to B (in)."""
         self.loaded: Mailbox = Mailbox(env)
-        """Parts dropped on the belt by the feeder (their records)."""
+        """Parts dropped on the belt by the feeder."""
         self.at_bot: Mailbox = Mailbox(env)
         """Parts as they reach B (the controller waits on it)."""
         self.x_fed: dict[int, float] = {}
         """Belt travel at the instant each part on the belt was dropped (by index)."""
         self.due_s = -math.inf
         """When the part on its way to B gets there (-inf: none is)."""
-        self.feeder: Any = None
-        """The feeder, told of a replan while it holds a part back."""
+        self.on_replan: Callable[[], None] | None = None
+        """Called after each replan (the feeder's, which times a held part's wait again)."""
         self.timing = False
         """True while :meth:`run_stoppable` waits for a part to reach B (a stop re-times it)."""
         self.process = env.process(self.run_stoppable() if stoppable else self.run())
 
-    def drop(self, part: Any, x: float) -> None:
-        """The feeder puts a part (its record) on the belt now, the belt's travel being x."""
-        self.x_fed[part.part - 1] = x
+    def drop(self, part: Part, x: float) -> None:
+        """The feeder puts a part on the belt now, the belt's travel being x."""
+        self.x_fed[part.index] = x
         self.loaded.put(part)
 
     def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
@@ -276,16 +277,16 @@ class InputConveyor:
         if self.env.now < self.due_s:
             raise RuntimeError("the input belt was replanned while a part was on its way to B")
         self.belt.plan(t1, v1, t2, v2)
-        feeder = self.feeder
-        if feeder is not None and feeder.holding:
-            feeder.process.interrupt()
+        told = self.on_replan
+        if told is not None:
+            told()
 
     def run(self):  # noqa: ANN201 (SimPy generator)
         env, get, hand_over = self.env, self.loaded.get, self.at_bot.put_after
         time_at, x_fed, length = self.belt.time_at, self.x_fed, self.length_in
         while True:
             part = yield get()
-            i = part.part - 1
+            i = part.index
             now = env.now
             delay = time_at(x_fed[i] + length) - now
             if delay < 0.0:  # max(delay, 0) without the builtin call
@@ -302,7 +303,7 @@ class InputConveyor:
         env, get, hand_over, belt = self.env, self.loaded.get, self.at_bot.put_after, self.belt
         while True:
             part = yield get()
-            i = part.part - 1
+            i = part.index
             target = self.x_fed[i] + self.length_in
             while True:
                 self.timing = True
@@ -338,7 +339,7 @@ class OutputConveyor:
     """
 
     def __init__(self, env: simpy.Environment, speed_in_s: float,
-                 delivered: Callable[[Any], Any],
+                 delivered: Callable[[Part], Any],
                  on_change: Callable[[float, float], Any] | None = None):
         self.env = env
         self.belt = Belt(speed_in_s, on_change)

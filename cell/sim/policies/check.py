@@ -2,7 +2,7 @@
 
 A policy (built in or a plug-in) answers :meth:`~cell.sim.policies.base.Policy.plan` with the
 regime times and belt speeds of one cycle.  :func:`checked` wraps that method, where the
-policy is built (:func:`cell.sim.assembly.make_policy`), so that each plan must obey the same
+policy is built (:func:`cell.sim.policy_setup.make_policy`), so that each plan must obey the same
 physics the built-in policies do before the controller uses it:
 
 * every regime time finite and no shorter than the motors allow (the floors of
