@@ -418,3 +418,14 @@ def test_the_run_log_hands_parts_on_in_part_order_whatever_order_they_finish(fin
             ready += 1
         assert handed == list(range(1, ready + 1))
     assert len(log.per_part) == 8 * 8 * len(PER_PART)  # PER_PART's doubles a part, each once
+
+
+@pytest.mark.parametrize("policy", ["adaptive", "non-adaptive"])
+def test_parts_in_cell_are_the_parts_come_but_not_done_when_the_run_ends(policy):
+    """``run.hours`` stops the run sharp: the parts on the belt or in the hand then are
+    ``parts_in_cell``, the parts that came less the rows (every part done has its row)."""
+    s = default_scenario().with_overrides({"run.hours": 0.25, "controller.policy": policy})
+    r = simulate(s, seed=2)
+    assert r.summary.parts_in_cell == r.summary.parts_arrived - len(r.records) >= 1
+    assert r.summary.parts_arrived == r.summary.parts_delivered + r.summary.parts_missed + \
+        r.summary.parts_in_cell
