@@ -121,7 +121,7 @@ class Controller:
 
     def run(self):  # noqa: ANN201 (SimPy generator)
         """Once per part, with locals bound."""
-        env, robot, view, plan_for = self.env, self.robot, self.view, self.policy.plan
+        robot, view, plan_for = self.robot, self.view, self.policy.plan
         replan_in, replan_out, u_nom = self.conveyor.replan, self.output.replan, self.k.u_nom
         output_floor, u_min = self.output.belt.then, self.k.output_min
         aim = self.k.lookahead_margin_s  # step 6.3 from when the next part is aimed at B
@@ -130,7 +130,7 @@ class Controller:
             robot.order
         while True:
             part: Part = yield get()
-            now = env.now
+            now = part.at_bot_s  # env.now: the part is taken the instant it reaches B
             if not robot.free_at_s <= now + EPS_S:  # the robot is not back: the part rides on
                 flag(part, robot.loss(now))  # let go, or lost to downtime (RODE_OFF)
                 missed(part)

@@ -67,7 +67,8 @@ class Belt:
         """While stopped by a failure: the speed it ran at and the changes planned after."""
         self._anchor: tuple[float, float, float] = (0.0, 0.0, speed_in_s)
         """The last settled change (instant, travel, speed): still in force when a replan
-        from a later instant has settled past the present (a stop then starts from it)."""
+        from a later instant has settled past the present (a stop then starts from it; kept
+        by :class:`StoppableBelt` only)."""
 
     @property
     def held(self) -> int:
@@ -168,8 +169,6 @@ class Belt:
             if v < lo:
                 lo = v
         self.max_speed_in_s, self.min_speed_in_s = hi, lo
-        if n:
-            self._anchor = (self._t[n - 1], self._x[n - 1], vs[n - 1])
         told = self.on_change
         if told is not None:
             ts = self._t
@@ -180,22 +179,6 @@ class Belt:
     def stopped(self) -> bool:
         """Whether the belt stands (a failure, :meth:`stop`) until :meth:`restart`."""
         return self._halted is not None
-
-    def stop(self, t: float) -> None:
-        """Stand from instant t (now) on: speed 0, parts stay where they are; what was
-        planned after t is kept for :meth:`restart` (docs/model.md, "When equipment fails")."""
-        ts, vs = self._t, self._v
-        if ts[0] > t:  # a replan from a later instant settled the change in force now: stop
-            t0, x0, v0 = self._anchor  # from it, every held change kept for the restart
-            self._halted = (v0, list(zip(ts, vs)))
-            self._t, self._x, self._v = [t], [x0 + v0 * (t - t0)], [0.0]
-            return
-        k = bisect_right(ts, t)
-        later = list(zip(ts[k:], vs[k:]))
-        running = vs[k - 1] if k > 0 else vs[0]
-        del ts[k:], self._x[k:], vs[k:]
-        self._run_from(t, 0.0)
-        self._halted = (running, later)
 
     def plan_stopped(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
         """:meth:`plan` while stopped: the plan takes effect from the restart on."""
@@ -232,6 +215,36 @@ class Belt:
         del self._t[:], self._x[:], self._v[:]
 
 
+class StoppableBelt(Belt):
+    """A belt that a failure can stop (``failures:``): it keeps its last settled change for
+    :meth:`stop`.  Chosen when the run is assembled, so a run without failures does not pay
+    for it: ``make bench``'s ``parts_per_s_adaptive_5k`` does two settles a part, and the
+    anchor's tuple was about 1 % of it (2 shared cores, best of 7)."""
+
+    __slots__ = ()
+
+    def _settle(self, n: int) -> None:
+        if n:
+            self._anchor = (self._t[n - 1], self._x[n - 1], self._v[n - 1])
+        Belt._settle(self, n)
+
+    def stop(self, t: float) -> None:
+        """Stand from instant t (now) on: speed 0, parts stay where they are; what was
+        planned after t is kept for :meth:`restart` (docs/model.md, "When equipment fails")."""
+        ts, vs = self._t, self._v
+        if ts[0] > t:  # a replan from a later instant settled the change in force now: stop
+            t0, x0, v0 = self._anchor  # from it, every held change kept for the restart
+            self._halted = (v0, list(zip(ts, vs)))
+            self._t, self._x, self._v = [t], [x0 + v0 * (t - t0)], [0.0]
+            return
+        k = bisect_right(ts, t)
+        later = list(zip(ts[k:], vs[k:]))
+        running = vs[k - 1] if k > 0 else vs[0]
+        del ts[k:], self._x[k:], vs[k:]
+        self._run_from(t, 0.0)
+        self._halted = (running, later)
+
+
 class InputConveyor:
     """Carries parts from the feeder, ``length_in`` upstream of B, to B.
 
@@ -249,7 +262,7 @@ class InputConveyor:
     def __init__(self, env: simpy.Environment, speed_in_s: float, length_in: float,
                  on_change: Callable[[float, float], Any] | None = None, stoppable: bool = False):
         self.env = env
-        self.belt = Belt(speed_in_s, on_change)
+        self.belt = (StoppableBelt if stoppable else Belt)(speed_in_s, on_change)
         self.length_in = length_in
         """Feeder drop point to B (in)."""
         self.loaded: Mailbox = Mailbox(env)
@@ -340,9 +353,9 @@ class OutputConveyor:
 
     def __init__(self, env: simpy.Environment, speed_in_s: float,
                  delivered: Callable[[Part], Any],
-                 on_change: Callable[[float, float], Any] | None = None):
+                 on_change: Callable[[float, float], Any] | None = None, stoppable: bool = False):
         self.env = env
-        self.belt = Belt(speed_in_s, on_change)
+        self.belt = (StoppableBelt if stoppable else Belt)(speed_in_s, on_change)
         self.placed: Mailbox = Mailbox(env)
         """Parts set down by the robot, each due at its touch-down."""
         self.delivered = delivered

@@ -54,10 +54,10 @@ class Feeder:
         self.holding = False
         """True while a part waits for the belt to clear (a replan interrupts the wait)."""
         self.process = env.process(self.run())
-        conveyor.on_replan = self.belt_replanned
 
     def belt_replanned(self) -> None:
-        """The input belt was replanned: a part held back times its wait again."""
+        """The input belt was replanned while a part is held back: its wait is timed again
+        (the conveyor's ``on_replan`` while the feeder holds a part, None otherwise)."""
         if self.holding:
             self.process.interrupt()
 
@@ -68,14 +68,19 @@ class Feeder:
         after = Timer(env).after  # env.timeout's schedule, without a new event a part
         size = self.part_size_in
         clear_at = -float("inf")
+        now = env.now  # the clock, kept here: each wait ends exactly ``now + delay`` later
         for i in range(self.n_parts):
             f = fed[i]
-            delay = f - env.now
-            yield after(delay if delay > 0.0 else 0.0)  # max(delay, 0): after a hold it may be due
-            x = travel(env.now)
+            delay = f - now
+            if delay < 0.0:  # max(delay, 0): after a hold it may be due
+                delay = 0.0
+            yield after(delay)
+            now += delay  # env.now, as the timer fell (two property reads a part saved)
+            x = travel(now)
             if x < clear_at - CLEAR_TOL_IN:
                 belt = self.conveyor.belt
                 self.holding = True
+                self.conveyor.on_replan = self.belt_replanned
                 while x < clear_at - CLEAR_TOL_IN:
                     try:
                         if belt.stopped:  # a failure: wait for the restart to interrupt
@@ -85,7 +90,9 @@ class Feeder:
                         pass
                     x = travel(env.now)
                 self.holding = False
-                part = Part(i, env.now, env.now - f)
+                self.conveyor.on_replan = None
+                now = env.now
+                part = Part(i, now, now - f)
                 if flag is not None:
                     flag(part, HELD_AT_FEEDER)
             else:

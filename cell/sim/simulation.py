@@ -244,7 +244,8 @@ def simulate(scenario: Scenario | AssembledCell,
     wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
     conveyor = InputConveyor(env, k.v_nom, k.input_length, belts.told(0),
                              stoppable=downtime is not None)
-    output = OutputConveyor(env, k.u_nom, log.delivered_part, belts.told(1))
+    output = OutputConveyor(env, k.u_nom, log.delivered_part, belts.told(1),
+                            stoppable=downtime is not None)
     robot = Robot(env, output.placed, None if downtime is None else downtime.robot.cycle)
     feeder = Feeder(env, t_list, conveyor, n, k.part_size, log.flag)
     view = _view(cell, seed, n, feeder, conveyor, output)
