@@ -14,8 +14,10 @@ from typing import Protocol
 
 import simpy
 
+from cell.plumbing.errors import CellError
 from cell.sim.conveyors import EPS_S, InputConveyor, OutputConveyor
 from cell.sim.policies.base import CellConstants, Policy
+from cell.sim.policies.check import ALL_LIMITS, MAX_S, SUM_S, plan_bounds, plan_failed, refuse
 from cell.sim.records import Part
 from cell.sim.robot import Robot
 from cell.sim.sensor import Sensor
@@ -66,8 +68,6 @@ class View:
     def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
         """(a, b) of the first part after this one that can still be caught: the ideal
         look-ahead, which reads the feeder's schedule (``sensor.lookahead: ideal``)."""
-        if not self.sensor_up:
-            return None
         now, fed_s, length = self.now, self.fed_s, self._length
         x_now = None
         for j in range(self.part + 1, self.n):
@@ -83,6 +83,15 @@ class View:
             if d > 0:
                 return (lag, d)
         return None
+
+
+class FallibleView(View):
+    """The ideal look-ahead of a run whose sensor can fail (``failures.sensor``): nothing
+    while it is down.  Chosen when the run is assembled, so that a run without failures
+    does not ask (``make bench``: one test a part, a fraction of a percent)."""
+
+    def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
+        return View.next_part(self, lag, v) if self.sensor_up else None
 
 
 class SensorView(View):
@@ -114,8 +123,11 @@ class Controller:
     """Decides each part's cycle when it reaches B (SimPy process)."""
 
     def __init__(self, env: simpy.Environment, k: CellConstants, policy: Policy, view: View,
-                 conveyor: InputConveyor, output: OutputConveyor, robot: Robot, log: RunLog):
+                 conveyor: InputConveyor, output: OutputConveyor, robot: Robot, log: RunLog,
+                 name: str = ""):
         self.env, self.k, self.policy, self.view = env, k, policy, view
+        self.name = name or getattr(policy, "name", "")
+        """The policy's name, as the scenario gives it (for a bad plan's message)."""
         self.conveyor, self.output, self.robot, self.log = conveyor, output, robot, log
         self.process = env.process(self.run())
 
@@ -126,6 +138,8 @@ class Controller:
         output_floor, u_min = self.output.belt.then, self.k.output_min
         aim = self.k.lookahead_margin_s  # step 6.3 from when the next part is aimed at B
         floor_after_td = math.nan  # the last planned TD (the spacing contract; nan: none)
+        a1, a2, a3, a4, a5, a6, c1, d1, c2, d2, c3, d3, c4, d4 = plan_bounds(self.k)
+        bad_bits, top, eps, name, passed = ~ALL_LIMITS, MAX_S, SUM_S, self.name, None
         get, flag, missed, order = self.conveyor.at_bot.get, self.log.flag, self.log.missed, \
             robot.order
         while True:
@@ -138,7 +152,30 @@ class Controller:
                     replan_out(max(now, floor_after_td), u_min)  # floor from TD (or now)
                 continue
             view.part, view.now = part.index, now
-            plan = plan_for(view)
+            try:
+                plan = plan_for(view)
+            except CellError:
+                raise
+            except Exception as exc:  # noqa: BLE001 - a plug-in's failure, named
+                raise plan_failed(name, exc) from exc
+            if plan is not passed:  # checked at the boundary (cell.sim.policies.check)
+                try:
+                    r1a, r1b, r2, r3a, r3b, r4 = \
+                        plan.r1_pre, plan.r1_post, plan.r2, plan.r3_pre, plan.r3_post, plan.r4
+                    to_g, cycle, limits = plan.to_g, plan.cycle, plan.limits
+                    ok = (a1 <= r1a and a2 <= r1b and a3 <= r2 and a4 <= r3a and a5 <= r3b
+                          and a6 <= r4 and c1 <= plan.input_speed <= d1
+                          and c2 <= plan.input_after_lo <= d2 and c3 <= plan.input_next <= d3
+                          and c4 <= plan.output_to_g <= d4
+                          and -eps <= to_g - (r1a + r1b + r2) <= eps
+                          and -eps <= cycle - (to_g + r3a + r3b + r4) <= eps and cycle < top
+                          and limits.__class__ is int and not limits & bad_bits
+                          and plan.steers_belts.__class__ is bool)
+                except Exception:  # noqa: BLE001 - a field missing or not a number: said below
+                    ok = False
+                if not ok:
+                    refuse(plan, name, self.k)
+                passed = plan
             r1_pre, r3_pre, to_g = plan.r1_pre, plan.r3_pre, plan.to_g
             if plan.steers_belts:
                 cycle = plan.cycle

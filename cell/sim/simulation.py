@@ -35,7 +35,7 @@ from cell.scenario.schema import Scenario
 from cell.sim import accounting, oee, wear_clock
 from cell.sim.assembly import AssembledCell, assemble
 from cell.sim.bound import parts_bound
-from cell.sim.controller import Controller, SensorView, View
+from cell.sim.controller import Controller, FallibleView, SensorView, View
 from cell.sim.conveyors import InputConveyor, OutputConveyor
 from cell.sim.failures import Downtime
 from cell.sim.feeder import Feeder
@@ -249,7 +249,7 @@ def simulate(scenario: Scenario | AssembledCell,
     robot = Robot(env, output.placed, None if downtime is None else downtime.robot.cycle)
     feeder = Feeder(env, t_list, conveyor, n, k.part_size, log.flag)
     view = _view(cell, seed, n, feeder, conveyor, output)
-    Controller(env, k, policy, view, conveyor, output, robot, log)
+    Controller(env, k, policy, view, conveyor, output, robot, log, s.controller.policy)
     wear = wear_clock.alone(cell, robot, seed, downtime)  # wear: without failures (or None)
     if downtime is None and horizon is None:
         env.run()
@@ -279,7 +279,8 @@ def _view(cell: AssembledCell, seed: Any, n: int, feeder: Feeder, conveyor: Inpu
     what a physical sensor has reported (``sensor``)."""
     s, k = cell.scenario, cell.k
     if s.sensor.lookahead == "ideal":
-        return View(k, feeder.fed_s, n, conveyor, output)
+        fallible = s.failures is not None and s.failures.sensor is not None
+        return (FallibleView if fallible else View)(k, feeder.fed_s, n, conveyor, output)
     position = sensor_position(s.sensor, k.input_length, s.source)
     return SensorView(k, Sensor(s.sensor, position, conveyor, n, seed), n, conveyor, output)
 
