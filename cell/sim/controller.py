@@ -132,7 +132,8 @@ class Controller:
         self.process = env.process(self.run())
 
     def run(self):  # noqa: ANN201 (SimPy generator)
-        """Once per part, with locals bound."""
+        """Once per part, locals bound, the clock read from the part's arrival at B and the plan
+        checked inline (for speed: :meth:`.Feeder.run`, :mod:`cell.sim.policies.check`)."""
         robot, view, plan_for = self.robot, self.view, self.policy.plan
         replan_in, replan_out, u_nom = self.conveyor.replan, self.output.replan, self.k.u_nom
         output_floor, u_min = self.output.belt.then, self.k.output_min
@@ -140,8 +141,7 @@ class Controller:
         floor_after_td = math.nan  # the last planned TD (the spacing contract; nan: none)
         a1, a2, a3, a4, a5, a6, c1, d1, c2, d2, c3, d3, c4, d4 = plan_bounds(self.k)
         bad_bits, top, eps, name, passed = ~ALL_LIMITS, MAX_S, SUM_S, self.name, None
-        get, flag, missed, order = self.conveyor.at_bot.get, self.log.flag, self.log.missed, \
-            robot.order
+        get, flag, missed, order = self.conveyor.at_bot.get, self.log.flag, self.log.missed, robot.order
         while True:
             part: Part = yield get()
             now = part.at_bot_s  # env.now: the part is taken the instant it reaches B
@@ -178,15 +178,14 @@ class Controller:
                 passed = plan
             r1_pre, r3_pre, to_g = plan.r1_pre, plan.r3_pre, plan.to_g
             if plan.steers_belts:
-                cycle = plan.cycle
-                replan_in(now + r1_pre, plan.input_after_lo, now + cycle + aim, plan.input_next)
+                replan_in(now + r1_pre, plan.input_after_lo, now + plan.cycle + aim,
+                          plan.input_next)
                 replan_out(now, plan.output_to_g, now + to_g, u_nom)
                 if plan.output_floor_at < INF:  # the spacing contract: the belt's floor after TD
                     output_floor(now + plan.output_floor_at, u_min)
                     floor_after_td = now + to_g + r3_pre
             part.plan = plan  # the part's regime times and belt speeds (read as its row is made)
-            limits = plan.limits
-            if limits:
-                flag(part, limits)
+            if plan.limits:
+                flag(part, plan.limits)
             # B → TD summed as LO + (LO → TD), the order the robot's legs are timed in
             order(part, r1_pre, r1_pre + (to_g - r1_pre + r3_pre), plan.cycle)

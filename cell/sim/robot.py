@@ -182,6 +182,9 @@ class Robot:
         self.orders.put((part, to_lo_s, to_td_s, now))
 
     def run(self):  # noqa: ANN201 (SimPy generator)
+        """Each order taken the instant it is given, so its instant is the clock's (for
+        speed: the order carries it, one ``env.now`` read a part saved, see
+        :meth:`cell.sim.feeder.Feeder.run`)."""
         set_down, get = self.output.put_after, self.orders.get
         while True:  # taken the instant it is given: the order's instant is the clock's
             part, to_lo_s, to_td_s, now = yield get()
