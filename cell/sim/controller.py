@@ -136,7 +136,7 @@ class Controller:
         checked inline (for speed: :meth:`.Feeder.run`, :mod:`cell.sim.policies.check`)."""
         robot, view, plan_for = self.robot, self.view, self.policy.plan
         replan_in, replan_out, u_nom = self.conveyor.replan, self.output.replan, self.k.u_nom
-        output_floor, u_min = self.output.belt.then, self.k.output_min
+        replan_out_floor, u_min = self.output.replan_then, self.k.output_min
         aim = self.k.lookahead_margin_s  # step 6.3 from when the next part is aimed at B
         floor_after_td = math.nan  # the last planned TD (the spacing contract; nan: none)
         a1, a2, a3, a4, a5, a6, c1, d1, c2, d2, c3, d3, c4, d4 = plan_bounds(self.k)
@@ -180,10 +180,12 @@ class Controller:
             if plan.steers_belts:
                 replan_in(now + r1_pre, plan.input_after_lo, now + plan.cycle + aim,
                           plan.input_next)
-                replan_out(now, plan.output_to_g, now + to_g, u_nom)
                 if plan.output_floor_at < INF:  # the spacing contract: the belt's floor after TD
-                    output_floor(now + plan.output_floor_at, u_min)
+                    replan_out_floor(now, plan.output_to_g, now + to_g, u_nom,
+                                     now + plan.output_floor_at, u_min)
                     floor_after_td = now + to_g + r3_pre
+                else:
+                    replan_out(now, plan.output_to_g, now + to_g, u_nom)
             part.plan = plan  # the part's regime times and belt speeds (read as its row is made)
             if plan.limits:
                 flag(part, plan.limits)

@@ -1,13 +1,12 @@
 """The two belt conveyors (thesis §4.1, §5.2, §6.2 a).
 
-A belt is a speed schedule: piecewise-constant speeds from given instants, so
-its travel X(t) is piecewise linear and exact.  Speed changes take effect at
-once (§6.2 a: negligible lag).  The controller writes the schedule ahead of
-time (a change at LO, the step 6.3 decay at the end of the cycle, the output
-belt back to nominal at G); a part's arrival is the instant the belt has
-carried it the required distance, so the input conveyor's SimPy process only
-wakes when a part reaches B (the controller, which replans only then, having
-taken it first), and the output conveyor's when a part is set down.
+A belt is a speed schedule: piecewise-constant speeds from given instants, so its travel X(t) is
+piecewise linear and exact.  Speed changes take effect at once (§6.2 a: negligible lag).  The
+controller writes the schedule ahead of time (a change at LO, the step 6.3 decay at the end of the
+cycle, the output belt back to nominal at G); a part's arrival is the instant the belt has carried
+it the required distance, so the input conveyor's SimPy process only wakes when a part reaches B
+(the controller, which replans only then, having taken it first), and the output conveyor's when a
+part is set down.
 """
 
 from __future__ import annotations
@@ -41,16 +40,14 @@ def speed_at(instants: Sequence[float] | Array, speeds: Sequence[float] | Array,
 class Belt:
     """A belt's speed schedule and travel X(t) (inches since t = 0).
 
-    Only the schedule from the present on is kept: a change whose successor has
-    started is final and is handed to ``on_change`` (e.g. a ``belts.csv``
-    writer) and dropped, so a long run keeps a few entries, not its history.
+    Only the schedule from the present on is kept: a change whose successor has started is final and
+    is handed to ``on_change`` (e.g. a ``belts.csv`` writer) and dropped, so a long run keeps a few
+    entries, not its history.
     """
 
-    __slots__ = ("_t", "_x", "_v", "on_change", "max_speed_in_s", "min_speed_in_s", "_halted",
-                 "_anchor")
+    __slots__ = ("_t", "_x", "_v", "on_change", "max_speed_in_s", "min_speed_in_s", "_halted", "_anchor")
 
-    def __init__(self, speed_in_s: float,
-                 on_change: Callable[[float, float], Any] | None = None):
+    def __init__(self, speed_in_s: float, on_change: Callable[[float, float], Any] | None = None):
         self._t: list[float] = [0.0]
         """Instants at which a speed starts."""
         self._x: list[float] = [0.0]
@@ -66,14 +63,12 @@ class Belt:
         self._halted: tuple[float, list[tuple[float, float]]] | None = None
         """While stopped by a failure: the speed it ran at and the changes planned after."""
         self._anchor: tuple[float, float, float] = (0.0, 0.0, speed_in_s)
-        """The last settled change (instant, travel, speed): still in force when a replan
-        from a later instant has settled past the present (a stop then starts from it; kept
-        by :class:`StoppableBelt` only)."""
+        """The last settled change (instant, travel, speed), in force when a replan from a later
+        instant has settled past the present (a stop starts from it; :class:`StoppableBelt`'s)."""
 
     @property
     def held(self) -> int:
-        """Speed segments held in memory: the one in force and those planned ahead
-        (what is behind is told to ``on_change`` and dropped, so memory stays flat)."""
+        """Speed segments held: the one in force and those planned (memory stays flat)."""
         return len(self._t)
 
     def speed(self, t: float) -> float:
@@ -97,13 +92,12 @@ class Belt:
         return self._t[k] + (x - self._x[k]) / self._v[k]
 
     def plan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
-        """From instant t1 (now or later) run at v1, and from t2 > t1 at v2, dropping
-        later plans.
+        """From instant t1 (now or later) run at v1, and from t2 > t1 at v2, dropping later plans.
 
-        A new plan supersedes whatever was planned after t1 (the controller
-        replans every cycle); a change within EPS_S of the last one replaces it.
-        Changes before ``t1`` whose successors have started are settled.
-        (Called twice a part: the controller's case is unrolled first, for speed.)
+        A new plan supersedes whatever was planned after t1 (the controller replans every cycle); a
+        change within EPS_S of the last one replaces it. Changes before ``t1`` whose successors have
+        started are settled. (Called twice a part: the controller's case is unrolled first, for
+        speed.)
         """
         if not v1 > 0 or (t2 is not None and not v2 > 0):
             raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}")
@@ -135,6 +129,28 @@ class Belt:
         self._run_from(t1, v1)
         if t2 is not None:
             self._run_from(t2, v2)
+
+    def plan_then(self, t1: float, v1: float, t2: float, v2: float, t3: float, v3: float) -> None:
+        """:meth:`plan` (t1, v1, t2, v2) then :meth:`then` (t3, v3): the output belt's replan under
+        the spacing contract, unrolled (for speed: a call and three appends a part fewer, about
+        2 % of ``make bench``'s ``parts_per_s_adaptive_5k``, CPU time, best of 12, interleaved)."""
+        ts, xs, vs = self._t, self._x, self._v
+        t0 = ts[-1]
+        if t0 > t1 + EPS_S and len(ts) > 1 and ts[-2] < t1:  # the last floor, not yet begun:
+            del ts[-1], xs[-1], vs[-1]  # dropped, as :meth:`plan` drops it
+            t0 = ts[-1]
+        if t0 < t1 < t2 < t3 and v1 > 0 and v2 > 0 and v3 > 0:
+            n = len(ts) - 1
+            if n > 0:
+                self._settle(n)
+            x0, v0 = xs[-1], vs[-1]
+            x1 = x0 + v0 * (t1 - t0)
+            x2 = x1 + v1 * (t2 - t1)
+            self._t, self._x, self._v = [t0, t1, t2, t3], [x0, x1, x2, x2 + v2 * (t3 - t2)], \
+                [v0, v1, v2, v3]
+            return
+        self.plan(t1, v1, t2, v2)
+        self.then(t3, v3)
 
     def then(self, t: float, v: float) -> None:
         """And from instant t, after every change planned, run at v (a third change)."""
@@ -216,10 +232,9 @@ class Belt:
 
 
 class StoppableBelt(Belt):
-    """A belt that a failure can stop (``failures:``): it keeps its last settled change for
-    :meth:`stop`.  Chosen when the run is assembled, so a run without failures does not pay
-    for it: ``make bench``'s ``parts_per_s_adaptive_5k`` does two settles a part, and the
-    anchor's tuple was about 1 % of it (2 shared cores, best of 7)."""
+    """A belt a failure can stop (``failures:``), keeping its last settled change for :meth:`stop`;
+    chosen at assembly (for speed: the anchor's tuple, two settles a part, was about 1 % of ``make
+    bench``'s ``parts_per_s_adaptive_5k`` on 2 shared cores, best of 7)."""
 
     __slots__ = ()
 
@@ -248,15 +263,14 @@ class StoppableBelt(Belt):
 class InputConveyor:
     """Carries parts from the feeder, ``length_in`` upstream of B, to B.
 
-    Its process takes each part the feeder drops (``loaded``), works out when
-    the belt will have carried it to B, and hands it to the controller (``at_bot``)
-    due at that instant: one event, which wakes the controller and then this
-    process, so the controller plans (and may replan the belt) before the next
-    part is timed.  A part nobody picks up rides on to F and falls off (§6.3).
+    Its process takes each part the feeder drops (``loaded``), works out when the belt will have
+    carried it to B, and hands it to the controller (``at_bot``) due at that instant: one event,
+    which wakes the controller and then this process, so the controller plans (and may replan the
+    belt) before the next part is timed.  A part nobody picks up rides on to F and falls off (§6.3).
 
-    The controller replans the belt only when a part reaches B, so a part on its
-    way to B never has its arrival moved; a replan at any other instant while a
-    part is due is refused (it would need the part timed again).
+    The controller replans the belt only when a part reaches B, so a part on its way to B never has
+    its arrival moved; a replan at any other instant while a part is due is refused (it would need
+    the part timed again).
     """
 
     def __init__(self, env: simpy.Environment, speed_in_s: float, length_in: float,
@@ -285,14 +299,12 @@ class InputConveyor:
         self.loaded.put(part)
 
     def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
-        """New speed plan from the controller (see :meth:`Belt.plan`), made as a part
-        reaches B: before the next part is timed."""
+        """New speed plan from the controller (:meth:`Belt.plan`), as a part reaches B."""
         if self.env.now < self.due_s:
             raise RuntimeError("the input belt was replanned while a part was on its way to B")
         self.belt.plan(t1, v1, t2, v2)
-        told = self.on_replan
-        if told is not None:
-            told()
+        if self.on_replan is not None:
+            self.on_replan()
 
     def run(self):  # noqa: ANN201 (SimPy generator)
         env, get, hand_over = self.env, self.loaded.get, self.at_bot.put_after
@@ -345,10 +357,10 @@ class InputConveyor:
 class OutputConveyor:
     """Takes parts from the robot at TD and records their spacing (thesis §4.3 f).
 
-    Spacing of a part = the output belt's travel between the previous part's
-    touch-down and its own: the distance between the two on the belt.  Each part
-    set down is handed on to ``delivered`` (the run's log).  The robot hands a part
-    over due at its touch-down (``placed``), so this process wakes once per part, at TD.
+    Spacing of a part = the output belt's travel between the previous part's touch-down and its own:
+    the distance between the two on the belt.  Each part set down is handed on to ``delivered`` (the
+    run's log).  The robot hands a part over due at its touch-down (``placed``), so this process
+    wakes once per part, at TD.
     """
 
     def __init__(self, env: simpy.Environment, speed_in_s: float,
@@ -365,7 +377,14 @@ class OutputConveyor:
         """Instant of the last touch-down (read once ``last_td_x`` is set)."""
         self.replan = self.belt.plan
         """New speed plan from the controller (:meth:`Belt.plan`)."""
+        self.replan_then = self._replan_then if stoppable else self.belt.plan_then
+        """The same with the spacing contract's floor after it (:meth:`Belt.plan_then`)."""
         self.process = env.process(self.run())
+
+    def _replan_then(self, t1: float, v1: float, t2: float, v2: float, t3: float, v3: float) -> None:
+        """With failures: :attr:`replan` (which :mod:`cell.sim.failures` wraps), then the floor."""
+        self.replan(t1, v1, t2, v2)
+        self.belt.then(t3, v3)
 
     def run(self):  # noqa: ANN201 (SimPy generator)
         env, get, travel, delivered = self.env, self.placed.get, self.belt.travel, self.delivered
