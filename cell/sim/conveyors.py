@@ -72,7 +72,8 @@ class Belt:
         return len(self._t)
 
     def speed(self, t: float) -> float:
-        """The speed at instant t (:func:`speed_at`, hand-written for speed: no ``max`` call)."""
+        """The speed at t (:func:`speed_at` less its ``max``: once a part, a fraction of 1 % of
+        ``make bench``'s ``parts_per_s_adaptive_5k``)."""
         k = bisect_right(self._t, t) - 1
         return self._v[k if k > 0 else 0]
 
@@ -221,9 +222,8 @@ class Belt:
             self._run_from(tp, vp)
 
     def close(self, until: float | None = None) -> None:
-        """Hand every change still held (planned ones included) to ``on_change``; with
-        ``until`` (the end of the run), those planned to start then or later, which never
-        took effect, are dropped instead."""
+        """Hand every change still held (planned ones included) to ``on_change``; with ``until``
+        (the run's end), those planned to start then or later, which never took effect, dropped."""
         if until is not None:
             keep = max(bisect_left(self._t, until - EPS_S), 1)
             del self._t[keep:], self._x[keep:], self._v[keep:]
