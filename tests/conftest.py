@@ -13,7 +13,9 @@ import yaml
 
 from cell.scenario import catalog
 from cell.scenario.schema import Scenario, default_scenario, load_scenario
-from cell.sim.assembly import constants, robot_timing, step_table
+from cell.sim.physics_checks import step_table
+from cell.sim.policy_setup import constants
+from cell.sim.timing_cache import robot_timing
 
 # The suite's own disk cache (cell.plumbing.cache), in this checkout's .pytest_cache: other
 # checkouts' code (another fingerprint) cannot replace its entries mid-run, and a user's

@@ -52,7 +52,8 @@ def _kinematic_speed(repeat: int) -> tuple[list[RegimePath], dict[str, np.ndarra
     from cell.arm.mintime.reference import toppra_profile
     from cell.arm.mintime.regimes import FREE_REGIMES, regime_path, regime_rows
     from cell.scenario.schema import load_scenario
-    from cell.sim.assembly import geometry_of, motors_of, planner_bounds, step_table
+    from cell.sim.physics_checks import step_table
+    from cell.sim.scenario_values import geometry_of, motors_of, planner_bounds
 
     kin = load_scenario("mintime_kinematic")
     table = step_table(kin)
@@ -85,7 +86,7 @@ def _torque_speed(base: Scenario, paths: list[RegimePath],
     from cell.arm.dynamics import chain
     from cell.arm.mintime.planner import PathRows, path_grid, plan, torque_rows, velocity_rows
     from cell.arm.mintime.reference import toppra_profile
-    from cell.sim.assembly import planner_bounds
+    from cell.sim.scenario_values import planner_bounds
 
     model = planner_bounds(base).dynamics
     assert model is not None, "scenarios/baseline.yaml names a dynamics file"
@@ -113,7 +114,8 @@ def _r4_dynamic_rel_err(base: Scenario) -> float:
     """R IV under the baseline's dynamic model on its default grid against the converged
     (Richardson) time."""
     from cell.arm.mintime.regimes import regime_path
-    from cell.sim.assembly import geometry_of, motors_of, planner_bounds, step_table
+    from cell.sim.physics_checks import step_table
+    from cell.sim.scenario_values import geometry_of, motors_of, planner_bounds
 
     base_geometry, base_motors, base_bounds = geometry_of(base), motors_of(base), planner_bounds(base)
     base_r4 = regime_path(step_table(base), "R4", base_geometry)

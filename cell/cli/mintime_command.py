@@ -65,7 +65,8 @@ def main(args: argparse.Namespace) -> int:
     from cell.plumbing.errors import InfeasibleError, NoMotionError, ScenarioError
     from cell.plumbing.output.atomic import OutputDir
     from cell.scenario.schema import MAX_TIME_S, inert_settings
-    from cell.sim.assembly import geometry_of, motors_of, planner_bounds, planner_error, step_table
+    from cell.sim.physics_checks import planner_error, step_table
+    from cell.sim.scenario_values import geometry_of, motors_of, planner_bounds
 
     check_out(args.out)  # before any work
     scenario = scenario_of(args)

@@ -18,7 +18,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     from cell.plumbing.output.atomic import check_file, write_csv
-    from cell.sim.assembly import step_table
+    from cell.sim.physics_checks import step_table
 
     check_file(args.out)  # before any work (refuses '-': no command writes to standard output)
     scenario = scenario_of(args)

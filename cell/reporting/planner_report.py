@@ -17,15 +17,10 @@ from cell.plumbing.output.atomic import OutputDir
 from cell.reporting.formatting import table_head, table_row
 from cell.scenario import catalog
 from cell.scenario.schema import Scenario, load_scenario
-from cell.sim.assembly import (
-    constants,
-    dynamics_path,
-    geometry_of,
-    motors_of,
-    planner_bounds,
-    robot_timing,
-    step_table,
-)
+from cell.sim.physics_checks import step_table
+from cell.sim.policy_setup import constants
+from cell.sim.scenario_values import dynamics_path, geometry_of, motors_of, planner_bounds
+from cell.sim.timing_cache import robot_timing
 
 SCENARIOS = {"kinematic": "mintime_kinematic.yaml", "dynamic": "baseline.yaml"}
 #: The files this report writes.

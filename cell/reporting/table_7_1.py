@@ -91,8 +91,8 @@ def summary_column(accounting: str, measure: str, columns: Sequence[str]) -> str
 def fixed_cycle(s: Scenario) -> float:
     """The non-adaptive robot's cycle in ``s``, as ``cell run`` runs it (a Table 7.1 row's,
     Fig. 23/24's): ``controller.ideal_cycle_s``, else the nominal cycle
-    (:func:`cell.sim.assembly.nominal_cycle`: the arrivals' mean when the scenario sets none)."""
-    from cell.sim.assembly import nominal_cycle
+    (:func:`cell.sim.policy_setup.nominal_cycle`: the arrivals' mean when the scenario sets none)."""
+    from cell.sim.policy_setup import nominal_cycle
 
     c = s.controller.ideal_cycle_s
     return float(c) if c is not None else nominal_cycle(s)

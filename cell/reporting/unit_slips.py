@@ -2,7 +2,7 @@
 scenario reads seconds (a trace exported in ms, ``controller.nominal_cycle_s: 22587``).
 
 Said, not refused: a supply that slow may be meant.  A belt whose length is left out is
-derived from the nominal cycle (:func:`cell.sim.assembly.constants`: twice the nominal input
+derived from the nominal cycle (:func:`cell.sim.policy_setup.constants`: twice the nominal input
 speed times the cycle), so a cycle in ms makes it kilometres long; the warning says so.
 """
 

@@ -4,7 +4,7 @@
 the maths' plain values (:mod:`cell.sim.scenario_values`), the checks that need the robot's
 maths and the key each blames (:mod:`cell.sim.physics_checks`), the robot's timing solved and
 cached (:mod:`cell.sim.timing_cache`), and the constants and policy
-(:mod:`cell.sim.policy_setup`).  Their public names are importable from here as well.
+(:mod:`cell.sim.policy_setup`).  Their names are imported from those modules, not from here.
 """
 
 from __future__ import annotations
@@ -12,19 +12,17 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from cell.scenario.schema import Scenario
-from cell.sim.physics_checks import GEOMETRY_KEYS, SPEED_KEYS, planner_error, step_table
+from cell.sim.physics_checks import step_table
 from cell.sim.policies.base import CellConstants, Policy
-from cell.sim.policy_setup import constants, lookahead_margin, make_policy, nominal_cycle
+from cell.sim.policy_setup import constants, make_policy
 from cell.sim.robot import RobotTiming
-from cell.sim.scenario_values import dynamics_path, geometry_of, motors_of, planner_bounds
-from cell.sim.timing_cache import TIMING_SECTIONS, robot_timing
+from cell.sim.scenario_values import dynamics_path
+from cell.sim.timing_cache import robot_timing
 
 if TYPE_CHECKING:
     from cell.arm.steptable import StepTable
 
-__all__ = ["GEOMETRY_KEYS", "SPEED_KEYS", "TIMING_SECTIONS", "AssembledCell", "assemble", "constants",
-           "dynamics_path", "geometry_of", "lookahead_margin", "make_policy", "motors_of",
-           "nominal_cycle", "planner_bounds", "planner_error", "robot_timing", "step_table"]
+__all__ = ["AssembledCell", "assemble"]
 
 
 # --------------------------------------------------------------------------- the whole cell

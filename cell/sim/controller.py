@@ -10,13 +10,15 @@ policy's; nothing here knows which policy runs.
 from __future__ import annotations
 
 import math
-from typing import Any, Protocol
+from typing import Protocol
 
 import simpy
 
+from cell.plumbing.errors import CellError
 from cell.sim.conveyors import EPS_S, InputConveyor, OutputConveyor
 from cell.sim.policies.base import CellConstants, Policy
-from cell.sim.records import PartRecord
+from cell.sim.policies.check import ALL_LIMITS, MAX_S, SUM_S, plan_bounds, plan_failed, refuse
+from cell.sim.records import Part
 from cell.sim.robot import Robot
 from cell.sim.sensor import Sensor
 
@@ -26,9 +28,9 @@ INF = math.inf
 class RunLog(Protocol):
     """Where a part's limits are noted, and where a part lost at B goes."""
 
-    def flag(self, part: PartRecord, limits: int) -> None: ...
+    def flag(self, part: Part, limits: int) -> None: ...
 
-    def missed(self, part: PartRecord) -> None: ...
+    def missed(self, part: Part) -> None: ...
 
 
 class View:
@@ -66,8 +68,6 @@ class View:
     def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
         """(a, b) of the first part after this one that can still be caught: the ideal
         look-ahead, which reads the feeder's schedule (``sensor.lookahead: ideal``)."""
-        if not self.sensor_up:
-            return None
         now, fed_s, length = self.now, self.fed_s, self._length
         x_now = None
         for j in range(self.part + 1, self.n):
@@ -83,6 +83,15 @@ class View:
             if d > 0:
                 return (lag, d)
         return None
+
+
+class FallibleView(View):
+    """The ideal look-ahead of a run whose sensor can fail (``failures.sensor``): nothing
+    while it is down.  Chosen when the run is assembled, so that a run without failures
+    does not ask (``make bench``: one test a part, a fraction of a percent)."""
+
+    def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
+        return View.next_part(self, lag, v) if self.sensor_up else None
 
 
 class SensorView(View):
@@ -114,56 +123,71 @@ class Controller:
     """Decides each part's cycle when it reaches B (SimPy process)."""
 
     def __init__(self, env: simpy.Environment, k: CellConstants, policy: Policy, view: View,
-                 conveyor: InputConveyor, output: OutputConveyor, robot: Robot, log: RunLog):
+                 conveyor: InputConveyor, output: OutputConveyor, robot: Robot, log: RunLog,
+                 name: str = ""):
         self.env, self.k, self.policy, self.view = env, k, policy, view
+        self.name = name or getattr(policy, "name", "")
+        """The policy's name, as the scenario gives it (for a bad plan's message)."""
         self.conveyor, self.output, self.robot, self.log = conveyor, output, robot, log
         self.process = env.process(self.run())
 
     def run(self):  # noqa: ANN201 (SimPy generator)
-        """Once per part, with locals bound."""
-        env, robot, view, plan_for = self.env, self.robot, self.view, self.policy.plan
+        """Once per part, locals bound, the clock read from the part's arrival at B and the plan
+        checked inline (for speed: :meth:`.Feeder.run`, :mod:`cell.sim.policies.check`)."""
+        robot, view, plan_for = self.robot, self.view, self.policy.plan
         replan_in, replan_out, u_nom = self.conveyor.replan, self.output.replan, self.k.u_nom
-        output_floor, u_min = self.output.belt.then, self.k.output_min
+        replan_out_floor, u_min = self.output.replan_then, self.k.output_min
         aim = self.k.lookahead_margin_s  # step 6.3 from when the next part is aimed at B
         floor_after_td = math.nan  # the last planned TD (the spacing contract; nan: none)
-        get, flag, missed, order = self.conveyor.at_bot.get, self.log.flag, self.log.missed, \
-            robot.order
-        t = self.k.timing
-        l1, l2, l3, l4 = t.r1_length_in, t.r2.length_in, t.r3_length_in, t.r4.length_in
-        # the previous cycle's TD → K and R IV (step 5.0, 6.2); nominal before the first
-        residual = self.k.r3_post_nom + self.k.r4_nom
+        a1, a2, a3, a4, a5, a6, c1, d1, c2, d2, c3, d3, c4, d4 = plan_bounds(self.k)
+        bad_bits, top, eps, name, passed = ~ALL_LIMITS, MAX_S, SUM_S, self.name, None
+        get, flag, missed, order = self.conveyor.at_bot.get, self.log.flag, self.log.missed, robot.order
         while True:
-            part: Any = yield get()
-            now = env.now
+            part: Part = yield get()
+            now = part.at_bot_s  # env.now: the part is taken the instant it reaches B
             if not robot.free_at_s <= now + EPS_S:  # the robot is not back: the part rides on
-                part.missed = True
-                flag(part, robot.loss(now))  # let go, or lost to downtime
+                flag(part, robot.loss(now))  # let go, or lost to downtime (RODE_OFF)
                 missed(part)
                 if floor_after_td == floor_after_td:  # a wait now foreseen: the output belt's
                     replan_out(max(now, floor_after_td), u_min)  # floor from TD (or now)
                 continue
-            view.part, view.now = part.part - 1, now
-            plan = plan_for(view)
-            r1_pre, r3_pre, r3_post, to_g, cycle = \
-                plan.r1_pre, plan.r3_pre, plan.r3_post, plan.to_g, plan.cycle
-            output_to_g, r2, r4, limits = plan.output_to_g, plan.r2, plan.r4, plan.limits
+            view.part, view.now = part.index, now
+            try:
+                plan = plan_for(view)
+            except CellError:
+                raise
+            except Exception as exc:  # noqa: BLE001 - a plug-in's failure, named
+                raise plan_failed(name, exc) from exc
+            if plan is not passed:  # checked at the boundary (cell.sim.policies.check)
+                try:
+                    r1a, r1b, r2, r3a, r3b, r4 = \
+                        plan.r1_pre, plan.r1_post, plan.r2, plan.r3_pre, plan.r3_post, plan.r4
+                    to_g, cycle, limits = plan.to_g, plan.cycle, plan.limits
+                    ok = (a1 <= r1a and a2 <= r1b and a3 <= r2 and a4 <= r3a and a5 <= r3b
+                          and a6 <= r4 and c1 <= plan.input_speed <= d1
+                          and c2 <= plan.input_after_lo <= d2 and c3 <= plan.input_next <= d3
+                          and c4 <= plan.output_to_g <= d4
+                          and -eps <= to_g - (r1a + r1b + r2) <= eps
+                          and -eps <= cycle - (to_g + r3a + r3b + r4) <= eps and cycle < top
+                          and limits.__class__ is int and not limits & bad_bits
+                          and plan.steers_belts.__class__ is bool)
+                except Exception:  # noqa: BLE001 - a field missing or not a number: said below
+                    ok = False
+                if not ok:
+                    refuse(plan, name, self.k)
+                passed = plan
+            r1_pre, r3_pre, to_g = plan.r1_pre, plan.r3_pre, plan.to_g
             if plan.steers_belts:
-                replan_in(now + r1_pre, plan.input_after_lo, now + cycle + aim, plan.input_next)
-                replan_out(now, output_to_g, now + to_g, u_nom)
+                replan_in(now + r1_pre, plan.input_after_lo, now + plan.cycle + aim,
+                          plan.input_next)
                 if plan.output_floor_at < INF:  # the spacing contract: the belt's floor after TD
-                    output_floor(now + plan.output_floor_at, u_min)
+                    replan_out_floor(now, plan.output_to_g, now + to_g, u_nom,
+                                     now + plan.output_floor_at, u_min)
                     floor_after_td = now + to_g + r3_pre
-            r1, r3 = r1_pre + plan.r1_post, r3_pre + r3_post
-            part.picked = True
-            part.motion_cycle_s = cycle
-            part.input_speed_in_s, part.output_speed_in_s = plan.input_speed, output_to_g
-            part.r1_s, part.r2_s, part.r3_s, part.r4_s = r1, r2, r3, r4
-            part.v_r1_in_s, part.v_r2_in_s = l1 / r1, l2 / r2
-            part.v_r3_in_s, part.v_r4_in_s = l3 / r3, l4 / r4
-            if limits:
-                flag(part, limits)
-            # step 6.2: motion time to TD plus the previous cycle's residual
-            part.thesis_interval_s = to_g + r3_pre + residual
-            residual = r3_post + r4
+                else:
+                    replan_out(now, plan.output_to_g, now + to_g, u_nom)
+            part.plan = plan  # the part's regime times and belt speeds (read as its row is made)
+            if plan.limits:
+                flag(part, plan.limits)
             # B → TD summed as LO + (LO → TD), the order the robot's legs are timed in
-            order(part, r1_pre, r1_pre + (to_g - r1_pre + r3_pre), cycle)
+            order(part, r1_pre, r1_pre + (to_g - r1_pre + r3_pre), plan.cycle)

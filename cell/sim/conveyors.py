@@ -1,13 +1,12 @@
 """The two belt conveyors (thesis §4.1, §5.2, §6.2 a).
 
-A belt is a speed schedule: piecewise-constant speeds from given instants, so
-its travel X(t) is piecewise linear and exact.  Speed changes take effect at
-once (§6.2 a: negligible lag).  The controller writes the schedule ahead of
-time (a change at LO, the step 6.3 decay at the end of the cycle, the output
-belt back to nominal at G); a part's arrival is the instant the belt has
-carried it the required distance, so the input conveyor's SimPy process only
-wakes when a part reaches B (the controller, which replans only then, having
-taken it first), and the output conveyor's when a part is set down.
+A belt is a speed schedule: piecewise-constant speeds from given instants, so its travel X(t) is
+piecewise linear and exact.  Speed changes take effect at once (§6.2 a: negligible lag).  The
+controller writes the schedule ahead of time (a change at LO, the step 6.3 decay at the end of the
+cycle, the output belt back to nominal at G); a part's arrival is the instant the belt has carried
+it the required distance, so the input conveyor's SimPy process only wakes when a part reaches B
+(the controller, which replans only then, having taken it first), and the output conveyor's when a
+part is set down.
 """
 
 from __future__ import annotations
@@ -20,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 import simpy
 
 from cell.sim.mailbox import Mailbox
+from cell.sim.records import Part
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -40,16 +40,14 @@ def speed_at(instants: Sequence[float] | Array, speeds: Sequence[float] | Array,
 class Belt:
     """A belt's speed schedule and travel X(t) (inches since t = 0).
 
-    Only the schedule from the present on is kept: a change whose successor has
-    started is final and is handed to ``on_change`` (e.g. a ``belts.csv``
-    writer) and dropped, so a long run keeps a few entries, not its history.
+    Only the schedule from the present on is kept: a change whose successor has started is final and
+    is handed to ``on_change`` (e.g. a ``belts.csv`` writer) and dropped, so a long run keeps a few
+    entries, not its history.
     """
 
-    __slots__ = ("_t", "_x", "_v", "on_change", "max_speed_in_s", "min_speed_in_s", "_halted",
-                 "_anchor")
+    __slots__ = ("_t", "_x", "_v", "on_change", "max_speed_in_s", "min_speed_in_s", "_halted", "_anchor")
 
-    def __init__(self, speed_in_s: float,
-                 on_change: Callable[[float, float], Any] | None = None):
+    def __init__(self, speed_in_s: float, on_change: Callable[[float, float], Any] | None = None):
         self._t: list[float] = [0.0]
         """Instants at which a speed starts."""
         self._x: list[float] = [0.0]
@@ -65,17 +63,17 @@ class Belt:
         self._halted: tuple[float, list[tuple[float, float]]] | None = None
         """While stopped by a failure: the speed it ran at and the changes planned after."""
         self._anchor: tuple[float, float, float] = (0.0, 0.0, speed_in_s)
-        """The last settled change (instant, travel, speed): still in force when a replan
-        from a later instant has settled past the present (a stop then starts from it)."""
+        """The last settled change (instant, travel, speed), in force when a replan from a later
+        instant has settled past the present (a stop starts from it; :class:`StoppableBelt`'s)."""
 
     @property
     def held(self) -> int:
-        """Speed segments held in memory: the one in force and those planned ahead
-        (what is behind is told to ``on_change`` and dropped, so memory stays flat)."""
+        """Speed segments held: the one in force and those planned (memory stays flat)."""
         return len(self._t)
 
     def speed(self, t: float) -> float:
-        """The speed at instant t (:func:`speed_at`, hand-written for speed: no ``max`` call)."""
+        """The speed at t (:func:`speed_at` less its ``max``: once a part, a fraction of 1 % of
+        ``make bench``'s ``parts_per_s_adaptive_5k``)."""
         k = bisect_right(self._t, t) - 1
         return self._v[k if k > 0 else 0]
 
@@ -95,13 +93,12 @@ class Belt:
         return self._t[k] + (x - self._x[k]) / self._v[k]
 
     def plan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
-        """From instant t1 (now or later) run at v1, and from t2 > t1 at v2, dropping
-        later plans.
+        """From instant t1 (now or later) run at v1, and from t2 > t1 at v2, dropping later plans.
 
-        A new plan supersedes whatever was planned after t1 (the controller
-        replans every cycle); a change within EPS_S of the last one replaces it.
-        Changes before ``t1`` whose successors have started are settled.
-        (Called twice a part: the controller's case is unrolled first, for speed.)
+        A new plan supersedes whatever was planned after t1 (the controller replans every cycle); a
+        change within EPS_S of the last one replaces it. Changes before ``t1`` whose successors have
+        started are settled. (Called twice a part: the controller's case is unrolled first, for
+        speed.)
         """
         if not v1 > 0 or (t2 is not None and not v2 > 0):
             raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}")
@@ -133,6 +130,28 @@ class Belt:
         self._run_from(t1, v1)
         if t2 is not None:
             self._run_from(t2, v2)
+
+    def plan_then(self, t1: float, v1: float, t2: float, v2: float, t3: float, v3: float) -> None:
+        """:meth:`plan` (t1, v1, t2, v2) then :meth:`then` (t3, v3): the output belt's replan under
+        the spacing contract, unrolled (for speed: a call and three appends a part fewer, about
+        2 % of ``make bench``'s ``parts_per_s_adaptive_5k``, CPU time, best of 12, interleaved)."""
+        ts, xs, vs = self._t, self._x, self._v
+        t0 = ts[-1]
+        if t0 > t1 + EPS_S and len(ts) > 1 and ts[-2] < t1:  # the last floor, not yet begun:
+            del ts[-1], xs[-1], vs[-1]  # dropped, as :meth:`plan` drops it
+            t0 = ts[-1]
+        if t0 < t1 < t2 < t3 and v1 > 0 and v2 > 0 and v3 > 0:
+            n = len(ts) - 1
+            if n > 0:
+                self._settle(n)
+            x0, v0 = xs[-1], vs[-1]
+            x1 = x0 + v0 * (t1 - t0)
+            x2 = x1 + v1 * (t2 - t1)
+            self._t, self._x, self._v = [t0, t1, t2, t3], [x0, x1, x2, x2 + v2 * (t3 - t2)], \
+                [v0, v1, v2, v3]
+            return
+        self.plan(t1, v1, t2, v2)
+        self.then(t3, v3)
 
     def then(self, t: float, v: float) -> None:
         """And from instant t, after every change planned, run at v (a third change)."""
@@ -167,8 +186,6 @@ class Belt:
             if v < lo:
                 lo = v
         self.max_speed_in_s, self.min_speed_in_s = hi, lo
-        if n:
-            self._anchor = (self._t[n - 1], self._x[n - 1], vs[n - 1])
         told = self.on_change
         if told is not None:
             ts = self._t
@@ -179,22 +196,6 @@ class Belt:
     def stopped(self) -> bool:
         """Whether the belt stands (a failure, :meth:`stop`) until :meth:`restart`."""
         return self._halted is not None
-
-    def stop(self, t: float) -> None:
-        """Stand from instant t (now) on: speed 0, parts stay where they are; what was
-        planned after t is kept for :meth:`restart` (docs/model.md, "When equipment fails")."""
-        ts, vs = self._t, self._v
-        if ts[0] > t:  # a replan from a later instant settled the change in force now: stop
-            t0, x0, v0 = self._anchor  # from it, every held change kept for the restart
-            self._halted = (v0, list(zip(ts, vs)))
-            self._t, self._x, self._v = [t], [x0 + v0 * (t - t0)], [0.0]
-            return
-        k = bisect_right(ts, t)
-        later = list(zip(ts[k:], vs[k:]))
-        running = vs[k - 1] if k > 0 else vs[0]
-        del ts[k:], self._x[k:], vs[k:]
-        self._run_from(t, 0.0)
-        self._halted = (running, later)
 
     def plan_stopped(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
         """:meth:`plan` while stopped: the plan takes effect from the restart on."""
@@ -221,9 +222,8 @@ class Belt:
             self._run_from(tp, vp)
 
     def close(self, until: float | None = None) -> None:
-        """Hand every change still held (planned ones included) to ``on_change``; with
-        ``until`` (the end of the run), those planned to start then or later, which never
-        took effect, are dropped instead."""
+        """Hand every change still held (planned ones included) to ``on_change``; with ``until``
+        (the run's end), those planned to start then or later, which never took effect, dropped."""
         if until is not None:
             keep = max(bisect_left(self._t, until - EPS_S), 1)
             del self._t[keep:], self._x[keep:], self._v[keep:]
@@ -231,61 +231,87 @@ class Belt:
         del self._t[:], self._x[:], self._v[:]
 
 
+class StoppableBelt(Belt):
+    """A belt a failure can stop (``failures:``), keeping its last settled change for :meth:`stop`;
+    chosen at assembly (for speed: the anchor's tuple, two settles a part, was about 1 % of ``make
+    bench``'s ``parts_per_s_adaptive_5k`` on 2 shared cores, best of 7)."""
+
+    __slots__ = ()
+
+    def _settle(self, n: int) -> None:
+        if n:
+            self._anchor = (self._t[n - 1], self._x[n - 1], self._v[n - 1])
+        Belt._settle(self, n)
+
+    def stop(self, t: float) -> None:
+        """Stand from instant t (now) on: speed 0, parts stay where they are; what was
+        planned after t is kept for :meth:`restart` (docs/model.md, "When equipment fails")."""
+        ts, vs = self._t, self._v
+        if ts[0] > t:  # a replan from a later instant settled the change in force now: stop
+            t0, x0, v0 = self._anchor  # from it, every held change kept for the restart
+            self._halted = (v0, list(zip(ts, vs)))
+            self._t, self._x, self._v = [t], [x0 + v0 * (t - t0)], [0.0]
+            return
+        k = bisect_right(ts, t)
+        later = list(zip(ts[k:], vs[k:]))
+        running = vs[k - 1] if k > 0 else vs[0]
+        del ts[k:], self._x[k:], vs[k:]
+        self._run_from(t, 0.0)
+        self._halted = (running, later)
+
+
 class InputConveyor:
     """Carries parts from the feeder, ``length_in`` upstream of B, to B.
 
-    Its process takes each part the feeder drops (``loaded``), works out when
-    the belt will have carried it to B, and hands it to the controller (``at_bot``)
-    due at that instant: one event, which wakes the controller and then this
-    process, so the controller plans (and may replan the belt) before the next
-    part is timed.  A part nobody picks up rides on to F and falls off (§6.3).
+    Its process takes each part the feeder drops (``loaded``), works out when the belt will have
+    carried it to B, and hands it to the controller (``at_bot``) due at that instant: one event,
+    which wakes the controller and then this process, so the controller plans (and may replan the
+    belt) before the next part is timed.  A part nobody picks up rides on to F and falls off (§6.3).
 
-    The controller replans the belt only when a part reaches B, so a part on its
-    way to B never has its arrival moved; a replan at any other instant while a
-    part is due is refused (it would need the part timed again).
+    The controller replans the belt only when a part reaches B, so a part on its way to B never has
+    its arrival moved; a replan at any other instant while a part is due is refused (it would need
+    the part timed again).
     """
 
     def __init__(self, env: simpy.Environment, speed_in_s: float, length_in: float,
                  on_change: Callable[[float, float], Any] | None = None, stoppable: bool = False):
         self.env = env
-        self.belt = Belt(speed_in_s, on_change)
+        self.belt = (StoppableBelt if stoppable else Belt)(speed_in_s, on_change)
         self.length_in = length_in
         """Feeder drop point to B (in)."""
         self.loaded: Mailbox = Mailbox(env)
-        """Parts dropped on the belt by the feeder (their records)."""
+        """Parts dropped on the belt by the feeder."""
         self.at_bot: Mailbox = Mailbox(env)
         """Parts as they reach B (the controller waits on it)."""
         self.x_fed: dict[int, float] = {}
         """Belt travel at the instant each part on the belt was dropped (by index)."""
         self.due_s = -math.inf
         """When the part on its way to B gets there (-inf: none is)."""
-        self.feeder: Any = None
-        """The feeder, told of a replan while it holds a part back."""
+        self.on_replan: Callable[[], None] | None = None
+        """Called after each replan (the feeder's, which times a held part's wait again)."""
         self.timing = False
         """True while :meth:`run_stoppable` waits for a part to reach B (a stop re-times it)."""
         self.process = env.process(self.run_stoppable() if stoppable else self.run())
 
-    def drop(self, part: Any, x: float) -> None:
-        """The feeder puts a part (its record) on the belt now, the belt's travel being x."""
-        self.x_fed[part.part - 1] = x
+    def drop(self, part: Part, x: float) -> None:
+        """The feeder puts a part on the belt now, the belt's travel being x."""
+        self.x_fed[part.index] = x
         self.loaded.put(part)
 
     def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
-        """New speed plan from the controller (see :meth:`Belt.plan`), made as a part
-        reaches B: before the next part is timed."""
+        """New speed plan from the controller (:meth:`Belt.plan`), as a part reaches B."""
         if self.env.now < self.due_s:
             raise RuntimeError("the input belt was replanned while a part was on its way to B")
         self.belt.plan(t1, v1, t2, v2)
-        feeder = self.feeder
-        if feeder is not None and feeder.holding:
-            feeder.process.interrupt()
+        if self.on_replan is not None:
+            self.on_replan()
 
     def run(self):  # noqa: ANN201 (SimPy generator)
         env, get, hand_over = self.env, self.loaded.get, self.at_bot.put_after
         time_at, x_fed, length = self.belt.time_at, self.x_fed, self.length_in
         while True:
             part = yield get()
-            i = part.part - 1
+            i = part.index
             now = env.now
             delay = time_at(x_fed[i] + length) - now
             if delay < 0.0:  # max(delay, 0) without the builtin call
@@ -302,7 +328,7 @@ class InputConveyor:
         env, get, hand_over, belt = self.env, self.loaded.get, self.at_bot.put_after, self.belt
         while True:
             part = yield get()
-            i = part.part - 1
+            i = part.index
             target = self.x_fed[i] + self.length_in
             while True:
                 self.timing = True
@@ -331,17 +357,17 @@ class InputConveyor:
 class OutputConveyor:
     """Takes parts from the robot at TD and records their spacing (thesis §4.3 f).
 
-    Spacing of a part = the output belt's travel between the previous part's
-    touch-down and its own: the distance between the two on the belt.  Each part
-    set down is handed on to ``delivered`` (the run's log).  The robot hands a part
-    over due at its touch-down (``placed``), so this process wakes once per part, at TD.
+    Spacing of a part = the output belt's travel between the previous part's touch-down and its own:
+    the distance between the two on the belt.  Each part set down is handed on to ``delivered`` (the
+    run's log).  The robot hands a part over due at its touch-down (``placed``), so this process
+    wakes once per part, at TD.
     """
 
     def __init__(self, env: simpy.Environment, speed_in_s: float,
-                 delivered: Callable[[Any], Any],
-                 on_change: Callable[[float, float], Any] | None = None):
+                 delivered: Callable[[Part], Any],
+                 on_change: Callable[[float, float], Any] | None = None, stoppable: bool = False):
         self.env = env
-        self.belt = Belt(speed_in_s, on_change)
+        self.belt = (StoppableBelt if stoppable else Belt)(speed_in_s, on_change)
         self.placed: Mailbox = Mailbox(env)
         """Parts set down by the robot, each due at its touch-down."""
         self.delivered = delivered
@@ -351,7 +377,14 @@ class OutputConveyor:
         """Instant of the last touch-down (read once ``last_td_x`` is set)."""
         self.replan = self.belt.plan
         """New speed plan from the controller (:meth:`Belt.plan`)."""
+        self.replan_then = self._replan_then if stoppable else self.belt.plan_then
+        """The same with the spacing contract's floor after it (:meth:`Belt.plan_then`)."""
         self.process = env.process(self.run())
+
+    def _replan_then(self, t1: float, v1: float, t2: float, v2: float, t3: float, v3: float) -> None:
+        """With failures: :attr:`replan` (which :mod:`cell.sim.failures` wraps), then the floor."""
+        self.replan(t1, v1, t2, v2)
+        self.belt.then(t3, v3)
 
     def run(self):  # noqa: ANN201 (SimPy generator)
         env, get, travel, delivered = self.env, self.placed.get, self.belt.travel, self.delivered

@@ -200,11 +200,11 @@ class RobotStops:
     def cycle(self, part: Any, to_lo: float, to_td: float):  # noqa: ANN201 (SimPy generator)
         """One order, leg by leg (the robot's process runs it)."""
         env, cell = self.env, self.cell
-        to_g = part.r1_s + part.r2_s
-        r3_pre = to_td - to_g
-        r3_post = part.r3_s - r3_pre
-        cycle = part.motion_cycle_s
-        legs = (to_lo, part.r1_s - to_lo, part.r2_s, r3_pre, r3_post, cycle - to_td - r3_post)
+        plan = part.plan  # the regimes as parts.csv has them (R I, R III: their two legs summed)
+        r1, r2, cycle = plan.r1_pre + plan.r1_post, plan.r2, plan.cycle
+        r3_pre = to_td - (r1 + r2)
+        r3_post = plan.r3_pre + plan.r3_post - r3_pre
+        legs = (to_lo, r1 - to_lo, r2, r3_pre, r3_post, cycle - to_td - r3_post)
         self.planned_free, self.in_cycle, self.part = env.now + cycle, True, part
         self.proc = env.active_process
         for clock in self.clocks:
@@ -254,8 +254,8 @@ class RobotStops:
         self.stop = "down"
         part, log = self.part, self.cell.log
         if part is not None and self.at_leg == 0:
-            part.picked, part.missed, self.part = False, True, None
-            log.flag(part, LOST_DOWNTIME)
+            self.part = None
+            log.flag(part, LOST_DOWNTIME)  # rode off (RODE_OFF): not picked
             log.missed(part)
         elif part is not None and self.scrap:
             self.part = None
@@ -265,7 +265,7 @@ class RobotStops:
             self.touch()
         else:
             self._doing(STOPPED, math.inf)
-        return part.part if part is not None else ""
+        return part.index + 1 if part is not None else ""  # parts.csv's number
 
     def repaired(self) -> None:
         self.stop = None

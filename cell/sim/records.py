@@ -1,12 +1,25 @@
-"""One record type per row of each output file, filled as events happen.
+"""One record type per row of each output file, and the part in flight.
 
-* :class:`PartRecord`: a row of ``parts.csv``, one per arriving part;
+* :class:`PartRecord`: a row of ``parts.csv``, one per arriving part, made once when
+  the part is done, from its :class:`Part`;
 * :class:`RunSummary`: the one row of ``summary.csv`` (and of a sweep's
   ``replications.csv``, after the grid columns);
 * :class:`BeltChange`: a row of ``belts.csv``, one per speed change of a belt.
 
 The fields, in order, *are* the columns; each field's docstring is its
 meaning (docs/usage.md's column tables are checked against them).
+
+One writer for each field.  A part travels through the processes as a :class:`Part`, whose
+slots are each written once, by the process that owns the event (the feeder its drop, the
+input conveyor its arrival at B, the controller its plan, the robot its lift-off, the output
+conveyor its set-down); its limits (:data:`LIMITS`) are bits the run's log collects.  The row
+(:class:`PartRecord`, immutable) is made from these once, by the run's log, when the part
+is done: whatever a column derives from (a regime time from the plan, ``picked`` and
+``missed`` from the limit bits, the thesis's columns from the accounting) is derived then,
+in one place.  A write-once record per part rather than an immutable record per event (as
+Ciw's): one object a part instead of four, and no row is made at all when nobody keeps or
+streams the rows (``make bench``'s case).  ``tests/sim/test_one_writer.py`` checks that
+each slot has its one writer.
 """
 
 from __future__ import annotations
@@ -39,6 +52,9 @@ LIMIT_BIT = {name: 1 << i for i, name in enumerate(LIMITS)}
 (INPUT_FLOOR, INPUT_CEILING, INPUT_TRACKING, OUTPUT_FLOOR, OUTPUT_CEILING, R2_PEAK, R4_PEAK,
  LET_GO, SPACING_OFF, HELD_AT_FEEDER, LOST_DOWNTIME, SCRAPPED, SPACING_WAIT, SPACING_UNFORESEEN) = \
     (1 << i for i in range(len(LIMITS)))
+#: The one encoding of a part lost at B: it rode off (let go, or lost to downtime).  A part
+#: scrapped in the hand is ``SCRAPPED``; every other part done was set down.
+RODE_OFF = LET_GO | LOST_DOWNTIME
 
 
 class LimitCount(NamedTuple):
@@ -84,12 +100,12 @@ LIMIT_NAMES: dict[int, str] = {}
 """:func:`limit_names`' answers so far, by flag word."""
 
 
-@dataclass(slots=True)
-class PartRecord:
-    """What happened to one part, from the feeder to the output belt (or the floor)."""
+class PartRecord(NamedTuple):
+    """What happened to one part, from the feeder to the output belt (or the floor): a row
+    of parts.csv, made once, when the part is done (:class:`Part` holds it till then)."""
 
     part: int
-    """1 … N, in order of arrival."""
+    """1 … N, in order of arrival (the part's :attr:`Part.index` + 1)."""
     arrival_s: float = NAN
     """When the feeder dropped it on the input belt."""
     interarrival_s: float = NAN
@@ -97,9 +113,11 @@ class PartRecord:
     at_bot_s: float = NAN
     """When it reached B, the beginning of tracking."""
     picked: bool = False
-    """Picked up by the robot (the robot was back at B when it arrived)."""
+    """Picked up by the robot (the robot was back at B when it arrived): no :data:`RODE_OFF`
+    bit in its limits."""
     missed: bool = False
-    """Reached B while the robot was busy: rode on and fell off at F (§6.3)."""
+    """Reached B while the robot was busy (or stopped): rode on and fell off at F (§6.3); the
+    negation of ``picked``, both read from the limits' :data:`RODE_OFF` bits."""
     missed_thesis: bool = False
     """Lost under the thesis's bookkeeping (docs/accounting.md)."""
     pick_s: float = NAN
@@ -142,6 +160,27 @@ class PartRecord:
     """How long the feeder held the part back, the belt not having cleared a part's size."""
     limits: str = ""
     """The limits this part's cycle hit (names from :data:`LIMITS`, space-separated)."""
+
+
+class Part:
+    """A part in flight, from the feeder to the output belt (or the floor).
+
+    Each slot is written once, by its owner (see the module's text): ``index`` (0 … N − 1,
+    the one numbering of parts inside the model; parts.csv's ``part`` is ``index + 1``),
+    ``arrival_s`` and ``feed_delay_s`` by the feeder, ``at_bot_s`` by the input conveyor,
+    ``plan`` (the policy's :class:`~cell.sim.policies.base.Plan`, or None: not picked) by the
+    controller, ``pick_s`` by the robot, ``touchdown_s``, ``spacing_in`` and
+    ``delivery_interval_s`` by the output conveyor.
+    """
+
+    __slots__ = ("index", "arrival_s", "feed_delay_s", "at_bot_s", "plan", "pick_s",
+                 "touchdown_s", "spacing_in", "delivery_interval_s")
+
+    def __init__(self, index: int, arrival_s: float, feed_delay_s: float = 0.0):
+        self.index, self.arrival_s, self.feed_delay_s = index, arrival_s, feed_delay_s
+        self.at_bot_s = self.pick_s = self.touchdown_s = self.spacing_in = \
+            self.delivery_interval_s = NAN
+        self.plan: Any = None
 
 
 @dataclass(slots=True)
@@ -337,7 +376,8 @@ class Stop:
 
 def columns(record_type: type) -> list[str]:
     """The CSV columns of a record type: its fields, in order."""
-    return [f.name for f in fields(record_type)]
+    named = getattr(record_type, "_fields", None)  # a NamedTuple's
+    return list(named) if named is not None else [f.name for f in fields(record_type)]
 
 
 PART_COLUMNS = columns(PartRecord)

@@ -159,7 +159,7 @@ class Robot:
     def __init__(self, env: simpy.Environment, output: Mailbox, cycle: Any = None):
         self.env = env
         self.orders: Mailbox = Mailbox(env)
-        """Cycles to run, from the controller: (part, B → LO, B → TD) tuples."""
+        """Cycles to run, from the controller: (part, B → LO, B → TD, the instant) tuples."""
         self.output = output
         """Where parts are set down (the output conveyor's mailbox)."""
         self.free_at_s = 0.0
@@ -177,14 +177,18 @@ class Robot:
     def order(self, part: Any, to_lo_s: float, to_td_s: float, cycle_s: float) -> None:
         """Start a cycle now (the robot must be free): lift-off ``to_lo_s``, touch-down
         ``to_td_s`` and back at B ``cycle_s`` from now."""
-        self.free_at_s = self.env.now + cycle_s
-        self.orders.put((part, to_lo_s, to_td_s))
+        now = self.env.now
+        self.free_at_s = now + cycle_s
+        self.orders.put((part, to_lo_s, to_td_s, now))
 
     def run(self):  # noqa: ANN201 (SimPy generator)
-        env, set_down, get = self.env, self.output.put_after, self.orders.get
-        while True:
-            part, to_lo_s, to_td_s = yield get()
-            part.pick_s = env.now + to_lo_s
+        """Each order taken the instant it is given, so its instant is the clock's (for
+        speed: the order carries it, one ``env.now`` read a part saved, see
+        :meth:`cell.sim.feeder.Feeder.run`)."""
+        set_down, get = self.output.put_after, self.orders.get
+        while True:  # taken the instant it is given: the order's instant is the clock's
+            part, to_lo_s, to_td_s, now = yield get()
+            part.pick_s = now + to_lo_s
             set_down(part, to_td_s)  # touch-down: B + (B → TD), as a timeout would fall
 
     def run_stoppable(self):  # noqa: ANN201 (SimPy generator)
@@ -192,5 +196,5 @@ class Robot:
         comes once it is over is dropped, as SimPy drops them for a finished process)."""
         env, get, cycle = self.env, self.orders.get, self.cycle
         while True:
-            order = yield get()
-            yield env.process(cycle(*order))
+            part, to_lo_s, to_td_s, _ = yield get()
+            yield env.process(cycle(part, to_lo_s, to_td_s))

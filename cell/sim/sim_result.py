@@ -59,7 +59,7 @@ class SimResult:
     @functools.cached_property
     def records(self) -> list[PartRecord] | None:
         """Every part's record, in part order (None if the run did not keep them)."""
-        return None if self._rows is None else [PartRecord(*row) for row in self._rows]
+        return None if self._rows is None else [PartRecord._make(row) for row in self._rows]
 
     @functools.cached_property
     def belt_changes(self) -> list[BeltChange]:

@@ -7,10 +7,11 @@ policy for the part's cycle, sets the belts and sends the robot an order; the
 robot hands the part to the output conveyor due at its touch-down, and the
 conveyor measures its spacing.  A part picked up costs about four SimPy events
 (its drop, its arrival at B, the order, the set-down), one fallen off at F two.
-Each part's :class:`~cell.sim.records.PartRecord` is filled in as these things
-happen; when a part is done (set down, or fallen off at F) the run's log
-completes its accounting and passes it on, in part order, to whoever asked for
-rows (a CSV writer, a list), keeping only a few numbers per part for the summary.
+Each part's :class:`~cell.sim.records.Part` is filled in as these things happen,
+each slot by its owner; when a part is done (set down, or fallen off at F) the run's
+log completes its accounting, makes its :class:`~cell.sim.records.PartRecord` row and
+passes it on, in part order, to whoever asked for rows (a CSV writer, a list),
+keeping only a few numbers per part for the summary.
 
 Nothing per part outlives its part unless the run keeps the rows, and those are
 kept as tuples of plain values, which Python's cyclic garbage collector stops
@@ -34,7 +35,7 @@ from cell.scenario.schema import Scenario
 from cell.sim import accounting, oee, wear_clock
 from cell.sim.assembly import AssembledCell, assemble
 from cell.sim.bound import parts_bound
-from cell.sim.controller import Controller, SensorView, View
+from cell.sim.controller import Controller, FallibleView, SensorView, View
 from cell.sim.conveyors import InputConveyor, OutputConveyor
 from cell.sim.failures import Downtime
 from cell.sim.feeder import Feeder
@@ -44,14 +45,17 @@ from cell.sim.records import (
     LIMIT_BIT,
     LIMIT_COUNTS,
     LIMIT_NAMES,
+    NAN,
+    RODE_OFF,
     SPACING_OFF,
+    Part,
     PartRecord,
     RunSummary,
     limit_names,
 )
 from cell.sim.robot import Robot
 from cell.sim.sensor import Sensor, sensor_position
-from cell.sim.sim_result import BeltLog, BeltSink, SimResult, part_row
+from cell.sim.sim_result import BeltLog, BeltSink, SimResult
 
 __all__ = ["PER_PART", "BeltLog", "BeltSink", "PartSink", "RunLog", "SimResult", "simulate"]
 
@@ -73,7 +77,8 @@ class RunLog:
     """
 
     def __init__(self, t: list[float], acct: Accounting, sink: PartSink | None,
-                 spacing_in: float, tol_in: float, rows: list[tuple[Any, ...]] | None = None):
+                 spacing_in: float, tol_in: float, rows: list[tuple[Any, ...]] | None = None,
+                 lengths: tuple[float, float, float, float] = (NAN, NAN, NAN, NAN)):
         self.t = t
         """T_1 … T_{n+1}: the last is only part n's "next arrival"."""
         self.acct, self.sink = acct, sink
@@ -81,54 +86,61 @@ class RunLog:
         self.spacing_in, self.tol_in = spacing_in, tol_in
         self.rows = rows
         """The kept rows (parts.csv's columns), if the run keeps them."""
-        self.waiting: dict[int, PartRecord] = {}
+        self.lengths = lengths
+        """The four regimes' lengths (in): a row's average tip velocities."""
+        self.waiting: dict[int, Part] = {}
         """Parts done but not yet handed on (a part before them is not done)."""
         self.flags: dict[int, int] = {}
-        """Limit bits of parts not yet handed on."""
+        """Limit bits of parts not yet handed on, by index."""
         self.per_part = bytearray()
         """What the summary needs of each part, :data:`PER_PART` values a part in that order,
         as packed doubles (``struct``'s pack is a third of ``array.extend``'s cost a part)."""
         self.missed = self.delivered_part = self._logger()
         """A part fell off at F / was set down: see :meth:`_logger`."""
 
-    def flag(self, part: PartRecord, limits: int) -> None:
-        self.flags[part.part] = self.flags.get(part.part, 0) | limits
+    def flag(self, part: Part, limits: int) -> None:
+        i = part.index
+        self.flags[i] = self.flags.get(i, 0) | limits
 
-    def _logger(self) -> Callable[[PartRecord], None]:
+    def _logger(self) -> Callable[[Part], None]:
         """``done(part)``: a part is done; it is completed and handed on now if every part
-        before it is, else kept till then.  The log's hot path, hand-written for speed
-        (locals bound, the in-order part completed in the same call)."""
+        before it is, else kept till then.  The log's hot path, hand-written for speed (locals
+        bound, the in-order part completed in the same call), and its row made only if someone
+        keeps or streams the rows: ``make bench`` does neither, and making them costs 7 % of
+        its ``parts_per_s_adaptive_5k``, 26 % of ``parts_per_s_non_adaptive_5k`` (CPU time,
+        best of 12, interleaved, on 2 shared cores)."""
         t, acct_part, flags_of = self.t, self.acct.part, self.flags.pop
         spacing_in, tol = self.spacing_in, self.tol_in + 1e-9
         note, pack = self.per_part.extend, _PACK_PER_PART
-        sink = self.sink
-        keep = self.rows.append if self.rows is not None else None
+        row_of = self._row if self.rows is not None or self.sink is not None else None
         names_of = LIMIT_NAMES.get  # limit_names' cache, read first
         waiting = self.waiting
-        following = 1  # the part to hand on next
+        following = 0  # the index of the part to hand on next
 
-        def done(p: PartRecord) -> None:
+        def done(p: Part) -> None:
             nonlocal following
-            i = p.part
+            i = p.index
             if i != following:
                 waiting[i] = p
                 return
             while True:  # complete p (part i) and hand it on, then any waiting after it
-                t_next = t[i]
-                d = p.delivery_interval_s
-                p.ip_wallclock = t_next / d
-                acct_part(p, t_next)
                 flags = flags_of(i, 0)
                 sp = p.spacing_in
                 if sp == sp and abs(sp - spacing_in) > tol:
                     flags |= SPACING_OFF
-                p.limits = (names_of(flags) or limit_names(flags)) if flags else ""
-                note(pack(p.touchdown_s, p.picked, p.r4_s, p.output_speed_in_s, d, sp, flags,
-                          p.feed_delay_s, i, p.arrival_s, p.at_bot_s, p.motion_cycle_s))
-                if keep is not None:
-                    keep(part_row(p))
-                if sink is not None:
-                    sink(p)
+                picked = not flags & RODE_OFF
+                plan = p.plan
+                acct_part(plan, picked, t[i])
+                if plan is None:
+                    note(pack(p.touchdown_s, picked, NAN, NAN, p.delivery_interval_s, sp, flags,
+                              p.feed_delay_s, i, p.arrival_s, p.at_bot_s, NAN))
+                else:
+                    note(pack(p.touchdown_s, picked, plan.r4, plan.output_to_g,
+                              p.delivery_interval_s, sp, flags, p.feed_delay_s, i, p.arrival_s,
+                              p.at_bot_s, plan.cycle))
+                if row_of is not None:
+                    row_of(p, flags, picked,
+                           (names_of(flags) or limit_names(flags)) if flags else "")
                 i += 1
                 if not waiting or i not in waiting:
                     following = i
@@ -140,6 +152,28 @@ class RunLog:
             following = i
         self._skip_to = skip_to
         return done
+
+    def _row(self, p: Part, flags: int, picked: bool, limits: str) -> None:
+        """The part's row of parts.csv, made from its :class:`Part`, its limit bits and the
+        accounting's last values: every derived column derived here, once."""
+        i, t, plan = p.index, self.t, p.plan
+        t_next, d = t[i + 1], p.delivery_interval_s
+        lost_thesis, thesis_d, ip_thesis = self.acct.last(t_next)
+        if plan is None:
+            cycle = speed_in = speed_out = r1 = r2 = r3 = r4 = v1 = v2 = v3 = v4 = NAN
+        else:
+            cycle, speed_in, speed_out = plan.cycle, plan.input_speed, plan.output_to_g
+            r1, r2 = plan.r1_pre + plan.r1_post, plan.r2
+            r3, r4 = plan.r3_pre + plan.r3_post, plan.r4
+            (l1, l2, l3, l4) = self.lengths
+            v1, v2, v3, v4 = l1 / r1, l2 / r2, l3 / r3, l4 / r4
+        row = (i + 1, p.arrival_s, t[i], p.at_bot_s, picked, not picked, lost_thesis, p.pick_s,
+               p.touchdown_s, d, cycle, thesis_d, t_next / d, ip_thesis, speed_in, speed_out,
+               p.spacing_in, v1, v2, v3, v4, r1, r2, r3, r4, p.feed_delay_s, limits)
+        if self.rows is not None:
+            self.rows.append(row)
+        if self.sink is not None:
+            self.sink(PartRecord._make(row))
 
     @property
     def handed_on(self) -> int:
@@ -205,17 +239,19 @@ def simulate(scenario: Scenario | AssembledCell,
 
     acct = policy.accounting()
     env = simpy.Environment()
-    log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows)
+    tm = k.timing
+    log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows,
+                 (tm.r1_length_in, tm.r2.length_in, tm.r3_length_in, tm.r4.length_in))
     downtime = None if s.failures is None else Downtime(env, s.failures, seed)
     wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
     conveyor = InputConveyor(env, k.v_nom, k.input_length, belts.told(0),
                              stoppable=downtime is not None)
-    output = OutputConveyor(env, k.u_nom, log.delivered_part, belts.told(1))
+    output = OutputConveyor(env, k.u_nom, log.delivered_part, belts.told(1),
+                            stoppable=downtime is not None)
     robot = Robot(env, output.placed, None if downtime is None else downtime.robot.cycle)
     feeder = Feeder(env, t_list, conveyor, n, k.part_size, log.flag)
-    conveyor.feeder = feeder
     view = _view(cell, seed, n, feeder, conveyor, output)
-    Controller(env, k, policy, view, conveyor, output, robot, log)
+    Controller(env, k, policy, view, conveyor, output, robot, log, s.controller.policy)
     wear = wear_clock.alone(cell, robot, seed, downtime)  # wear: without failures (or None)
     if downtime is None and horizon is None:
         env.run()
@@ -245,7 +281,8 @@ def _view(cell: AssembledCell, seed: Any, n: int, feeder: Feeder, conveyor: Inpu
     what a physical sensor has reported (``sensor``)."""
     s, k = cell.scenario, cell.k
     if s.sensor.lookahead == "ideal":
-        return View(k, feeder.fed_s, n, conveyor, output)
+        fallible = s.failures is not None and s.failures.sensor is not None
+        return (FallibleView if fallible else View)(k, feeder.fed_s, n, conveyor, output)
     position = sensor_position(s.sensor, k.input_length, s.source)
     return SensorView(k, Sensor(s.sensor, position, conveyor, n, seed), n, conveyor, output)
 
@@ -259,7 +296,7 @@ def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, 
     picked = log.column("picked", w) != 0
     vout = log.column("output_speed", w)[picked]
     # each part's IP, as its record has it (T_{i+1} over its interval)
-    ip_wall = t[log.column("part", w).astype(np.int_)] / log.column("interval", w)
+    ip_wall = t[log.column("part", w).astype(np.int_) + 1] / log.column("interval", w)
     sp = log.column("spacing", w)
     sp = sp[np.isfinite(sp)]
     limits = log.column("limits", w).astype(np.int_)
@@ -292,7 +329,7 @@ def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, 
         setattr(r, counted.field, count(name))
     # every handed-on part's next inter-arrival time (all of T_2 … T_{n+1} unless the run
     # stopped with parts in the cell)
-    acct.finish(r, w, log.column("r4", w)[picked], t[log.column("part").astype(np.int_)])
+    acct.finish(r, w, log.column("r4", w)[picked], t[log.column("part").astype(np.int_) + 1])
     r.parts_per_hr_wallclock = float(accounting.parts_per_hr(r.actual_cycle_wallclock_s))
     r.parts_per_hr_thesis = float(accounting.parts_per_hr(r.actual_cycle_thesis_s))
     r.vavg_r4_in_s = k.timing.r4.length_in / r.r4_s if r.r4_s == r.r4_s else math.nan

@@ -98,9 +98,10 @@ def attach(table: StepTable, timing: RobotTiming, settings: WearSettingsLike, ro
     env = robot.env
 
     def order(part: Any, to_lo_s: float, to_td_s: float, cycle_s: float) -> None:
-        r1, r2, r3 = part.r1_s, part.r2_s, part.r3_s
+        plan = part.plan  # the regimes as parts.csv has them (R I, R III: their legs summed)
+        r1, r2, r3 = plan.r1_pre + plan.r1_post, plan.r2, plan.r3_pre + plan.r3_post
         r3_pre = round(to_td_s - (r1 + r2), 9)  # B → TD less R I and R II
-        joint = run((to_lo_s, r1 - to_lo_s, r2, r3_pre, r3 - r3_pre, part.r4_s))
+        joint = run((to_lo_s, r1 - to_lo_s, r2, r3_pre, r3 - r3_pre, plan.r4))
         if joint >= 0:
             back = env.now + cycle_s
             stops.append((back, back + repair_s, joint))

@@ -285,7 +285,7 @@ def test_a_plan_is_the_same_bit_for_bit_in_fresh_processes_and_without_avx512(tm
 
 _CELL_TIMES = """
 import json
-from cell.sim.assembly import geometry_of, motors_of, planner_bounds
+from cell.sim.scenario_values import geometry_of, motors_of, planner_bounds
 from cell.scenario.catalog import BUILT_IN
 from cell.arm.mintime.regimes import plan_regimes
 from cell.scenario.schema import load_scenario

@@ -13,7 +13,7 @@ from cell.arm.mintime.regimes import fastest_regime_times as planner_times
 from cell.cli.main import main
 from cell.scenario.catalog import BUILT_IN as SCENARIOS
 from cell.scenario.schema import load_scenario
-from cell.sim.assembly import geometry_of, motors_of, planner_bounds
+from cell.sim.scenario_values import geometry_of, motors_of, planner_bounds
 
 BASELINE = SCENARIOS / "baseline.yaml"
 

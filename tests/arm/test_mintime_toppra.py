@@ -27,7 +27,8 @@ from cell.arm.mintime.regimes import FREE_REGIMES, plan_regimes, regime_path
 from cell.scenario.catalog import BUILT_IN as SCENARIOS
 from cell.scenario.dynamics_file import load_dynamics
 from cell.scenario.schema import load_scenario
-from cell.sim.assembly import geometry_of, motors_of, planner_bounds, step_table
+from cell.sim.physics_checks import step_table
+from cell.sim.scenario_values import geometry_of, motors_of, planner_bounds
 
 SW = np.linspace(0, 1, 25)
 # Joint 1 reverses twice (zero-inertia points at s = 0.25 and 0.75), the others do not.

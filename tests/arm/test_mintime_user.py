@@ -8,7 +8,7 @@ import pytest
 from cell.arm.mintime.regimes import fastest_regime_times, plan_regimes
 from cell.cli.main import main
 from cell.scenario.schema import load_scenario
-from cell.sim.assembly import geometry_of, motors_of, planner_bounds
+from cell.sim.scenario_values import geometry_of, motors_of, planner_bounds
 
 KIN = load_scenario("mintime_kinematic")
 

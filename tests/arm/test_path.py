@@ -7,7 +7,7 @@ from cell.arm.kinematics import Arm, forward, tool_centre
 from cell.arm.path import CellGeometry, build_path
 from cell.arm.transforms import trans
 from cell.scenario.schema import default_scenario
-from cell.sim.assembly import geometry_of
+from cell.sim.scenario_values import geometry_of
 
 G = CellGeometry()
 P = build_path(G)

@@ -8,7 +8,8 @@ import pytest
 from cell.arm.mintime.regimes import FREE_REGIMES, plan_regimes, regime_path
 from cell.bench.planner_speed import RICHARDSON, converged_time, regime_time
 from cell.scenario.schema import load_scenario
-from cell.sim.assembly import geometry_of, motors_of, planner_bounds, step_table
+from cell.sim.physics_checks import step_table
+from cell.sim.scenario_values import geometry_of, motors_of, planner_bounds
 
 
 @pytest.mark.parametrize("error", [0.37, -2.5])

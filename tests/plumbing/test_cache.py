@@ -13,7 +13,7 @@ import pytest
 
 from cell.plumbing import cache
 from cell.scenario.schema import load_scenario
-from cell.sim import assembly
+from cell.sim import timing_cache
 from cell.sim.simulation import simulate
 
 
@@ -131,10 +131,10 @@ def test_a_remembered_key_is_made_text_once_per_look_and_once_per_keep(own_cache
 @pytest.mark.parametrize("timing", ["constant-rate", "minimum-time"])
 def test_the_timing_read_back_is_the_solved_one(own_cache, timing):
     s = load_scenario("baseline", {"robot.timing": timing, "mintime.grid_points": 120})
-    solved = assembly.robot_timing(s)
+    solved = timing_cache.robot_timing(s)
     assert any(p.name.startswith("timing-") for p in own_cache.iterdir())
     _forget()
-    read = assembly.robot_timing(s)
+    read = timing_cache.robot_timing(s)
     assert read is not solved
     assert _segments(read) == _segments(solved)
     assert {n: getattr(read, n) for n in ("r2_min_s", "r4_min_s", "r4_nominal_s",
@@ -159,17 +159,17 @@ def test_a_run_is_the_same_with_the_cache_off_cold_and_warm(own_cache, monkeypat
 
 def _text(result) -> list[str]:
     """Every value of a run's records and summary as exact text (NaN included)."""
-    rows = [repr(dataclasses.astuple(r)) for r in result.records]
+    rows = [repr(tuple(r)) for r in result.records]
     return rows + [repr(dataclasses.astuple(result.summary))]
 
 
 def test_a_damaged_timing_entry_is_solved_again(own_cache):
     s = load_scenario("baseline")
-    solved = assembly.robot_timing(s)
+    solved = timing_cache.robot_timing(s)
     for path in own_cache.glob("timing-*"):
         path.write_bytes(path.read_bytes().replace(b"_ub", b"_xx"))
     _forget()
-    assert _segments(assembly.robot_timing(s)) == _segments(solved)
+    assert _segments(timing_cache.robot_timing(s)) == _segments(solved)
 
 
 def test_a_warm_start_imports_nothing_heavy(tmp_path, own_cache):

@@ -5,6 +5,7 @@ so that pandas reads a float column as floats whatever its values (parts.csv's
 from __future__ import annotations
 
 import math
+import typing
 
 import pandas as pd
 from hypothesis import given
@@ -32,7 +33,7 @@ def test_whole_floats_keep_their_point_and_others_are_as_printf_writes_them():
 def test_a_runs_float_columns_are_floats_in_pandas_even_when_whole(tmp_path):
     assert main(["run", "baseline", "--set", "run.parts=30", "--out", str(tmp_path)]) == 0
     parts = pd.read_csv(tmp_path / "parts.csv")
-    floats = [name for name, kind in PartRecord.__annotations__.items() if kind == "float"]
+    floats = [name for name, kind in typing.get_type_hints(PartRecord).items() if kind is float]
     assert "feed_delay_s" in floats and (parts["feed_delay_s"].fillna(0) == 0).all()
     assert {name: str(parts[name].dtype) for name in floats} == {name: "float64" for name in floats}
     summary = pd.read_csv(tmp_path / "summary.csv")

@@ -20,7 +20,8 @@ from cell.cli.main import main
 from cell.reporting.figures.motion import nominal_timeline
 from cell.reporting.figures.thesis_figures import FILES, make_figures
 from cell.scenario.schema import default_scenario, load_scenario
-from cell.sim.assembly import motors_of, step_table
+from cell.sim.physics_checks import step_table
+from cell.sim.scenario_values import motors_of
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 

@@ -14,8 +14,9 @@ from cell.plumbing.errors import ScenarioError
 from cell.reporting.figures.thesis_figures import FILES, make_figures
 from cell.reporting.published import TABLE_7_1_CYCLES
 from cell.scenario.schema import default_scenario
-from cell.sim.assembly import constants, robot_timing
 from cell.sim.policies.fixed import fixed_plan
+from cell.sim.policy_setup import constants
+from cell.sim.timing_cache import robot_timing
 
 #: Arrivals 3 % slower than the thesis's: the nominal cycle follows their mean (docs/usage.md), and R IV
 #: shortened from it to 20.5 or 20.0907 s falls below what the base can do.

@@ -58,7 +58,7 @@ def sources() -> dict[str, Any]:
     from cell.reporting.figures.motion import joint_travel_min_times, nominal_timeline
     from cell.reporting.figures.runs import LOT, running_mean, simulate_runs
     from cell.scenario.schema import load_scenario
-    from cell.sim.assembly import step_table
+    from cell.sim.physics_checks import step_table
 
     s = load_scenario("baseline")
     t = step_table(s)

@@ -8,7 +8,7 @@ import yaml
 from cell.plumbing.errors import ScenarioError
 from cell.scenario import catalog
 from cell.scenario.schema import WEIBULL_SHAPE, default_scenario, known_key, load_scenario, validate
-from cell.sim.assembly import step_table
+from cell.sim.physics_checks import step_table
 
 
 def from_dict(raw, file="<dict>"):

@@ -14,7 +14,7 @@ from cell.cli.main import main
 from cell.scenario import catalog
 from cell.scenario.schema import default_scenario, load_scenario
 from cell.sim.assembly import assemble
-from cell.sim.records import PART_COLUMNS, SUMMARY_COLUMNS, PartRecord
+from cell.sim.records import LET_GO, PART_COLUMNS, SUMMARY_COLUMNS, Part, PartRecord
 from cell.sim.simulation import PER_PART, RunLog, simulate
 
 BASELINE = catalog.path("baseline")
@@ -60,7 +60,7 @@ def test_adaptive_baseline_loses_nothing_and_spaces_parts_45_in(adaptive):
 
 def test_adaptive_never_exceeds_motor_or_belt_limits(adaptive):
     s = load_scenario(BASELINE)
-    from cell.sim.assembly import robot_timing
+    from cell.sim.timing_cache import robot_timing
 
     t = robot_timing(s)
     p = adaptive.parts
@@ -224,7 +224,7 @@ def test_hostile_override_on_the_command_line(tmp_path, capsys):
 
 def test_minimum_time_robot_takes_its_fastest_r4_from_the_planner():
     from cell.arm.mintime.regimes import fastest_regime_times
-    from cell.sim.assembly import geometry_of, motors_of, planner_bounds
+    from cell.sim.scenario_values import geometry_of, motors_of, planner_bounds
 
     s = default_scenario().with_overrides({"robot.timing": "minimum-time", "run.parts": 60})
     fastest = fastest_regime_times(geometry_of(s), motors_of(s), planner_bounds(s))
@@ -338,7 +338,7 @@ def _reference_non_adaptive(s, seed):
     from cell.scenario.arrivals import interarrival_times
     from cell.sim.accounting import THESIS_SLACK_S
     from cell.sim.assembly import assemble
-    from cell.sim.records import LET_GO, R4_PEAK, SPACING_OFF, PartRecord, limit_names
+    from cell.sim.records import R4_PEAK, SPACING_OFF, limit_names
 
     cell = assemble(s)
     k, plan, c = cell.k, cell.policy.cycle, cell.policy.ideal_cycle_s
@@ -359,32 +359,34 @@ def _reference_non_adaptive(s, seed):
         now = max(fed[i], at_bot)                      # the conveyor times it from here
         delay = max((0.0 + (x + length - 0.0) / v) - now, 0.0)
         at_bot = now + delay
-        p = PartRecord(i + 1, fed[i], t[i], at_bot_s=at_bot)
+        p = {c: np.nan for c in PART_COLUMNS}
+        p.update(part=i + 1, arrival_s=fed[i], interarrival_s=t[i], at_bot_s=at_bot,
+                 picked=False, missed=False, feed_delay_s=0.0)
         flags = 0
         if free_at <= at_bot + 1e-6:
             free_at = at_bot + plan.cycle
-            p.picked, p.motion_cycle_s = True, plan.cycle
-            p.input_speed_in_s, p.output_speed_in_s = plan.input_speed, plan.output_to_g
-            p.r1_s, p.r2_s, p.r3_s, p.r4_s = r1, plan.r2, r3, plan.r4
-            p.v_r1_in_s, p.v_r2_in_s = tm.r1_length_in / r1, tm.r2.length_in / plan.r2
-            p.v_r3_in_s, p.v_r4_in_s = tm.r3_length_in / r3, tm.r4.length_in / plan.r4
-            p.pick_s = at_bot + plan.r1_pre
-            p.touchdown_s = td = at_bot + to_td
+            p.update(picked=True, motion_cycle_s=plan.cycle, input_speed_in_s=plan.input_speed,
+                     output_speed_in_s=plan.output_to_g, r1_s=r1, r2_s=plan.r2, r3_s=r3,
+                     r4_s=plan.r4, v_r1_in_s=tm.r1_length_in / r1,
+                     v_r2_in_s=tm.r2.length_in / plan.r2, v_r3_in_s=tm.r3_length_in / r3,
+                     v_r4_in_s=tm.r4.length_in / plan.r4, pick_s=at_bot + plan.r1_pre)
+            p["touchdown_s"] = td = at_bot + to_td
             x_td = 0.0 + u * (td - 0.0)
             if last_x is not None:
-                p.spacing_in, p.delivery_interval_s = x_td - last_x, td - last_td
+                p["spacing_in"], p["delivery_interval_s"] = x_td - last_x, td - last_td
             last_x, last_td = x_td, td
             flags |= R4_PEAK if plan.limits else 0
         else:
-            p.missed, flags = True, LET_GO
-        p.ip_wallclock = t[i + 1] / p.delivery_interval_s
+            p["missed"], flags = True, LET_GO
+        p["ip_wallclock"] = t[i + 1] / p["delivery_interval_s"]
         lost = t[i] < c - THESIS_SLACK_S
-        p.missed_thesis, p.thesis_interval_s = lost, t[i] + c if lost else t[i]
-        p.ip_thesis = t[i + 1] / (2.0 * p.thesis_interval_s)
-        if p.spacing_in == p.spacing_in and abs(p.spacing_in - k.spacing) > k.tol + 1e-9:
+        p["missed_thesis"], p["thesis_interval_s"] = lost, t[i] + c if lost else t[i]
+        p["ip_thesis"] = t[i + 1] / (2.0 * p["thesis_interval_s"])
+        sp = p["spacing_in"]
+        if sp == sp and abs(sp - k.spacing) > k.tol + 1e-9:
             flags |= SPACING_OFF
-        p.limits = limit_names(flags) if flags else ""
-        out.append(p)
+        p["limits"] = limit_names(flags) if flags else ""
+        out.append(PartRecord(**p))
     return out
 
 
@@ -407,10 +409,23 @@ def test_the_run_log_hands_parts_on_in_part_order_whatever_order_they_finish(fin
     log = RunLog([20.0] * 9, policy.accounting(), lambda p: handed.append(p.part), 45.0, 0.25)
     done: set[int] = set()
     for i in finish_order:
-        log.missed(PartRecord(i, float(i), 20.0))
+        part = Part(i - 1, float(i))
+        log.flag(part, LET_GO)
+        log.missed(part)
         done.add(i)
         ready = 0  # every part up to the first not yet done has been handed on, no other
         while ready + 1 in done:
             ready += 1
         assert handed == list(range(1, ready + 1))
     assert len(log.per_part) == 8 * 8 * len(PER_PART)  # PER_PART's doubles a part, each once
+
+
+@pytest.mark.parametrize("policy", ["adaptive", "non-adaptive"])
+def test_parts_in_cell_are_the_parts_come_but_not_done_when_the_run_ends(policy):
+    """``run.hours`` stops the run sharp: the parts on the belt or in the hand then are
+    ``parts_in_cell``, the parts that came less the rows (every part done has its row)."""
+    s = default_scenario().with_overrides({"run.hours": 0.25, "controller.policy": policy})
+    r = simulate(s, seed=2)
+    assert r.summary.parts_in_cell == r.summary.parts_arrived - len(r.records) >= 1
+    assert r.summary.parts_arrived == r.summary.parts_delivered + r.summary.parts_missed + \
+        r.summary.parts_in_cell

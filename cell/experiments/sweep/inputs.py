@@ -30,7 +30,7 @@ def digest(path: str | Path) -> str | None:
 
 def named_files(scenario: Scenario) -> list[Path]:
     """The files a scenario names (its trace, its dynamics model), where they are read from."""
-    from cell.sim.assembly import dynamics_path
+    from cell.sim.scenario_values import dynamics_path
 
     found: list[Path] = []
     for section, key in PATH_KEYS:

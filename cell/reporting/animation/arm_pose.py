@@ -83,7 +83,7 @@ def arm_pose(scenario: Scenario, q_rad: ArrayLike, opening_in: ArrayLike) -> Arm
     """
     q = np.atleast_2d(np.asarray(q_rad, dtype=float))
     g = np.atleast_1d(np.asarray(opening_in, dtype=float))
-    from cell.sim.assembly import geometry_of
+    from cell.sim.scenario_values import geometry_of
 
     geometry = geometry_of(scenario)
     arm = geometry.arm

@@ -126,7 +126,7 @@ def simulate_scenes(scenario: Scenario, policies: list[str], first: int, count: 
     policies, and the window starts at its arrival in the first run.
     """
     from cell.reporting.animation.scene import build_scene, frames_input, window
-    from cell.sim.assembly import step_table
+    from cell.sim.physics_checks import step_table
 
     if count < 1 or first < 1:
         raise CellError(f"--parts {count} --from-part {first}: both must be at least 1")

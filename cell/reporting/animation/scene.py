@@ -92,7 +92,8 @@ def frames_input(result: Any, scenario: Scenario) -> AnimationInput:
     belts' speeds are the run's recorded changes (:func:`belt_history`); the drop
     point is the cell's ``input_length``.
     """
-    from cell.sim.assembly import constants, robot_timing
+    from cell.sim.policy_setup import constants
+    from cell.sim.timing_cache import robot_timing
 
     d = result.parts
     picked = d["picked"].to_numpy(dtype=bool)

@@ -23,7 +23,7 @@ from cell.reporting.figures.style import (
     save,
 )
 from cell.scenario.schema import Scenario
-from cell.sim.assembly import geometry_of
+from cell.sim.scenario_values import geometry_of
 
 BELT_COLOUR = "#c8c8c8"
 

@@ -119,7 +119,8 @@ def nominal_timeline(table: StepTable, s: Scenario,
     motor rates, and R II the rest of the ideal cycle (the thesis's
     22.5872 - 8/3 - 4 - 9.9855 = 5.935 s if R I took exactly 8/3 s).  ``floors`` as
     in :func:`timeline`."""
-    from cell.sim.assembly import constants, robot_timing
+    from cell.sim.policy_setup import constants
+    from cell.sim.timing_cache import robot_timing
 
     k = constants(s, robot_timing(s))
     return timeline(table, {"r1_pre": k.r1_pre_nom, "r1_post": k.r1_post_nom, "r2": k.r2_nom,

@@ -27,7 +27,7 @@ from cell.reporting.figures.style import (
 from cell.reporting.published import TABLE_7_1_CYCLES
 from cell.reporting.table_7_1 import fixed_cycle
 from cell.scenario.schema import Scenario
-from cell.sim.assembly import nominal_cycle
+from cell.sim.policy_setup import nominal_cycle
 
 #: Parts per lot of Fig. 23's lumped averages (§7.2).
 LOT = 10
@@ -63,8 +63,9 @@ def missed_cycles(s: Scenario, cycles: tuple[float, ...] = TABLE_7_1_CYCLES
                   ) -> tuple[tuple[float, ...], float]:
     """(the ``cycles`` the non-adaptive robot of ``s`` cannot make, its shortest cycle)."""
     from cell.plumbing.errors import ScenarioError
-    from cell.sim.assembly import constants, robot_timing
     from cell.sim.policies.fixed import fixed_plan
+    from cell.sim.policy_setup import constants
+    from cell.sim.timing_cache import robot_timing
 
     k = constants(s, robot_timing(s))
     missed = []

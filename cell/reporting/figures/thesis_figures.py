@@ -18,7 +18,7 @@ from cell.reporting.figures import interarrival as arrivals
 from cell.reporting.figures import layout, motion, runs, tip
 from cell.reporting.figures.style import style
 from cell.scenario.schema import Scenario
-from cell.sim.assembly import step_table
+from cell.sim.physics_checks import step_table
 
 #: Figure number -> file stem, as written into the output folder.
 FILES: dict[int, str] = {

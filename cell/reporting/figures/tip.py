@@ -39,8 +39,8 @@ from cell.reporting.figures.style import (
     shade_regimes,
 )
 from cell.scenario.schema import Scenario
-from cell.sim.assembly import nominal_cycle
 from cell.sim.conveyors import speed_at
+from cell.sim.policy_setup import nominal_cycle
 
 #: Offsets (points) tried, in order, for a label next to what it names.
 OFFSETS = [(0, 9), (0, -9), (0, 16), (0, -16), (0, 24), (0, -24), (0, 34), (0, -34), (0, 48),

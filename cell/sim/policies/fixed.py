@@ -15,7 +15,7 @@ import numpy as np
 from cell.plumbing.errors import ScenarioError
 from cell.sim import accounting
 from cell.sim.policies.base import Accounting, CellConstants, CellView, Plan, Policy
-from cell.sim.records import R4_PEAK, PartRecord, RunSummary
+from cell.sim.records import R4_PEAK, RunSummary
 
 #: The thesis's figures are rounded to 4 decimals: a requested R IV this much
 #: below the motors' minimum is taken as the minimum (20.0907 s in Table 7.1 is
@@ -82,15 +82,15 @@ class ReconstructedAccounting(Accounting):
         self._lost_below = self.cycle_s - accounting.THESIS_SLACK_S
         """C − s: a part that comes sooner than this after the last is lost."""
 
-    def part(self, rec: PartRecord, next_interarrival_s: float) -> None:
-        t = rec.interarrival_s
+    def part(self, plan: Any, picked: bool, interarrival_s: float) -> None:
+        t = interarrival_s
         lost = t < self._lost_below
-        d = t + self.cycle_s if lost else t
-        rec.missed_thesis = lost
-        rec.thesis_interval_s = d
-        rec.ip_thesis = next_interarrival_s / (2.0 * d)
-        self.interval.append(d)
+        self.interval.append(t + self.cycle_s if lost else t)
         self.lost.append(lost)
+
+    def last(self, next_interarrival_s: float) -> tuple[bool, float, float]:
+        d = self.interval[-1]
+        return bool(self.lost[-1]), d, next_interarrival_s / (2.0 * d)
 
     def finish(self, s: RunSummary, start: int, picked_r4_s: np.ndarray,
                t_next: np.ndarray) -> None:
