@@ -22,7 +22,7 @@ venv: $(STAMP)
 TEST_WORKERS ?= 2
 
 test: $(STAMP)
-	$(PY) -m pytest -q -n $(TEST_WORKERS)
+	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadgroup
 
 # Each sweep target starts from an empty build folder: a sweep refuses to replace results
 # without --resume, and a report regenerated here must come from this code, not reused tasks.

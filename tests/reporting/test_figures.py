@@ -23,6 +23,10 @@ from cell.scenario.schema import default_scenario, load_scenario
 from cell.sim.physics_checks import step_table
 from cell.sim.scenario_values import motors_of
 
+# One worker draws every figure once (``make test`` runs ``--dist loadgroup``): the module's
+# fixtures would otherwise draw them on each worker.
+pytestmark = pytest.mark.xdist_group("figures")
+
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
