@@ -160,3 +160,20 @@ def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter) -> None:
     total = counts() + _WORKER_COUNTS
     if total["cases"]:
         terminalreporter.write_line(summary_line(total))
+
+
+#: Modules whose tests take seconds each (``pytest --durations``), run first: on two
+#: workers a long test left to the end keeps one worker busy while the other idles.
+SLOW_FIRST = ("tests/reporting/test_reports_regenerate.py", "tests/reporting/test_figures.py",
+              "tests/plumbing/test_output_streams.py", "tests/experiments/test_optimize.py",
+              "tests/arm/test_mintime_toppra.py", "tests/robust/", "tests/animate/",
+              "tests/reporting/test_figures_cycles.py", "tests/arm/test_mintime.py")
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    def rank(item: pytest.Item) -> int:
+        path = item.nodeid.split("::")[0]
+        return next((k for k, prefix in enumerate(SLOW_FIRST) if path.startswith(prefix)),
+                    len(SLOW_FIRST))
+
+    items.sort(key=rank)  # stable: within a rank, the collected order
