@@ -174,10 +174,11 @@ class Robot:
         (with failures: lost to downtime, if a stop kept the robot away)."""
         return LET_GO
 
-    def order(self, part: Any, to_lo_s: float, to_td_s: float, cycle_s: float) -> None:
-        """Start a cycle now (the robot must be free): lift-off ``to_lo_s``, touch-down
-        ``to_td_s`` and back at B ``cycle_s`` from now."""
-        now = self.env.now
+    def order(self, part: Any, to_lo_s: float, to_td_s: float, cycle_s: float,
+              now: float) -> None:
+        """Start a cycle now, at the clock's ``now`` (the robot must be free): lift-off
+        ``to_lo_s``, touch-down ``to_td_s`` and back at B ``cycle_s`` from now.  (The instant
+        given, not read: ``env.now`` is a property, see :meth:`cell.sim.feeder.Feeder.run`.)"""
         self.free_at_s = now + cycle_s
         self.orders.put((part, to_lo_s, to_td_s, now))
 
