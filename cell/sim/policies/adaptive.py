@@ -73,7 +73,7 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
     touch-down (None before the first).  ``lag``: B → LO at v, if known.  ``idle_s``: seconds
     since that touch-down (to name why the spacing is off; None: both causes marked,
     :class:`Adaptive` names the one).  Steps 5.0 and the spacing contract inline (the rare cases:
-    :func:`output_speed`, :func:`floor_at`), for speed: 120.6k to 118.6k instructions per part,
+    :func:`output_speed`, :func:`floor_at`), for speed: 122.5k to 118.4k instructions per part,
     cachegrind, with the controller's own steps (:meth:`.Controller.run`)."""
     t = k.timing
     flags = 0
