@@ -232,7 +232,7 @@ class RobotStops:
             if p is not None and i == 0:
                 p.pick_s = env.now
             elif p is not None and i == 3:
-                cell.output.placed.put(p)  # touch-down: the output conveyor takes it now
+                cell.output.placed.put((p, env.now))  # touch-down: taken now, its instant
                 self.part = None
         self.in_cycle, self.part = False, None
         self.at_rest()

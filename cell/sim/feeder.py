@@ -32,7 +32,7 @@ class Loadable(Protocol):
     belt: Any
     on_replan: Callable[[], None] | None
 
-    def drop(self, part: Part, x: float) -> None: ...
+    def drop(self, part: Part, x: float, now: float) -> None: ...
 
 
 class Feeder:
@@ -101,5 +101,5 @@ class Feeder:
                     flag(part, HELD_AT_FEEDER)
             else:
                 part = Part(i, f)
-            drop(part, x)
+            drop(part, x, now)
             clear_at = x + size

@@ -95,19 +95,18 @@ def attach(table: StepTable, timing: RobotTiming, settings: WearSettingsLike, ro
     clock = WearClock(CycleWear(table, timing, model_of(settings)), stream(seed, WEAR_STREAM))
     log = WearLog(clock, float(settings.repair_h) * HOUR_S)
     run, stops, repair_s, original = clock.cycle, log.stops, log.repair_s, robot.order
-    env = robot.env
 
-    def order(part: Any, to_lo_s: float, to_td_s: float, cycle_s: float) -> None:
+    def order(part: Any, to_lo_s: float, to_td_s: float, cycle_s: float, now: float) -> None:
         plan = part.plan  # the regimes as parts.csv has them (R I, R III: their legs summed)
         r1, r2, r3 = plan.r1_pre + plan.r1_post, plan.r2, plan.r3_pre + plan.r3_post
         r3_pre = round(to_td_s - (r1 + r2), 9)  # B → TD less R I and R II
         joint = run((to_lo_s, r1 - to_lo_s, r2, r3_pre, r3 - r3_pre, plan.r4))
         if joint >= 0:
-            back = env.now + cycle_s
+            back = now + cycle_s
             stops.append((back, back + repair_s, joint))
             clock.replace(joint)
             cycle_s += repair_s
-        original(part, to_lo_s, to_td_s, cycle_s)
+        original(part, to_lo_s, to_td_s, cycle_s, now)
 
     robot.order = order
     return log

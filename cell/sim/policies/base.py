@@ -10,12 +10,11 @@ would have (docs/accounting.md); the default is step 6.2's motion time.
 
 from __future__ import annotations
 
-import functools
 import math
 from abc import ABC, abstractmethod
 from array import array
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, ClassVar, Protocol
 
 import numpy as np
@@ -69,6 +68,20 @@ class CellConstants:
     nominal_from: str = "scenario"
     """Where ``cycle_nom`` came from: ``scenario`` (``controller.nominal_cycle_s``),
     ``arrivals`` (their mean) or ``fastest`` (the arrivals are faster than the robot)."""
+    floor_gap_in: float = field(init=False, repr=False, compare=False)
+    """The spacing contract's threshold: the most the last part set down may have travelled
+    when the next part reaches B for 45 in to be kept with the output belt at its floor until
+    G (R I + R II at their nominal sum) and at nominal from G to TD.  Set once, at
+    construction: read once a part by :func:`cell.sim.policies.adaptive.adaptive_plan`, as a
+    property it cost about 2 % of ``parts_per_s_adaptive_5k``; as a ``functools.cached_property``
+    it gave the constants an instance ``__dict__`` CPython 3.11 cannot specialise attribute
+    reads on (every ``k.x`` a generic lookup): as a field, the adaptive run 115.6k to 110.2k
+    instructions per part, cachegrind."""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "floor_gap_in", self.spacing - self.u_nom * self.r3_pre_nom
+                           - self.output_min * (self.r1_nom + self.r2_nom) - 1e-6)
+
 
     @property
     def shortest_cycle_s(self) -> float:
@@ -80,18 +93,6 @@ class CellConstants:
         """The robot's fastest cycle: R II and R IV at the motors' peak, belts at nominal."""
         t = self.timing
         return self.r1_nom + t.r2_min_s + self.r3_pre_nom + self.r3_post_nom + t.r4_min_s
-
-    @functools.cached_property
-    def floor_gap_in(self) -> float:
-        """The spacing contract's threshold: the most the last part set down may have travelled
-        when the next part reaches B for 45 in to be kept with the output belt at its floor
-        until G (R I + R II at their nominal sum) and at nominal from G to TD.
-
-        Computed once (read once a part by :func:`cell.sim.policies.adaptive.floor_at`: as a
-        property it cost about 2 % of ``make bench``'s ``parts_per_s_adaptive_5k``, 2 shared
-        cores, CPU time, best of 12, interleaved)."""
-        return self.spacing - self.u_nom * self.r3_pre_nom - \
-            self.output_min * (self.r1_nom + self.r2_nom) - 1e-6
 
     @property
     def offered_load(self) -> float:
