@@ -9,10 +9,12 @@ WORKERS ?= 2
 
 all: test
 
+# --no-compile: Python compiles the modules a run imports as it first imports them; compiling
+# every installed module up front took about half of a fresh install (60 s against 23 s).
 $(STAMP): pyproject.toml
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -qq --upgrade pip
-	$(PY) -m pip install -qq -e ".[dev,dist]"
+	$(PY) -m pip install -qq --no-compile -e ".[dev,dist]"
 	@touch $(STAMP)
 
 venv: $(STAMP)
