@@ -16,6 +16,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from cell.sim.timeline import union
+
 #: How a stop's cause reads on a frame.
 STOP_WORDS = {"failure": "breakdown", "wear": "worn motor", "maintenance": "maintenance"}
 DOWN_COLOUR = "#c0392b"
@@ -81,15 +83,9 @@ class OperatingClock:
     @classmethod
     def of(cls, stops: Iterable[tuple[str, str, float, float]]) -> OperatingClock:
         """The clock of a run's stops, (equipment, cause, from_s, to_s): the robot's only."""
-        spans = sorted((a, b) for name, _, a, b in stops if name == "robot" and b > a)
-        merged: list[list[float]] = []
-        for a, b in spans:
-            if merged and a <= merged[-1][1]:
-                merged[-1][1] = max(merged[-1][1], b)
-            else:
-                merged.append([a, b])
-        pair = np.asarray(merged, dtype=float).reshape(-1, 2)
-        return cls(pair[:, 0].copy(), pair[:, 1].copy())
+        spans = np.asarray([(a, b) for name, _, a, b in stops if name == "robot"],
+                           dtype=float).reshape(-1, 2)
+        return cls(*union(spans[:, 0], spans[:, 1]))
 
     @property
     def _down_before(self) -> NDArray[np.float64]:
