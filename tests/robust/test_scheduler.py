@@ -149,6 +149,9 @@ def test_a_scheduler_that_goes_away_mid_sweep_is_one_line_and_resume_finishes(
                                   dashboard_address=None) as lc:
         def close_when_told():
             midsweep.STARTED.wait(120)
+            deadline = time.monotonic() + 120  # the first task on disk, however loaded the machine
+            while not any((out / "tasks").glob("*")) and time.monotonic() < deadline:
+                time.sleep(0.05)
             midsweep.CLOSING.set()
             lc.close()
         threading.Thread(target=close_when_told, daemon=True).start()
