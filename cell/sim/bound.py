@@ -38,16 +38,17 @@ def greedy_picks(come_s: Iterable[float], length_in: float, v_min: float, v_max:
     """The most parts, coming at ``come_s`` (in order), that fit their windows at B with
     picks ``cycle_min_s`` apart (see the module's text)."""
     early, late, clear = length_in / v_max, length_in / v_min, part_size_in / v_min
-    last_pick = latest_drop = -float("inf")
+    next_drop = next_pick = -float("inf")  # the latest drop and the last pick, plus clear, c_min
     count = 0
     for a in come_s:
-        latest_drop = a if a > latest_drop + clear else latest_drop + clear
+        latest_drop = a if a > next_drop else next_drop
+        next_drop = latest_drop + clear
         pick = a + early
-        if pick < last_pick + cycle_min_s:
-            pick = last_pick + cycle_min_s
+        if pick < next_pick:
+            pick = next_pick
         if pick <= latest_drop + late:
             count += 1
-            last_pick = pick
+            next_pick = pick + cycle_min_s
     return count
 
 

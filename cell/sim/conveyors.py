@@ -74,22 +74,17 @@ class Belt:
     def speed(self, t: float) -> float:
         """The speed at t (:func:`speed_at` less its ``max``: once a part, a fraction of 1 % of
         ``make bench``'s ``parts_per_s_adaptive_5k``)."""
-        k = bisect_right(self._t, t) - 1
-        return self._v[k if k > 0 else 0]
+        return self._v[bisect_right(self._t, t, 1) - 1]  # lo=1: the first change if t is before it
 
     def travel(self, t: float) -> float:
         """X(t): inches the belt has moved by time t (t ≥ the last settled change, or a
         rounding before it: a replan within EPS_S of a change may settle up to it)."""
-        k = bisect_right(self._t, t) - 1
-        if k < 0:  # max(k, 0) without the builtin call; index -1 would be the last change
-            k = 0
+        k = bisect_right(self._t, t, 1) - 1  # lo=1: k >= 0, the first change if t is before it
         return self._x[k] + self._v[k] * (t - self._t[k])
 
     def time_at(self, x: float) -> float:
         """First instant at which the belt's travel reaches x (speeds are > 0)."""
-        k = bisect_right(self._x, x) - 1
-        if k < 0:  # max(k, 0) without the builtin call (once a part)
-            k = 0
+        k = bisect_right(self._x, x, 1) - 1  # lo=1: k >= 0, as in travel
         return self._t[k] + (x - self._x[k]) / self._v[k]
 
     def plan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
