@@ -14,6 +14,11 @@ must obey the same physics the built-in policies do before the cell acts on it:
   R III + R IV;
 * ``limits`` a set of the known limit bits, ``steers_belts`` a boolean.
 
+A number is an int or a float (a boolean in a numeric field is read as its 0 or 1, as the
+controller's comparisons read it; an integer beyond the floats' range is an infinity).
+tests/robust/test_plan_check_agrees.py checks that the controller's check and :func:`problem`
+agree on any plan.
+
 The plan is read by attribute name only (``plan.r1_pre``, ``plan.cycle``...), so any
 record with those fields passes.  A bad plan stops the run with one line naming the
 policy and the first bad value (:class:`PolicyError`, exit 2); so does a policy whose
@@ -78,6 +83,21 @@ def _bounds(k: Any) -> dict[str, tuple[float, float]]:
     }
 
 
+def _float(v: float) -> float:
+    """``v`` as a float; an integer beyond the floats' range is an infinity of its sign."""
+    try:
+        return float(v)
+    except OverflowError:
+        return math.inf if v > 0 else -math.inf
+
+
+def _shown(v: Any) -> str:
+    """``v`` for a message: an integer too long to print whole is named by its size."""
+    if isinstance(v, int) and not isinstance(v, bool) and abs(v) >= 10**60:
+        return f"an integer of {len(str(abs(v))) if abs(v) < 10**4000 else 'over 4000'} digits"
+    return one_line(repr(v), 60)
+
+
 def _near(a: float, b: float) -> bool:
     return abs(a - b) <= SUM_S
 
@@ -90,11 +110,11 @@ def problem(plan: Any, bounds: dict[str, tuple[float, float]]) -> str | None:
             v = getattr(plan, name)
         except AttributeError:
             return f"the plan has no field {name!r}"
-        if isinstance(v, bool) or not isinstance(v, (int, float)):
+        if not isinstance(v, (int, float)):  # an int or a float (a boolean is its 0 or 1)
             return f"{name} = {one_line(repr(v), 60)}: not a number"
-        v = float(v)
+        given, v = v, _float(v)
         if not math.isfinite(v):
-            return f"{name} = {v}: not finite"
+            return f"{name} = {_shown(given) if isinstance(given, int) else v}: not finite"
         unit = "s" if name in TIMES else "in/s"
         if v < lo - ABS - REL * abs(lo):
             what = "the motors' fastest" if name in TIMES else "the belt's floor"
@@ -107,8 +127,9 @@ def problem(plan: Any, bounds: dict[str, tuple[float, float]]) -> str | None:
             return f"the plan has no field {name!r}"
     to_g, cycle = plan.to_g, plan.cycle
     for name, v in (("to_g", to_g), ("cycle", cycle)):
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            return f"{name} = {one_line(repr(v), 60)}: not a finite number"
+        if not isinstance(v, (int, float)) or not math.isfinite(_float(v)):
+            return f"{name} = {_shown(v)}: not a finite number"
+    to_g, cycle = _float(to_g), _float(cycle)
     r12 = values["r1_pre"] + values["r1_post"] + values["r2"]
     if not _near(to_g, r12):
         return f"to_g = {to_g:.6g} s: not R I + R II = {r12:.6g} s"
