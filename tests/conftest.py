@@ -54,6 +54,18 @@ def k(thesis_cell, timing):
     return constants(thesis_cell, timing)
 
 
+@pytest.fixture
+def unrendered(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Figures laid out (texts, ticks, their warnings) but not rasterised: each PNG file holds
+    only the signature (tests/reporting/conftest.py).  For tests that read tables, markdown and
+    CSVs, not pixels: a sweep's report draws a figure a measure."""
+    from matplotlib.figure import Figure
+
+    from tests.reporting.conftest import unrendered_savefig
+
+    monkeypatch.setattr(Figure, "savefig", unrendered_savefig)
+
+
 # --------------------------------------------------------------------------- sweep stand-ins
 # The sweep runner takes the replication as a function; these small deterministic stand-ins
 # draw from the stream they are given (module-level, so worker processes can run them).
