@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 from collections import Counter
 from pathlib import Path
 from types import SimpleNamespace
@@ -51,6 +52,18 @@ def timing(thesis_cell):
 def k(thesis_cell, timing):
     """The policies' constants for the thesis's cell."""
     return constants(thesis_cell, timing)
+
+
+@pytest.fixture
+def unrendered(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Figures laid out (texts, ticks, their warnings) but not rasterised: each PNG file holds
+    only the signature (tests/reporting/conftest.py).  For tests that read tables, markdown and
+    CSVs, not pixels: a sweep's report draws a figure a measure."""
+    from matplotlib.figure import Figure
+
+    from tests.reporting.conftest import unrendered_savefig
+
+    monkeypatch.setattr(Figure, "savefig", unrendered_savefig)
 
 
 # --------------------------------------------------------------------------- sweep stand-ins
@@ -177,3 +190,31 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
                     len(SLOW_FIRST))
 
     items.sort(key=rank)  # stable: within a rank, the collected order
+
+
+# --------------------------------------------------------------------------- one worker a module
+#: Test modules that hold a module-scoped fixture (or an ``xdist_group`` mark), by path from the
+#: repository: each runs on one worker, so the fixture is computed once a suite, not once on
+#: each worker (the figures' drawing, toppra's solutions, the fits, the reports' runs).
+_TESTS = Path(__file__).resolve().parent
+ONE_WORKER = frozenset(
+    path.relative_to(_TESTS.parent).as_posix() for path in sorted(_TESTS.rglob("test_*.py"))
+    if re.search(r"""scope=["'](module|class)["']|xdist_group""", path.read_text("utf-8")))
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config: pytest.Config, log):  # noqa: ANN001, ANN201 (xdist's hook)
+    """``--dist loadgroup`` with each of ONE_WORKER's modules one unit of work.  xdist marks a
+    group by appending ``@name`` to the test's node id on the worker, which pytest 9.2 no longer
+    honours (the id is its ``_id``, not ``_nodeid``): the marks alone split the figures' module
+    over both workers and drew every figure twice."""
+    if config.getvalue("dist") != "loadgroup":
+        return None
+    from xdist.scheduler import LoadGroupScheduling
+
+    class ModulesTogether(LoadGroupScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            path = nodeid.split("::", 1)[0]
+            return path if path in ONE_WORKER else super()._split_scope(nodeid)
+
+    return ModulesTogether(config, log)

@@ -13,6 +13,9 @@ from cell.cli.main import main
 from cell.experiments.sweep import load_sweep, run_sweep
 from cell.reporting.experiment import difference_table
 
+# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unrendered")
+
 
 def scenario(tmp_path: Path, name: str, **settings) -> Path:
     doc = {"run": {"parts": 40}, "controller": {"policy": "adaptive"}}

@@ -9,9 +9,13 @@ import re
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from cell.cli.main import main
 from cell.experiments.stats import paired_difference
+
+# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unrendered")
 
 
 def test_compare_gives_each_sides_share_of_the_bound(tmp_path, capsys):

@@ -6,10 +6,14 @@ from __future__ import annotations
 import shlex
 
 import pandas as pd
+import pytest
 import yaml
 
 from cell.cli.main import main
 from cell.reporting.formatting import too_few
+
+# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unrendered")
 
 
 def test_a_rate_no_run_has_is_not_compared_rather_than_nan(tmp_path, capsys):

@@ -13,6 +13,9 @@ from cell.cli.compare_command import labels
 from cell.cli.main import main
 from cell.scenario.schema import load_scenario
 
+# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unrendered")
+
 
 def write(path: Path, name: str | None, **run: object) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)

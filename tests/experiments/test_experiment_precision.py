@@ -5,8 +5,13 @@ from __future__ import annotations
 import math
 import re
 
+import pytest
+
 from cell.experiments.sweep import load_sweep, run_sweep
 from cell.reporting.experiment import plan_report, write_report
+
+# Figures laid out, not rasterised: these tests read the tables and markdown.
+pytestmark = pytest.mark.usefixtures("unrendered")
 
 
 def gaps(scenario, seed) -> dict:

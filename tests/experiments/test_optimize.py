@@ -33,7 +33,8 @@ def _study(tmp_path: Path, text: str, name: str = "study.yaml") -> Path:
     return path
 
 
-def test_the_optimiser_finds_the_grid_optimum_of_the_fixed_cycle_robot(tmp_path: Path) -> None:
+def test_the_optimiser_finds_the_grid_optimum_of_the_fixed_cycle_robot(tmp_path: Path,
+                                                                        unrendered) -> None:
     """The fixed-cycle robot's ideal cycle that loses fewest parts, on the same streams: the
     exhaustive grid (9 cycles) is the independent answer; 8 trials of TPE must reach its
     best within one part."""
@@ -79,7 +80,8 @@ sys.exit(main(sys.argv[1:]))
 """
 
 
-def test_a_killed_optimize_resumes_without_losing_or_repeating_a_trial(tmp_path: Path) -> None:
+def test_a_killed_optimize_resumes_without_losing_or_repeating_a_trial(tmp_path: Path,
+                                                                        unrendered) -> None:
     path = _study(tmp_path, FIXED.replace("TRIALS", "8"))
     out = tmp_path / "out"
     cmd = [sys.executable, "-c", KILLED_AT_THE_4TH_TRIAL, "optimize", str(path), "--out", str(out)]

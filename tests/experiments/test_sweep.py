@@ -18,6 +18,9 @@ from cell.plumbing.errors import CellError, ScenarioError
 from cell.scenario import catalog
 from cell.scenario.schema import load_scenario
 
+# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unrendered")
+
 TABLE_7_1_CYCLES = [22.5872, 22.0, 21.5, 21.0, 20.5, 20.0907]
 
 

@@ -10,6 +10,9 @@ from cell.cli.main import main
 from cell.experiments.sweep import load_sweep, run_sweep
 from cell.plumbing.errors import CellError
 
+# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unrendered")
+
 TABLE_7_1_CYCLES = [22.5872, 22.0, 21.5, 21.0, 20.5, 20.0907]
 
 

@@ -7,6 +7,9 @@ import pytest
 
 from cell.cli.main import main
 
+# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unrendered")
+
 
 def test_a_folder_with_a_users_replications_csv_is_refused_and_left_alone(sweeps, tmp_path,
                                                                           capsys):

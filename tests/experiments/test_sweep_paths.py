@@ -6,9 +6,13 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
+import pytest
 import yaml
 
 from cell.cli.main import main
+
+# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unrendered")
 
 
 def _trace(path: Path, gap: float) -> None:

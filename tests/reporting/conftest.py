@@ -1,11 +1,11 @@
-"""Figures laid out but not rasterised, for tests of what a figure says or which are drawn."""
+"""Figures laid out but not rasterised, for tests of what a figure says or which are drawn
+(the ``unrendered`` fixture, in tests/conftest.py, puts :func:`unrendered_savefig` in place)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Any
 
-import pytest
 from matplotlib.figure import Figure
 
 #: A PNG signature: what an unrendered figure's file holds (tests/reporting/test_figures.py reads
@@ -21,8 +21,3 @@ def unrendered_savefig(fig: Figure, fname: Any, *args: Any, **kwargs: Any) -> No
         fname.write(STUB)
     else:
         Path(fname).write_bytes(STUB)
-
-
-@pytest.fixture
-def unrendered(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(Figure, "savefig", unrendered_savefig)

@@ -28,6 +28,11 @@ from cell.reporting.experiment import (
 )
 from cell.scenario import catalog
 
+# Figures laid out, not rasterised, in the tests that make their own reports (they read the
+# tables, markdown and file names); known_report, module-scoped and so set up before any
+# function fixture, draws real PNGs.
+pytestmark = pytest.mark.usefixtures("unrendered")
+
 ROOT = Path(__file__).resolve().parents[2]
 WHATIF = ROOT / "reports" / "whatif"
 
@@ -137,6 +142,7 @@ def test_report_md_prints_the_tables_intervals(known_report):
     for name in ("fig_parts_delivered.png", "fig_parts_per_hr_wallclock.png",
                  "fig_spacing_outside_tol.png"):
         assert (rep / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and name in text
+        assert (rep / name).stat().st_size > 1000  # drawn (not the unrendered stub)
 
 
 # --------------------------------------------------------------------------- replications to a precision

@@ -11,6 +11,9 @@ from cell.cli.main import main
 from cell.experiments.sweep import load_sweep
 from cell.scenario import catalog
 
+# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unrendered")
+
 ROOT = Path(__file__).resolve().parents[2]
 WHATIF = ROOT / "reports" / "whatif"
 

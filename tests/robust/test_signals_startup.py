@@ -84,14 +84,20 @@ def test_a_signal_from_the_first_millisecond_on(tmp_path, number, how):
 
 
 #: A ``sitecustomize`` (run by the interpreter before any code of cell) that holds the import
-#: of one module: it marks that it got there, then waits, so the signal lands in that import.
+#: of one module: it marks that it got there, then waits, so the signal lands in that import,
+#: until the test says the signal is sent (HOLD_GO, made after ``send_signal``: the kernel
+#: delivers the signal before the hold can see the file) or 30 s pass.  A handler that only
+#: notes the signal (SIGTERM in cell.cli's import) lets the import go on: a plain 30 s sleep
+#: kept that test waiting the whole 30 s.
 HOLD = """
 import os, sys, time
 class Hold:
     def find_spec(self, name, path=None, target=None):
         if name == os.environ["HOLD_AT"]:
             open(os.environ["HOLD_MARK"], "w").close()
-            time.sleep(30)
+            end = time.monotonic() + 30
+            while not os.path.exists(os.environ["HOLD_GO"]) and time.monotonic() < end:
+                time.sleep(0.002)
         return None
 sys.meta_path.insert(0, Hold())
 """
@@ -108,7 +114,7 @@ def test_a_signal_while_cell_is_imported(tmp_path, number, at):
     (tmp_path / "hook" / "sitecustomize.py").write_text(HOLD)
     mark = tmp_path / "there"
     env = {**os.environ, "PYTHONPATH": str(tmp_path / "hook"), "HOLD_AT": at,
-           "HOLD_MARK": str(mark), "TMPDIR": str(tmp_path)}
+           "HOLD_MARK": str(mark), "HOLD_GO": str(tmp_path / "go"), "TMPDIR": str(tmp_path)}
     proc = subprocess.Popen([sys.executable, "-m", "cell", "scenarios"], cwd=tmp_path, env=env,
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     end = time.monotonic() + 60
@@ -116,9 +122,10 @@ def test_a_signal_while_cell_is_imported(tmp_path, number, at):
         time.sleep(0.002)
     assert mark.exists(), proc.stderr.read()
     proc.send_signal(number)
+    (tmp_path / "go").touch()
     err = proc.stderr.read()
     assert (proc.wait(timeout=60), err) == (LINES[number][0], LINES[number][1] + "\n")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["hook", "there"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["go", "hook", "there"]
 
 
 @pytest.mark.parametrize(("argv", "orig", "command"), [

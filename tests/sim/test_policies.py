@@ -188,7 +188,7 @@ def test_a_policy_from_outside_the_package_runs_like_the_fixed_cycle_it_is(plug_
     assert ours.belt_changes == [c for c in fixed.belt_changes]   # never steered
 
 
-def test_a_plug_in_policy_runs_through_a_sweep(plug_in, tmp_path, capsys):
+def test_a_plug_in_policy_runs_through_a_sweep(plug_in, tmp_path, capsys, unrendered):
     sweep = tmp_path / "sweep.yaml"
     sweep.write_text(f"base: {catalog.path('baseline')}\nset: {{run.parts: 60}}\n"
                      f"policies: [{plug_in}, non-adaptive]\nreplications: 3\nseed: 7\n")

@@ -14,6 +14,9 @@ from cell.experiments.sweep.windows import count_measures, extreme_measures, win
 from cell.reporting.formatting import HEADLINES
 from cell.sim.records import RunSummary
 
+# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unrendered")
+
 RATES = ("parts_per_hr_wallclock", "actual_cycle_wallclock_s", "ip_wallclock")
 
 
