@@ -174,18 +174,19 @@ class Controller:
                         plan.input_after_lo, plan.input_next, plan.output_to_g, plan.to_g, \
                         plan.cycle, plan.limits, plan.steers_belts, plan.input_speed
                     off_g, off_b = to_g - (r1a + r1b + r2), cycle - (to_g + r3a + r3b + r4)
+                    floor_at = plan.output_floor_at if steers else INF  # at or after TD
                     if (a1 <= r1a and a2 <= r1b and a3 <= r2 and a4 <= r3a and a5 <= r3b and a6 <= r4
                             and c1 <= v and v <= d1 and c2 <= w and w <= d2 and c3 <= w_next
                             and w_next <= d3 and c4 <= u and u <= d4 and -eps <= off_g and off_g <= eps
                             and -eps <= off_b and off_b <= eps and cycle < top and limits.__class__ is int
-                            and not limits & bad_bits and steers.__class__ is bool):
+                            and not limits & bad_bits and steers.__class__ is bool
+                            and floor_at >= to_g + r3a - eps):
                         passed = plan
                 except Exception:  # noqa: BLE001 - a field missing or not a number: said below
                     pass
                 if plan is not passed:
                     refuse(plan, name, self.k)
                     passed = plan
-                floor_at = plan.output_floor_at if steers else INF
             if steers:
                 replan_in(now + r1a, w, now + cycle + aim, w_next)
                 if floor_at < INF:  # the spacing contract: the belt's floor after TD

@@ -2,7 +2,7 @@
 (cell.sim.policies.check.problem, which words the message) agree: a run stops on a plug-in's
 plan exactly when :func:`problem` finds something wrong with it, whatever the plan holds
 (hypothesis: any field set to any number, NaN, an infinity, a huge integer, a boolean, text or
-None, or nudged just past its bound)."""
+None, or nudged just past its bound; the output belt's floor there or not)."""
 
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ from cell.sim.policies.check import SPEEDS, TIMES, PolicyError, _bounds, problem
 from cell.sim.policies.fixed import fixed_plan
 from cell.sim.simulation import simulate
 
-FIELDS = (*TIMES, *SPEEDS, "to_g", "cycle", "limits", "steers_belts")
+FIELDS = (*TIMES, *SPEEDS, "to_g", "cycle", "limits", "steers_belts", "output_floor_at")
 NAME = "agreement-test-policy"
 
 
@@ -65,6 +65,8 @@ def plans(draw, k):
     for name in draw(st.lists(st.sampled_from(FIELDS), max_size=3, unique=True)):
         near = _near_bound(*bounds[name]) if name in bounds else st.nothing()
         fields[name] = draw(st.one_of(near, ODD) if name in bounds else ODD)
+    if draw(st.booleans()):  # a plug-in's record may leave out the floor (read when it steers)
+        del fields["output_floor_at"]
     return SimpleNamespace(**fields)
 
 

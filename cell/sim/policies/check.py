@@ -12,7 +12,9 @@ must obey the same physics the built-in policies do before the cell acts on it:
   also within the speed the robot can track);
 * the cycle consistent with its parts: ``to_g`` = R I + R II and ``cycle`` = ``to_g`` +
   R III + R IV;
-* ``limits`` a set of the known limit bits, ``steers_belts`` a boolean.
+* ``limits`` a set of the known limit bits, ``steers_belts`` a boolean;
+* a plan that steers the belts says when the output belt drops to its floor
+  (``output_floor_at``, from the cycle's start): at or after the touch-down, or inf.
 
 A number is an int or a float (a boolean in a numeric field is read as its 0 or 1, as the
 controller's comparisons read it; an integer beyond the floats' range is an infinity).
@@ -142,6 +144,20 @@ def problem(plan: Any, bounds: dict[str, tuple[float, float]]) -> str | None:
         return f"limits = {one_line(repr(limits), 60)}: not a set of the known limit bits"
     if not isinstance(plan.steers_belts, bool):
         return f"steers_belts = {one_line(repr(plan.steers_belts), 60)}: not true or false"
+    return _floor_problem(plan, to_g + values["r3_pre"]) if plan.steers_belts else None
+
+
+def _floor_problem(plan: Any, td: float) -> str | None:
+    """What is wrong with a belt-steering plan's ``output_floor_at`` (when, from the start of
+    the cycle, the output belt drops to its floor; inf: not planned): it must be at or after
+    the touch-down ``td``."""
+    if not hasattr(plan, "output_floor_at"):
+        return "the plan has no field 'output_floor_at' (inf: no floor planned)"
+    v = plan.output_floor_at
+    if not isinstance(v, (int, float)) or _float(v) != _float(v):
+        return f"output_floor_at = {one_line(repr(v), 60)}: not a number"
+    if _float(v) < td - SUM_S:
+        return f"output_floor_at = {_float(v):.6g} s: before the touch-down, {td:.6g} s"
     return None
 
 
