@@ -24,7 +24,16 @@ taking time off R II (down to its fastest) before that, and a part still too ear
 go (it reaches B while the robot is busy); step 6.3 also raises a belt left slower than
 R II can absorb (``k.input_absorb``), so a slowed belt never lengthens the next cycle;
 step 5.0 keeps the output belt within its floor and ceiling, and the spacing contract
-steers it after TD as well (:func:`floor_at`).
+steers it after TD as well.
+
+The spacing contract (docs/model.md): the output belt drops to its floor after this part's
+touch-down, at ``output_floor_at`` s from the start of the cycle.  The next part is expected
+at B at ``t_e`` (the look-ahead's part at the planned input speeds: ``w`` until the cycle
+ends, ``v_next`` after; the robot back at ``cycle``).  If the belt at nominal until a margin
+after ``t_e`` still leaves room for 45 in, the floor is planned for then: a decision on time
+replans first, and nothing changes.  A wait foreseen too long for that, or no part in sight,
+slows the belt at TD, so that the gap grows as slowly as the belt allows until the next part
+is planned.
 
 Targets are physical: the controller knows the belts' schedules, so it aims
 the next part at B for the instant the robot gets back, and the spacing at 45 in,
@@ -73,7 +82,7 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
     touch-down (None before the first).  ``lag``: B → LO at v, if known.  ``idle_s``: seconds
     since that touch-down (to name why the spacing is off; None: both causes marked,
     :class:`Adaptive` names the one).  Steps 5.0 and the spacing contract inline (the rare cases:
-    :func:`output_speed`, :func:`floor_at`), for speed: 122.5k to 118.4k instructions per part,
+    :func:`output_speed`; the module's text), for speed: 122.5k to 118.4k instructions per part,
     cachegrind, with the controller's own steps (:meth:`.Controller.run`)."""
     t = k.timing
     flags = 0
@@ -104,7 +113,7 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
             u, out_flags = output_speed(k, gap_in, ttsot, r3a, idle_s)
             flags |= out_flags
     floor = td = ttsot + r3a
-    if nxt is not None:  # the spacing contract (:func:`floor_at`, inline)
+    if nxt is not None:  # the spacing contract (the module's text)
         a, b = nxt
         switch = cycle + k.lookahead_margin_s
         run = switch - a
@@ -186,29 +195,6 @@ def output_speed(k: CellConstants, gap_in: float, ttsot: float, r3a: float,
     if u > k.output_max:
         return k.output_max, OUTPUT_CEILING
     return u, 0
-
-
-def floor_at(k: CellConstants, nxt: tuple[float, float] | None, w: float, v_next: float,
-             cycle: float, td: float) -> float:
-    """The spacing contract (docs/model.md): when, in seconds from the start of this cycle,
-    the output belt is to drop to its floor after this part's touch-down ``td``.
-
-    The next part is expected at B at ``t_e`` (the look-ahead's part at the planned input
-    speeds: ``w`` until the cycle ends, ``v_next`` after; the robot back at ``cycle``).  If
-    the belt at nominal until a margin after ``t_e`` still leaves room for 45 in, the floor
-    is planned for then: a decision on time replans first, and nothing changes.  A wait
-    foreseen too long for that, or no part in sight, slows the belt at TD, so that the
-    gap grows as slowly as the belt allows until the next part is planned.
-    """
-    if nxt is None:
-        return td
-    a, b = nxt
-    switch = cycle + k.lookahead_margin_s  # step 6.3's change of the input belt
-    run = switch - a
-    eta = a + b / w if b <= w * run else (switch if switch > a else a) + \
-        (b - (w * run if run > 0 else 0.0)) / v_next
-    t_e = (eta if eta > cycle else cycle) + FLOOR_MARGIN_S
-    return t_e if k.u_nom * (t_e - td) <= k.floor_gap_in else td
 
 
 #: Both spacing causes: the mark of a part set down off spacing whose cause is still to name.

@@ -154,7 +154,7 @@ def _floor_problem(plan: Any, td: float) -> str | None:
     if not hasattr(plan, "output_floor_at"):
         return "the plan has no field 'output_floor_at' (inf: no floor planned)"
     v = plan.output_floor_at
-    if not isinstance(v, (int, float)) or _float(v) != _float(v):
+    if not isinstance(v, (int, float)) or math.isnan(_float(v)):
         return f"output_floor_at = {one_line(repr(v), 60)}: not a number"
     if _float(v) < td - SUM_S:
         return f"output_floor_at = {_float(v):.6g} s: before the touch-down, {td:.6g} s"
