@@ -73,31 +73,32 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
                   gap_in: float | None, lag: float | None = None,
                   idle_s: float | None = None) -> Plan:
     """Thesis §5.3 steps 2.0-6.3 for one part (pure), within the belts' and motors' limits (the
-    departures from the thesis: the module's text).
-
-    ``v``: the input belt's speed now (R I tracks it).  ``nxt = (a, b)``: the next part reaches B
-    a + b/w s from now if the input belt runs at w from LO on (a: the lag B → LO, b: its
-    pseudo-distance then; for a part not yet on the belt, a: until the feeder drops it, b: the
-    belt's length); None if none is coming.  ``gap_in``: the output belt's travel since the last
-    touch-down (None before the first).  ``lag``: B → LO at v, if known.  ``idle_s``: seconds
-    since that touch-down (to name why the spacing is off; None: both causes marked,
-    :class:`Adaptive` names the one).  Steps 5.0 and the spacing contract inline (the rare cases:
-    :func:`output_speed`; the module's text), for speed: 122.5k to 118.4k instructions per part,
-    cachegrind, with the controller's own steps (:meth:`.Controller.run`)."""
-    t = k.timing
-    flags = 0
+    departures: the module's text).  ``v``: the input belt's speed now; ``nxt = (a, b)``: the
+    next part reaches B a + b/w s from now if the belt runs at w from LO on (a: the lag B → LO,
+    b: its pseudo-distance then; a part not yet on the belt: a until the feeder drops it, b the
+    belt's length), None: none is coming; ``gap_in``: the output belt's travel since the last
+    touch-down (None: none yet); ``lag``: B → LO at v, if known; ``idle_s``: seconds since that
+    touch-down (None: both spacing causes marked, :class:`Adaptive` names the one).  For speed,
+    inline with their rare cases called: 3.1 (3.2: :func:`aim_early`; 108.45k to 107.19k
+    instructions a part, cachegrind), 5.0 (:func:`output_speed`) and the contract (122.5k to 118.4k)."""
+    t, flags = k.timing, 0
     r1a = t.r1_pre.time(v) if lag is None else lag
     r1b = t.r1_post.time(v)
     # 2.1-2.3: R I's difference from nominal goes to R II.
     r2 = k.r2_nom + (k.r1_nom - r1a - r1b)
     if r2 < t.r2_min_s:
-        flags |= R2_PEAK
-        r2 = t.r2_min_s
+        r2, flags = t.r2_min_s, R2_PEAK
     r3a, r3b, r4 = k.r3_pre_nom, k.r3_post_nom, k.r4_nom
-    cycle = r1a + r1b + r2 + r3a + r3b + r4
-    w = v
-    if nxt is not None:
-        w, r2, r4, cycle, flags = aim_next(k, nxt, v, r2, r4, cycle, flags)
+    cycle, w = r1a + r1b + r2 + r3a + r3b + r4, v
+    if nxt is not None:  # 3.0: the next part at B late at v: 3.1, after the lag, speed up
+        a, b = nxt
+        m = k.lookahead_margin_s  # the next part aimed at B this long after the robot is back
+        if a + b / v > cycle + m:
+            w = b / (cycle + m - a) if cycle + m > a else math.inf
+            if w > k.input_max:
+                w, flags = k.input_max, flags | INPUT_CEILING
+        else:  # early (3.2) or on time
+            w, r2, r4, cycle, flags = aim_early(k, nxt, v, r2, r4, cycle, flags)
     # 6.3: decay toward nominal after the cycle; departure: never below what R II absorbs.
     v_next = 0.5 * (w + k.v_nom) if w > k.v_nom else \
         (k.input_absorb if k.input_absorb > w else w)  # max(w, absorb)
@@ -114,8 +115,7 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
             flags |= out_flags
     floor = td = ttsot + r3a
     if nxt is not None:  # the spacing contract (the module's text)
-        a, b = nxt
-        switch = cycle + k.lookahead_margin_s
+        switch = cycle + m
         run = switch - a
         eta = a + b / w if b <= w * run else (switch if switch > a else a) + \
             (b - (w * run if run > 0 else 0.0)) / v_next
@@ -131,28 +131,23 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
     return plan
 
 
-def aim_next(k: CellConstants, nxt: tuple[float, float], v: float, r2: float, r4: float,
-             cycle: float, flags: int) -> tuple[float, float, float, float, int]:
-    """Thesis §5.3 steps 3.0-3.2: aim the next part ``nxt = (a, b)`` (as in
-    :func:`adaptive_plan`) at B a look-ahead margin after the robot is back.
+def aim_early(k: CellConstants, nxt: tuple[float, float], v: float, r2: float, r4: float,
+              cycle: float, flags: int) -> tuple[float, float, float, float, int]:
+    """Thesis §5.3 step 3.2: the next part ``nxt = (a, b)`` (as in :func:`adaptive_plan`), not
+    late at the belt's speed v (3.0; 3.1, late, is :func:`adaptive_plan`'s), aimed at B a
+    look-ahead margin after the robot is back.
 
-    Late (3.1): the input belt speeds up after the lag, up to its ceiling.  Early (3.2):
-    the time is made up in R IV down to its fastest, then the input belt slows; departure
-    (docs/model.md): no further than its floor, R II (down to its fastest) taking time off
-    first, and a part still too early is let go.  Returns the input speed after LO ``w``,
-    R II, R IV, the cycle and ``flags`` with the limits hit added.
+    Early: the time is made up in R IV down to its fastest, then the input belt slows;
+    departure (docs/model.md): no further than its floor, R II (down to its fastest) taking
+    time off first, and a part still too early is let go.  On time: nothing changes.  Returns
+    the input speed after LO ``w``, R II, R IV, the cycle and ``flags`` with the limits hit added.
     """
     t = k.timing
     w = v
     m = k.lookahead_margin_s  # the next part aimed at B this long after the robot is back
     a, b = nxt
     eta = a + b / v                       # 3.0: next arrival at the current speed
-    if eta > cycle + m:                       # 3.1: late; speed the belt up after the lag
-        w = b / (cycle + m - a) if cycle + m > a else math.inf
-        if w > k.input_max:
-            w = k.input_max
-            flags |= INPUT_CEILING
-    elif eta < cycle + m:                     # 3.2: early; R IV first, then the belt
+    if eta < cycle + m:                       # 3.2: early; R IV first, then the belt
         need = cycle + m - eta
         if r4 - need >= t.r4_min_s:
             r4 -= need
