@@ -68,9 +68,11 @@ class View:
     def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
         """(a, b) of the first part after this one that can still be caught: the ideal
         look-ahead, which reads the feeder's schedule (``sensor.lookahead: ideal``)."""
-        now, fed_s, length = self.now, self.fed_s, self._length
+        now, fed_s, length, n = self.now, self.fed_s, self._length, self.n
         x_now = None
-        for j in range(self.part + 1, self.n):
+        j = self.part + 1  # for speed, a while, not a ``range`` (making one is dear, and one part
+        # is looked at, mostly): the adaptive run 106.57k to 104.77k instructions a part, cachegrind
+        while j < n:
             f = fed_s[j]
             if f > now + lag:
                 return (f - now, length)
@@ -82,6 +84,7 @@ class View:
             d = x_fed + length - (x_now + v * lag)
             if d > 0:
                 return (lag, d)
+            j += 1
         return None
 
 
@@ -190,8 +193,9 @@ class Controller:
             if steers:
                 replan_in(now + r1a, w, now + cycle + aim, w_next)
                 if floor_at < INF:  # the spacing contract: the belt's floor after TD
-                    replan_out_floor(now, u, now + to_g, u_nom, now + floor_at, u_min)
-                    floor_after_td = now + to_g + r3a
+                    at_g = now + to_g
+                    replan_out_floor(now, u, at_g, u_nom, now + floor_at, u_min)
+                    floor_after_td = at_g + r3a
                 else:
                     replan_out(now, u, now + to_g, u_nom)
             part.plan = plan  # the part's regime times and belt speeds (read as its row is made)
