@@ -117,6 +117,7 @@ class RunLog:
         best of 12, interleaved, on 2 shared cores)."""
         t, acct_part, flags_of = self.t, self.acct.part, self.flags.pop
         spacing_in, tol = self.spacing_in, self.tol_in + 1e-9
+        below = -tol
         note, pack = self.per_part.extend, _PACK_PER_PART
         row_of = self._row if self.rows is not None or self.sink is not None else None
         names_of = LIMIT_NAMES.get  # limit_names' cache, read first
@@ -132,7 +133,9 @@ class RunLog:
             while True:  # complete p (part i) and hand it on, then any waiting after it
                 flags = flags_of(i, 0)
                 sp = p.spacing_in
-                if sp == sp and abs(sp - spacing_in) > tol:
+                off = sp - spacing_in  # NaN (none yet): neither test holds
+                if off > tol or off < below:  # abs(off) > tol, no builtin call: 0.11k of 104.9k
+                    # instructions a part (the adaptive run, cachegrind)
                     flags |= SPACING_OFF
                 picked = not flags & RODE_OFF
                 plan = p.plan
