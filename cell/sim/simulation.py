@@ -60,15 +60,16 @@ from cell.sim.sim_result import BeltLog, BeltSink, SimResult
 __all__ = ["PER_PART", "BeltLog", "BeltSink", "PartSink", "RunLog", "SimResult", "simulate"]
 
 PartSink = Callable[[PartRecord], Any]
-#: What the run's log keeps of each part for the summary: nine floats, then the limits' bits
-#: and the part's index as 32-bit unsigned integers (80 bytes a part; ``picked`` is read off the
-#: limits, :meth:`RunLog.column`).  ``make bench``'s ``peak_mb_1m_parts``: twelve floats a part
-#: (96 bytes) made it 325 MB.
-PER_PART = ("touchdown", "r4", "output_speed", "interval", "spacing", "feed_delay", "arrival",
-            "at_bot", "cycle", "limits", "part")
+#: What the run's log keeps of each part for the summary: seven floats, then the limits' bits
+#: and the part's index as 32-bit unsigned integers (64 bytes a part, as before failures came
+#: in); ``picked``, ``interval`` and ``feed_delay`` are derived (:meth:`RunLog.column`).  ``make
+#: bench``'s ``peak_mb_1m_parts``: twelve floats a part (96 bytes) made it 325 MB, nine and two
+#: integers (80 bytes) 313 MB.
+PER_PART = ("touchdown", "r4", "output_speed", "spacing", "arrival", "at_bot", "cycle", "limits",
+            "part")
 _PER_PART_DTYPE = np.dtype([(name, "=u4" if name in ("limits", "part") else "=f8")
                             for name in PER_PART])
-_PER_PART_STRUCT = struct.Struct("=9d2I")
+_PER_PART_STRUCT = struct.Struct("=7d2I")
 _PACK_PER_PART = _PER_PART_STRUCT.pack
 
 
@@ -141,11 +142,10 @@ class RunLog:
                 plan = p.plan
                 acct_part(plan, picked, t[i])
                 if plan is None:
-                    note(pack(p.touchdown_s, NAN, NAN, p.delivery_interval_s, sp, p.feed_delay_s,
-                              p.arrival_s, p.at_bot_s, NAN, flags, i))
+                    note(pack(p.touchdown_s, NAN, NAN, sp, p.arrival_s, p.at_bot_s, NAN, flags, i))
                 else:
-                    note(pack(p.touchdown_s, plan.r4, plan.output_to_g, p.delivery_interval_s, sp,
-                              p.feed_delay_s, p.arrival_s, p.at_bot_s, plan.cycle, flags, i))
+                    note(pack(p.touchdown_s, plan.r4, plan.output_to_g, sp, p.arrival_s,
+                              p.at_bot_s, plan.cycle, flags, i))
                 if row_of is not None:
                     row_of(p, flags, picked,
                            (names_of(flags) or limit_names(flags)) if flags else "")
@@ -197,11 +197,21 @@ class RunLog:
             self.delivered_part(waiting.pop(first))
 
     def column(self, name: str, start: int = 0) -> np.ndarray:
-        """One of :data:`PER_PART`'s values of every part from ``start`` on (a copy), or
-        ``picked``: 1.0 for a part picked, 0.0 for one that rode off."""
+        """One of :data:`PER_PART`'s values of every part from ``start`` on (a copy), or one
+        derived, to the bit as the processes have it: ``picked`` (1.0 for a part picked, 0.0
+        for one that rode off), ``interval`` (the time since the last set-down: parts are set
+        down in part order) and ``feed_delay`` (the drop less the feeder's schedule)."""
         if name == "picked":
             return ((self.column("limits", start) & RODE_OFF) == 0).astype(np.float64)
         table = np.frombuffer(self.per_part, dtype=_PER_PART_DTYPE)
+        if name == "interval":  # as the output conveyor subtracts (OutputConveyor.run)
+            td = table["touchdown"]
+            done = np.flatnonzero(np.isfinite(td))
+            out = np.full(td.size, NAN)
+            out[done[1:]] = td[done[1:]] - td[done[:-1]]
+            return out[start:]
+        if name == "feed_delay":  # the feeder's schedule, as Feeder.fed_s sums it
+            return table["arrival"][start:] - np.cumsum(self.t)[table["part"][start:]]
         return np.ascontiguousarray(table[name][start:])
 
     def warmup(self, setting: int | str) -> int:
@@ -300,44 +310,35 @@ def _view(cell: AssembledCell, seed: Any, n: int, feeder: Feeder, conveyor: Inpu
 
 def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, n: int,
              end_s: float) -> RunSummary:
-    """The run's measures over the parts after the warm-up (all of them by default)."""
+    """The run's measures over the parts after the warm-up (all of them by default), each
+    column read as it is needed and let go (``make bench``'s ``peak_mb_1m_parts``: all read at
+    once, the summary took the run from 231 to 315 MB)."""
     s, k = cell.scenario, cell.k
     w = log.warmup(s.run.warmup_parts)
-    td = log.column("touchdown", w)
-    picked = log.column("picked", w) != 0
-    vout = log.column("output_speed", w)[picked]
-    # each part's IP, as its record has it (T_{i+1} over its interval)
-    ip_wall = t[log.column("part", w).astype(np.int_) + 1] / log.column("interval", w)
-    sp = log.column("spacing", w)
-    sp = sp[np.isfinite(sp)]
-    limits = log.column("limits", w).astype(np.int_)
-    delay = log.column("feed_delay", w)
-    done = td[np.isfinite(td)]
-    d = done.size
-    missed = int((~picked).sum())
+    limits = log.column("limits", w)
+    picked = (limits & RODE_OFF) == 0
 
     def count(name: str) -> int:
         return int(np.count_nonzero(limits & LIMIT_BIT[name]))
 
-    held = limits & LIMIT_BIT["held_at_feeder"] != 0
     r = RunSummary(
         scenario=s.name, policy=cell.policy.name, ideal_cycle_s=cell.policy.ideal_cycle_s,
-        parts_arrived=n - w, parts_delivered=d, parts_missed=missed,
-        parts_in_cell=n - w - d - missed - count("scrapped"),
-        actual_cycle_wallclock_s=float((done[-1] - done[0]) / (d - 1)) if d > 1 else math.nan,
-        ip_wallclock=float(np.nanmean(ip_wall)) if np.isfinite(ip_wall).any() else math.nan,
-        spacing_min_in=float(sp.min()) if sp.size else math.nan,
-        spacing_max_in=float(sp.max()) if sp.size else math.nan,
+        parts_arrived=n - w, parts_missed=int((~picked).sum()),
         spacing_outside_tol=count("spacing_off"),
-        feed_delay_max_s=float(delay[held].max()) if held.any() else 0.0,
-        output_speed_min_in_s=float(vout.min()) if vout.size else math.nan,
-        output_speed_max_in_s=float(vout.max()) if vout.size else math.nan,
         r1_nominal_s=k.r1_nom, r2_nominal_s=k.r2_nom, nominal_cycle_s=k.cycle_nom,
         nominal_from=k.nominal_from, mean_interarrival_s=k.mean_interarrival_s,
         fastest_cycle_s=k.fastest_cycle_s, offered_load=k.offered_load, warmup_parts=w,
         sim_end_s=end_s)
     for name, counted in LIMIT_COUNTS.items():
         setattr(r, counted.field, count(name))
+    _deliveries(r, log, t, w)
+    r.parts_in_cell = n - w - r.parts_delivered - r.parts_missed - count("scrapped")
+    held = limits & LIMIT_BIT["held_at_feeder"] != 0
+    r.feed_delay_max_s = float(log.column("feed_delay", w)[held].max()) if held.any() else 0.0
+    vout = log.column("output_speed", w)[picked]
+    r.output_speed_min_in_s = float(vout.min()) if vout.size else math.nan
+    r.output_speed_max_in_s = float(vout.max()) if vout.size else math.nan
+    del vout, held
     # every handed-on part's next inter-arrival time (all of T_2 … T_{n+1} unless the run
     # stopped with parts in the cell)
     acct.finish(r, w, log.column("r4", w)[picked], t[log.column("part").astype(np.int_) + 1])
@@ -345,3 +346,20 @@ def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, 
     r.parts_per_hr_thesis = float(accounting.parts_per_hr(r.actual_cycle_thesis_s))
     r.vavg_r4_in_s = k.timing.r4.length_in / r.r4_s if r.r4_s == r.r4_s else math.nan
     return r
+
+
+def _deliveries(r: RunSummary, log: RunLog, t: np.ndarray, w: int) -> None:
+    """The summary's measures of the parts set down: their count, the wall-clock cycle, the
+    mean IP (each part's, as its row has it: T_{i+1} over its interval) and the spacings."""
+    td = log.column("touchdown", w)
+    done = td[np.isfinite(td)]
+    d = r.parts_delivered = done.size
+    r.actual_cycle_wallclock_s = float((done[-1] - done[0]) / (d - 1)) if d > 1 else math.nan
+    del td, done
+    ip_wall = t[log.column("part", w).astype(np.int_) + 1] / log.column("interval", w)
+    r.ip_wallclock = float(np.nanmean(ip_wall)) if np.isfinite(ip_wall).any() else math.nan
+    del ip_wall
+    sp = log.column("spacing", w)
+    sp = sp[np.isfinite(sp)]
+    r.spacing_min_in = float(sp.min()) if sp.size else math.nan
+    r.spacing_max_in = float(sp.max()) if sp.size else math.nan
