@@ -48,18 +48,13 @@ class Belt:
     __slots__ = ("_t", "_x", "_v", "on_change", "max_speed_in_s", "min_speed_in_s", "_halted", "_anchor")
 
     def __init__(self, speed_in_s: float, on_change: Callable[[float, float], Any] | None = None):
-        self._t: list[float] = [0.0]
-        """Instants at which a speed starts."""
-        self._x: list[float] = [0.0]
-        """Travel at those instants."""
-        self._v: list[float] = [speed_in_s]
-        """Speed from each instant on (the last one holds for ever)."""
+        self._t, self._x, self._v = [0.0], [0.0], [speed_in_s]
+        """Instants at which a speed starts, the travel then, and the speed from then on (the last
+        holds for ever)."""
         self.on_change = on_change
         """Told (instant, speed) of every change once it is final."""
-        self.max_speed_in_s = speed_in_s
-        """The fastest of the settled speeds (of all of them once closed)."""
-        self.min_speed_in_s = speed_in_s
-        """The slowest of them."""
+        self.max_speed_in_s = self.min_speed_in_s = speed_in_s
+        """The fastest and the slowest of the settled speeds (of all of them once closed)."""
         self._halted: tuple[float, list[tuple[float, float]]] | None = None
         """While stopped by a failure: the speed it ran at and the changes planned after."""
         self._anchor: tuple[float, float, float] = (0.0, 0.0, speed_in_s)
@@ -88,13 +83,10 @@ class Belt:
         return self._t[k] + (x - self._x[k]) / self._v[k]
 
     def plan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
-        """From instant t1 (now or later) run at v1, and from t2 > t1 at v2, dropping later plans.
-
-        A new plan supersedes whatever was planned after t1 (the controller replans every cycle); a
-        change within EPS_S of the last one replaces it. Changes before ``t1`` whose successors have
-        started are settled. (Called twice a part: the controller's case is unrolled first, for
-        speed.)
-        """
+        """From instant t1 (now or later) run at v1, and from t2 > t1 at v2, dropping later plans: a
+        new plan supersedes what was planned after t1 (the controller replans every cycle), a change
+        within EPS_S of the last one replaces it, and the changes before t1 whose successors have
+        started are settled.  For speed, the controller's case first, unrolled (twice a part)."""
         if not v1 > 0 or (t2 is not None and not v2 > 0):
             raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}")
         ts, xs, vs = self._t, self._x, self._v
@@ -103,14 +95,19 @@ class Belt:
             del ts[-1], xs[-1], vs[-1]  # (the output belt's floor): dropped, as below
             t0 = ts[-1]
         if t0 < t1 and t2 is not None and t1 < t2:
-            # the controller's every replan: both changes after the last one, which alone
-            # is kept (the general case below, unrolled)
+            # the controller's every replan: both after the last change, which alone is kept
             n = len(ts) - 1
             if n > 0:
                 self._settle(n)
             x0, v0 = xs[-1], vs[-1]
             x1 = x0 + v0 * (t1 - t0)
-            self._t, self._x, self._v = [t0, t1, t2], [x0, x1, x1 + v1 * (t2 - t1)], [v0, v1, v2]
+            if n == 2:  # for speed, the last plan's lists reused in place (and in plan_then): no
+                # new lists, 104.50k to 104.01k instructions a part (the adaptive run, cachegrind)
+                ts[0] = t0; ts[1] = t1; ts[2] = t2  # noqa: E702 (one by one: no tuple)
+                xs[0] = x0; xs[1] = x1; xs[2] = x1 + v1 * (t2 - t1)  # noqa: E702
+                vs[0] = v0; vs[1] = v1; vs[2] = v2  # noqa: E702
+            else:
+                self._t, self._x, self._v = [t0, t1, t2], [x0, x1, x1 + v1 * (t2 - t1)], [v0, v1, v2]
             return
         k = bisect_right(ts, t1 + EPS_S)
         if k == 0:  # would rewrite what is settled (and leave no schedule at all)
@@ -138,10 +135,17 @@ class Belt:
         if t0 < t1 < t2 < t3 and v1 > 0 and v2 > 0 and v3 > 0:
             if n > 0:
                 self._settle(n)
-            x0, v0 = self._x[n], self._v[n]
+            xs, vs = self._x, self._v
+            x0, v0 = xs[n], vs[n]
             x1 = x0 + v0 * (t1 - t0)
             x2 = x1 + v1 * (t2 - t1)
-            self._t, self._x, self._v = [t0, t1, t2, t3], [x0, x1, x2, x2 + v2 * (t3 - t2)], [v0, v1, v2, v3]
+            if len(ts) == 4:  # the last plan's lists, reused in place (for speed)
+                ts[0] = t0; ts[1] = t1; ts[2] = t2; ts[3] = t3  # noqa: E702
+                xs[0] = x0; xs[1] = x1; xs[2] = x2; xs[3] = x2 + v2 * (t3 - t2)  # noqa: E702
+                vs[0] = v0; vs[1] = v1; vs[2] = v2; vs[3] = v3  # noqa: E702
+            else:
+                self._t, self._x, self._v = [t0, t1, t2, t3], [x0, x1, x2, x2 + v2 * (t3 - t2)], \
+                    [v0, v1, v2, v3]
             return
         if n < len(ts) - 1:
             del ts[-1], self._x[-1], self._v[-1]
