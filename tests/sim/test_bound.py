@@ -52,7 +52,7 @@ _GAPS = st.lists(st.one_of(st.sampled_from([0.0, 0.5, 1.0, 10.0, 25.0]),
 @given(gaps=_GAPS, start=st.floats(-100.0, 1e6), length=st.floats(0.5, 200.0),
        v_min=st.floats(0.01, 5.0), spread=st.floats(0.5, 20.0), size=st.floats(0.0, 5.0),
        cycle=st.sampled_from([0.0, 1.0, 10.0, 18.0841]) | st.floats(0.0, 60.0))
-def test_the_array_pass_counts_what_the_step_by_step_pass_counts(
+def test_the_count_is_what_the_step_by_step_pass_counts(
         gaps: list[float], start: float, length: float, v_min: float, spread: float,
         size: float, cycle: float) -> None:
     come = [start]
