@@ -68,11 +68,11 @@ def check_time(spec: Any, key: str, file: object) -> float:
     except (TypeError, ValueError) as exc:
         raise ScenarioError(file, f"{key}.params", dict(spec.params),
                             f"not accepted by scipy.stats.{spec.distribution}: {exc}") from None
-    if math.isnan(mean):
+    if math.isnan(mean) and math.isnan(low):  # scipy's answer for parameters out of range
         raise ScenarioError(file, f"{key}.params", dict(spec.params),
                             f"scipy.stats.{spec.distribution} takes no such parameters (a zero "
                             "or negative scale?): the mean time would be undefined")
-    if not math.isfinite(mean):
+    if not math.isfinite(mean):  # infinite, or undefined (a Cauchy's)
         raise ScenarioError(file, f"{key}.params", dict(spec.params),
                             f"scipy.stats.{spec.distribution} with these has no finite mean")
     if not low >= 0 or not mean > 0:

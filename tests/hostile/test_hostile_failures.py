@@ -24,6 +24,8 @@ CASES = [
      ("failures.robot.time_to_failure.params", "non-negative")),
     ("no finite mean", robot("{distribution: pareto, params: {b: 0.8}}"),
      ("failures.robot.time_to_failure.params", "no finite mean")),
+    ("undefined mean (a Cauchy's, not a bad scale)", robot("{distribution: cauchy, params: {scale: 100}}"),
+     ("failures.robot.time_to_failure.params", "cauchy with these has no finite mean")),
     ("no finite mean repair",
      f"{{input_belt: {{time_to_failure: {R}, time_to_repair: {{distribution: levy, params: {{}}}}}}}}",
      ("failures.input_belt.time_to_repair.params", "no finite mean")),
