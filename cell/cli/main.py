@@ -137,9 +137,12 @@ def _open_files() -> str:
 
 def _run(args: argparse.Namespace) -> int:
     """The command; a warning that a finished command met is one line each (a refused one's are
-    dropped: its error says what went wrong)."""
+    dropped: its error says what went wrong).  Not a ResourceWarning: an unclosed file reported
+    whenever the collector happens to free it is not about the command (Python hides those too),
+    and in-process, as the tests run it, it may be another caller's."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("default")
+        warnings.simplefilter("ignore", ResourceWarning)
         code = int(_module(args.command).main(args) or 0)
     for text in dict.fromkeys(f"{w.message} ({w.category.__name__})" for w in caught):
         print(f"cell: warning: {one_line(text, 300)}", file=sys.stderr)

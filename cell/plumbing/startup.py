@@ -13,7 +13,9 @@ outputs whole.
 Before this module runs, the interpreter's own start-up (its initialisation, ``site`` and
 the ``.pth`` files of the environment, ``runpy`` or the console script's first line: about
 15-40 ms) has Python's defaults: SIGINT raises KeyboardInterrupt, whose traceback Python
-prints before it ends by SIGINT; SIGTERM ends the process at once.  No code of a package can
+prints before it ends by SIGINT (unless it is raised in a weakref callback of importlib's, which
+Python reports as "Exception ignored in" and drops, CPython issue 95959: the command then runs
+to its end); SIGTERM ends the process at once.  No code of a package can
 run earlier, and nothing of ``cell`` exists then either.
 
 The standard library only (``os`` and ``sys`` are loaded already; ``signal`` adds ``enum``

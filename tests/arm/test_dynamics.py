@@ -129,7 +129,7 @@ def test_free_speed_holds_the_no_load_rate():
     ({"drives": {"gearratio": 3}}, "drives.gearratio"),
 ])
 def test_bad_values_name_file_key_and_value(tmp_path, patch, key):
-    raw = yaml.safe_load(open(Path(__file__).parents[2] / "scenarios" / "microbot_dynamics.yaml"))
+    raw = yaml.safe_load((Path(__file__).parents[2] / "scenarios" / "microbot_dynamics.yaml").read_text())
     for sec, vals in patch.items():
         raw[sec].update(vals)
     f = tmp_path / "dyn.yaml"

@@ -253,3 +253,23 @@ def test_an_hours_long_run_shows_its_progress_towards_the_parts_expected(
     assert lines[-1].startswith(f"cell run: {arrived:,}/{arrived:,} parts (100 %), done in ")
     first_total = int(lines[0].split("/")[1].split()[0].replace(",", ""))
     assert abs(first_total - arrived) < 0.25 * arrived  # 2 h over the mean gap, about
+
+
+def test_a_warning_is_one_line_but_not_an_unclosed_file_freed_meanwhile(monkeypatch, capsys):
+    """A command's warnings come as ``cell: warning:`` lines; a ResourceWarning does not (an
+    object of anybody's, freed while the command ran, as Python's own filters hide it)."""
+    import warnings
+
+    import cell.cli.scenarios_command as command
+
+    real = command.main
+
+    def warns(args):
+        warnings.warn("unclosed file <_io.TextIOWrapper name=21>", ResourceWarning, stacklevel=1)
+        warnings.warn("a sample warning", UserWarning, stacklevel=1)
+        return real(args)
+
+    monkeypatch.setattr(command, "main", warns)
+    assert main(["scenarios"]) == 0
+    lines = [line for line in capsys.readouterr().err.splitlines() if line.startswith("cell: warning")]
+    assert lines == ["cell: warning: a sample warning (UserWarning)"]

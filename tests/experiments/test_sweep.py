@@ -354,7 +354,8 @@ def test_an_interrupted_sweep_says_how_to_go_on(tmp_path):
         if "replications (" in line:
             proc.send_signal(signal.SIGINT)
             break
-    err = proc.stderr.read()
+    with proc.stderr:
+        err = proc.stderr.read()
     assert proc.wait(timeout=120) == 130, err
     hint = next(line for line in err.splitlines() if line.startswith("cell sweep: stopped"))
     kept = int(hint.split("; ")[1].split()[0])

@@ -45,7 +45,8 @@ def _wait_for(proc: subprocess.Popen, ready, what: str, limit_s: float = 120) ->
 
 def _stop(proc: subprocess.Popen, number: int) -> list[str]:
     proc.send_signal(number)
-    err = proc.stderr.read()
+    with proc.stderr:
+        err = proc.stderr.read()
     code = proc.wait(timeout=60)
     expected_code, line = LINES[number]
     assert code == expected_code, err

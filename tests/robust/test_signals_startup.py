@@ -50,6 +50,15 @@ def _python_default(number: int, code: int, err: str) -> bool:
     return code in (-signal.SIGINT, 1) and (err == "" or err.rstrip().endswith("KeyboardInterrupt"))
 
 
+def _lost_by_python(number: int, code: int, err: str) -> bool:
+    """The one other end Python's default gives a SIGINT in its start-up: the KeyboardInterrupt
+    raised inside a weakref callback (an import lock's ``cb`` in importlib), which the
+    interpreter reports as "Exception ignored in" and drops (CPython issue 95959), so the
+    command runs on to its end as if no signal came."""
+    return (number == signal.SIGINT and code == 0 and err.startswith("Exception ignored in")
+            and "KeyboardInterrupt" in err)
+
+
 def _one(command: list[str], number: int, delay: float | None, where: Path) -> None:
     where.mkdir()
     (where / "tmp").mkdir()
@@ -65,13 +74,16 @@ def _one(command: list[str], number: int, delay: float | None, where: Path) -> N
         time.sleep(delay)
     ours = _caught_term(proc.pid)
     proc.send_signal(number)
-    err = proc.stderr.read()
+    with proc.stderr:
+        err = proc.stderr.read()
     code = proc.wait(timeout=60)
     said = (code, err) == (LINES[number][0], LINES[number][1] + "\n")
-    assert said or (not ours and _python_default(number, code, err)), (delay, ours, code, err)
+    lost = not ours and _lost_by_python(number, code, err)
+    assert said or lost or (not ours and _python_default(number, code, err)), (delay, ours, code, err)
     assert ours or delay is not None, "the handlers never came"
     left = sorted(p.name for p in where.iterdir() if p.name != ".cache")
-    assert left == ["tmp"] and list((where / "tmp").iterdir()) == [], (delay, left)
+    whole = ["out", "tmp"] if lost and (where / "out" / "summary.csv").is_file() else ["tmp"]  # ran whole
+    assert left == whole and list((where / "tmp").iterdir()) == [], (delay, left)
 
 
 @pytest.mark.parametrize("number", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
@@ -123,7 +135,8 @@ def test_a_signal_while_cell_is_imported(tmp_path, number, at):
     assert mark.exists(), proc.stderr.read()
     proc.send_signal(number)
     (tmp_path / "go").touch()
-    err = proc.stderr.read()
+    with proc.stderr:
+        err = proc.stderr.read()
     assert (proc.wait(timeout=60), err) == (LINES[number][0], LINES[number][1] + "\n")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["go", "hook", "there"]
 
