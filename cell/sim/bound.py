@@ -48,8 +48,8 @@ def greedy_picks(come_s: Sequence[float] | Array, length_in: float, v_min: float
     a part (cachegrind); other arrivals pay the pass as before, and the reading."""
     early, late, clear = length_in / v_max, length_in / v_min, part_size_in / v_min
     a = np.asarray(come_s, dtype=float)
-    if a.size and (a + early <= a + late).all() and \
-            (a[1:] + early >= a[:-1] + early + cycle_min_s).all():
+    first = a + early  # each part's earliest pick (a + early <= a + late where early <= late)
+    if a.size and early <= late and (first[1:] >= first[:-1] + cycle_min_s).all():
         return int(a.size)
     next_drop = next_pick = -float("inf")  # the latest drop and the last pick, plus clear, c_min
     count = 0
