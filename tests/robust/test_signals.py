@@ -45,9 +45,8 @@ def _wait_for(proc: subprocess.Popen, ready, what: str, limit_s: float = 120) ->
 
 def _stop(proc: subprocess.Popen, number: int) -> list[str]:
     proc.send_signal(number)
-    with proc.stderr:
-        err = proc.stderr.read()
-    code = proc.wait(timeout=60)
+    err = proc.communicate()[1]  # read to the end, closed, waited for
+    code = proc.returncode
     expected_code, line = LINES[number]
     assert code == expected_code, err
     lines = [x for x in err.splitlines() if "%)" not in x and not x.startswith("cell: warning")]
