@@ -27,6 +27,7 @@ if TYPE_CHECKING:
     from cell.experiments.sweep import Sweep
     from cell.experiments.sweep.spec import Point
     from cell.reporting.formatting import Headline
+    from cell.scenario.run_length import RunLength
     from cell.scenario.schema import Scenario
 
 HELP = "compare two scenarios, paired over common random numbers"
@@ -94,13 +95,16 @@ def window_warning(sweep: Sweep) -> str | None:
     differ = windows_apart(a.scenario, b.scenario)
     if not differ:
         return None
-    said = {"parts": "runs {} parts", "warmup_parts": "has run.warmup_parts {}"}
+    said = {"parts": "runs {} parts", "length": "runs {}", "warmup_parts": "has run.warmup_parts {}"}
     what = "; ".join(f"{la} {said[k].format(va)}, {lb} {vb}" for k, va, vb in differ)
     if any(AUTO in (va, vb) for _, va, vb in differ):
         what += f" (auto: {AUTO_WHY}, so {la}'s and {lb}'s windows differ in length)"
-    sets = " ".join(f"--set run.{k}={_suggest(va, vb)}" for k, va, vb in differ)
+    sets = " ".join("--set run.hours=H" if k == "length" else  # H hours for both
+                    f"--set run.{k}={_suggest(va, vb)}" for k, va, vb in differ)
     if any(va == vb == AUTO for _, va, vb in differ):
         sets += ", N a fixed number of parts"
+    if any(k == "length" for k, _, _ in differ):
+        sets += ", H the hours of both"
     return (f"{what}: {WINDOW_MEASURES_TEXT} are not comparable; compare the rates, or give "
             f"both the same window ({sets})")
 
@@ -205,22 +209,24 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
         rates_differ,
         still_sides,
     )
-    from cell.experiments.sweep.windows import windows_apart
+    from cell.experiments.sweep.windows import setting, windows_apart
     from cell.reporting.formatting import HEADLINES
+    from cell.scenario.run_length import RunLength
 
     (la, a), (lb, b) = _sides(sweep)
     differ = windows_apart(a.scenario, b.scenario)
     demand = rates_differ(summary, la, lb)
-    parts = a.scenario.run.parts if a.scenario.run.parts == b.scenario.run.parts else None
-    lines = [_verdict_header(sweep, la, a, lb, b, parts)]
+    length_a = RunLength.of(a.scenario.run)
+    length = length_a if length_a == RunLength.of(b.scenario.run) else None
+    lines = [_verdict_header(sweep, la, a, lb, b, length)]
     if demand:
         lines.append(f"  {demand}")
     lines += [f"  {w}" for w in still_sides(summary, la, lb)]
-    apart = ", ".join(f"run.{k} {va} against {vb}" for k, va, vb in differ)
+    apart = ", ".join(f"{setting(k)} {va} against {vb}" for k, va, vb in differ)
     sides: list[tuple[str, int]] = []
     width = max(len(t) for t in [*(h.title for h in HEADLINES), *(r[0] for r in RATE_FREE)])
     for h in HEADLINES:
-        line = _headline_verdict(h, summary, differences, la, lb, parts, width,
+        line = _headline_verdict(h, summary, differences, la, lb, length, width,
                                  apart if differ else None, bool(demand), sides)
         if line is not None:
             lines.append(line)
@@ -234,18 +240,22 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
 
 
 def _verdict_header(sweep: Sweep, la: str, a: Point, lb: str, b: Point,
-                    parts: int | None) -> str:
+                    length: RunLength | None) -> str:
     """The verdict's first line: the two sides, the replications, run length and seed."""
+    from cell.scenario.run_length import RunLength
+
     level = f"{sweep.confidence * 100:g} %"
-    length = (f" of {parts} part{'s' if parts != 1 else ''}" if parts else
-              f" of {a.scenario.run.parts} and {b.scenario.run.parts} parts")
+    la_length, lb_length = RunLength.of(a.scenario.run), RunLength.of(b.scenario.run)
+    of = (f" of {length}" if length else
+          f" of {la_length.number} and {lb_length}" if la_length.unit == lb_length.unit else
+          f" of {la_length} and {lb_length}")
     return (f"{la} ({a.policy}) against {lb} ({b.policy}): {sweep.replications} replications"
-            f"{length}, seed {sweep.seed}, common random numbers; A - B with its paired "
+            f"{of}, seed {sweep.seed}, common random numbers; A - B with its paired "
             f"{level} confidence interval")
 
 
 def _headline_verdict(h: Headline, summary: pd.DataFrame, differences: pd.DataFrame, la: str,
-                      lb: str, parts: int | None, width: int, apart: str | None,
+                      lb: str, length: RunLength | None, width: int, apart: str | None,
                       demand: bool, sides: list[tuple[str, int]]) -> str | None:
     """One headline measure's verdict line (None if it was not measured); its side (1: A
     better, -1: B better, 0: neither) is appended to ``sides`` unless the arrival rates
@@ -266,7 +276,7 @@ def _headline_verdict(h: Headline, summary: pd.DataFrame, differences: pd.DataFr
     if int(row["n"]) < 2:
         return (f"  {h.title:<{width}}  not compared: "
                 f"{too_few(int(row['n']), sides='both A and B')}")
-    what, judged = _difference_said(h, row, la, lb, parts)
+    what, judged = _difference_said(h, row, la, lb, length)
     side = better(h, float(means[la]), float(means[lb])) if judged else 0
     who = {1: f"{la} better", -1: f"{lb} better", 0: "neither"}[side]
     if h.better == "one" and side:
@@ -280,7 +290,7 @@ def _headline_verdict(h: Headline, summary: pd.DataFrame, differences: pd.DataFr
 
 
 def _difference_said(h: Headline, row: pd.Series, la: str, lb: str,
-                     parts: int | None) -> tuple[str, bool]:
+                     length: RunLength | None) -> tuple[str, bool]:
     """A - B for one measure as a sentence with A its subject, and whether it is judged (the
     paired interval excludes 0, or A and B differ by the same in every replication)."""
     from cell.reporting.formatting import half_width, number, plus_minus
@@ -288,10 +298,10 @@ def _difference_said(h: Headline, row: pd.Series, la: str, lb: str,
     mean, sd, lo, hi = (float(row[k]) for k in ("mean", "sd", "ci_low", "ci_high"))
     if sd == 0.0:
         what = (f"{la} and {lb} equal in every replication" if mean == 0 else
-                f"{h.says(la, number(abs(mean)), mean, lb, parts)} in every replication")
+                f"{h.says(la, number(abs(mean)), mean, lb, length)} in every replication")
         return what, bool(mean != 0)
     judged = not (lo <= 0.0 <= hi)
-    what = (f"{h.says(la, plus_minus(abs(mean), half_width(row)), mean, lb, parts)} "
+    what = (f"{h.says(la, plus_minus(abs(mean), half_width(row)), mean, lb, length)} "
             + ("(interval excludes 0)" if judged else
                "(interval includes 0: no difference shown)"))
     return what, judged

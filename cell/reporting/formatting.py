@@ -18,6 +18,8 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     import pandas as pd
 
+    from cell.scenario.run_length import RunLength
+
 
 @dataclass(frozen=True)
 class Headline:
@@ -33,13 +35,13 @@ class Headline:
     better: str
     """``higher``, ``lower`` or ``one`` (nearer 1 is better)."""
     per_run: bool = False
-    """A count per run: the sentence says ``per N-part run``."""
+    """A count per run: the sentence says ``per N-part run`` (or ``per N-hour run``)."""
 
-    def says(self, a: str, x: str, mean: float, b: str, parts: int | None) -> str:
+    def says(self, a: str, x: str, mean: float, b: str, length: RunLength | None) -> str:
         """``a``'s paired difference ``mean`` from ``b`` in words, ``x`` its size as shown:
         ``a delivers 3.1 ± 0.4 parts more than b per 500-part run``."""
         direction = self.words[0] if mean >= 0 else self.words[1]
-        per = f" per {parts}-part run" if self.per_run and parts else ""
+        per = f" per {length.run}" if self.per_run and length else ""
         return self.sentence.format(a=a, x=x, dir=direction, b=b) + per
 
 

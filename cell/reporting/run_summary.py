@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from cell.reporting import published
+from cell.scenario.run_length import RunLength
 from cell.scenario.schema import Scenario, load_scenario
 from cell.sim.assembly import AssembledCell
 from cell.sim.policies.base import CellConstants
@@ -36,7 +37,7 @@ def run_heading(cell: AssembledCell) -> str:
     source = {"scenario": "controller.nominal_cycle_s",
               "arrivals": "the arrivals' mean",
               "fastest": "the robot's fastest cycle: the arrivals come faster"}[k.nominal_from]
-    length = f"{s.run.parts} parts" if s.run.hours is None else f"{s.run.hours:g} hours"
+    length = RunLength.of(s.run)
     heading = (f"cell run: {s.name} ({cell.policy.name}), {length}, seed {s.run.seed}\n"
                f"nominal cycle {k.cycle_nom:.4f} s ({source}); mean inter-arrival "
                f"{k.mean_interarrival_s:.4f} s; the robot's fastest cycle {k.fastest_cycle_s:.4f} "

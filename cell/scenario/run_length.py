@@ -4,12 +4,41 @@ hours-long run would bring stay within the bound on parts (checked where a scena
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.arrivals import mean_interarrival
 
 SECONDS_PER_HOUR = 3600.0
+
+
+@dataclass(frozen=True)
+class RunLength:
+    """How long each run is: ``run.parts`` parts, or ``run.hours`` hours."""
+
+    count: float
+    unit: str
+    """``part`` or ``hour``."""
+
+    @classmethod
+    def of(cls, run: Any) -> RunLength:
+        """A scenario's ``run`` section's length."""
+        return cls(run.parts, "part") if run.hours is None else cls(run.hours, "hour")
+
+    @property
+    def number(self) -> str:
+        """``500``, ``0.5``: a count of parts as a whole number, hours as given."""
+        return str(self.count) if isinstance(self.count, int) else f"{self.count:g}"
+
+    @property
+    def run(self) -> str:
+        """``500-part run``, ``8-hour run``."""
+        return f"{self.number}-{self.unit} run"
+
+    def __str__(self) -> str:
+        """``500 parts``, ``1 hour``."""
+        return f"{self.number} {self.unit}{'s' if self.count != 1 else ''}"
 
 
 def check_hours(s: Any, default_parts: int, file: object) -> None:

@@ -10,6 +10,7 @@ from cell.cli.compare_command import verdict
 from cell.experiments.sweep.spec import comparison
 from cell.reporting.experiment_text import sentence
 from cell.reporting.formatting import HEADLINES
+from cell.scenario.run_length import RunLength
 from cell.scenario.schema import load_scenario
 
 #: A (non_adaptive) against B (fitted): A is worse on every measure, B better.
@@ -77,7 +78,7 @@ def test_the_verdict_says_what_report_md_says(sweep):
     _, differences = tables(DIFFS)
     for h in HEADLINES:
         row = differences[differences["measure"] == h.column].iloc[0]
-        reported = sentence(h, row, "non_adaptive", "fitted", 500, 0.95)
+        reported = sentence(h, row, "non_adaptive", "fitted", RunLength(500, "part"), 0.95)
         assert said[h.title].split(": ", 1)[1].split(" (interval")[0] == \
             reported.split(" (95 % CI")[0]
 
@@ -89,3 +90,34 @@ def test_a_difference_in_every_replication_and_none_at_all(sweep):
                                        "than fitted per 500-part run in every replication")
     assert said["Parts lost (wall clock)"] == ("neither: non_adaptive and fitted equal in every "
                                                "replication")
+
+
+DELIVERED = ("fitted better: non_adaptive delivers 158.9 ± 2.4 parts fewer than fitted{} "
+             "(interval excludes 0)")
+APART = "not compared: a count, over different windows ({}); compare the rates"
+
+
+@pytest.mark.parametrize(("a_set", "b_set", "header", "delivered"), [
+    ({"run.hours": 2}, {"run.hours": 2}, "of 2 hours,", DELIVERED.format(" per 2-hour run")),
+    ({"run.parts": 1}, {"run.parts": 1}, "of 1 part,", DELIVERED.format(" per 1-part run")),
+    ({"run.hours": 0.5}, {}, "of 0.5 hours and 500 parts,",
+     APART.format("run length 0.5 hours against 500 parts")),
+    ({"run.hours": 1}, {"run.hours": 2}, "of 1 and 2 hours,",
+     APART.format("run length 1 hour against 2 hours")),
+    ({"run.parts": 300}, {}, "of 300 and 500 parts,", APART.format("run.parts 300 against 500")),
+])
+def test_the_verdict_names_the_runs_length_in_parts_or_hours(a_set, b_set, header, delivered):
+    """A run given in hours is said to be so ('per 2-hour run', not the 500 parts of the
+    run.parts it leaves at its default), and runs of different lengths, in hours or parts,
+    have their counts left uncompared."""
+    sides = comparison(load_scenario("non_adaptive", a_set), load_scenario("baseline", b_set),
+                       ("non_adaptive", "fitted"), 30, 1)
+    text = verdict(*tables(DIFFS), sides)
+    assert f"30 replications {header} seed 1," in text.splitlines()[0]
+    assert lines_of(text)["Parts delivered"] == delivered
+
+
+def test_a_run_length_in_words():
+    assert [str(RunLength(1, "part")), str(RunLength(1_000_000, "part")), str(RunLength(0.5, "hour")),
+            str(RunLength(4000.0, "hour"))] == ["1 part", "1000000 parts", "0.5 hours", "4000 hours"]
+    assert RunLength(8.0, "hour").run == "8-hour run"

@@ -1,15 +1,15 @@
 """The windows a run's counts and extremes are taken over, and the paired comparisons
 they spoil.
 
-A run's summary is taken over its window: its ``run.parts``, after the
-``run.warmup_parts`` of warm-up.  Two kinds of measure depend on the window's length,
-not only on how the cell behaves in it: its *counts* (parts delivered, parts lost,
-spacings outside tolerance, belt limits: its whole-number columns) and its *extremes*
-(the closest and widest spacing, the longest hold at the feeder, the belts' slowest
-and fastest, the simulated end: a longer run sees a more extreme value).  So two
-points' counts and extremes compare only if both have the same window; their rates
-and means (parts/hr, actual cycle, IP) compare whatever the windows.  ``cell
-compare`` and ``cell sweep`` both warn when a paired comparison's points differ
+A run's summary is taken over its window: its ``run.parts`` (or the parts that come in
+its ``run.hours``), after the ``run.warmup_parts`` of warm-up. Two kinds of measure
+depend on the window's length, not only on how the cell behaves in it: its *counts*
+(parts delivered, parts lost, spacings outside tolerance, belt limits: its whole-number
+columns) and its *extremes* (the closest and widest spacing, the longest hold at the
+feeder, the belts' slowest and fastest, the simulated end: a longer run sees a more
+extreme value). So two points' counts and extremes compare only if both have the same
+window; their rates and means (parts/hr, actual cycle, IP) compare whatever the windows.
+``cell compare`` and ``cell sweep`` both warn when a paired comparison's points differ
 there, and leave its counts and extremes out of ``differences.csv``
 (:func:`window_measures` decides which they are, for both).
 """
@@ -26,8 +26,9 @@ if TYPE_CHECKING:
     from cell.experiments.sweep.spec import Pair, Sweep
     from cell.scenario.schema import Scenario
 
-#: The ``run`` settings that decide a run's window.
-WINDOW_KEYS = ("parts", "warmup_parts")
+#: The ``run`` settings that decide a run's window (``length``: its run.parts or run.hours,
+#: where one of the two runs is given in hours).
+WINDOW_KEYS = ("parts", "length", "warmup_parts")
 
 #: The warm-up MSER-5 chooses run by run (``run.warmup_parts: auto``).
 AUTO = "auto"
@@ -81,11 +82,22 @@ def windows_apart(a: Scenario, b: Scenario) -> list[tuple[str, Any, Any]]:
     A warm-up of ``auto`` on either side differs even from ``auto``: MSER-5 cuts each run
     where its own output settles, so two points (of different policies or settings) count
     over windows of different lengths."""
-    def apart(key: str) -> bool:
-        va, vb = getattr(a.run, key), getattr(b.run, key)
-        return va != vb or (key == "warmup_parts" and AUTO in (va, vb))
+    from cell.scenario.run_length import RunLength
 
-    return [(key, getattr(a.run, key), getattr(b.run, key)) for key in WINDOW_KEYS if apart(key)]
+    out: list[tuple[str, Any, Any]] = []
+    la, lb = RunLength.of(a.run), RunLength.of(b.run)
+    if la != lb:  # run.parts's numbers, or where hours come in, the lengths in words
+        out.append(("parts", a.run.parts, b.run.parts) if la.unit == lb.unit == "part" else
+                   ("length", str(la), str(lb)))
+    wa, wb = a.run.warmup_parts, b.run.warmup_parts
+    if wa != wb or AUTO in (wa, wb):
+        out.append(("warmup_parts", wa, wb))
+    return out
+
+
+def setting(key: str) -> str:
+    """How a window setting is named: ``run.parts``, ``run length``."""
+    return "run length" if key == "length" else f"run.{key}"
 
 
 def pair_apart(sweep: Sweep, pair: Pair) -> list[tuple[str, Any, Any]]:
@@ -107,7 +119,7 @@ def window_warning(sweep: Sweep) -> str | None:
         return ", ".join(show(v) for v in distinct(s[i] for s in settings if s[0] == key))
 
     keys = [k for k in WINDOW_KEYS if any(s[0] == k for s in settings)]
-    what = "; ".join(f"run.{k} {side(k, 1)} against {side(k, 2)}" for k in keys)
+    what = "; ".join(f"{setting(k)} {side(k, 1)} against {side(k, 2)}" for k in keys)
     auto = (f" (auto: {AUTO_WHY}, so no two points share a window)"
             if any(AUTO in s[1:] for s in settings) else "")
     return (f"{len(apart)} of {len(pairs)} paired comparisons are between points that run "
