@@ -135,6 +135,22 @@ def test_markdown_puts_the_thesis_beside_ours_and_reads_from_the_numbers(thesis_
     assert "18 of 18 cases" in text
 
 
+def test_markdown_of_hours_long_runs_names_no_parts_count(thesis_table):
+    """The same table from runs of run.hours: said to be of hours, with no count of parts a run
+    (run.parts' default, 500, is not what such a run brings) and no share of it lost."""
+    from types import SimpleNamespace
+
+    from cell.scenario.schema import load_scenario
+
+    sweep, _frame, table = thesis_table
+    hours = SimpleNamespace(points=[SimpleNamespace(scenario=load_scenario("baseline", {"run.hours": 2}))],
+                            replications=sweep.replications, source=sweep.source, seed=sweep.seed)
+    text = markdown(table, hours)
+    assert f"{sweep.replications} replications of 2 hours per row" in text
+    assert "of 500 parts" not in text and "of the parts are lost" not in text
+    assert "of the parts are lost" in markdown(table, sweep)
+
+
 def _synthetic(thesis_missed: float, wall_missed: float) -> pd.DataFrame:
     rows = []
     for cycle in (22.5872, 20.0907):
