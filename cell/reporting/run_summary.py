@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from cell.reporting import published
-from cell.scenario.run_length import RunLength
+from cell.scenario.run_length import SECONDS_PER_HOUR, RunLength
 from cell.scenario.schema import Scenario, load_scenario
 from cell.sim.assembly import AssembledCell
 from cell.sim.policies.base import CellConstants
@@ -46,8 +46,14 @@ def run_heading(cell: AssembledCell) -> str:
     if trace is not None:
         from cell.scenario.arrivals import read_trace
 
-        n = len(read_trace(Path(s.base_dir) / trace))
-        if n == s.run.parts:  # every part has its own; only the look-ahead comes round again
+        times = read_trace(Path(s.base_dir) / trace)
+        n, hours = len(times), s.run.hours
+        if hours is not None:  # the parts that come in the hours: replayed if it ends sooner
+            covers = float(times.sum())
+            if covers < hours * SECONDS_PER_HOUR:
+                heading += (f"\narrivals: {trace} covers {covers / SECONDS_PER_HOUR:.3g} of the "
+                            f"run's {hours:g} hours: it is replayed from the start")
+        elif n == s.run.parts:  # every part has its own; only the look-ahead comes round again
             heading += (f"\narrivals: {trace} holds one inter-arrival time a part; the last "
                         "part's next arrival (for its IP) is the trace's first again")
         elif n < s.run.parts + 1:  # the run needs T_1 .. T_{parts+1}

@@ -223,6 +223,22 @@ def test_cell_run_says_when_a_short_trace_is_replayed(tmp_path, capsys):
     assert pd.read_csv(tmp_path / "c" / "parts.csv")["interarrival_s"].tolist() == [21.0, 24.5] * 5
 
 
+def test_an_hours_long_run_says_when_its_trace_is_replayed(tmp_path, capsys):
+    """With run.hours the trace is replayed if its times end before the run does (227.5 s
+    here); the run.parts default (500) has nothing to do with it."""
+    (tmp_path / "gaps.csv").write_text("interarrival_s\n" + "\n".join(["21.0", "24.5"] * 5))
+    (tmp_path / "traced.yaml").write_text("arrivals: {trace_csv: gaps.csv}\nrun: {hours: 0.1}\n")
+    assert main(["run", str(tmp_path / "traced.yaml"), "--out", str(tmp_path / "a")]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("cell run: traced (adaptive), 0.1 hours")
+    assert "gaps.csv covers 0.0632 of the run's 0.1 hours: it is replayed from the start" in out
+    gaps = pd.read_csv(tmp_path / "a" / "parts.csv")["interarrival_s"].tolist()
+    assert len(gaps) > 10 and gaps == ([21.0, 24.5] * 10)[:len(gaps)]  # the trace, round again
+    assert main(["run", str(tmp_path / "traced.yaml"), "--set", "run.hours=0.05",
+                 "--out", str(tmp_path / "b")]) == 0
+    assert "replayed" not in capsys.readouterr().out and "holds" not in out
+
+
 def test_cell_docs_reads_the_pages_its_output_refers_to(tmp_path, capsys):
     """``cell docs`` lists every page of docs/; a page by name (or as the output writes it,
     docs/accounting.md) is that file's text; an unknown page is one line, exit 2."""
