@@ -87,13 +87,15 @@ def notes(scenario: Scenario, first: int, parts: int) -> list[str]:
     """``cell run``'s warnings (:func:`~cell.reporting.unit_slips.run_warnings`), and a note if the
     parts shown go past the scenario's ``run.parts`` (the run is simulated on to reach them)."""
     from cell.reporting.unit_slips import run_warnings
+    from cell.scenario.run_length import expected_parts
     from cell.sim.assembly import assemble
 
     out = [f"warning: {line}" for line in run_warnings(assemble(scenario))]
-    last, n = first + parts - 1, scenario.run.parts
+    last, n, hours = first + parts - 1, round(expected_parts(scenario)), scenario.run.hours
     if last > n:
+        end = f"run.parts = {n:,}" if hours is None else f"the about {n:,} that come in run.hours = {hours:g}"
         out.append(f"note: --from-part {first} --parts {parts} shows parts up to {last:,}, past "
-                   f"run.parts = {n:,}: the run is simulated on past its end to show them")
+                   f"{end}: the run is simulated on past its end to show them")
     return out
 
 

@@ -56,6 +56,20 @@ def test_parts_past_the_run_get_a_note(tmp_path: Path,
                             "run.parts = 5: the run is simulated on past its end to show them"]
 
 
+def test_a_run_of_hours_is_animated_and_its_parts_counted_from_its_hours(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A scenario with run.hours animates (the window's run is of parts: it was refused as
+    giving both), and the note counts the parts the hours bring, 0.1 h / 22.586 s: about 16."""
+    common = ["animate", "baseline", "--set", "run.hours=0.1", "--out", str(tmp_path / "a.gif"),
+              "--speed", "200", "--dpi", "20", "--parts", "2"]
+    assert cli([*common, "--from-part", "15"]) == 0
+    assert said(capsys) == []
+    assert cli([*common, "--from-part", "16"]) == 0
+    assert said(capsys) == ["cell: note: --from-part 16 --parts 2 shows parts up to 17, past the "
+                            "about 16 that come in run.hours = 0.1: the run is simulated on past "
+                            "its end to show them"]
+
+
 def test_both_policies_show_a_fixed_robot_at_its_own_cycle(tmp_path: Path) -> None:
     """``--policy both`` of a non-adaptive scenario with its own cycle: the fixed panel runs
     at that cycle, the adaptive one at the nominal cycle (it used to be refused: the adaptive

@@ -139,7 +139,8 @@ def simulate_scenes(scenario: Scenario, policies: list[str], first: int, count: 
             # the adaptive robot runs at the nominal cycle: a fixed robot's own cycle
             # (controller.ideal_cycle_s) is the non-adaptive panel's alone, as in cell figures
             own = {"controller.ideal_cycle_s": None} if policy == "adaptive" else {}
-            s = scenario.with_overrides({"controller.policy": policy, "run.parts": n, **own})
+            s = scenario.with_overrides({"controller.policy": policy, "run.parts": n,
+                                         "run.hours": None, **own})  # a run of parts, hours or not
             run = simulated(s, progress)
             runs.append((frames_input(run, s), s, run.stops))
         from_s = min(float(data.arrival_s[first - 1]) for data, _, _ in runs)
