@@ -10,6 +10,7 @@ from typing import Any
 from cell.experiments.kn import Selection
 from cell.experiments.optimize import SELECT_OFFSET, measured
 from cell.experiments.study import Study
+from cell.scenario.run_length import RunLength
 
 FILES = ("trials.csv", "best.csv", "front.csv", "selection.csv", "history.png", "front.png",
          "importance.png", "report.md")
@@ -206,7 +207,7 @@ def markdown(study: Study, frame: Any, picked: list[int], sel: Selection | None,
              f"Regenerate: `{command}`", "",
              f"- Search: {len(frame)} trials by "
              f"{'NSGA-II' if len(s.objectives) > 1 else 'TPE'} (Optuna), seed {s.seed}; {goals}.",
-             f"- Each trial: {s.replications} replications of {study.scenario({}).run.parts} parts "
+             f"- Each trial: {s.replications} replications of {RunLength.of(study.scenario({}).run)} "
              "over common random numbers (the same streams at every trial), so two trials differ "
              "by their keys, not their draws; each measure's mean has a 95 % t-interval.",
              "- Constraints (on the means): " + (", ".join(str(c) for c in study.constraints) or "none")

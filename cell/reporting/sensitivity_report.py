@@ -10,6 +10,7 @@ import numpy as np
 
 from cell.experiments.sensitivity import ADVANTAGE
 from cell.experiments.study import Study
+from cell.scenario.run_length import RunLength
 
 FILES = ("morris.csv", "sobol.csv", "points.csv", "sensitivity.png", "report.md")
 #: A key "moves" a measure when its total index's lower 95 % bound is above this ...
@@ -70,7 +71,8 @@ def reading(study: Study, sobol: Any, morris: Any, points: Any, policies: Sequen
 def _conclusion(study: Study, sobol: Any, points: Any) -> list[str]:
     """Whether any point reverses the thesis's conclusion, and what the advantage depends on."""
     adv = points[ADVANTAGE]
-    parts = study.scenario({}).run.parts
+    length = RunLength.of(study.scenario({}).run)
+    of = f"of {length.number}" if length.unit == "part" else f"per {length.run}"  # parts of 500
     n_bad = int((adv <= 0).sum())
     fixed = study.scenario({"controller.policy": "non-adaptive"}).controller
     cycle = fixed.ideal_cycle_s if fixed.ideal_cycle_s is not None else fixed.nominal_cycle_s
@@ -84,13 +86,13 @@ def _conclusion(study: Study, sobol: Any, points: Any) -> list[str]:
                        and not abs(worst[k] - base[k]) <= 1e-9 * max(1, abs(base[k])))
         return [f"- **The thesis's conclusion ({claim}) is reversed** at {n_bad} of {len(points)} "
                 f"points: the fixed-cycle robot delivers as many or more (worst {adv.min():.1f} "
-                f"parts of {parts}, at {worst['design']} point {int(adv.idxmin())}: "
+                f"parts {of}, at {worst['design']} point {int(adv.idxmin())}: "
                 f"{at or 'the base values'})."]
     if adv.min() == adv.max():
-        size = (f"the advantage is {adv.min():.1f} parts of {parts} at every point: no "
+        size = (f"the advantage is {adv.min():.1f} parts {of} at every point: no "
                 "assumption in its range changes it")
     else:
-        size = (f"the advantage is {adv.min():.1f} to {adv.max():.1f} parts of {parts} "
+        size = (f"the advantage is {adv.min():.1f} to {adv.max():.1f} parts {of} "
                 f"(mean {adv.mean():.1f})")
     out = [f"- **The thesis's conclusion holds** ({claim}) at every one of the {len(points)} "
            f"points, each assumption anywhere in its plausible range: {size}. None of them, alone or "
@@ -161,7 +163,7 @@ def markdown(study: Study, sobol: Any, morris: Any, points: Any, policies: Seque
              "measure at all): enough to tell a key that matters from one that does not, not to "
              "rank close ones; quadrupling the samples would halve it.",
              f"- Every point runs {', '.join(policies)} on the same {s.replications} "
-             f"replication streams of {study.scenario({}).run.parts} parts (common random numbers), "
+             f"replication streams of {RunLength.of(study.scenario({}).run)} (common random numbers), "
              "so a measure is a deterministic function of the keys and an index is the keys' "
              "share, not the draws'.",
              "", "## Sobol indices", "", "![sensitivity](sensitivity.png)", "",
