@@ -216,9 +216,9 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
     (la, a), (lb, b) = _sides(sweep)
     differ = windows_apart(a.scenario, b.scenario)
     demand = rates_differ(summary, la, lb)
-    length_a = RunLength.of(a.scenario.run)
-    length = length_a if length_a == RunLength.of(b.scenario.run) else None
-    lines = [_verdict_header(sweep, la, a, lb, b, length)]
+    length_a, length_b = RunLength.of(a.scenario.run), RunLength.of(b.scenario.run)
+    length = length_a if length_a == length_b else None
+    lines = [_verdict_header(sweep, la, a, lb, b, length_a, length_b)]
     if demand:
         lines.append(f"  {demand}")
     lines += [f"  {w}" for w in still_sides(summary, la, lb)]
@@ -240,15 +240,12 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
 
 
 def _verdict_header(sweep: Sweep, la: str, a: Point, lb: str, b: Point,
-                    length: RunLength | None) -> str:
-    """The verdict's first line: the two sides, the replications, run length and seed."""
-    from cell.scenario.run_length import RunLength
-
+                    length_a: RunLength, length_b: RunLength) -> str:
+    """The verdict's first line: the two sides, the replications, run lengths and seed."""
     level = f"{sweep.confidence * 100:g} %"
-    la_length, lb_length = RunLength.of(a.scenario.run), RunLength.of(b.scenario.run)
-    of = (f" of {length}" if length else
-          f" of {la_length.number} and {lb_length}" if la_length.unit == lb_length.unit else
-          f" of {la_length} and {lb_length}")
+    of = (f" of {length_a}" if length_a == length_b else
+          f" of {length_a.number} and {length_b}" if length_a.unit == length_b.unit else
+          f" of {length_a} and {length_b}")
     return (f"{la} ({a.policy}) against {lb} ({b.policy}): {sweep.replications} replications"
             f"{of}, seed {sweep.seed}, common random numbers; A - B with its paired "
             f"{level} confidence interval")
