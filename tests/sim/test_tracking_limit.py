@@ -8,6 +8,8 @@ each part picked, the input belt from its arrival at B until lift-off."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 from hypothesis import example, given, settings
@@ -15,6 +17,8 @@ from hypothesis import strategies as st
 
 from cell.scenario.schema import default_scenario
 from cell.sim.conveyors import EPS_S, speed_at
+from cell.sim.policies.check import problem
+from cell.sim.policies.fixed import fixed_plan
 from cell.sim.simulation import simulate
 
 #: Slack on the belt's speed (in/s): the check's own.
@@ -58,6 +62,34 @@ def test_the_adaptive_robot_never_picks_from_a_belt_it_cannot_follow(
     worst, picked = fastest_at_picks(simulate(s, seed=seed))
     assert picked > 0
     assert worst <= k.timing.input_track_max_in_s + SLACK
+
+
+def test_the_check_refuses_a_pick_from_a_belt_the_arm_cannot_follow(k) -> None:
+    """The issue's pick: the input belt at 6.19 in/s, above the 4.3693 in/s the robot can
+    follow, refused even with R I as long as at that limit, and with R I timed at 6.19 in/s
+    (below its 2.2112 s at the limit); and a pick at 3 in/s with R I timed as at 4 in/s."""
+    t = k.timing
+    plan = fixed_plan(k, k.cycle_nom)
+    fast, limit = 6.19, t.input_track_max_in_s
+    r1a, r1b = t.r1_time(limit)
+    why = problem(_with(plan, input_speed=fast, r1_pre=r1a, r1_post=r1b), k)
+    assert why is not None and why.startswith("input_speed =") and f"{limit:.6g}" in why
+    r1a, r1b = t.r1_time(fast)
+    assert r1a + r1b < sum(t.r1_time(limit))
+    assert problem(_with(plan, input_speed=fast, r1_pre=r1a, r1_post=r1b), k) is not None
+    r1a, r1b = t.r1_time(4.0)
+    ahead_of_belt = _with(plan, r1_pre=r1a, r1_post=r1b)  # the belt at 3 in/s
+    why = problem(ahead_of_belt, k)
+    assert why is not None and why.startswith("r1_pre =")
+    assert f"{t.r1_pre.time(k.v_nom):.6g}" in why
+
+
+def _with(plan, **change):
+    """``plan`` with fields changed and ``to_g`` and ``cycle`` summed again."""
+    p = replace(plan, **change)
+    p.to_g = p.r1_pre + p.r1_post + p.r2
+    p.cycle = p.to_g + p.r3_pre + p.r3_post + p.r4
+    return p
 
 
 def test_the_reading_of_the_belt_sees_a_pick_above_the_limit() -> None:

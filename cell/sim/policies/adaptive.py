@@ -98,8 +98,7 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
         if a + b / v > cycle + m:
             w = b / (cycle + m - a) if cycle + m > a else math.inf
             if w > k.input_max or (m > 0.0 and w > t.input_track_max_in_s):
-                w, bit = late_speed_cap(k, m)
-                flags |= bit
+                w, flags = late_speed_cap(k, m, flags)
         else:  # early (3.2) or on time
             w, r2, r4, cycle, flags = aim_early(k, nxt, v, r2, r4, cycle, flags)
     # 6.3: decay toward nominal after the cycle; departure: never below what R II absorbs.
@@ -134,15 +133,15 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
     return plan
 
 
-def late_speed_cap(k: CellConstants, m: float) -> tuple[float, int]:
-    """Step 3.1's fastest input belt after LO and its limit bit: the belt's ceiling; with a
-    look-ahead margin ``m`` > 0 also the fastest the robot can follow, since the part aimed at
-    B ``m`` after the robot is back may reach B early, while the belt still runs at this speed
-    (the module's text): the part then comes later, and the robot waits for it."""
+def late_speed_cap(k: CellConstants, m: float, flags: int) -> tuple[float, int]:
+    """Step 3.1's fastest input belt after LO, and ``flags`` with the limit it hits: the belt's
+    ceiling; with a look-ahead margin ``m`` > 0 also the fastest the robot can follow, since the
+    part aimed at B ``m`` after the robot is back may reach B early, while the belt still runs at
+    this speed (the module's text): the part then comes later, and the robot waits for it."""
     track = k.timing.input_track_max_in_s
     if m > 0.0 and track < k.input_max:
-        return track, INPUT_TRACKING
-    return k.input_max, INPUT_CEILING
+        return track, flags | INPUT_TRACKING
+    return k.input_max, flags | INPUT_CEILING
 
 
 def aim_early(k: CellConstants, nxt: tuple[float, float], v: float, r2: float, r4: float,
