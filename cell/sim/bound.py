@@ -28,12 +28,13 @@ if TYPE_CHECKING:
 
 
 def fastest_possible_cycle(k: CellConstants) -> float:
-    """The shortest B → B cycle the robot can run: R II and R IV at the motors' peak, both
-    tracking regimes at the fastest belt speed the robot can follow (and the belt give)."""
+    """The shortest B → B cycle the robot can run: what a cycle may take
+    (:meth:`~cell.sim.robot.RobotTiming.shortest_parts`, which the plan check reads too) with
+    both belts at the fastest speed the robot can follow (and the belt give).  The check holds
+    the output belt at its nominal speed from G; the bound does not lean on that, so it holds
+    for a controller that ran the output belt as fast as the robot can follow."""
     t = k.timing
-    r1a, r1b = t.r1_time(min(t.input_track_max_in_s, k.input_max))
-    r3a, r3b = t.r3_time(min(t.output_track_max_in_s, k.output_max))
-    return r1a + r1b + t.r2_min_s + r3a + r3b + t.r4_min_s
+    return sum(t.shortest_parts(*t.fastest_followed(k.input_max, k.output_max)))
 
 
 def greedy_picks(come_s: Sequence[float] | Array, length_in: float, v_min: float, v_max: float,

@@ -17,7 +17,17 @@ import simpy
 from cell.plumbing.errors import CellError
 from cell.sim.conveyors import EPS_S, InputConveyor, OutputConveyor
 from cell.sim.policies.base import CellConstants, Policy
-from cell.sim.policies.check import ALL_LIMITS, MAX_S, SUM_S, plan_bounds, plan_failed, refuse
+from cell.sim.policies.check import (
+    ABS,
+    ALL_LIMITS,
+    MAX_S,
+    REL,
+    SUM_S,
+    plan_bounds,
+    plan_failed,
+    refuse,
+    tracking_floors,
+)
 from cell.sim.records import Part
 from cell.sim.robot import Robot
 from cell.sim.sensor import Sensor
@@ -150,12 +160,11 @@ class Controller:
         adaptive run 122.5k to 118.4k instructions per part, cachegrind (20,000 parts)."""
         robot, view, plan_for = self.robot, self.view, self.policy.plan
         replan_in, replan_out, u_nom = self.conveyor.replan, self.output.replan, self.k.u_nom
-        replan_out_floor, u_min = self.output.replan_then, self.k.output_min
-        aim = self.k.lookahead_margin_s  # step 6.3 from when the next part is aimed at B
+        replan_out_floor, u_min, aim = self.output.replan_then, self.k.output_min, self.k.lookahead_margin_s
         floor_after_td = math.nan  # the last planned TD (the spacing contract; nan: none)
         a1, a2, a3, a4, a5, a6, c1, d1, c2, d2, c3, d3, c4, d4 = plan_bounds(self.k)
         bad_bits, top, eps, name, passed = ~ALL_LIMITS, MAX_S, SUM_S, self.name, None
-        get, flag, order = self.conveyor.at_bot.get, self.log.flag, robot.order
+        get, flag, order, r1 = self.conveyor.at_bot.get, self.log.flag, robot.order, tracking_floors(self.k)
         while True:
             part: Part = yield get()
             now = part.at_bot_s  # env.now: the part is taken the instant it reaches B
@@ -183,7 +192,8 @@ class Controller:
                             and w_next <= d3 and c4 <= u and u <= d4 and -eps <= off_g and off_g <= eps
                             and -eps <= off_b and off_b <= eps and cycle < top and limits.__class__ is int
                             and not limits & bad_bits and steers.__class__ is bool
-                            and floor_at >= to_g + r3a - eps):
+                            and floor_at >= to_g + r3a - eps  # and R I at the belt's pace (v checked):
+                            and (f := r1(v))[0] - ABS - REL * f[0] <= r1a and f[1] - ABS - REL * f[1] <= r1b):
                         passed = plan
                 except Exception:  # noqa: BLE001 - a field missing or not a number: said below
                     pass
@@ -191,7 +201,7 @@ class Controller:
                     refuse(plan, name, self.k)
                     passed = plan
             if steers:
-                replan_in(now + r1a, w, now + cycle + aim, w_next)
+                replan_in(now + r1a, w, now + cycle + aim, w_next)  # 6.3 as the next part is aimed at B
                 if floor_at < INF:  # the spacing contract: the belt's floor after TD
                     at_g = now + to_g
                     replan_out_floor(now, u, at_g, u_nom, now + floor_at, u_min)

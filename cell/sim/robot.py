@@ -10,10 +10,17 @@ with no per-move work while the simulation runs.
 The tracking regimes (R I, R III) are timed against the belt, not along the
 path: a move's "length" there is the belt's travel during it (the path divides
 the belt equally, §4.2), so at belt speed v the robot keeps up with the part
-unless a joint cannot.  Before LO (and before TD) the robot must keep up; the
-grasp (release) move that ends at LO (TD) changes the hand's length (eq. 6.2)
-and may take longer than the belt's pace; after LO (TD) the hand is off the belt
-and the move times are only floored by the motors (§4.3 c).
+unless a joint cannot.  The grasp (release) move that ends at LO (TD) changes the
+hand's length (eq. 6.2) and may take longer than the belt's pace.
+
+What a cycle may take is stated once, here (:meth:`RobotTiming.shortest_parts`,
+docs/model.md "What a cycle may take"), and read by the plan check
+(:mod:`cell.sim.policies.check`, the controller's inline copy included) and by the
+bound on any controller (:mod:`cell.sim.bound`): R I and R III keep their belt's
+pace over the whole window, B → F and G → K (the thesis's R III, 4.0 s at 2 in/s,
+tracks the output belt to K), at a belt speed no faster than the robot can follow
+(the tracking limit), each move floored by its slowest joint at peak rate; R II and
+R IV are at least their fastest.
 """
 
 from __future__ import annotations
@@ -70,6 +77,22 @@ class RobotTiming:
     def r3_time(self, u: float) -> tuple[float, float]:
         """(G → TD, TD → K) times tracking an output belt at u."""
         return self.r3_pre.time(u), self.r3_post.time(u)
+
+    def shortest_parts(self, v: float, u: float) -> tuple[float, float, float, float, float, float]:
+        """What a cycle may take: the shortest B → LO, LO → F, R II, G → TD, TD → K and R IV with
+        the input belt at ``v`` while R I follows it and the output belt at ``u`` while R III
+        does, each no faster than the robot can follow (:meth:`fastest_followed`).  A tracking
+        regime keeps its belt's pace from the window's start to its end (B → F, G → K), every
+        move at least its belt travel over the belt's speed and at least its slowest joint's
+        time at peak rate; R II and R IV at the motors' peak (the module's text)."""
+        r1a, r1b = self.r1_time(v)
+        r3a, r3b = self.r3_time(u)
+        return r1a, r1b, self.r2_min_s, r3a, r3b, self.r4_min_s
+
+    def fastest_followed(self, input_max: float, output_max: float) -> tuple[float, float]:
+        """The fastest input and output belt speeds the robot can follow: each belt's tracking
+        limit, or its ceiling (``input_max``, ``output_max``) where that is lower."""
+        return min(self.input_track_max_in_s, input_max), min(self.output_track_max_in_s, output_max)
 
 
 def build_timing(t: StepTable, fastest: dict[str, float] | None = None) -> RobotTiming:

@@ -74,7 +74,7 @@ def plans(draw, k):
 @given(data=st.data())
 def test_a_run_stops_exactly_when_problem_finds_something(scenario, k, data):
     plan = data.draw(plans(k))
-    why = problem(plan, _bounds(k))
+    why = problem(plan, k)
     _Planned.planned = plan
     if why is None:
         simulate(scenario, keep_parts=False, keep_belts=False)

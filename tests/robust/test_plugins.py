@@ -91,19 +91,13 @@ def _run(tmp_path, capsys, policy=NAME):
 @pytest.mark.parametrize("field,what", CASES)
 def test_a_bad_value_in_any_field_stops_the_run_naming_policy_and_field(field, what, k):
     values = _bad_values(k, field)
-    why = problem(_plain(_good(k), **{field: values[what]}), _bounds(k))
+    why = problem(_plain(_good(k), **{field: values[what]}), k)
     assert why is not None and why.startswith(f"{field} ="), why
 
 
-def _bounds(k):
-    from cell.sim.policies.check import _bounds as bounds
-
-    return bounds(k)
-
-
 def test_the_built_in_plans_pass(k):
-    assert problem(_good(k), _bounds(k)) is None
-    assert problem(_plain(_good(k)), _bounds(k)) is None
+    assert problem(_good(k), k) is None
+    assert problem(_plain(_good(k)), k) is None
 
 
 # one a check: a regime time, a belt command, the cycle (each field's values: the test above)

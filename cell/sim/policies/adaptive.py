@@ -7,7 +7,9 @@ One part ahead:
      nominal R I time is given to (2.1) or taken from (2.2) R II, so the cycle
      stays at the ideal 22.5872 s unless R II is already at its fastest;
 3.1  next part late: after the tracking lag (B → LO) the input belt speeds up so
-     that the part reaches B as the robot gets back;
+     that the part reaches B as the robot gets back (with a look-ahead margin, a part
+     may reach B early, before the belt's change at the margin's end: then no faster
+     than the robot can follow, and the part comes later, the robot waiting for it);
 3.2  next part early: the time is made up in R IV down to the base's maximum rate,
      then the input belt slows for the rest;
 5.0  the output belt runs, until the robot reaches G, at the average of the
@@ -95,8 +97,8 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
         m = k.lookahead_margin_s  # the next part aimed at B this long after the robot is back
         if a + b / v > cycle + m:
             w = b / (cycle + m - a) if cycle + m > a else math.inf
-            if w > k.input_max:
-                w, flags = k.input_max, flags | INPUT_CEILING
+            if w > k.input_max or (m > 0.0 and w > t.input_track_max_in_s):
+                w, flags = late_speed_cap(k, m, flags)
         else:  # early (3.2) or on time
             w, r2, r4, cycle, flags = aim_early(k, nxt, v, r2, r4, cycle, flags)
     # 6.3: decay toward nominal after the cycle; departure: never below what R II absorbs.
@@ -129,6 +131,17 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
     plan.to_g, plan.cycle, plan.limits, plan.steers_belts, plan.output_floor_at = \
         ttsot, cycle, flags, True, floor
     return plan
+
+
+def late_speed_cap(k: CellConstants, m: float, flags: int) -> tuple[float, int]:
+    """Step 3.1's fastest input belt after LO, and ``flags`` with the limit it hits: the belt's
+    ceiling; with a look-ahead margin ``m`` > 0 also the fastest the robot can follow, since the
+    part aimed at B ``m`` after the robot is back may reach B early, while the belt still runs at
+    this speed (the module's text): the part then comes later, and the robot waits for it."""
+    track = k.timing.input_track_max_in_s
+    if m > 0.0 and track < k.input_max:
+        return track, flags | INPUT_TRACKING
+    return k.input_max, flags | INPUT_CEILING
 
 
 def aim_early(k: CellConstants, nxt: tuple[float, float], v: float, r2: float, r4: float,

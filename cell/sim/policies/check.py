@@ -5,11 +5,16 @@ regime times and belt speeds of one cycle.  The controller checks each plan the 
 gets it (:class:`cell.sim.controller.Controller`, with :func:`plan_bounds`), so that each plan
 must obey the same physics the built-in policies do before the cell acts on it:
 
-* every regime time finite and no shorter than the motors allow (the floors of
-  :class:`~cell.sim.robot.RobotTiming`: each segment's ``floor_s``, R II's and R IV's fastest);
+* every regime time finite and no shorter than what a cycle may take
+  (:meth:`~cell.sim.robot.RobotTiming.shortest_parts`, the one statement of it, which the
+  bound on any controller reads too: :mod:`cell.sim.bound`): R I at the pace of the input belt
+  the part reached B on (``input_speed``) from B to F, R III at the pace of the output belt
+  from G to K (nominal: the controller sets it so at G), each move floored by the motors; R II
+  and R IV at least their fastest;
 * every belt speed finite and within the belt's floor and ceiling (``belts.input_min_in_s``
-  .. ``belts.input_max_in_s``, the output belt's likewise; the input belt after the cycle
-  also within the speed the robot can track);
+  .. ``belts.input_max_in_s``, the output belt's likewise); the input belt at the pick
+  (``input_speed``) and after the cycle (``input_next``) also no faster than the robot can
+  follow (the tracking limit: 4.3693 in/s in the thesis's cell);
 * the cycle consistent with its parts: ``to_g`` = R I + R II and ``cycle`` = ``to_g`` +
   R III + R IV;
 * ``limits`` a set of the known limit bits, ``steers_belts`` a boolean;
@@ -69,20 +74,37 @@ class PolicyError(CellError):
 
 
 def _bounds(k: Any) -> dict[str, tuple[float, float]]:
-    """Each numeric field's (lowest, highest) allowed value for constants ``k``."""
+    """Each numeric field's (lowest, highest) allowed value for constants ``k``, whatever the
+    plan's other fields: R I's floors here are at the fastest input belt the robot can follow
+    (:func:`tracking_floors` ties them to the plan's own ``input_speed``), R III's at the output
+    belt's nominal speed, which it runs at from G."""
     t = k.timing
     inf = math.inf
     top_in = max(k.input_max, k.v_nom)
+    followed, _ = t.fastest_followed(top_in, k.output_max)
+    r1a, r1b, r2, r3a, r3b, r4 = t.shortest_parts(followed, k.u_nom)
     return {
-        "r1_pre": (t.r1_pre.floor_s, inf), "r1_post": (t.r1_post.floor_s, inf),
-        "r2": (t.r2_min_s, inf), "r3_pre": (t.r3_pre.floor_s, inf),
-        "r3_post": (t.r3_post.floor_s, inf), "r4": (t.r4_min_s, inf),
-        "input_speed": (min(k.input_min, k.v_nom), max(top_in, t.input_track_max_in_s)),
+        "r1_pre": (r1a, inf), "r1_post": (r1b, inf), "r2": (r2, inf), "r3_pre": (r3a, inf),
+        "r3_post": (r3b, inf), "r4": (r4, inf),
+        "input_speed": (min(k.input_min, k.v_nom), followed),
         "input_after_lo": (min(k.input_min, k.v_nom), top_in),
-        "input_next": (min(k.input_min, k.v_nom),
-                       max(min(top_in, t.input_track_max_in_s), k.input_absorb)),
+        "input_next": (min(k.input_min, k.v_nom), max(followed, k.input_absorb)),
         "output_to_g": (min(k.output_min, k.u_nom), max(k.output_max, k.u_nom)),
     }
+
+
+def tracking_floors(k: Any) -> Any:
+    """What R I may take at the input belt's speed v: (B → LO, LO → F), the shortest at that
+    belt's pace (:meth:`~cell.sim.robot.RobotTiming.shortest_parts`' first two)."""
+    return k.timing.r1_time
+
+
+#: What each regime time's lowest bound is, for a message.
+_FLOOR_WORDS = {"r1_pre": "its shortest at the fastest input belt the robot can follow",
+                "r1_post": "its shortest at the fastest input belt the robot can follow",
+                "r2": "the motors' fastest", "r4": "the motors' fastest",
+                "r3_pre": "its shortest following the output belt at its nominal speed",
+                "r3_post": "its shortest following the output belt at its nominal speed"}
 
 
 def _float(v: float) -> float:
@@ -104,10 +126,11 @@ def _near(a: float, b: float) -> bool:
     return abs(a - b) <= SUM_S
 
 
-def problem(plan: Any, bounds: dict[str, tuple[float, float]]) -> str | None:
-    """What is wrong with ``plan`` (the first bad value, as a phrase), or None."""
+def problem(plan: Any, k: Any) -> str | None:
+    """What is wrong with ``plan`` for constants ``k`` (the first bad value, as a phrase), or
+    None."""
     values: dict[str, float] = {}
-    for name, (lo, hi) in bounds.items():
+    for name, (lo, hi) in _bounds(k).items():
         try:
             v = getattr(plan, name)
         except AttributeError:
@@ -119,11 +142,18 @@ def problem(plan: Any, bounds: dict[str, tuple[float, float]]) -> str | None:
             return f"{name} = {_shown(given) if isinstance(given, int) else v}: not finite"
         unit = "s" if name in TIMES else "in/s"
         if v < lo - ABS - REL * abs(lo):
-            what = "the motors' fastest" if name in TIMES else "the belt's floor"
+            what = _FLOOR_WORDS[name] if name in TIMES else "the belt's floor"
             return f"{name} = {v:.6g} {unit}: below {what}, {lo:.6g} {unit}"
         if v > hi + ABS + REL * abs(hi):
-            return f"{name} = {v:.6g} {unit}: above the belt's ceiling, {hi:.6g} {unit}"
+            what = "the fastest the robot can follow" if name in ("input_speed", "input_next") \
+                else "the belt's ceiling"
+            return f"{name} = {v:.6g} {unit}: above {what}, {hi:.6g} {unit}"
         values[name] = v
+    speed = values["input_speed"]
+    for name, lo in zip(("r1_pre", "r1_post"), tracking_floors(k)(speed)):
+        if values[name] < lo - ABS - REL * abs(lo):
+            return f"{name} = {values[name]:.6g} s: below its shortest at the input belt's " \
+                f"{speed:.6g} in/s, {lo:.6g} s"
     for name in ("to_g", "cycle", "limits", "steers_belts"):
         if not hasattr(plan, name):
             return f"the plan has no field {name!r}"
@@ -164,7 +194,8 @@ def _floor_problem(plan: Any, td: float) -> str | None:
 def plan_bounds(k: Any) -> tuple[float, ...]:
     """The check's bounds for constants ``k``, the slack baked in: the six regime times'
     floors (R I before and after LO, R II, R III before and after TD, R IV), then each belt
-    speed's floor and ceiling (:data:`SPEEDS`' order)."""
+    speed's floor and ceiling (:data:`SPEEDS`' order).  R I's floors at the plan's own input
+    speed are :func:`tracking_floors`' (the slack baked in as here: ``lo - ABS - REL * lo``)."""
     out: list[float] = []
     for name, (lo, hi) in _bounds(k).items():
         out.append(lo - ABS - REL * abs(lo))
@@ -182,7 +213,7 @@ def plan_failed(name: str, exc: Exception) -> PolicyError:
 def refuse(plan: Any, name: str, k: Any) -> None:
     """Raise :class:`PolicyError` naming the first bad value of a plan the controller's check
     did not pass (and return if :func:`problem` finds nothing after all)."""
-    why = problem(plan, _bounds(k))
+    why = problem(plan, k)
     if why is not None:
         raise PolicyError(f"policy {name!r} planned {why}")
 
