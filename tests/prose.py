@@ -4,7 +4,8 @@
 constant, or the literal parts of an f-string put together, longer than 40 characters with a space in it, in
 the test expression of an ``assert`` (not its message).  A test function is a ``test_*``
 function of a ``test_*.py`` module, or a ``test_*`` method of a ``Test*`` class there; a
-parametrised function counts once.  ``error_parts`` splits the one line ``cell`` prints for bad
+parametrised function counts once.  ``in_order`` asserts the parts of a message in
+their order; ``error_parts`` splits the one line ``cell`` prints for bad
 input, so that a test can assert the file, key and value it names rather than its sentence.
 """
 
@@ -60,6 +61,18 @@ def prose_tests(root: Path = TESTS) -> tuple[list[str], int]:
             if phrases(function):
                 offenders.append(f"{path.relative_to(root)}::{function.name}")
     return offenders, total
+
+
+def in_order(text: str, *parts: str) -> bool:
+    """Whether ``text`` holds each of ``parts`` (the keys, values and numbers a message is
+    for), one after the other."""
+    at = 0
+    for part in parts:
+        at = text.find(part, at)
+        if at < 0:
+            return False
+        at += len(part)
+    return True
 
 
 class ErrorLine(NamedTuple):
