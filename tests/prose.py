@@ -1,12 +1,13 @@
 """What the tests hold of a message: its parts (file, key, value) and the phrases they assert.
 
 ``prose_tests`` counts the test functions whose assertions hold a phrase (issue 31): a string
-constant, or the literal parts of an f-string put together, longer than 40 characters with a space in it, in
-the test expression of an ``assert`` (not its message).  A test function is a ``test_*``
-function of a ``test_*.py`` module, or a ``test_*`` method of a ``Test*`` class there; a
-parametrised function counts once.  ``in_order`` asserts the parts of a message in
-their order; ``error_parts`` splits the one line ``cell`` prints for bad
-input, so that a test can assert the file, key and value it names rather than its sentence.
+constant, or the literal parts of an f-string put together, longer than 40 characters with a
+space in it, in the test expression of an ``assert`` (not its message).  A test function is
+one pytest collects: a ``test*`` function of a ``test_*.py`` module, or a ``test*`` method of
+a ``Test*`` class there; a parametrised function counts once.  ``in_order`` asserts the parts
+of a message (its keys, values, numbers) in their order; ``error_parts`` splits the one line
+``cell`` prints for bad input, so that a test can assert the file, key and value it names
+rather than its sentence.  ``python -m tests.prose`` lists the functions it counts.
 """
 
 from __future__ import annotations
@@ -84,7 +85,8 @@ class ErrorLine(NamedTuple):
     why: str
 
 
-_ERROR = re.compile(r"^(?:cell: )?(?:error: )?(?P<file>.*?): (?P<key>[\w.\[\]-]+) = (?P<value>.*?): (?P<why>.*)$")
+_ERROR = re.compile(r"^(?:cell: )?(?:error: )?(?P<file>.*?): (?P<key>[\w.\[\]-]+) = "
+                    r"(?P<value>.*?): (?P<why>.*)$")
 
 
 def error_parts(line: str) -> ErrorLine:
