@@ -14,6 +14,7 @@ from cell.cli.main import main
 from cell.scenario.catalog import BUILT_IN as SCENARIOS
 from cell.scenario.schema import load_scenario
 from cell.sim.scenario_values import geometry_of, motors_of, planner_bounds
+from tests.prose import in_order
 
 BASELINE = SCENARIOS / "baseline.yaml"
 
@@ -160,7 +161,7 @@ def test_acceleration_bounds_switched_off_make_their_values_a_warning(tmp_path, 
     tiny = "mintime.qddot_max_rad_s2=[1e-9, 1e-9, 1e-9, 1e-9, 1e-9]"
     assert main(["mintime", "baseline", "--set", tiny, "--out", str(tmp_path / "a")]) == 0
     err = capsys.readouterr().err
-    assert "mintime.qddot_max_rad_s2 ([1e-09, 1e-09, 1e-09, 1e-09, 1e-09]) has no effect" in err
+    assert in_order(err, "warning: mintime.qddot_max_rad_s2", f"({[1e-9] * 5})", "no effect")
     assert main(["mintime", "baseline", "--out", str(tmp_path / "b")]) == 0
     assert "warning" not in capsys.readouterr().err
     a, b = (json.loads((tmp_path / d / "summary.json").read_text()) for d in "ab")

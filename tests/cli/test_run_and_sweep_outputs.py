@@ -85,7 +85,8 @@ def test_a_usage_error_points_to_the_subcommands_help_once(capsys):
     assert main(["sweep", "x", "--out", "y", "--frobnicate"]) == 2
     err = capsys.readouterr().err.strip()
     # every refusal opens "cell: error: "; the subcommand is named once, with its own --help
-    assert err == "cell: error: sweep: unrecognized arguments: --frobnicate (see cell sweep --help)"
+    assert "\n" not in err and err.startswith("cell: error: sweep: ") and "--frobnicate" in err
+    assert err.endswith("(see cell sweep --help)") and err.count("sweep") == 2
 
 
 def test_a_heavy_part_refused_names_the_belt_speed_key(tmp_path, capsys):

@@ -24,6 +24,7 @@ from cell.experiments.fit_budget import MAX_FIT_VALUES, OutOfTime, subsample, ti
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.schema import load_scenario
 from cell.scenario.trace_file import cells_of, find_column, records
+from tests.prose import in_order
 
 
 def parse(*argv: str) -> argparse.Namespace:
@@ -58,8 +59,7 @@ def test_a_family_past_its_budget_is_left_out_with_a_line(small: Path, capsys):
 def test_no_family_within_its_budget_is_one_line_naming_it(small: Path):
     with pytest.raises(ScenarioError) as err:
         cmd_fit(parse(str(small), "--families", "studentized_range", "--budget", "0.2"))
-    assert err.value.why.startswith("no family could be fitted: studentized_range: its fit took more "
-                                    "than the 0.2 s budget")
+    assert in_order(err.value.why, "no family", "studentized_range", "the 0.2 s budget")
 
 
 def test_the_budget_timer_puts_back_the_handler_and_a_running_timer() -> None:
@@ -102,8 +102,8 @@ def test_a_long_trace_is_fitted_on_a_seeded_subsample(tmp_path: Path, capsys):
     out = tmp_path / "arrivals.yaml"
     assert cmd_fit(parse(str(gaps_csv(tmp_path / "long.csv", x)), "--families", "expon,gamma",
                          "--out", str(out))) == 0
-    assert f"fitted to 5,000 of the {x.size:,} values, drawn at random with a fixed seed" in \
-        " ".join(out.read_text().split())
+    assert in_order(" ".join(out.read_text().split()), f"fitted to {MAX_FIT_VALUES:,} of the {x.size:,}",
+                    "fixed seed")
     capsys.readouterr()
 
 
@@ -148,9 +148,7 @@ def test_a_family_without_a_finite_mean_is_refused_and_nothing_written(small: Pa
     out = small.parent / "arrivals.yaml"
     with pytest.raises(ScenarioError) as err:
         cmd_fit(parse(str(small), "--families", family, "--out", str(out)))
-    assert (err.value.key, err.value.why) == ("--families", f"no fitted family gives times a scenario "
-                                                            f"accepts (non-negative, with a finite positive "
-                                                            f"mean): {family}: {why}")
+    assert err.value.key == "--families" and err.value.why.endswith(f": {family}: {why}")
     assert sorted(p.name for p in small.parent.iterdir()) == ["gaps.csv"]
 
 
@@ -167,9 +165,7 @@ def test_truncpareto_on_a_small_sample_is_refused_by_the_scenario_check(small: P
     digits the block rounds away, and a scenario holding the block refuses it."""
     with pytest.raises(ScenarioError) as err:
         cmd_fit(parse(str(small), "--families", "truncpareto"))
-    assert err.value.why == ("no fitted family gives times a scenario accepts (non-negative, with a finite "
-                             "positive mean): truncpareto: arrivals.params refused: inter-arrival times must "
-                             "be non-negative with a finite, positive mean")
+    assert in_order(err.value.why, "no fitted family", ": truncpareto: arrivals.params refused")
 
 
 def test_every_candidate_is_validated_as_a_scenario_before_one_is_written(small: Path, monkeypatch, capsys):

@@ -65,9 +65,9 @@ def test_resume_after_a_file_the_sweep_reads_changed_is_refused_naming_it(sweeps
     before = files(tmp_path / "o")
     with pytest.raises(CellError) as refused:
         sweep_into(path, Path("o"), sweeps, resume=True)
-    assert str(refused.value) == (f"--out o (--resume): holds the results of this sweep (s4) as "
-                                  f"it was before {name} changed: choose another --out or "
-                                  "remove it")
+    message = str(refused.value)  # the folder, the sweep, the file that changed, the way out
+    assert message.startswith("--out o (--resume): ") and "(s4)" in message
+    assert f" {name} changed" in message and "another --out" in message
     assert files(tmp_path / "o") == before
 
 
@@ -110,8 +110,8 @@ def test_another_sweeps_results_are_refused_and_kept(sweeps, tmp_path, capsys):
     path = sweeps.write(other, name="second", seed=99)
     assert main(["sweep", str(path), "--out", str(tmp_path / "o"), "--workers", "1"]) == 2
     err = capsys.readouterr().err.splitlines()
-    assert err == [f"cell: error: --out {tmp_path / 'o'}: holds the results of another sweep "
-                   "(first): choose another --out or remove it"]
+    assert len(err) == 1 and err[0].startswith(f"cell: error: --out {tmp_path / 'o'}: ")
+    assert "another sweep (first)" in err[0] and "another --out" in err[0]
     assert files(tmp_path / "o") == before
 
 
@@ -122,9 +122,9 @@ def test_unfinished_tasks_of_this_sweep_want_resume(sweeps, tmp_path, capsys):
                   replicate=sweeps.Interrupt(after=4, of=sweeps.first_draw))
     before = files(tmp_path / "o")
     assert main(["sweep", str(path), "--out", str(tmp_path / "o"), "--workers", "1"]) == 2
-    assert capsys.readouterr().err == (f"cell: error: --out {tmp_path / 'o'}: holds 2 finished "
-                                       "tasks of this sweep: add --resume to go on, or remove "
-                                       "the folder\n")
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith(f"cell: error: --out {tmp_path / 'o'}: ")
+    assert "2 finished tasks" in err and "--resume" in err
     assert files(tmp_path / "o") == before
 
 
@@ -144,8 +144,8 @@ def test_a_second_sweep_into_a_locked_folder_is_refused(sweeps, tmp_path, capsys
         assert (out / LOCK).read_text().split()[0] == str(os.getpid())
         code = main(["sweep", str(sweeps.write(tmp_path)), "--out", str(out), "--workers", "1"])
         err = capsys.readouterr().err
-        assert code == 2 and err.startswith(f"cell: error: --out {out}: another sweep is running "
-                                            f"into it (process {os.getpid()} on ")
+        assert code == 2 and err.startswith(f"cell: error: --out {out}: ")
+        assert "another sweep" in err and f"(process {os.getpid()} on " in err
         assert err.count("\n") == 1
     assert not out.exists()  # made for the lock, and left empty: removed
 
@@ -169,9 +169,9 @@ def test_a_key_both_set_and_varied_is_refused(sweeps, tmp_path):
                         grid={"belts.input_nominal_in_s": [2, 3]})
     with pytest.raises(ScenarioError) as refused:
         load_sweep(path)
-    assert str(refused.value) == (f"{path}: set.belts.input_nominal_in_s = 4: also varied in "
-                                  "'grid' (belts.input_nominal_in_s), whose values would "
-                                  "replace it; keep one")
+    error = refused.value
+    assert (error.file, error.key, error.value) == (str(path), "set.belts.input_nominal_in_s", 4)
+    assert "'grid'" in error.why
 
 
 def test_a_key_set_and_varied_under_a_policy_is_refused(sweeps, tmp_path):
@@ -212,7 +212,7 @@ def test_a_large_sweep_says_its_size_first(sweeps, tmp_path):
     assert size_note(small, 2) is None
     large = load_sweep(sweeps.write(tmp_path, replications=60_000))  # 3 points
     note = size_note(large, 2)
-    assert note.startswith("180,000 runs (3 points x 60,000 replications): roughly ")
+    assert note.startswith("180,000 runs ") and "(3 points x 60,000 replications)" in note
     assert "hours of one core, about " in note and "with 2 workers" in note
 
 
@@ -224,8 +224,7 @@ def test_an_auto_warmup_is_a_different_window_on_either_side(sweeps, tmp_path):
     assert pairs and all(pair_apart(sweep, p) == [("warmup_parts", "auto", "auto")]
                          for p in pairs)
     warned = window_warning(sweep)
-    assert warned.startswith(f"{len(pairs)} of {len(pairs)} paired comparisons are between "
-                             "points that run over different windows (run.warmup_parts auto "
-                             "against auto (auto: MSER-5 cuts each run's warm-up")
+    assert warned.startswith(f"{len(pairs)} of {len(pairs)} paired comparisons ")
+    assert "(run.warmup_parts auto against auto " in warned and "MSER-5" in warned
     fixed = load_sweep(sweeps.write(tmp_path, set={"run.parts": 30, "run.warmup_parts": 4}))
     assert window_warning(fixed) is None

@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 from cell.reporting import reliability as rel
+from tests.prose import in_order
 
 ROOT = Path(__file__).resolve().parents[2]
 REPORT = ROOT / "reports" / "reliability"
@@ -38,7 +39,8 @@ def test_the_verdict_and_where_it_flips() -> None:
     assert v["mtbf_ratio"].iloc[3] == pytest.approx(np.exp(-0.3))
     assert rel.flip_exponent(v) == pytest.approx(1.5)
     text = rel.headline(t)
-    assert "only for exponents 2, 3 (it flips at p ≈ 1.50)" in text
+    held = ", ".join(f"{p:g}" for p in v.loc[v["holds"], "wear_exponent"])  # 2, 3 (above)
+    assert in_order(text, f"exponents {held}", f"p ≈ {rel.flip_exponent(v):.2f}")
     assert f"{100 * (1 - np.exp(-0.3)):.0f} % shorter" in text
 
 

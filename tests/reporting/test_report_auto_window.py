@@ -8,6 +8,7 @@ import pandas as pd
 from cell.experiments.sweep import load_sweep, run_sweep
 from cell.reporting.experiment import difference_table, summary_table
 from cell.reporting.experiment_text import markdown
+from tests.prose import in_order
 
 
 def report(sweeps, tmp_path, **fields) -> tuple[str, pd.DataFrame]:
@@ -28,22 +29,22 @@ def test_all_auto_names_no_number_of_parts(sweeps, tmp_path):
                          grid={"belts.output_nominal_in_s": [1.8, 2.0]})
     assert frame["warmup_parts"].nunique() > 1  # the cuts really differ run by run
     assert "part run" not in text
-    assert headings(text) == ["## Parts delivered, per run, after the warm-up MSER-5 chose "
-                              "for it", "## Parts lost (wall clock), per run, after the warm-up "
-                              "MSER-5 chose for it"]
+    delivered, lost = headings(text)
+    assert delivered.startswith("## Parts delivered, per run,") and lost.startswith("## Parts lost")
+    assert all(in_order(h, "per run", "warm-up MSER-5 chose") for h in (delivered, lost))
 
 
 def test_some_auto_says_where_mser5_chose(sweeps, tmp_path):
     text, _ = report(sweeps, tmp_path, set={"run.parts": 40},
                      grid={"run.warmup_parts": [4, "auto"]})
     assert "part run" not in text
-    assert headings(text)[0] == ("## Parts delivered, per run, after its warm-up (chosen by "
-                                 "MSER-5 where it is auto)")
+    assert in_order(headings(text)[0], "## Parts delivered, per run,", "MSER-5", "where it is auto")
 
 
 def test_fixed_warmup_keeps_the_run_length(sweeps, tmp_path):
     text, _ = report(sweeps, tmp_path, set={"run.parts": 40, "run.warmup_parts": 4},
                      grid={"belts.output_nominal_in_s": [1.8, 2.0]})
-    assert headings(text)[0] == "## Parts delivered, per 40-part run"
-    assert headings(text)[1] == "## Parts lost (wall clock), per 40-part run"
+    delivered, lost = headings(text)
+    assert delivered.startswith("## Parts delivered") and lost.startswith("## Parts lost")
+    assert [h.split(", per ")[1] for h in (delivered, lost)] == ["40-part run"] * 2
     assert "after the warm-up" not in text and "MSER-5" not in text

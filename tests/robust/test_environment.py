@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from cell.scenario import catalog
+from tests.prose import in_order
 
 BASELINE = str(catalog.path("baseline"))
 RUN = ["run", BASELINE, "--set", "run.parts=20"]
@@ -57,8 +58,8 @@ def test_a_deleted_working_directory_is_one_line(tmp_path):
     p = subprocess.run(f"cd {gone} && rmdir {gone} && exec {sys.executable} -m cell run "
                        f"{BASELINE} --out o", shell=True, capture_output=True, text=True, timeout=300)
     assert p.returncode == 2
-    assert p.stderr.splitlines() == ["cell: error: the working directory is gone (no such file "
-                                     "or directory): cd into one that exists"]
+    (line,) = p.stderr.splitlines()
+    assert in_order(line, "cell: error: the working directory", "(no such file or directory)", "cd ")
     assert os.listdir(tmp_path) == []
 
 
@@ -98,9 +99,8 @@ def test_a_sweep_on_two_workers_under_twelve_open_files_is_one_line(tmp_path):
         assert (tmp_path / "o" / "replications.csv").is_file()
         return
     assert p.returncode == 2, p.stderr
-    assert p.stderr.splitlines()[-1] == ("cell: error: cell sweep: too many open files (this "
-                                         "process may open 12: raise it with ulimit -n, or use "
-                                         "fewer --workers)")
+    assert in_order(p.stderr.splitlines()[-1], "cell: error: cell sweep:", "too many open files",
+                    "may open 12", "ulimit -n", "--workers")
     assert os.listdir(tmp_path) == ["sweep.yaml"]
 
 

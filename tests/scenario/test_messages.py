@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 
 from cell.cli.main import main
+from tests.prose import in_order
 
 
 def refused(capsys: pytest.CaptureFixture[str], *argv: object) -> str:
@@ -21,7 +22,7 @@ def refused(capsys: pytest.CaptureFixture[str], *argv: object) -> str:
 def test_a_set_without_key_and_value_names_the_option_once(capsys, tmp_path: Path, pair):
     out = tmp_path / "out"
     line = refused(capsys, "run", "baseline", "--set", pair, "--out", out)
-    assert line == f"--set {pair!r}: expected KEY=VALUE, e.g. run.parts=100"
+    assert line.startswith(f"--set {pair!r}: ") and in_order(line, "KEY=VALUE", "run.parts=100")
     assert not out.exists()
 
 
@@ -49,15 +50,15 @@ def test_a_tab_in_the_indentation_is_called_a_tab(capsys, tmp_path: Path, text, 
     scenario = tmp_path / "s.yaml"
     scenario.write_text(text)
     line = refused(capsys, "run", scenario, "--out", tmp_path / "out")
-    assert line.endswith(f": invalid YAML at {where}: a tab: YAML indents with spaces only")
+    assert line.startswith(f"{scenario}: ") and in_order(line, f"YAML at {where}: a tab", "spaces")
 
 
 @pytest.mark.parametrize("argv, what", [
-    (["path", "baseline", "--out", "-"], "--out -: {} a file"),
-    (["run", "baseline", "--out", "-"], "--out -: {} a directory"),
-    (["compare", "baseline", "non_adaptive", "--out", "-"], "--out -: {} a directory"),
-    (["sweep", "table_7_1", "--out", "-"], "--out -: {} a directory"),
-    (["fit", "trace.csv", "--out", "-"], "--out -: {} a file"),
+    (["path", "baseline", "--out", "-"], "a file"),
+    (["run", "baseline", "--out", "-"], "a directory"),
+    (["compare", "baseline", "non_adaptive", "--out", "-"], "a directory"),
+    (["sweep", "table_7_1", "--out", "-"], "a directory"),
+    (["fit", "trace.csv", "--out", "-"], "a file"),
     (["fit", "trace.csv", "--out", "f.yaml", "--figure", "-"], None),  # the suffix, first
     (["path", "baseline", "--out", "./-"], None),  # a file named '-', asked for: written
 ])
@@ -71,7 +72,7 @@ def test_a_dash_for_an_output_is_refused_instead_of_writing_a_file_named_dash(
         return
     line = refused(capsys, *argv)
     if what is not None:
-        assert line == what.format("no cell command writes to standard output; name")
+        assert line.startswith("--out -: ") and in_order(line, "standard output", f"name {what}")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["trace.csv"]
 
 
@@ -83,6 +84,6 @@ def test_a_name_without_its_suffix_suggests_the_file_beside_it(capsys, tmp_path,
     monkeypatch.chdir(tmp_path)
     (tmp_path / f"slow_robot{suffix}").write_text("run: {parts: 3}\n")
     line = refused(capsys, command, "slow_robot", "--out", "out")
-    assert line == (f"slow_robot: (file) = 'slow_robot': no such {what} file; "
-                    f"did you mean slow_robot{suffix}?")
+    assert line.startswith("slow_robot: (file) = 'slow_robot': ")
+    assert in_order(line, f"no such {what} file", f"slow_robot{suffix}?")
     assert refused(capsys, command, "slow_robots", "--out", "out").endswith(f"no such {what} file")

@@ -9,6 +9,7 @@ from cell.plumbing.errors import ScenarioError
 from cell.scenario import catalog
 from cell.scenario.schema import WEIBULL_SHAPE, default_scenario, known_key, load_scenario, validate
 from cell.sim.physics_checks import step_table
+from tests.prose import error_parts
 
 
 def from_dict(raw, file="<dict>"):
@@ -84,7 +85,9 @@ def test_a_physics_error_from_a_set_value_also_says_so(tmp_path, capsys):
     code = main(["run", "baseline", "--set", "belts.input_nominal_in_s=1000", "--set",
                  "belts.input_max_in_s=1000", "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
-    assert code == 2 and "baseline.yaml (--set): belts.input_nominal_in_s = 1000.0" in err
+    line = error_parts(err.strip())
+    assert code == 2 and (line.key, line.value) == ("belts.input_nominal_in_s", "1000.0")
+    assert line.file.endswith("baseline.yaml (--set)")
     assert not (tmp_path / "o").exists()
 
 
