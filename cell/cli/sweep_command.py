@@ -105,10 +105,7 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
     from cell.scenario.overrides import parse_sets
 
     sweep = load_sweep(args.sweep, parse_sets(args.sets))
-    if args.select_best:
-        from cell.experiments.selection import check_sweep
-
-        check_sweep(sweep, args.select_best, args.goal)  # before anything runs or is written
+    _check_select(args, sweep)  # what the sweep file decides: before anything runs or is written
     check_owner(sweep, out, args.resume)  # no results of another sweep, nor this one's, lost
     target = None
     if args.report:
@@ -157,15 +154,20 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
     return 0
 
 
-def _check_select(args: argparse.Namespace) -> None:
+def _check_select(args: argparse.Namespace, sweep: Any = None) -> None:
     """Refuse a --select-best without its --delta (a finite number above 0), or a --pcs out
-    of range, before any work."""
+    of range, before any work; with the ``sweep`` loaded, what KN cannot do on it
+    (:func:`cell.experiments.selection.check_sweep`)."""
     import math
 
+    from cell.experiments.selection import check_sweep
     from cell.experiments.study import summary_measures
     from cell.plumbing.errors import CellError
 
     if args.select_best is None:
+        return
+    if sweep is not None:
+        check_sweep(sweep, args.select_best, args.goal)
         return
     if args.select_best not in summary_measures():
         raise CellError(f"--select-best {args.select_best}: no run reports it (a measure of the "

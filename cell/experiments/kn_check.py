@@ -93,7 +93,17 @@ def poisson_draw(means: np.ndarray | list[float], macro: int, seed: int) -> Draw
     return lambda r: np.random.default_rng((seed, r)).poisson(lam, size=(macro, len(lam)))
 
 
-def pool_draw(pool: np.ndarray, macro: int, seed: int) -> Draw:
-    """Replications drawn with replacement from ``pool`` (n, k), a whole row at a time, so
-    the systems keep their common random numbers; the pool's means are the true means."""
-    return lambda r: pool[np.random.default_rng((seed, r)).integers(len(pool), size=macro)]
+def pool_draw(pool: np.ndarray, macro: int, seed: int, common: bool = True) -> Draw:
+    """Replications drawn with replacement from ``pool`` (n, k), the pool's means being the
+    true means: whole rows, so the systems keep their common random numbers, or with
+    ``common=False`` each system's from a row of its own (systems whose counts do not move
+    together)."""
+    k = pool.shape[1]
+
+    def draw(r: int) -> np.ndarray:
+        rng = np.random.default_rng((seed, r))
+        if common:
+            return pool[rng.integers(len(pool), size=macro)]
+        return pool[rng.integers(len(pool), size=(macro, k)), np.arange(k)]
+
+    return draw
