@@ -11,7 +11,7 @@ WORKERS ?= 2
 export PYTHONDONTWRITEBYTECODE :=
 export PYTHONPYCACHEPREFIX := $(if $(filter /%,$(VENV)),$(VENV),$(CURDIR)/$(VENV))/pycache
 
-.PHONY: all venv test sweep sweep-mintime whatif stress sensor reliability figures animation bench lint clean optimize sensitivity
+.PHONY: all venv test sweep sweep-mintime whatif stress sensor reliability figures animation bench lint clean optimize sensitivity kn-check
 
 all: test
 
@@ -67,6 +67,10 @@ figures: $(STAMP)
 
 animation: $(STAMP)
 	$(PY) -m cell.reporting.animation reports/animation/both.gif
+
+# KN's probability of correct selection on count measures, over 2,000 problems a row (issue 35).
+kn-check: $(STAMP)
+	$(PY) -m cell.reporting.kn_report reports/kn
 
 bench: $(STAMP)
 	$(PY) -m cell bench --out reports/bench.json

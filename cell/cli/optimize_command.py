@@ -113,7 +113,9 @@ def write_results(study: Study, o: Any, out: Path, command: str) -> list[Path]:
         m, up = selection_measure(study)
         scen = [study.scenario({p.key: frame.loc[i, p.key] for p in study.params}) for i in picked]
         sel = select_scenarios(scen, m, up, s.delta, s.pcs, s.n0, s.max,
-                               lambda r: study.stream(r, SELECT_OFFSET))
+                               lambda r: study.stream(r, SELECT_OFFSET),
+                               labels=[label(study, frame.loc[i]) for i in picked],
+                               where=f"{study.source}: select.measure = {m}")
         names.insert(2, "selection.csv")
     imp = importances(study, o)
     fmt = float_formatter()

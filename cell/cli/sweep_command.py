@@ -105,6 +105,7 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
     from cell.scenario.overrides import parse_sets
 
     sweep = load_sweep(args.sweep, parse_sets(args.sets))
+    _check_select(args, sweep)  # what the sweep file decides: before anything runs or is written
     check_owner(sweep, out, args.resume)  # no results of another sweep, nor this one's, lost
     target = None
     if args.report:
@@ -153,19 +154,27 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
     return 0
 
 
-def _check_select(args: argparse.Namespace) -> None:
-    """Refuse a --select-best without its --delta, or a --pcs out of range, before any work."""
+def _check_select(args: argparse.Namespace, sweep: Any = None) -> None:
+    """Refuse a --select-best without its --delta (a finite number above 0), or a --pcs out
+    of range, before any work; with the ``sweep`` loaded, what KN cannot do on it
+    (:func:`cell.experiments.selection.check_sweep`)."""
+    import math
+
+    from cell.experiments.selection import check_sweep
     from cell.experiments.study import summary_measures
     from cell.plumbing.errors import CellError
 
     if args.select_best is None:
         return
+    if sweep is not None:
+        check_sweep(sweep, args.select_best, args.goal)
+        return
     if args.select_best not in summary_measures():
         raise CellError(f"--select-best {args.select_best}: no run reports it (a measure of the "
                         "run summary: parts_missed, parts_per_hr_wallclock, ...)")
-    if args.delta is None or not args.delta > 0:
+    if args.delta is None or not 0 < args.delta < math.inf:
         raise CellError(f"--delta {args.delta}: --select-best needs the indifference zone, a "
-                        "number above 0 in the measure's units")
+                        "finite number above 0 in the measure's units")
     if not 0.5 < args.pcs < 1:
         raise CellError(f"--pcs {args.pcs}: a probability between 0.5 and 1")
 

@@ -19,6 +19,20 @@ If the best mean is at least δ above every other, the survivor is the best with
 at least 1 - α; otherwise it is within δ of the best with that probability.  A budget
 ``max_n`` stops the procedure early; the survivors left then cannot be told apart.
 
+KN assumes normal observations: S²_il is then never 0 and is as sure as its n0 - 1 degrees
+of freedom make it, which is what h² is worked out for.  A count (parts missed, mostly 0)
+breaks that.  Two systems' first-stage difference is often the same in every replication:
+S²_il = 0, W_il = 0, and KN eliminates on the first difference, whichever system it falls
+on.  And a difference that departs from its most common value in only m of the n0
+replications gives an S²_il that is a count of m rare events: its relative spread is about
+1/√m, that of a normal sample variance on 2m degrees of freedom (a χ²_ν/ν has variance 2/ν),
+however large n0 is.  So (:func:`first_stage_df`): a first stage in which some pair's
+difference never varies is refused (:class:`FlatFirstStage`); otherwise h² is worked out for
+ν = min(n0 - 1, 2 m) degrees of freedom, m the fewest departures of any pair, as if the first
+stage were ν + 1 replications long.  A measure that varies continuously has m = n0 - 1 and
+is screened as KN has it.  ``make kn-check`` measures the probability of correct selection
+on counts with and without the rule (reports/kn/).
+
 :func:`screen` is the elimination step, vectorised over any leading axes (so 1,000
 macro-replications run at once in a test); :func:`kn` drives it for one problem, asking
 ``sample`` for each stage's observations of the survivors only.
@@ -52,13 +66,49 @@ def pair_variances(first: np.ndarray) -> np.ndarray:
     return np.asarray(diff.var(axis=-3, ddof=1))
 
 
-def screen(means: np.ndarray, s2: np.ndarray, alive: np.ndarray, r: int, h2: float,
-           delta: float) -> np.ndarray:
+def screen(means: np.ndarray, s2: np.ndarray, alive: np.ndarray, r: int,
+           h2: float | np.ndarray, delta: float) -> np.ndarray:
     """Who survives stage ``r``: ``means`` (..., k) after r replications, ``s2`` (..., k, k),
-    ``alive`` (..., k) booleans; larger is better."""
+    ``alive`` (..., k) booleans, ``h2`` a number or (..., 1, 1); larger is better."""
     w = np.maximum(0.0, delta / (2 * r) * (h2 * s2 / delta ** 2 - r))
     beaten = (means[..., :, None] < means[..., None, :] - w) & alive[..., None, :]
     return alive & ~beaten.any(axis=-1)
+
+
+def departures(first: np.ndarray) -> np.ndarray:
+    """m_il: in how many of the first stage's replications the difference X_i - X_l is not
+    its most common value; ``first`` is (..., n0, k), the result (..., k, k), n0 on the
+    diagonal.  n0 - 1 when no value repeats (a measure that varies continuously)."""
+    n0, k = first.shape[-2], first.shape[-1]
+    diff = first[..., :, :, None] - first[..., :, None, :]  # (..., n0, k, k)
+    same = (diff[..., :, None, :, :] == diff[..., None, :, :, :]).sum(axis=-3)
+    m = n0 - same.max(axis=-3)
+    return np.where(np.eye(k, dtype=bool), n0, m)
+
+
+def first_stage_df(first: np.ndarray) -> np.ndarray:
+    """The degrees of freedom the first stage's variances are worth, ν = min(n0 - 1, 2 m)
+    with m the fewest :func:`departures` of any pair: (...,) for ``first`` (..., n0, k).
+    0 means some pair's difference never varied: KN cannot screen it."""
+    n0 = first.shape[-2]
+    return np.minimum(n0 - 1, 2 * departures(first).min(axis=(-2, -1)))
+
+
+class FlatFirstStage(ValueError):
+    """Systems ``i`` and ``l`` differ by the same amount in all ``n0`` first-stage replications."""
+
+    def __init__(self, i: int, l: int, n0: int):
+        self.i, self.l, self.n0 = i, l, n0
+        super().__init__(f"systems {i} and {l} differ by the same amount in all {n0} "
+                         "first-stage replications")
+
+
+class NotANumber(ValueError):
+    """An observation is NaN or infinite: system ``i``, replication ``r``."""
+
+    def __init__(self, i: int, r: int, value: float):
+        self.i, self.r, self.value = i, r, value
+        super().__init__(f"system {i}, replication {r}: {value}")
 
 
 @dataclass(frozen=True)
@@ -93,18 +143,22 @@ class Selection:
 def kn(sample: Sample, k: int, delta: float, pcs: float = 0.95, n0: int = 10,
        maximize: bool = True, max_n: int = 1000) -> Selection:
     """Kim & Nelson's KN over ``k`` systems, replication ``r`` of each from ``sample``."""
-    if delta <= 0 or not 0 < pcs < 1 or n0 < 2 or max_n < n0:
+    if not 0 < delta < np.inf or not 0 < pcs < 1 or n0 < 2 or max_n < n0:
         raise ValueError(f"KN needs delta > 0, 0 < pcs < 1, 2 <= n0 <= max_n "
                          f"(delta={delta}, pcs={pcs}, n0={n0}, max_n={max_n})")
     sign = 1.0 if maximize else -1.0
     every = list(range(k))
     obs = np.full((max_n, k), np.nan)
     for r in range(n0):
-        obs[r] = sample(every, r)
+        obs[r] = _finite(sample(every, r), every, r)
     if k == 1:
         return Selection(0, (0,), (float(obs[:n0, 0].mean()),), (n0,), delta, pcs)
+    df = int(first_stage_df(obs[:n0]))
+    if df == 0:
+        i, l = (int(v) for v in np.argwhere(departures(obs[:n0]) == 0)[0])
+        raise FlatFirstStage(i, l, n0)
     s2 = pair_variances(sign * obs[:n0])
-    h2 = h_squared(k, 1 - pcs, n0)
+    h2 = h_squared(k, 1 - pcs, df + 1)
     alive = np.ones(k, dtype=bool)
     counts = np.full(k, n0)
     r = n0
@@ -112,9 +166,9 @@ def kn(sample: Sample, k: int, delta: float, pcs: float = 0.95, n0: int = 10,
         means = sign * obs[:r].sum(axis=0) / r
         alive = screen(means, s2, alive, r, h2, delta)
         live = np.flatnonzero(alive)
-        if len(live) == 1 or r == max_n or _all_tied(s2, live):
+        if len(live) == 1 or r == max_n:
             break
-        obs[r, live] = sample(live.tolist(), r)
+        obs[r, live] = _finite(sample(live.tolist(), r), live.tolist(), r)
         counts[live] += 1
         r += 1
     final = np.array([obs[:counts[i], i].mean() for i in every])
@@ -123,8 +177,9 @@ def kn(sample: Sample, k: int, delta: float, pcs: float = 0.95, n0: int = 10,
                      tuple(int(n) for n in counts), delta, pcs)
 
 
-def _all_tied(s2: np.ndarray, live: np.ndarray) -> bool:
-    """Whether the survivors' differences had no variance at all: equal under common random
-    numbers (a count that is 0 for all), so that no replication would ever part them."""
-    sub = s2[np.ix_(live, live)]
-    return bool(np.all(sub == 0))
+def _finite(values: Sequence[float], systems: Sequence[int], r: int) -> np.ndarray:
+    x = np.asarray(values, dtype=float)
+    bad = np.flatnonzero(~np.isfinite(x))
+    if len(bad):
+        raise NotANumber(systems[bad[0]], r, float(x[bad[0]]))
+    return x

@@ -14,7 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from cell.experiments.kn import Selection, kn
+from cell.experiments.kn import FlatFirstStage, NotANumber, Selection, kn
+from cell.plumbing.errors import CellError
 from cell.scenario.schema import Scenario
 
 Stream = Callable[[int], np.random.SeedSequence]
@@ -29,9 +30,14 @@ GOALS = {"parts_missed": "minimize", "parts_missed_pct": "minimize", "parts_miss
 
 def select_scenarios(scenarios: Sequence[Scenario], measure: str, maximize: bool, delta: float,
                      pcs: float, n0: int, max_n: int, stream: Stream,
-                     known: Mapping[int, Sequence[float]] | None = None) -> Selection:
+                     known: Mapping[int, Sequence[float]] | None = None,
+                     labels: Sequence[str] | None = None, where: str = "") -> Selection:
     """KN over ``scenarios`` on ``measure``: replication r of candidate i is ``known[i][r]``
-    where given, else a run of ``scenarios[i]`` on ``stream(r)`` (in this process)."""
+    where given, else a run of ``scenarios[i]`` on ``stream(r)`` (in this process).
+
+    A first stage KN cannot screen (:class:`cell.experiments.kn.FlatFirstStage`) or a run
+    whose measure is not a number is a :class:`CellError` whose line starts with ``where``
+    (the option or the study file's key) and names the candidates by ``labels``."""
     from cell.experiments.study import measures_of
     from cell.sim.assembly import assemble
     from cell.sim.simulation import simulate
@@ -48,8 +54,19 @@ def select_scenarios(scenarios: Sequence[Scenario], measure: str, maximize: bool
         row = simulate(cells[i], seed=stream(r), keep_parts=False, keep_belts=False).summary
         return measures_of(row.as_dict())[measure]
 
-    return kn(lambda systems, r: [one(i, r) for i in systems], len(scenarios), delta, pcs,
-              n0=n0, maximize=maximize, max_n=max_n)
+    names = list(labels) if labels is not None else [f"candidate {i}" for i in range(len(scenarios))]
+    try:
+        return kn(lambda systems, r: [one(i, r) for i in systems], len(scenarios), delta, pcs,
+                  n0=n0, maximize=maximize, max_n=max_n)
+    except FlatFirstStage as exc:
+        raise CellError(
+            f"{where}: {names[exc.i]} and {names[exc.l]} differ by the same {measure} in all "
+            f"{exc.n0} first-stage replications: KN scales its eliminations by that "
+            "difference's variance, here 0, and would decide on one replication's difference; "
+            "give more replications") from None
+    except NotANumber as exc:
+        raise CellError(f"{where}: {names[exc.i]}, replication {exc.r}: {measure} is {exc.value} "
+                        "(no run of it reports a number): KN cannot compare it") from None
 
 
 def verdicts(sel: Selection) -> list[str]:
@@ -85,6 +102,24 @@ def sentence(sel: Selection, labels: Sequence[str], measure: str) -> str:
     return text
 
 
+def check_sweep(sweep: Any, measure: str, goal: str | None) -> str:
+    """Refuse ``--select-best measure`` on ``sweep`` before it runs: a measure of no known
+    direction without ``goal``, fewer than 2 replications a point, or a measure that only a
+    policy the sweep does not run gives a value.  Returns the goal."""
+    from cell.experiments.study import unset_why
+
+    goal = goal or GOALS.get(measure)
+    if goal is None:
+        raise CellError(f"--select-best {measure}: say whether more or less is better "
+                        "(--goal maximize or --goal minimize)")
+    if sweep.first_round < 2:
+        raise CellError(f"--select-best {measure}: KN needs at least 2 replications of every "
+                        f"point (the sweep's replications: {sweep.first_round})")
+    if why := unset_why(measure, sweep.policies):
+        raise CellError(f"--select-best {measure}: {why}")
+    return goal
+
+
 def select_sweep(sweep: Any, replications: Any, measure: str, delta: float, pcs: float,
                  goal: str | None = None, max_n: int = 1000) -> tuple[Selection, list[str]]:
     """KN over a sweep's points on ``measure``: the replications ``replications.csv`` holds
@@ -92,12 +127,8 @@ def select_sweep(sweep: Any, replications: Any, measure: str, delta: float, pcs:
     sequence; more run on the sweep's own streams.  Returns the selection and the points'
     labels."""
     from cell.experiments.study import measures_of
-    from cell.plumbing.errors import CellError
 
-    goal = goal or GOALS.get(measure)
-    if goal is None:
-        raise CellError(f"--select-best {measure}: say whether more or less is better "
-                        "(--goal maximize or --goal minimize)")
+    goal = check_sweep(sweep, measure, goal)
     known: dict[int, list[float]] = {}
     labels: list[str] = []
     for i, p in enumerate(sweep.points):
@@ -109,8 +140,7 @@ def select_sweep(sweep: Any, replications: Any, measure: str, delta: float, pcs:
             known[i] = [measures_of(r)[measure] for r in rows.to_dict("records")]
         labels.append(", ".join([p.policy] + [f"{k} {p.name_of(k) or v}" for k, v in p.values]))
     n0 = min(len(v) for v in known.values())
-    if n0 < 2:
-        raise CellError(f"--select-best {measure}: KN needs at least 2 replications of every point")
     sel = select_scenarios([p.scenario for p in sweep.points], measure, goal == "maximize", delta,
-                           pcs, n0, max(max_n, n0), sweep.stream, known)
+                           pcs, n0, max(max_n, n0), sweep.stream, known,
+                           [f"'{label}'" for label in labels], f"--select-best {measure}")
     return sel, labels

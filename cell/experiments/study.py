@@ -79,8 +79,8 @@ class ObjectiveSettings(Section):
 class SelectSettings(Section):
     candidates: int = Field(5, ge=2)
     """How many of the best trials KN re-runs."""
-    delta: float = Field(gt=0)
-    """The indifference zone, in the measure's units."""
+    delta: float = Field(gt=0, allow_inf_nan=False)
+    """The indifference zone, in the measure's units (a finite number)."""
     pcs: float = Field(0.95, gt=0.5, lt=1)
     """The probability of correct selection asked."""
     n0: int = Field(10, ge=2)
@@ -230,10 +230,11 @@ def load_study(path: str | Path, corners: bool = True) -> Study:
         if m not in measures:
             raise ScenarioError(path, f"measures[{i}]", m, "no run reports it (a measure of the "
                                 "run summary: parts_missed, spacing_outside_tol, ...)")
-    if settings.select is not None and settings.select.measure is not None \
-            and settings.select.measure not in measures:
-        raise ScenarioError(path, "select.measure", settings.select.measure,
-                            "no run reports it: name a measure of the run summary")
+    if settings.select is not None and settings.select.measure is not None:
+        if settings.select.measure not in measures:
+            raise ScenarioError(path, "select.measure", settings.select.measure,
+                                "no run reports it: name a measure of the run summary")
+        _refuse_unset(study, "select.measure", settings.select.measure)
     return study
 
 
@@ -296,12 +297,18 @@ def _constraint(path: Path, i: int, text: Any, measures: Sequence[str]) -> Const
 
 
 def _refuse_unset(study: Study, where: str, measure: str) -> None:
+    if why := unset_why(measure, study.policies_run()):
+        raise ScenarioError(study.source, where, measure, why)
+
+
+def unset_why(measure: str, policies: Sequence[str]) -> str | None:
+    """Why no run of ``policies`` reports ``measure`` (NaN in every run: only a policy they
+    do not include gives it a value), or None."""
     givers = POLICY_MEASURES.get(measure)
-    policies = study.policies_run()
     if givers and not set(givers) & set(policies):
-        raise ScenarioError(study.source, where, measure, f"no run reports it: only "
-                            f"{' and '.join(givers)} gives it a value, and the study runs "
-                            f"{', '.join(policies)}")
+        return (f"no run reports it: only {' and '.join(givers)} gives it a value, and the "
+                f"runs are of {', '.join(policies)}")
+    return None
 
 
 def _check_corners(study: Study) -> None:

@@ -10,7 +10,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cell.experiments.kn import eta, h_squared, kn, pair_variances, screen
+from cell.experiments.kn import (
+    FlatFirstStage,
+    NotANumber,
+    eta,
+    first_stage_df,
+    h_squared,
+    kn,
+    pair_variances,
+    screen,
+)
+from cell.experiments.kn_check import macro_pcs, poisson_draw
 
 K, DELTA, SIGMA, N0, PCS = 5, 0.5, 1.0, 10, 0.95
 MACRO = 1000
@@ -66,12 +76,59 @@ def test_kn_driver_matches_the_vectorised_screen_and_minimises() -> None:
         assert rs == list(range(len(rs)))
 
 
-def test_tied_systems_stop_and_cannot_be_told_apart() -> None:
+def test_a_first_stage_that_never_varies_is_refused() -> None:
     """Two systems equal replication by replication (a count that common random numbers
-    make equal) never part: KN stops at once and names both."""
-    sel = kn(lambda systems, r: [0.0 for _ in systems], 3, delta=1.0, n0=5, max_n=50)
-    assert sel.survivors == (0, 1, 2) and sel.counts == (5, 5, 5)
-    assert set(sel.alike()) == {1, 2} - {sel.best} | ({0} if sel.best else set())
+    make equal): S² = 0 would make KN eliminate on the first difference; refused, naming
+    the pair, before any replication past the first stage."""
+    asked: list[int] = []
+
+    def sample(systems, r):
+        asked.append(r)
+        return [0.0, 0.0, float(r % 3)][:len(systems)]
+
+    with pytest.raises(FlatFirstStage) as caught:
+        kn(sample, 3, delta=1.0, n0=5, max_n=50)
+    assert (caught.value.i, caught.value.l, caught.value.n0) == (0, 1, 5)
+    assert max(asked) == 4
+
+
+def test_first_stage_degrees_of_freedom() -> None:
+    """A measure that varies continuously keeps KN's n0 - 1; a count whose pair difference
+    departs from its usual value in m replications is worth 2 m (a Poisson count's relative
+    variance 1/m against a χ²_ν/ν's 2/ν); never varying, 0."""
+    rng = np.random.default_rng(3)
+    assert int(first_stage_df(rng.standard_normal((10, 4)))) == 9
+    count = np.zeros((10, 3))
+    count[4, 1] = 1.0  # system 1 misses a part in one replication
+    count[[2, 7], 2] = 1.0  # system 2 in two others
+    # pair (0, 1): one departure, so 2; (0, 2): two; (1, 2): three
+    assert int(first_stage_df(count)) == 2
+    count[4, 1] = 0.0
+    assert int(first_stage_df(count)) == 0  # systems 0 and 1 never differ
+    assert int(first_stage_df(np.array([[0.0, 1.0], [1.0, 0.0]]))) == 1  # n0 = 2: n0 - 1
+
+
+@pytest.mark.parametrize("n0", [3, 10])
+def test_kn_keeps_its_probability_on_a_rare_count(n0: int) -> None:
+    """Parts missed, mostly 0 (Poisson means 0.1 for the best, 0.35 for three others, δ =
+    0.25: the slippage configuration): over 1,000 problems KN with the first-stage rule
+    chooses the best at least as often as asked (within its standard error), where the
+    same screening that takes every first stage at face value does not."""
+    draw = poisson_draw([0.1, 0.35, 0.35, 0.35], MACRO, seed=40 + n0)
+    ruled = macro_pcs(draw, 0, 0.25, n0, PCS, maximize=False)
+    assert ruled.decided >= 100 and ruled.pcs >= PCS - ruled.se, ruled
+    if n0 == 10:  # (n0 = 3 without the rule takes seconds; make kn-check has it)
+        plain = macro_pcs(draw, 0, 0.25, n0, PCS, maximize=False, rule=False)
+        assert plain.refused == 0 and plain.pcs + plain.se < PCS, plain
+
+
+def test_kn_refuses_what_it_cannot_compare() -> None:
+    with pytest.raises(NotANumber) as caught:
+        kn(lambda systems, r: [1.0, float("nan")][:len(systems)], 2, delta=1.0, n0=3)
+    assert (caught.value.i, caught.value.r) == (1, 0)
+    for delta in (float("inf"), float("nan"), 0.0):
+        with pytest.raises(ValueError):
+            kn(lambda systems, r: [float(r), 2.0 * r], 2, delta=delta, n0=3)
 
 
 def test_eta_closed_form() -> None:
