@@ -20,7 +20,7 @@ DESCRIPTION = ("Screen a study file's keys over their ranges with Morris's eleme
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("study", help="study YAML file, or a built-in one by name (assumptions)")
     p.add_argument("--out", required=True, help="directory for the results")
-    workers_argument(p)
+    workers_argument(p, default="1")  # args.workers or 1, below
 
 
 def main(args: argparse.Namespace) -> int:
