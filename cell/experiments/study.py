@@ -236,6 +236,7 @@ def load_study(path: str | Path, corners: bool = True) -> Study:
         if m not in measures:
             raise ScenarioError(path, f"measures[{i}]", m, "no run reports it (a measure of the "
                                 "run summary: parts_missed, spacing_outside_tol, ...)")
+        _refuse_unset(study, f"measures[{i}]", m)  # NaN in every run: no index to give it
     if settings.select is not None and settings.select.measure is not None \
             and settings.select.measure not in measures:
         raise ScenarioError(path, "select.measure", settings.select.measure,
