@@ -94,7 +94,7 @@ def test_compare_out_makes_each_table_once(tmp_path, capsys, monkeypatch):
 
 
 def test_verdict_says_which_is_better_on_each_measure():
-    from cell.cli.compare_command import verdict
+    from cell.cli.compare_command import judgement, verdict
     from cell.experiments.sweep.spec import comparison
     from cell.scenario.schema import load_scenario
 
@@ -117,6 +117,7 @@ def test_verdict_says_which_is_better_on_each_measure():
                                 ("actual_cycle_wallclock_s", -0.5, 2.0, -1.9, 0.9))])
     text = verdict(summary, diffs, sweep)
     lines = verdict_rows(text)
+    _, judged = judgement(summary, diffs, sweep)
     assert "a better: a delivers 100.0 ± 2.0 parts more than b per 500-part run" \
         in lines["Parts delivered"]
     assert "a better: a loses 100.0 ± 2.0 parts fewer than b per 500-part run" \
@@ -126,9 +127,14 @@ def test_verdict_says_which_is_better_on_each_measure():
     assert "neither" in lines["Actual cycle (wall clock, s)"]
     assert "interval includes 0: no difference shown" in lines["Actual cycle (wall clock, s)"]
     assert "means 500 against 400" in lines["Parts delivered"]  # both sides' means, A first
-    # one overall line: a ahead on three measures, neither on the fourth
-    assert text.splitlines()[-1] == ("Overall, on the headline measures: a better (a better "
-                                     "on 3, b on 0, neither on 1 of 4)")
+    # overall: a ahead on three measures, neither on the fourth; the largest difference, 100
+    # parts of 500 (200 per 1,000), decides
+    assert [j.side for j in judged.judged] == [1, 1, 0, 1]
+    assert (judged.winner, judged.deciding, judged.against, judged.trivial) == \
+        ("a", "Parts delivered", (), ())
+    assert judged.size("Parts delivered") == pytest.approx(200.0)
+    assert judged.size("IP (wall clock, eq. 5.1)") == pytest.approx(190.0)  # 0.2 - 0.01 from 1
+    assert text.splitlines()[-1].startswith("Overall")
 
 
 @pytest.mark.parametrize(("args", "shows"), [
