@@ -48,7 +48,12 @@ def reading(study: Study, sobol: Any, morris: Any, points: Any, policies: Sequen
     for policy in policies:
         for m in study.settings.measures:  # each measure asked for, in the study's order
             words = HEADLINE.get(m, f"`{m}`")
-            if m == ADVANTAGE or not ((sobol["policy"] == policy) & (sobol["measure"] == m)).any():
+            if m == ADVANTAGE:
+                continue
+            if not ((sobol["policy"] == policy) & (sobol["measure"] == m)).any():
+                if f"{policy}/{m}" in points.columns and points[f"{policy}/{m}"].isna().all():
+                    out.append(f"- **{words}, {policy}**: n/a, no run of this policy gives it "
+                               "a value, so it has no indices.")
                 continue
             mv = movers(sobol, policy, m)
             span, material = _span(points, policy, m)

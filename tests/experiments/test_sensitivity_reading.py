@@ -86,3 +86,28 @@ def test_a_measure_no_policy_run_reports_is_refused_before_any_work(tmp_path, ca
     assert not out.exists()
     both = study_file(tmp_path, ["thesis_slack_s"], "[adaptive, non-adaptive]")
     assert load_study(both, corners=False).settings.measures == ["thesis_slack_s"]
+
+
+def test_no_index_for_a_measure_no_run_gives():
+    """A column NaN at every point (the policy does not report it) gets NaN indices, not 0."""
+    from cell.experiments.sensitivity import sobol_design, sobol_indices
+    from cell.experiments.study import Param
+
+    d = sobol_design([Param("a", 0.0, 1.0), Param("b", 0.0, 1.0)], 8, seed=1)
+    res = sobol_indices(d, np.full(len(d.points), np.nan), seed=1)
+    assert all(np.isnan(res[k]).all() for k in ("S1", "S1_conf", "ST", "ST_conf"))
+
+
+def test_a_measure_one_policy_gives_has_indices_for_that_policy_alone(tmp_path, capsys):
+    out = tmp_path / "out"
+    path = study_file(tmp_path, ["parts_missed", "thesis_slack_s"], "[adaptive, non-adaptive]")
+    assert main(["sensitivity", str(path), "--out", str(out), "--workers", "1"]) == 0
+    sobol = pd.read_csv(out / "sobol.csv")
+    morris = pd.read_csv(out / "morris.csv")
+    for frame in (sobol, morris):
+        slack = frame[frame["measure"] == "thesis_slack_s"]
+        assert set(slack["policy"]) == {"non-adaptive"}  # the adaptive robot gives none
+        assert not frame.drop(columns=["policy", "measure", "key"]).isna().any().any()
+    report = (out / "report.md").read_text(encoding="utf-8")
+    assert "nan" not in report.lower()
+    assert "`thesis_slack_s`, adaptive**: n/a" in report
