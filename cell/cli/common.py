@@ -38,10 +38,12 @@ def set_argument(p: argparse.ArgumentParser) -> None:
                         "--set arrivals.params.scale=6.0 (repeatable)")
 
 
-def workers_argument(p: argparse.ArgumentParser) -> None:
-    """``--workers N``, as the commands that run a sweep take it."""
+def workers_argument(p: argparse.ArgumentParser, default: str = "number of cores") -> None:
+    """``--workers N``, as the commands that run a sweep take it; ``default`` says what
+    leaving it out means for this command (a sweep takes one worker a core; ``cell optimize``
+    and ``cell sensitivity`` one worker)."""
     p.add_argument("--workers", type=int, default=None,
-                   help="local worker processes (default: number of cores)")
+                   help=f"local worker processes (default: {default})")
 
 
 def check_workers(workers: int | None, scheduler: str | None = None) -> None:

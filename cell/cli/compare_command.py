@@ -20,12 +20,14 @@ import math
 from typing import TYPE_CHECKING
 
 from cell.cli.common import check_workers, set_argument, workers_argument
+from cell.reporting.compare_verdict import PRACTICAL_PER_1000
 
 if TYPE_CHECKING:
     import pandas as pd
 
     from cell.experiments.sweep import Sweep
     from cell.experiments.sweep.spec import Point
+    from cell.reporting.compare_verdict import Judged, Verdict
     from cell.reporting.formatting import Headline
     from cell.scenario.run_length import RunLength
     from cell.scenario.schema import Scenario
@@ -37,7 +39,8 @@ DESCRIPTION = ("Run scenarios A and B with the same replications (common random 
                "report.md and the CSVs' scenario column label A and B by each scenario's "
                "name setting (a file without one: its file name); if the two are the same, "
                "by their file names; if those are the same too, as 'A: <name>' and "
-               "'B: <name>'.")
+               "'B: <name>'.  The overall verdict weighs each difference shown in parts per "
+               "1,000: the largest at or above --practical decides; smaller ones are trivial.")
 DEFAULT_REPLICATIONS = 100
 
 
@@ -55,6 +58,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     set_argument(p)
     p.add_argument("--policy", default=None, metavar="NAME",
                    help="run this policy on both sides (controller.policy of A and B)")
+    p.add_argument("--practical", type=float, default=PRACTICAL_PER_1000, metavar="PER_1000",
+                   help="the smallest difference that decides the overall verdict, in parts per "
+                        f"1,000 (default {PRACTICAL_PER_1000:g}); a smaller one shown by its "
+                        "interval is said, and called trivial")
 
 
 def _stem(arg: str) -> str:
@@ -150,6 +157,9 @@ def main(args: argparse.Namespace) -> int:
                         f"(two scenarios: {MAX_RUNS:,} runs, a sweep's limit)")
     if args.seed is not None and not 0 <= args.seed < 2**63:
         raise CellError(f"--seed {args.seed}: must be a whole number from 0 to 2**63 - 1")
+    if not (math.isfinite(args.practical) and args.practical >= 0):
+        raise CellError(f"--practical {args.practical}: must be a number of parts per 1,000, "
+                        "0 or more")
     check_workers(args.workers)
     seed = a.run.seed if args.seed is None else args.seed
     sweep = comparison(a, b, labels(a, b, args.a, args.b), args.replications, seed)
@@ -173,7 +183,7 @@ def main(args: argparse.Namespace) -> int:
     from cell.reporting.experiment import difference_table, summary_table
 
     tables = summary_table(replications, sweep), difference_table(replications, sweep)
-    print(verdict(*tables, sweep, replications))
+    print(verdict(*tables, sweep, replications, args.practical))
     if target is not None:
         from cell.reporting.experiment import write_report
 
@@ -192,30 +202,47 @@ def command_line(args: argparse.Namespace, seed: int) -> str:
              "--seed", str(seed)]
     for value in args.sets or ():
         words += ["--set", value]
+    if args.practical != PRACTICAL_PER_1000:
+        words += ["--practical", f"{args.practical:g}"]
     return shlex.join(words)
 
 
 def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
-            replications: pd.DataFrame | None = None) -> str:
-    """A few lines: per headline measure, which is better, and A's difference from B (A - B)
-    as a sentence with A its subject (``b better: a delivers 3.1 ± 0.4 parts fewer than b
-    ...``).  Counts and extremes are not compared if A and B take them over different
-    windows (run length, warm-up)."""
+            replications: pd.DataFrame | None = None,
+            practical: float = PRACTICAL_PER_1000) -> str:
+    """A few lines: per headline measure (and OEE), which is better, and A's difference from B
+    (A - B) as a sentence with A its subject (``b better: a delivers 3.1 ± 0.4 parts fewer than
+    b ...``), then the overall verdict (:func:`judgement`).  Counts and extremes are not
+    compared if A and B take them over different windows (run length, warm-up)."""
+    from cell.reporting.compare_verdict import overall_line
+
+    lines, judged = judgement(summary, differences, sweep, replications, practical)
+    return "\n".join([*lines, overall_line(judged)])
+
+
+def judgement(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
+              replications: pd.DataFrame | None = None,
+              practical: float = PRACTICAL_PER_1000) -> tuple[list[str], Verdict]:
+    """The verdict's lines but its last, and the overall verdict they lead to, weighed by
+    practical size (:mod:`cell.reporting.compare_verdict`, ``practical`` parts per 1,000)."""
     from cell.cli.compare_rates import (
         RATE_FREE,
         SHOWN_ONLY,
-        overall,
+        rate_error_s,
         rate_free,
         rates_differ,
         still_sides,
     )
     from cell.experiments.sweep.windows import setting, windows_apart
+    from cell.reporting.compare_verdict import OEE, SCALES, Judged, decide
     from cell.reporting.formatting import HEADLINES
     from cell.scenario.run_length import RunLength
 
     (la, a), (lb, b) = _sides(sweep)
     differ = windows_apart(a.scenario, b.scenario)
-    demand = rates_differ(summary, la, lb)
+    errors = (rate_error_s(a.scenario.arrivals, a.scenario.base_dir),
+              rate_error_s(b.scenario.arrivals, b.scenario.base_dir))
+    demand = rates_differ(summary, la, lb, errors, sweep.confidence)
     length_a, length_b = RunLength.of(a.scenario.run), RunLength.of(b.scenario.run)
     length = length_a if length_a == length_b else None
     lines = [_verdict_header(sweep, la, a, lb, b, length_a, length_b)]
@@ -223,20 +250,29 @@ def verdict(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
         lines.append(f"  {demand}")
     lines += [f"  {w}" for w in still_sides(summary, la, lb)]
     apart = ", ".join(f"{setting(k)} {va} against {vb}" for k, va, vb in differ)
-    sides: list[tuple[str, int]] = []
-    width = max(len(t) for t in [*(h.title for h in HEADLINES), *(r[0] for r in RATE_FREE)])
-    for h in HEADLINES:
+    judged: list[Judged] = []
+    measures = (*HEADLINES, OEE)
+    width = max(len(t) for t in [*(h.title for h in measures), *(r[0] for r in RATE_FREE)])
+    scales = {m: _both(summary, m, la, lb) for m in SCALES}
+    if not scales["parts_arrived"] > 0 and length is not None and length.unit == "part":
+        scales["parts_arrived"] = float(length.number)  # a summary without the column
+    for h in measures:
         line = _headline_verdict(h, summary, differences, la, lb, length, width,
-                                 apart if differ else None, bool(demand), sides)
+                                 apart if differ else None, bool(demand), judged, scales)
         if line is not None:
             lines.append(line)
     if replications is not None:
-        for title, side, line in rate_free(replications, sweep, la, lb, width):
+        for title, side, size, line in rate_free(replications, sweep, la, lb, width):
             lines.append(line)
             if demand and title not in SHOWN_ONLY:
-                sides.append((title, side))
-    lines.append(overall(sides, la, lb, bool(demand)))
-    return "\n".join(lines)
+                judged.append(Judged(title, side, size))
+    return lines, decide(judged, la, lb, practical, bool(demand))
+
+
+def _both(summary: pd.DataFrame, measure: str, la: str, lb: str) -> float:
+    """A measure's mean over A's and B's means (NaN if either lacks it)."""
+    rows = summary[summary["measure"] == measure].set_index("scenario")["mean"]
+    return float((rows[la] + rows[lb]) / 2) if {la, lb} <= set(rows.index) else math.nan
 
 
 def _verdict_header(sweep: Sweep, la: str, a: Point, lb: str, b: Point,
@@ -253,12 +289,14 @@ def _verdict_header(sweep: Sweep, la: str, a: Point, lb: str, b: Point,
 
 def _headline_verdict(h: Headline, summary: pd.DataFrame, differences: pd.DataFrame, la: str,
                       lb: str, length: RunLength | None, width: int, apart: str | None,
-                      demand: bool, sides: list[tuple[str, int]]) -> str | None:
+                      demand: bool, weighed: list[Judged], scales: dict[str, float]) -> str | None:
     """One headline measure's verdict line (None if it was not measured); its side (1: A
-    better, -1: B better, 0: neither) is appended to ``sides`` unless the arrival rates
-    differ and the measure grows with the demand.  ``apart``: how the runs' windows differ,
-    None if they do not."""
+    better, -1: B better, 0: neither) and size (parts per 1,000; ``scales``: the parts
+    arrived and delivered, the means of both sides) are appended to ``weighed`` unless the
+    arrival rates differ and the measure grows with the demand.  ``apart``: how the runs'
+    windows differ, None if they do not."""
     from cell.experiments.sweep.windows import window_kind
+    from cell.reporting.compare_verdict import Judged, per_1000
     from cell.reporting.formatting import better, number, too_few
 
     d = differences[differences["measure"] == h.column]
@@ -281,7 +319,8 @@ def _headline_verdict(h: Headline, summary: pd.DataFrame, differences: pd.DataFr
     if demand and h.column in DEMAND_BOUND:
         who = "not judged (arrival rates differ)"
     else:
-        sides.append((h.title, side))
+        weighed.append(Judged(h.title, side, per_1000(h.column, float(row["mean"]),
+                                                      float(means[la]), float(means[lb]), scales)))
     shown = f"{number(float(means[la]))} against {number(float(means[lb]))}"
     return f"  {h.title:<{width}}  {who}: {what}; means {shown}"
 
@@ -307,4 +346,4 @@ def _difference_said(h: Headline, row: pd.Series, la: str, lb: str,
 #: Measures that grow with the demand: with different arrival rates they say more parts
 #: came, not which cell is better, and are left unjudged (the rate-free ones judge).
 DEMAND_BOUND = frozenset({"parts_per_hr_wallclock", "parts_delivered", "parts_missed",
-                          "spacing_outside_tol", "actual_cycle_wallclock_s"})
+                          "spacing_outside_tol", "actual_cycle_wallclock_s", "oee"})

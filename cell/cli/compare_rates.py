@@ -31,7 +31,7 @@ if TYPE_CHECKING:
 
     from cell.experiments.sweep import Sweep
 
-#: Arrival rates this far apart (relative) differ.
+#: Arrival rates closer than this (relative) are the same, whatever their sampling errors.
 RATE_APART = 1e-9
 #: (title, how it is computed from a replication's columns, higher is better?)
 RATE_FREE = (
@@ -49,10 +49,34 @@ def _mean(summary: pd.DataFrame, measure: str, label: str) -> float:
     return float(rows["mean"].iloc[0]) if len(rows) else math.nan
 
 
-def rates_differ(summary: pd.DataFrame, la: str, lb: str) -> str | None:
-    """A line if A's and B's mean inter-arrival times differ, else None."""
+def rate_error_s(arrivals: object, base_dir: object) -> float:
+    """The standard error of a side's mean inter-arrival time, s: a trace's mean is its
+    sample's (sd / sqrt(n) of its inter-arrival times), a distribution's is exact (0)."""
+    from pathlib import Path
+
+    from cell.scenario.arrivals import read_trace
+
+    trace = getattr(arrivals, "trace_csv", None)
+    if trace is None:
+        return 0.0
+    times = read_trace(Path(str(base_dir)) / trace)
+    return float(np.std(times, ddof=1) / math.sqrt(len(times))) if len(times) > 1 else 0.0
+
+
+def rates_differ(summary: pd.DataFrame, la: str, lb: str, errors: tuple[float, float] = (0, 0),
+                 confidence: float = 0.95) -> str | None:
+    """A line if A's and B's mean inter-arrival times differ by more than their sampling
+    errors explain, else None.  ``errors``: each side's standard error of its mean
+    (:func:`rate_error_s`); the two differ when their difference is outside the two-sided
+    ``confidence`` interval of a difference of 0 (a fitted distribution against the trace it
+    was fitted to: its mean agrees with the trace's within the trace's own sampling error)."""
+    from scipy.stats import norm
+
     ta, tb = (_mean(summary, "mean_interarrival_s", x) for x in (la, lb))
-    if not (math.isfinite(ta) and math.isfinite(tb)) or abs(ta - tb) <= RATE_APART * max(ta, tb):
+    if not (math.isfinite(ta) and math.isfinite(tb)):
+        return None
+    allowed = float(norm.ppf(0.5 + confidence / 2)) * math.hypot(*errors)
+    if abs(ta - tb) <= max(RATE_APART * max(ta, tb), allowed):
         return None
     return (f"arrival rates differ: {la} a part every {ta:.4g} s ({3600 / ta:.4g}/hr), {lb} every "
             f"{tb:.4g} s ({3600 / tb:.4g}/hr); parts per hour and the per-run counts follow the "
@@ -78,8 +102,9 @@ def still_sides(summary: pd.DataFrame, la: str, lb: str) -> list[str]:
 
 
 def rate_free(replications: pd.DataFrame, sweep: Sweep, la: str, lb: str,
-              width: int) -> list[tuple[str, int, str]]:
-    """(title, +1 A better / -1 B better / 0, the verdict's line) per rate-free measure."""
+              width: int) -> list[tuple[str, int, float, str]]:
+    """(title, +1 A better / -1 B better / 0, the difference's size in parts per 1,000, the
+    verdict's line) per rate-free measure."""
     from cell.experiments.stats import paired_difference
     from cell.reporting.formatting import half_width, number, plus_minus
 
@@ -105,25 +130,7 @@ def rate_free(replications: pd.DataFrame, sweep: Sweep, la: str, lb: str,
         diff = f"{float(d['mean']):+.6g} in every replication" if sd == 0 else \
             plus_minus(float(d["mean"]), half_width(d), signed=True) + \
             (" (interval excludes 0)" if judged else " (interval includes 0)")
-        out.append((title, side, f"  {title:<{width}}  {who}: {la} - {lb} {diff}; means "
-                                 f"{number(ma)} against {number(mb)}"))
+        size = 1000.0 * abs(float(d["mean"])) / scale  # a share (scale 1) or per 100
+        out.append((title, side, size, f"  {title:<{width}}  {who}: {la} - {lb} {diff}; means "
+                                       f"{number(ma)} against {number(mb)}"))
     return out
-
-
-def overall(sides: list[tuple[str, int]], la: str, lb: str, demand: bool) -> str:
-    """The one overall line: who is better on how many of the measures judged."""
-    a = [t for t, s in sides if s > 0]
-    b = [t for t, s in sides if s < 0]
-    basis = "the rate-free measures (the arrival rates differ)" if demand else \
-        "the headline measures"
-    n = len(sides)
-    if a and not b:
-        head = f"{la} better"
-    elif b and not a:
-        head = f"{lb} better"
-    elif a and b:
-        head = "mixed"
-    else:
-        head = "no difference shown"
-    return (f"Overall, on {basis}: {head} ({la} better on {len(a)}, {lb} on {len(b)}, "
-            f"neither on {n - len(a) - len(b)} of {n})")

@@ -135,16 +135,37 @@ def _open_files() -> str:
     return f" (this process may open {soft}: raise it with ulimit -n, or use fewer --workers)"
 
 
+#: Warnings Python's default filters show only when the program's own code raised them
+#: (``__main__``): a library's deprecations, and what compiling a library's source on its first
+#: import says of it (``invalid escape sequence``, once after an install: the Makefile installs
+#: without compiling), are for its maintainers; the user can do nothing about them.
+OWN_CODE_ONLY = (DeprecationWarning, PendingDeprecationWarning, ImportWarning, SyntaxWarning)
+#: cell's own source: a warning attributed to a file in it is the program's own.
+OWN_SOURCE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def shown(w: warnings.WarningMessage) -> bool:
+    """Whether a warning the command met is said: as Python's default filters would (those of
+    :data:`OWN_CODE_ONLY` only if attributed to cell's own code), never a ResourceWarning."""
+    if issubclass(w.category, ResourceWarning):
+        return False
+    if not issubclass(w.category, OWN_CODE_ONLY):
+        return True
+    where = os.path.abspath(str(w.filename or ""))
+    return where.startswith(OWN_SOURCE + os.sep)
+
+
 def _run(args: argparse.Namespace) -> int:
     """The command; a warning that a finished command met is one line each (a refused one's are
-    dropped: its error says what went wrong).  Not a ResourceWarning: an unclosed file reported
-    whenever the collector happens to free it is not about the command (Python hides those too),
-    and in-process, as the tests run it, it may be another caller's."""
+    dropped: its error says what went wrong), those Python would show (:func:`shown`).  Not a
+    ResourceWarning: an unclosed file reported whenever the collector happens to free it is not
+    about the command (Python hides those too), and in-process, as the tests run it, it may be
+    another caller's."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("default")
         warnings.simplefilter("ignore", ResourceWarning)
         code = int(_module(args.command).main(args) or 0)
-    for text in dict.fromkeys(f"{w.message} ({w.category.__name__})" for w in caught):
+    for text in dict.fromkeys(f"{w.message} ({w.category.__name__})" for w in caught if shown(w)):
         print(f"cell: warning: {one_line(text, 300)}", file=sys.stderr)
     return code
 

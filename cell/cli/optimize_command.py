@@ -24,7 +24,7 @@ DESCRIPTION = ("Search a study file's keys with Optuna (TPE for one objective, N
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("study", help="study YAML file, or a built-in one by name (optimize)")
     p.add_argument("--out", required=True, help="directory for the study and its results")
-    workers_argument(p)
+    workers_argument(p, default="1")  # args.workers or 1, below
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="run the trials on a dask.distributed cluster at ADDRESS (DIR on a "
                         "disk its workers share)")

@@ -102,7 +102,7 @@ def _on_part(parts: Any, progress: Any, n: int) -> Callable[[Any], None]:
 
 def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) -> None:
     """The run's summary on stdout, OEE with failures, and the files written."""
-    from cell.reporting.run_summary import format_summary, thesis_figures
+    from cell.reporting.run_summary import format_summary, oee_line, thesis_figures
 
     print(format_summary(result.summary, thesis_figures(scenario)))
     r = result.summary
@@ -112,9 +112,7 @@ def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) ->
     if scenario.failures is None:
         print(f"wrote {shown}/{written[0]}, {written[1]} and {written[2]}")
         return
-    print(f"availability {r.availability:.4f}, performance {r.performance:.4f}, quality "
-          f"{r.quality:.4f}: OEE {r.oee:.4f}; robot failures {r.robot_failures}, parts lost to "
-          f"downtime {r.parts_lost_downtime}, scrapped {r.parts_scrapped}")
+    print(oee_line(r))
     print(f"wrote {shown}/{written[0]}, {written[1]}, {written[2]}, states.csv and failures.csv")
 
 

@@ -20,7 +20,7 @@ DESCRIPTION = ("Screen a study file's keys over their ranges with Morris's eleme
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("study", help="study YAML file, or a built-in one by name (assumptions)")
     p.add_argument("--out", required=True, help="directory for the results")
-    workers_argument(p)
+    workers_argument(p, default="1")  # args.workers or 1, below
 
 
 def main(args: argparse.Namespace) -> int:
@@ -94,18 +94,22 @@ def run(study: Any, workers: int, sizes: dict[str, int]) -> dict[str, Any]:
     ym = evaluate(study, md, policies, measures, workers, bar)
     mrows, mu = [], {}
     for j, col in enumerate(cols):
+        if not np.isfinite(ym[:, j]).any():  # the policy does not give it (thesis_slack_s)
+            continue
         res = morris_indices(md, ym[:, j], sizes["levels"], seed)
         mu[col] = res["mu_star"]
         mrows += [{"policy": col[0], "measure": col[1], "key": k, "mu_star": res["mu_star"][i],
                    "mu_star_ci95": res["mu_star_conf"][i], "sigma": res["sigma"][i]}
                   for i, k in enumerate(md.keys)]
-    spread = {col: float(np.ptp(ym[:, j])) for j, col in enumerate(cols)}
+    spread = {col: float(np.ptp(ym[:, j])) for j, col in enumerate(cols) if col in mu}
     chosen = screened(params, mu, spread, keep)
     sd = sobol_design(chosen, sizes["samples"], seed)
     ys = evaluate(study, sd, policies, measures, workers, bar)
     bar.close()
     srows = []
     for j, col in enumerate(cols):
+        if col not in mu:  # no index for a measure this policy does not give: none written
+            continue
         res = sobol_indices(sd, ys[:, j], seed)
         srows += [{"policy": col[0], "measure": col[1], "key": k, "S1": res["S1"][i],
                    "S1_ci95": res["S1_conf"][i], "ST": res["ST"][i], "ST_ci95": res["ST_conf"][i]}

@@ -141,6 +141,9 @@ def morris_indices(design: Design, y: np.ndarray, levels: int, seed: int) -> dic
 def sobol_indices(design: Design, y: np.ndarray, seed: int) -> dict[str, np.ndarray]:
     from SALib.analyze import sobol
 
+    if not np.isfinite(y).any():  # no run gives the measure: no share of its variance
+        n = np.full(len(design.keys), np.nan)
+        return {"S1": n, "S1_conf": n, "ST": n, "ST_conf": n}
     if np.ptp(y) == 0:  # a measure no key moves: every index 0, exactly
         z = np.zeros(len(design.keys))
         return {"S1": z, "S1_conf": z, "ST": z, "ST_conf": z}

@@ -65,9 +65,15 @@ def measures_of(row: Mapping[str, Any]) -> dict[str, float]:
            if isinstance(v, (int, float)) and not isinstance(v, bool) and k != "seed"}
     gaps = max(out.get("parts_delivered", 0.0) - 1, 1.0)
     out["spacing_outside_pct"] = 100 * out.get("spacing_outside_tol", math.nan) / gaps
-    out["parts_missed_pct"] = 100 * out.get("parts_missed", math.nan) / max(
-        out.get("parts_arrived", 0.0), 1.0)
+    out["parts_missed_pct"] = float(parts_missed_pct(out.get("parts_missed", math.nan),
+                                                     out.get("parts_arrived", 0.0)))
     return out
+
+
+def parts_missed_pct(missed: Any, arrived: Any) -> Any:
+    """Parts lost on the wall clock, % of the parts arrived (of one part if none arrived):
+    run by run, a number or an array of them (a sweep's summary takes it from here too)."""
+    return 100 * np.asarray(missed, dtype=float) / np.maximum(np.asarray(arrived, dtype=float), 1.0)
 
 
 class ObjectiveSettings(Section):
@@ -230,6 +236,7 @@ def load_study(path: str | Path, corners: bool = True) -> Study:
         if m not in measures:
             raise ScenarioError(path, f"measures[{i}]", m, "no run reports it (a measure of the "
                                 "run summary: parts_missed, spacing_outside_tol, ...)")
+        _refuse_unset(study, f"measures[{i}]", m)  # NaN in every run: no index to give it
     if settings.select is not None and settings.select.measure is not None:
         if settings.select.measure not in measures:
             raise ScenarioError(path, "select.measure", settings.select.measure,

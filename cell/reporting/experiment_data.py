@@ -27,6 +27,10 @@ NOT_MEASURES = {"policy", "point", "seed", "replication"}
 #: arrivals), run by run, so its mean has an interval over the replications and two policies'
 #: shares a paired difference; a run whose bound is 0 has none.
 BOUND_SHARE = "delivered_of_bound_pct"
+#: Parts lost on the wall clock as a share of the parts arrived, in percent, run by run: the
+#: measure ``cell optimize`` and the studies report by this name
+#: (:func:`cell.experiments.study.parts_missed_pct`, the one rule of both).
+MISSED_SHARE = "parts_missed_pct"
 
 
 def measures(replications: pd.DataFrame, sweep: Sweep) -> list[str]:
@@ -35,6 +39,24 @@ def measures(replications: pd.DataFrame, sweep: Sweep) -> list[str]:
     return [c for c in replications.columns
             if c not in NOT_MEASURES and c not in grid
             and pd.api.types.is_numeric_dtype(replications[c])]
+
+
+def with_shares(replications: pd.DataFrame) -> pd.DataFrame:
+    """``replications`` with the run-by-run shares a report summarises beside the runs'
+    measures: :data:`MISSED_SHARE`, then :data:`BOUND_SHARE`, last."""
+    return with_bound_share(with_missed_share(replications))
+
+
+def with_missed_share(replications: pd.DataFrame) -> pd.DataFrame:
+    """``replications`` with :data:`MISSED_SHARE` after its other columns, if its runs count
+    parts lost and arrived (the frame itself otherwise, and if the share is already there)."""
+    from cell.experiments.study import parts_missed_pct
+
+    if MISSED_SHARE in replications.columns or \
+            not {"parts_missed", "parts_arrived"} <= set(replications.columns):
+        return replications
+    return replications.assign(**{MISSED_SHARE: parts_missed_pct(
+        replications["parts_missed"], replications["parts_arrived"])})
 
 
 def with_bound_share(replications: pd.DataFrame) -> pd.DataFrame:
@@ -108,8 +130,8 @@ def run_counts(replications: pd.DataFrame, sweep: Sweep) -> list[int]:
 
 def summary_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     """``summary.csv``: every point, policy and measure with its statistics (the runs'
-    measures and, last, :data:`BOUND_SHARE`)."""
-    replications = with_bound_share(replications)
+    measures, then :data:`MISSED_SHARE` and, last, :data:`BOUND_SHARE`)."""
+    replications = with_shares(replications)
     columns, names = grid_columns(sweep), measures(replications, sweep)
     rows = []
     found = _Rows(replications, sweep)
@@ -142,7 +164,7 @@ def difference_table(replications: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     only the partner varies.  A pair whose points run over different windows
     (:mod:`cell.experiments.sweep.windows`) has no rows for the counts and extremes.
     """
-    replications = with_bound_share(replications)
+    replications = with_shares(replications)
     columns, names = grid_columns(sweep), measures(replications, sweep)
     windowed = set(window_measures())
     rows: list[dict[str, object]] = []

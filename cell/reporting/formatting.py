@@ -98,9 +98,29 @@ def half_width(row: Mapping[Any, Any] | pd.Series) -> float:
     return (float(row["ci_high"]) - float(row["ci_low"])) / 2
 
 
+def no_interval(half: float) -> str:
+    """Why a confidence half-width is not a number: NaN, fewer than two replications (or runs
+    that give the measure); infinite, the replications' spread overflowed a float."""
+    return ("no interval: fewer than two replications" if half != half else
+            "no interval: the replications' spread overflows")
+
+
+def estimate(mean: float, half: float, fmt: str = ".4g", half_fmt: str = ".2g") -> str:
+    """``mean ± half`` in ``fmt`` and ``half_fmt``; never ``nan`` or ``inf``: a mean that is not
+    a number is ``n/a``, a half-width that is not one is said in words (:func:`no_interval`)."""
+    if not math.isfinite(mean):
+        return "n/a (no run gives it)" if mean != mean else "n/a (overflows)"
+    if not math.isfinite(half):
+        return f"{mean:{fmt}} ({no_interval(half)})"
+    return f"{mean:{fmt}} ± {half:{half_fmt}}"
+
+
 def plus_minus(mean: float, half: float, signed: bool = False) -> str:
-    """``mean ± half`` to the half-width's two significant figures (exponent form if huge)."""
+    """``mean ± half`` to the half-width's two significant figures (exponent form if huge);
+    never ``nan`` or ``inf`` (:func:`estimate`)."""
     sign = "+" if signed else ""
+    if not (math.isfinite(mean) and math.isfinite(half)):
+        return estimate(mean, half, f"{sign}.6g")
     if max(abs(mean), abs(half)) >= HUGE:
         return f"{mean:{sign}.3g} ± {half:.2g}"
     d = decimals(half)

@@ -200,6 +200,7 @@ def importance_measure(study: Study) -> tuple[str, bool]:
 def markdown(study: Study, frame: Any, picked: list[int], sel: Selection | None,
              imp: dict[str, float], command: str) -> str:
     from cell.experiments.selection import sentence, table
+    from cell.reporting.formatting import estimate
 
     s = study.settings
     goals = "; ".join(f"{o.goal} {o.measure}" for o in s.objectives)
@@ -232,7 +233,7 @@ def markdown(study: Study, frame: Any, picked: list[int], sel: Selection | None,
         lines += ["| trial | " + " | ".join(keys + ms) + " |", "|---" * (1 + len(keys) + len(ms)) + "|"]
         shown = front.drop_duplicates(subset=keys)  # a point the search tried twice: once
         for _, r in shown.sort_values([study.settings.objectives[0].measure, "trial"]).iterrows():
-            cells = [_show(r[k]) for k in keys] + [f"{r[m]:.4g} ± {r[m + '_ci95']:.2g}" for m in ms]
+            cells = [_show(r[k]) for k in keys] + [estimate(r[m], r[m + '_ci95']) for m in ms]
             lines.append(f"| {int(r['trial'])} | " + " | ".join(cells) + " |")
     lines += ["", "![history](history.png) ![front](front.png)", "", "## Importance", ""]
     lines += [f"- {k}: {v:.2f}" for k, v in imp.items()] or ["- (too few trials)"]

@@ -167,6 +167,28 @@ def shown_figure(value: float, fmt: str = "{:.4f}") -> str:
     return fmt.format(value) if value == value else UNDEFINED
 
 
+def _share(value: float) -> str:
+    return f"{value:.1%}" if math.isfinite(value) else "n/a"
+
+
+def _no_quality(r: RunSummary) -> str:
+    """Why quality (and OEE with it) has no value, if it has none."""
+    return "" if r.quality == r.quality else " (no part delivered: quality is undefined)"
+
+
+def oee_line(r: RunSummary) -> str:
+    """A run with failures: its OEE and what it is made of, the stops, the parts they cost; a
+    figure with no value (quality when no part was delivered, and OEE with it) is ``n/a``
+    with the reason, never ``nan``."""
+    def shown(v: float) -> str:
+        return f"{v:.4f}" if math.isfinite(v) else "n/a"
+
+    return (f"availability {shown(r.availability)}, performance {shown(r.performance)}, quality "
+            f"{shown(r.quality)}: OEE {shown(r.oee)}{_no_quality(r)}; robot failures "
+            f"{r.robot_failures}, parts lost to downtime {r.parts_lost_downtime}, scrapped "
+            f"{r.parts_scrapped}")
+
+
 def format_summary(r: RunSummary, thesis: dict[str, str] | None = None) -> str:
     """The summary as a two-column table; the thesis's figures beside ours when given."""
     rows: list[tuple[str, str]] = []
@@ -202,8 +224,8 @@ def format_summary(r: RunSummary, thesis: dict[str, str] | None = None) -> str:
         from cell.sim.oee import loss_waterfall
 
         steps = loss_waterfall(r.availability, r.performance, r.quality)
-        add("planned time lost to", "; ".join(f"{name} {share:.1%}" for name, share in steps[:-1])
-            + f"; left: OEE {steps[-1][1]:.1%}", "{}")
+        add("planned time lost to", "; ".join(f"{name} {_share(share)}" for name, share in steps[:-1])
+            + f"; left: OEE {_share(steps[-1][1])}" + _no_quality(r), "{}")
     if r.warmup_parts:
         add("warm-up left out, parts", r.warmup_parts, "{:d}")
     width = max(len(label) for label, _ in rows)

@@ -46,8 +46,14 @@ def reading(study: Study, sobol: Any, morris: Any, points: Any, policies: Sequen
     """The report's conclusions, in sentences built from the tables."""
     out = []
     for policy in policies:
-        for m, words in HEADLINE.items():
-            if m == ADVANTAGE or not ((sobol["policy"] == policy) & (sobol["measure"] == m)).any():
+        for m in study.settings.measures:  # each measure asked for, in the study's order
+            words = HEADLINE.get(m, f"`{m}`")
+            if m == ADVANTAGE:
+                continue
+            if not ((sobol["policy"] == policy) & (sobol["measure"] == m)).any():
+                if f"{policy}/{m}" in points.columns and points[f"{policy}/{m}"].isna().all():
+                    out.append(f"- **{words}, {policy}**: n/a, no run of this policy gives it "
+                               "a value, so it has no indices.")
                 continue
             mv = movers(sobol, policy, m)
             span, material = _span(points, policy, m)
@@ -102,6 +108,41 @@ def _conclusion(study: Study, sobol: Any, points: Any) -> list[str]:
         out.append("- The advantage's size depends most on " + ", ".join(
             f"`{k}` (ST {st:.2f} ± {h:.2f})" for k, st, h in mv) + ".")
     return out
+
+
+def negative_indices(sobol: Any) -> tuple[int, int, tuple[str, float, float] | None]:
+    """The indices (S1 and ST) estimated below 0: how many, how many of them have an interval
+    that covers 0, and the lowest as (index, estimate, half-width); None if there are none.
+
+    A share of a variance is never negative; Saltelli's and Jansen's estimators are differences
+    of sample means, so a key with no effect gets estimates scattered around 0, some below it.
+    One whose interval covers 0 is that noise, and reads as 0."""
+    found: list[tuple[str, float, float]] = []
+    for index in ("S1", "ST"):
+        below = sobol[sobol[index] < 0]
+        found += [(index, float(v), float(h)) for v, h in zip(below[index], below[f"{index}_ci95"])]
+    if not found:
+        return 0, 0, None
+    covered = sum(1 for _, v, h in found if v + h >= 0)
+    return len(found), covered, min(found, key=lambda f: f[1])
+
+
+def negative_note(sobol: Any) -> list[str]:
+    """What a negative index means, if the table has one: sampling noise around 0."""
+    n, covered, lowest = negative_indices(sobol)
+    if lowest is None:
+        return []
+    index, v, h = lowest
+    out = [f"{n} of the indices below are estimated below 0 (the lowest, {index} "
+           f"{v:.3f} ± {h:.3f}). An index is a share of a variance and cannot be negative: "
+           "such an estimate is sampling noise around 0 (the key moves the measure little or "
+           "not at all)"]
+    if covered == n:
+        out[0] += ", and each one's interval covers 0: read them as 0."
+    else:
+        out[0] += (f"; {n - covered} of them have intervals that stop short of 0: too few "
+                   "samples to say more; more `sobol.samples` would narrow them.")
+    return out + [""]
 
 
 def _widest(sobol: Any) -> float:
@@ -167,6 +208,7 @@ def markdown(study: Study, sobol: Any, morris: Any, points: Any, policies: Seque
              "so a measure is a deterministic function of the keys and an index is the keys' "
              "share, not the draws'.",
              "", "## Sobol indices", "", "![sensitivity](sensitivity.png)", "",
+             *negative_note(sobol),
              "| policy | measure | key | S1 | ST |", "|---|---|---|---|---|"]
     for r in sobol.sort_values(["policy", "measure", "ST"], ascending=[True, True, False]).itertuples():
         lines.append(f"| {r.policy} | {r.measure} | {r.key} | {r.S1:.3f} ± {r.S1_ci95:.3f} | "

@@ -95,7 +95,7 @@ def test_compare_out_makes_each_table_once(tmp_path, capsys, monkeypatch):
 
 
 def test_verdict_says_which_is_better_on_each_measure():
-    from cell.cli.compare_command import verdict
+    from cell.cli.compare_command import judgement, verdict
     from cell.experiments.sweep.spec import comparison
     from cell.scenario.schema import load_scenario
 
@@ -118,6 +118,7 @@ def test_verdict_says_which_is_better_on_each_measure():
                                 ("actual_cycle_wallclock_s", -0.5, 2.0, -1.9, 0.9))])
     text = verdict(summary, diffs, sweep)
     lines = verdict_rows(text)
+    _, judged = judgement(summary, diffs, sweep)
     # the paired means and the half-widths of their intervals, (ci_high - ci_low) / 2
     assert in_order(lines["Parts delivered"], "a better:", "delivers 100.0 ± 2.0 parts more",
                     "per 500-part run")
@@ -128,10 +129,14 @@ def test_verdict_says_which_is_better_on_each_measure():
     assert "neither" in lines["Actual cycle (wall clock, s)"]
     assert "interval includes 0: no difference shown" in lines["Actual cycle (wall clock, s)"]
     assert "means 500 against 400" in lines["Parts delivered"]  # both sides' means, A first
-    # one overall line: a ahead on three measures, neither on the fourth
-    overall = text.splitlines()[-1]
-    assert overall.startswith("Overall") and overall.endswith(")")
-    assert in_order(overall, ": a better (a better on 3,", "b on 0,", "neither on 1 of 4)")
+    # overall: a ahead on three measures, neither on the fourth; the largest difference, 100
+    # parts of 500 (200 per 1,000), decides
+    assert [j.side for j in judged.judged] == [1, 1, 0, 1]
+    assert (judged.winner, judged.deciding, judged.against, judged.trivial) == \
+        ("a", "Parts delivered", (), ())
+    assert judged.size("Parts delivered") == pytest.approx(200.0)
+    assert judged.size("IP (wall clock, eq. 5.1)") == pytest.approx(190.0)  # 0.2 - 0.01 from 1
+    assert text.splitlines()[-1].startswith("Overall")
 
 
 @pytest.mark.parametrize(("args", "shows"), [

@@ -287,7 +287,7 @@ def test_general_report_on_a_small_real_sweep(sweeps, tmp_path, capsys):
     numeric = [c for c in frame.columns[frame.columns.get_loc("replication") + 1:]
                if pd.api.types.is_numeric_dtype(frame[c])]
     assert "parts_delivered" in numeric and "spacing_outside_tol" in numeric
-    numeric.append("delivered_of_bound_pct")  # the share of the bound, after the runs' own
+    numeric += ["parts_missed_pct", "delivered_of_bound_pct"]  # the shares, after the runs' own
     assert len(summary) == 4 * len(numeric)
     assert list(dict.fromkeys(summary["measure"])) == numeric
     for r in summary[summary["measure"] == "parts_per_hr_wallclock"].to_dict("records"):

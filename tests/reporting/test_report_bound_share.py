@@ -78,3 +78,27 @@ def test_no_bound_no_share():
     assert with_bound_share(old) is old
     zero = with_bound_share(pd.DataFrame({"parts_delivered": [0, 2], "parts_bound": [0, 4]}))
     assert np.isnan(zero[BOUND_SHARE][0]) and zero[BOUND_SHARE][1] == 50.0
+
+
+def test_the_summary_has_parts_lost_as_a_share_of_arrivals_as_optimize_reports_it(report):
+    """Issue 35 item 5: a sweep's summary has ``parts_missed_pct``, the measure cell optimize
+    and the studies report, run by run from the same runs (the bound's share stays last)."""
+    from cell.experiments.study import measures_of
+    from cell.reporting.experiment_data import MISSED_SHARE
+
+    sweep, frame, summary, differences, _ = report
+    assert MISSED_SHARE == "parts_missed_pct" and MISSED_SHARE not in frame
+    share = summary[summary["measure"] == MISSED_SHARE]
+    assert len(share) == len(sweep.points)
+    lost_some = False
+    for p, row in zip(sweep.points, share.to_dict("records"), strict=True):
+        runs = frame[(frame["policy"] == p.policy) & (frame["point"] == p.index)]
+        by_hand = 100.0 * runs["parts_missed"].to_numpy(float) / runs["parts_arrived"]
+        assert row["mean"] == pytest.approx(by_hand.mean(), rel=1e-12, abs=1e-12)
+        assert row["mean"] == pytest.approx(np.mean(
+            [measures_of(r)[MISSED_SHARE] for r in runs.to_dict("records")]), rel=1e-12, abs=1e-12)
+        lost_some |= row["mean"] > 0
+    assert lost_some  # arrivals faster than the robot: parts are lost
+    assert len(differences[differences["measure"] == MISSED_SHARE]) == 2
+    order = list(dict.fromkeys(summary["measure"]))
+    assert order[-2:] == [MISSED_SHARE, BOUND_SHARE]
