@@ -32,7 +32,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 #: The files of a run, written as one set.
 RUN_FILES = ("parts.csv", "summary.csv", "belts.csv")
-#: Written as well when the scenario has a ``failures:`` section.
+#: Written as well when the scenario has a ``failures:`` section or its motors wear.
 FAILURE_FILES = ("states.csv", "failures.csv")
 #: The same, as ``--format parquet`` writes them.
 PARQUET_FILES = ("parts.parquet", "summary.parquet", "belts.parquet")
@@ -77,7 +77,7 @@ def main(args: argparse.Namespace) -> int:
             progress.update(done - progress.n)
         with out.open("summary.csv", newline="") as sf:
             RowWriter(sf, SUMMARY_COLUMNS).record(result.summary)
-        if scenario.failures is not None:
+        if _stops_anything(scenario):
             _write_failures(out, result)
         if args.format == "parquet":
             _as_parquet(out)
@@ -109,15 +109,20 @@ def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) ->
     print(f"robot busy (in motion) {r.robot_busy_fraction:.3f} of the run, beside its offered "
           f"load (fastest cycle / mean inter-arrival) {r.offered_load:.3f}")
     written = RUN_FILES if args.format == "csv" else PARQUET_FILES
-    if scenario.failures is None:
+    if not _stops_anything(scenario):
         print(f"wrote {shown}/{written[0]}, {written[1]} and {written[2]}")
         return
     print(oee_line(r))
     print(f"wrote {shown}/{written[0]}, {written[1]}, {written[2]}, states.csv and failures.csv")
 
 
+def _stops_anything(scenario: Any) -> bool:
+    """Whether the scenario can stop the cell (``failures:``, or ``wear:`` on)."""
+    return scenario.failures is not None or scenario.wear.enabled
+
+
 def _write_failures(out: Any, result: Any) -> None:
-    """states.csv and failures.csv of a run with failures."""
+    """states.csv and failures.csv of a run with failures or wear."""
     from cell.plumbing.csvfile import RowWriter
     from cell.sim.records import STATE_COLUMNS, STOP_COLUMNS
 

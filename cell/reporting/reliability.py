@@ -16,9 +16,11 @@ this writes, as one set,
 
 Downtime is given twice: as the runs had it (the robot stopped ``wear.repair_h`` at every
 worn-out motor: a handful a year, so it varies run to run), and as expected from each run's
-exposure (motor lives η_j = hours / ε_j, in series: the robot's mean time between wear
-stops, MTBF, and availability MTBF / (MTBF + repair), an alternating renewal process).  The
-reading uses the expected figures, which do not depend on how the few stops fell.
+exposure (motor lives η_j = up hours / ε_j; only the worn motor is replaced, so each motor's
+place is a renewal process and the robot's mean time between wear stops is MTBF =
+1 / Σ_j 1 / (η_j Γ(1 + 1/β)); availability MTBF / (MTBF + repair), an alternating renewal
+process).  The reading uses the expected figures, which do not depend on how the few stops
+fell.
 
 ``python -m cell.reporting.reliability SWEEP.yaml BUILD_DIR REPORT_DIR``.
 """
@@ -232,8 +234,9 @@ def markdown(t: pd.DataFrame, reps: pd.DataFrame) -> str:
         f"scenarios/baseline.yaml, docs/wear.md), {hours:.0f} simulated hours a run "
         f"(a year of two shifts), {n} replications a point. Downtime is quoted per "
         f"{YEAR_H:.0f} h year; *expected* downtime is from each run's motor exposures "
-        "(robot MTBF = the series life of its five motors at that duty), the figure the "
-        "reading uses; the runs' own stops are in `down_h_per_year`. OEE = availability × "
+        "(robot MTBF = 1 / Σ_j 1 / (η_j Γ(1 + 1/β)) over its five motors' lives η_j at that "
+        "duty: only the worn motor is replaced, so each motor's place renews on its own), the "
+        "figure the reading uses; the runs' own stops are in `down_h_per_year`. OEE = availability × "
         "performance (the arrivals' mean cycle × parts delivered / up time) × quality "
         "(parts set down within 45 ± 0.25 in). `reliability.csv` has every figure.", "",
         "![throughput against downtime](reliability.png)", "", "## Reading", ""]

@@ -13,7 +13,7 @@ Time measures cover the whole run (a warm-up in parts is not cut from them).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -24,7 +24,7 @@ from cell.sim.timeline import ROBOT_STATES, fractions, states
 _EMPTY = np.empty(0)
 
 
-def _spans(stops: list[tuple[str, str, float, float, Any]], keep: Callable[[str, str], bool]
+def _spans(stops: Sequence[tuple[str, str, float, float, Any]], keep: Callable[[str, str], bool]
            ) -> tuple[np.ndarray, np.ndarray]:
     chosen = [(a, b) for name, cause, a, b, _ in stops if keep(name, cause)]
     if not chosen:
@@ -37,11 +37,12 @@ def _named(equipment: str) -> Callable[[str, str], bool]:
     return lambda name, cause: name == equipment
 
 
-def timelines(column: Callable[[str], np.ndarray], downtime: Any, end_s: float
+def timelines(column: Callable[[str], np.ndarray], downtime: Any, end_s: float,
+              stops: Sequence[tuple[str, str, float, float, Any]] = ()
               ) -> dict[str, list[tuple[str, float, float]]]:
     """Each piece of equipment's (state, from, to) over [0, end_s]; ``column`` gives the run
-    log's per-part values (every part, warm-up included)."""
-    stops = downtime.all_stops(end_s) if downtime is not None else []
+    log's per-part values (every part, warm-up included); ``stops``: the run's (failures.csv's
+    rows, as :meth:`cell.sim.failures.Downtime.all_stops` gives them)."""
     arrival, at_bot = column("arrival"), column("at_bot")
     if downtime is not None:
         motion = np.frombuffer(downtime.robot.motion, dtype=float).reshape(-1, 2)
@@ -105,19 +106,21 @@ def fast_shares(column: Callable[[str], np.ndarray], end_s: float) -> dict[str, 
 
 
 def measure(r: RunSummary, column: Callable[[str], np.ndarray], downtime: Any,
-            fastest_cycle_s: float, end_s: float) -> dict[str, list[tuple[str, float, float]]]:
-    """Fill the summary's time shares, OEE and reliability figures; the timelines (with
-    failures only: without, the shares are summed directly, and no timeline is made)."""
-    if downtime is None:
+            fastest_cycle_s: float, end_s: float,
+            stops: list[tuple[str, str, float, float, Any]]
+            ) -> dict[str, list[tuple[str, float, float]]]:
+    """Fill the summary's time shares, OEE and reliability figures from the run's ``stops``
+    (failures.csv's rows: its failures', or wear's alone); the timelines (with failures or
+    wear only: without, the shares are summed directly, and no timeline is made)."""
+    if downtime is None and not stops:
         lines: dict[str, list[tuple[str, float, float]]] = {}
         share = fast_shares(column, end_s)
     else:
-        lines = timelines(column, downtime, end_s)
+        lines = timelines(column, downtime, end_s, stops)
         share = fractions(lines["robot"], end_s, ROBOT_STATES)
     r.robot_busy_fraction, r.robot_waiting_fraction = share["busy"], share["waiting"]
     r.robot_idle_fraction, r.robot_down_fraction = share["idle"], share["down"]
     r.robot_maintenance_fraction = share["maintenance"]
-    stops = downtime.all_stops(end_s) if downtime is not None else []
     if not stops:
         cell_share = {"maintenance": 0.0, "down": 0.0, "up": 1.0 if end_s > 0 else math.nan}
     else:

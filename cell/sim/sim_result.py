@@ -45,6 +45,8 @@ class SimResult:
         """The run's failures (None without a ``failures:`` section)."""
         self.timelines: dict[str, list[tuple[str, float, float]]] = {}
         """Each piece of equipment's (state, from_s, to_s) over the run."""
+        self.stop_rows: list[tuple[str, str, float, float, Any]] = []
+        """Every failure and planned stop (wear's included), in order of start."""
 
     def state_spans(self) -> list[StateSpan]:
         """states.csv's rows."""
@@ -52,9 +54,7 @@ class SimResult:
 
     def stops(self) -> list[Stop]:
         """failures.csv's rows: every failure and planned stop, in order of start."""
-        if self.downtime is None:
-            return []
-        return [Stop(*row) for row in self.downtime.all_stops(self.summary.sim_end_s)]
+        return [Stop(*row) for row in self.stop_rows]
 
     @functools.cached_property
     def records(self) -> list[PartRecord] | None:

@@ -285,13 +285,15 @@ def simulate(scenario: Scenario | AssembledCell,
     output.belt.close(until=env.now)  # a floor planned after the last touch-down never ran
 
     summary = _summary(cell, log, acct, t_all, n, env.now)
-    lines = oee.measure(summary, log.column, downtime, k.fastest_cycle_s, env.now)
+    stops = downtime.all_stops(env.now) if downtime is not None else \
+        wear_clock.stop_rows(wear, env.now)  # failures.csv's rows
+    lines = oee.measure(summary, log.column, downtime, k.fastest_cycle_s, env.now, stops)
     summary.seed = _seed_value(seed)
     summary.input_speed_max_in_s = conveyor.belt.max_speed_in_s
     summary.input_speed_min_in_s = conveyor.belt.min_speed_in_s
     summary.parts_bound = parts_bound(k, feeder.fed_s[summary.warmup_parts:n])
     result = SimResult(summary, rows, belts if keep_belts else None)
-    result.downtime, result.timelines = downtime, lines
+    result.downtime, result.timelines, result.stop_rows = downtime, lines, stops
     result.wear = wear_clock.measures(wear, downtime, env.now)
     return result
 

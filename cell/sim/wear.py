@@ -22,6 +22,8 @@ every breakpoint, so a cycle's exposure costs a bisection and a power per stretc
 
 The robot is a series system of its five motors: it stops at the first motor to wear
 out, which is replaced, its exposure starting again from zero (:mod:`cell.sim.wear_clock`).
+The other four keep their wear, so in the long run each motor's place is a renewal process
+and the robot's mean time between stops is :func:`renewal_mtbf_h`.
 """
 
 from __future__ import annotations
@@ -100,9 +102,15 @@ def series_life_h(lives_h: ArrayLike, shape: float) -> float:
     return math.inf if total == 0 else total ** (-1.0 / shape)
 
 
-def mean_life_h(characteristic_h: float, shape: float) -> float:
-    """Mean of a Weibull(β, η): η Γ(1 + 1/β)."""
-    return characteristic_h * math.gamma(1.0 + 1.0 / shape)
+def renewal_mtbf_h(lives_h: ArrayLike, shape: float) -> float:
+    """Long-run mean time between stops of motors in series, each replaced alone when it wears
+    out: motor j's place is a renewal process of mean η_j Γ(1 + 1/β), and the robot stops at
+    their summed rates, so MTBF = 1 / Σ_j 1 / (η_j Γ(1 + 1/β)) (inf: no motor wears).
+    Not the mean η Γ(1 + 1/β) of :func:`series_life_h` (five new motors' first stop), which
+    is longer."""
+    lives = np.asarray(lives_h, dtype=float)
+    rate = float(np.sum(1.0 / lives[np.isfinite(lives)])) / math.gamma(1.0 + 1.0 / shape)
+    return math.inf if rate == 0 else 1.0 / rate
 
 
 # --------------------------------------------------------------------------- per stretch

@@ -2,11 +2,13 @@
 
 Two ways in.  With ``wear:`` alone, :func:`alone` wraps the robot's orders: each cycle's
 stretch times wear the motors (:class:`WearClock`) and, when one wears out, the robot stops
-``wear.repair_h`` once it is back at B.  With ``failures.robot`` as well, the failures'
-robot clock counts the wear instead of a drawn time to failure (:class:`WearExposure`,
+``wear.repair_h`` once it is back at B (:func:`stop_rows`: its stops as failures.csv's rows,
+which the run's states and summary count as well).  With ``failures.robot`` as well, the
+failures' robot clock counts the wear instead of a drawn time to failure (:class:`WearExposure`,
 :func:`count_on`): the robot stops mid-move, waits for a crew and is repaired for a
 drawn ``failures.robot.time_to_repair``, and failures.csv says ``wear``.  Either way the
-run's measures come back as :class:`WearResult` (:func:`measures`).
+run's measures come back as :class:`WearResult` (:func:`measures`); its MTBF is the long-run
+figure of motors replaced one at a time (:func:`cell.sim.wear.renewal_mtbf_h`).
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ from cell.sim.wear import (
     CycleWear,
     WearModel,
     draw_thresholds,
-    mean_life_h,
+    renewal_mtbf_h,
     series_life_h,
 )
 
@@ -67,17 +69,23 @@ class WearLog:
     def __init__(self, clock: WearClock | WearExposure, repair_s: float):
         self.clock, self.repair_s = clock, repair_s
         self.stops: list[tuple[float, float, int]] = []
+        self.held_s = 0.0
+        """The robot's time in planned stops (maintenance), worn by no motor."""
 
     def row(self, end_s: float) -> dict[str, float]:
-        """The run's wear measures, one row (wear_* columns)."""
+        """The run's wear measures, one row (wear_* columns).  A motor's life at this duty is
+        the robot's up time (the run less its stops) over the motor's exposure; the MTBF is
+        the renewal figure (:func:`cell.sim.wear.renewal_mtbf_h`), up time between stops."""
         model = self.clock.wear.model
         hours = end_s / HOUR_S
-        down_h = sum(min(b, end_s) - a for a, b, _ in self.stops if a < end_s) / HOUR_S
-        lives = [hours / e if e > 0 else math.inf for e in self.clock.total]
+        stops = [(a, b) for a, b, _ in self.stops if a < end_s]
+        down_h = sum(min(b, end_s) - a for a, b in stops) / HOUR_S
+        up_h = hours - down_h - self.held_s / HOUR_S
+        lives = [up_h / e if e > 0 else math.inf for e in self.clock.total]
         robot = series_life_h(lives, model.shape)
-        mtbf = mean_life_h(robot, model.shape)
+        mtbf = renewal_mtbf_h(lives, model.shape)
         out: dict[str, float] = {
-            "wear_exponent": model.exponent, "wear_failures": float(len(self.stops)),
+            "wear_exponent": model.exponent, "wear_failures": float(len(stops)),
             "wear_down_h": down_h, "wear_hours": hours,
             "wear_robot_life_h": robot, "wear_mtbf_h": mtbf,
             "wear_availability": mtbf / (mtbf + self.repair_s / HOUR_S)
@@ -85,6 +93,14 @@ class WearLog:
         for name, life in zip(JOINTS, lives):
             out[f"wear_life_{name}_h"] = life
         return out
+
+
+def stop_rows(wear: WearLog | None, end_s: float) -> list[tuple[str, str, float, float, Any]]:
+    """failures.csv's rows of the stops of ``wear:`` alone (the robot at B, no part in hand),
+    as :meth:`cell.sim.failures.Downtime.all_stops` gives a run's with failures."""
+    if wear is None:
+        return []
+    return [("robot", "wear", a, min(b, end_s), "") for a, b, _ in wear.stops if a < end_s]
 
 
 def attach(table: StepTable, timing: RobotTiming, settings: WearSettingsLike, robot: Any,
@@ -204,8 +220,10 @@ def failures_log(exposure: WearExposure, downtime: Any, failures: Any, end_s: fl
     from cell.scenario.failure_spec import frozen
 
     log = WearLog(exposure, float(frozen(failures.robot.time_to_repair).mean()))
-    log.stops = [(a, b, -1) for name, cause, a, b, _ in downtime.all_stops(end_s)
-                 if name == "robot" and cause == "wear"]
+    robot = [(cause, a, b) for name, cause, a, b, _ in downtime.all_stops(end_s)
+             if name == "robot"]
+    log.stops = [(a, b, -1) for cause, a, b in robot if cause == "wear"]
+    log.held_s = sum(b - a for cause, a, b in robot if cause != "wear")
     return log
 
 

@@ -64,3 +64,28 @@ def test_without_failures_a_run_writes_its_three_files_and_the_busy_fraction(tmp
     assert f"robot busy (in motion) {summary.robot_busy_fraction:.3f}" in text
     loads = re.findall(r"offered load\b\D*([\d.]+)", text)
     assert loads == [f"{summary.offered_load:.3f}"] * 2  # the heading's and the busy line's: summary.csv's
+
+
+def test_a_run_whose_motors_wear_writes_its_stops_and_counts_them(tmp_path: Path):
+    """wear: on and no failures: section: the robot stops for worn motors, so the run writes
+    failures.csv and states.csv, and the summary's availability and MTBF count the stops."""
+    out = tmp_path / "run"
+    code, text = run("run", "baseline", "--set", "run.hours=3", "--set", "wear.enabled=true",
+                     "--set", "wear.rated_life_h=0.5", "--set", "wear.repair_h=0.05",
+                     "--out", str(out))
+    assert code == 0
+    assert sorted(p.name for p in out.iterdir()) == [
+        "belts.csv", "failures.csv", "parts.csv", "states.csv", "summary.csv"]
+    summary = pd.read_csv(out / "summary.csv").iloc[0]
+    stops = pd.read_csv(out / "failures.csv")
+    assert len(stops) == summary.robot_failures > 0
+    assert (stops.equipment == "robot").all() and (stops.cause == "wear").all()
+    down_s = (stops.to_s - stops.from_s).sum()
+    assert summary.availability == pytest.approx(1 - down_s / summary.sim_end_s)
+    assert summary.availability < 1
+    assert summary.mtbf_observed_s == pytest.approx(
+        (summary.sim_end_s - down_s) / summary.robot_failures)
+    states = pd.read_csv(out / "states.csv")
+    down = states[(states.equipment == "robot") & (states.state == "down")]
+    assert (down.to_s - down.from_s).sum() == pytest.approx(down_s)
+    assert "availability" in text

@@ -176,3 +176,62 @@ def test_wear_with_failures_but_no_robot_entry_is_refused() -> None:
                                                         "params": {"scale": 100.0}},
                                     "time_to_repair": {"distribution": "expon",
                                                        "params": {"scale": 10.0}}}}})
+
+
+# --------------------------------------------------------------------------- in the long run
+#: Short lives and repairs, so a few simulated days hold hundreds of stops (p = 0: the motors'
+#: lives differ most, so five fresh motors' mean life is twice the renewal figure).
+RENEWAL = {"controller.policy": "non-adaptive", "wear.enabled": True, "wear.exponent": 0.0,
+           "wear.rated_life_h": 1.0, "wear.repair_h": 0.02, "run.hours": 100.0}
+WARM_UP_S = 10 * 3600.0  # a few lives of the longest-lived motor: the stops are stationary after
+
+
+@pytest.fixture(scope="module")
+def renewal_runs():
+    s = default_scenario().with_overrides(RENEWAL)
+    return [simulate(s, seed=seed, keep_parts=False, keep_belts=False) for seed in range(10)]
+
+
+def test_wear_mtbf_is_the_long_run_mean_time_between_wear_stops(renewal_runs) -> None:
+    """Only the worn motor is replaced, so each motor's place is a renewal process of mean
+    η_j Γ(1 + 1/β) and the robot stops at their summed rates: wear_mtbf_h is the up time
+    between stops the run shows once past its start (fresh motors), within a 99 % interval
+    over the replications (a ratio estimator: up time over stops)."""
+    up, n, mtbf = [], [], []
+    for run in renewal_runs:
+        end = run.summary.sim_end_s
+        late = [(a, min(b, end)) for a, b, _ in run.wear.stops if WARM_UP_S <= a < end]
+        up.append((end - WARM_UP_S - sum(b - a for a, b in late)) / 3600.0)
+        n.append(len(late))
+        mtbf.append(run.wear["wear_mtbf_h"])
+    u, k = np.array(up), np.array(n, dtype=float)
+    ratio = u.sum() / k.sum()
+    se = np.sqrt(np.sum((u - ratio * k) ** 2) / (k.size * (k.size - 1))) / k.mean()
+    half = stats.t.ppf(0.995, k.size - 1) * se
+    assert k.min() > 150 and half < 0.06 * ratio  # enough stops for the interval to mean much
+    assert abs(np.mean(mtbf) - ratio) <= half
+
+
+def test_wear_alone_stops_are_in_the_failures_the_states_and_the_summary(renewal_runs) -> None:
+    """wear: without failures: each stop is a failures.csv row (robot, wear), the robot is
+    ``down`` in states.csv exactly then, and the summary's availability, down fraction and
+    observed MTBF count the stops (nothing else stops this cell)."""
+    run = renewal_runs[0]
+    r, end = run.summary, run.summary.sim_end_s
+    stops = run.stops()
+    assert run.wear is not None and len(stops) == run.wear["wear_failures"] > 50
+    assert {(x.equipment, x.cause, x.part) for x in stops} == {("robot", "wear", "")}
+    assert np.allclose([(x.from_s, x.to_s) for x in stops],
+                       [(a, min(b, end)) for a, b, _ in run.wear.stops if a < end])
+    down_s = sum(x.to_s - x.from_s for x in stops)
+    assert down_s / 3600.0 == pytest.approx(run.wear["wear_down_h"])
+    robot = [s for s in run.state_spans() if s.equipment == "robot"]
+    assert robot[0].from_s == 0 and robot[-1].to_s == end
+    assert all(a.to_s == b.from_s for a, b in zip(robot, robot[1:]))
+    assert np.allclose([(s.from_s, s.to_s) for s in robot if s.state == "down"],
+                       [(x.from_s, x.to_s) for x in stops])
+    assert r.robot_down_fraction == pytest.approx(down_s / end)
+    assert r.availability == pytest.approx(1 - down_s / end) and r.availability < 1
+    assert r.robot_failures == len(stops)
+    assert r.mtbf_observed_s == pytest.approx((end - down_s) / len(stops))
+    assert r.oee == pytest.approx(r.availability * r.performance * r.quality)
