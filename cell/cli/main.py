@@ -157,17 +157,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     With ``argv`` None the process is the command's: stopped, it ends at once with its code
     (:func:`cell.plumbing.interrupts.exit_now`), whatever Ctrl-C or kill met on its way."""
     global _stops
-    _stops = stops = Stops().install()
+    _stops = stops = Stops().install()  # not armed yet: a stop now is remembered, raised by arm()
     made: list[str] = []  # the folder _matplotlib_home makes, named before it is made
+    code = 0
     try:
-        from cell.plumbing.streams import reader_may_leave, standard_streams
+        try:
+            stops.arm()
+            from cell.plumbing.streams import reader_may_leave, standard_streams
 
-        standard_streams()
-        _matplotlib_home(made)
-        with reader_may_leave():
-            code = _where() or _main(argv)
-        if stops.settled():  # stopped while it finished: said so, its outputs whole
-            code = _said_stopped(None, stops.signum)
+            standard_streams()
+            _matplotlib_home(made)
+            with reader_may_leave():
+                code = _where() or _main(argv)
+            if stops.settled():  # stopped while it finished: said so, its outputs whole
+                code = _said_stopped(None, stops.signum)
+        finally:  # a stop before this line is raised, and caught below; after it, remembered
+            stops.disarm()
     except BaseException as exc:  # a stop, or one that became another error on its way
         if not (interrupted(exc) or stops.settled()):
             raise
@@ -180,6 +185,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             with contextlib.suppress(OSError):  # made, not yet opened to its owner (umask)
                 os.rmdir(made[0])
         stops.restore()
+    if stops.signum is not None and code not in (INTERRUPTED, TERMINATED):
+        code = _said_stopped(None, stops.signum)  # came as the command ended: not yet said
     if code in (INTERRUPTED, TERMINATED) and argv is None:
         exit_now(code)
     return code

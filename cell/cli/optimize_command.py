@@ -59,34 +59,22 @@ def main(args: argparse.Namespace) -> int:
     done = counted(o, running=False)
     bar = Progress(study.settings.trials, f"optimize {study.name}", "trials")
     bar.update(done)
-    _kill_stops()
-    try:
+    try:  # Ctrl-C and kill: cell.cli.main's handlers (KeyboardInterrupt, Terminated)
         run_workers(study, out, o, args.workers or 1, args.scheduler, bar)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
+        from cell.plumbing.interrupts import stopped_by
+
         bar.close()
         kept = counted(o, running=False)
         print(f"cell optimize: stopped; {kept} finished trial{'s' if kept != 1 else ''} kept in "
               f"{out / 'study.db'}: the same command with --resume runs only the rest",
               file=sys.stderr)
-        return 130  # as the shell reports Ctrl-C
+        return stopped_by(exc, None)[0]  # 130 or 143, and main says its line
     bar.close()
     shown = shlex.quote(catalog.shown(study.source))
     written = write_results(study, o, out, f"cell optimize {shown} --out ...")
     print(f"wrote {out}: " + ", ".join(Path(p).name for p in written))
     return 0
-
-
-def _kill_stops() -> None:
-    """A kill (SIGTERM) stops the study as Ctrl-C does: finished trials kept, one line."""
-    import signal
-    import threading
-
-    def stop(signum: int, frame: Any) -> None:
-        signal.signal(signal.SIGTERM, signal.SIG_IGN)
-        raise KeyboardInterrupt
-
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, stop)
 
 
 def write_results(study: Study, o: Any, out: Path, command: str) -> list[Path]:

@@ -126,3 +126,28 @@ def test_bad_study_files_get_one_line_and_exit_2(tmp_path: Path, capsys, case: s
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and str(path) in err[0] and where in err[0], err
     assert not out.exists()
+
+
+
+def test_a_killed_optimize_ends_as_every_command_does(tmp_path: Path, unrendered, monkeypatch,
+                                                      capsys) -> None:
+    """kill (SIGTERM) during the trials: 143 and ``cell: terminated`` last (it said 130 and
+    ``cell: interrupted``, its own handler's), the finished trial kept for --resume."""
+    import os
+
+    import cell.experiments.optimize as optimize
+
+    real, calls = optimize.replicate, []
+
+    def replicate(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            os.kill(os.getpid(), signal.SIGTERM)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(optimize, "replicate", replicate)
+    path = _study(tmp_path, FIXED.replace("TRIALS", "4"))
+    out = tmp_path / "out"
+    assert main(["optimize", str(path), "--out", str(out)]) == 143
+    assert capsys.readouterr().err.splitlines()[-1] == "cell: terminated"
+    assert _completed(out / "study.db") == 1 and not (out / "trials.csv").exists()
