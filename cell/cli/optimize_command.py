@@ -49,10 +49,23 @@ def main(args: argparse.Namespace) -> int:
         from cell.plumbing.errors import ScenarioError
 
         raise ScenarioError(args.study, "objectives", [], "name at least one {measure, goal}")
-    from cell.experiments.optimize import open_study, run_workers
+    from cell.experiments.optimize import check_storage, connect, open_study, run_workers
 
-    out.mkdir(parents=True, exist_ok=True)
-    o = open_study(study, out, args.resume)
+    check_storage(study, out, args.resume)  # a foreign or damaged study.db: never written into
+    client = None
+    if args.scheduler is not None:
+        from cell.experiments.sweep.cluster import CONNECT_TIMEOUT_S
+
+        print(f"connecting to the dask scheduler at {args.scheduler} (giving up after "
+              f"{CONNECT_TIMEOUT_S:g} s)", file=sys.stderr)
+        client = connect(args.scheduler)  # unreachable: one line, before anything is written
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        o = open_study(study, out, args.resume)
+    except BaseException:
+        if client is not None:
+            client.close()
+        raise
     from cell.experiments.optimize import counted
     from cell.plumbing.progress import Progress
 
@@ -60,7 +73,7 @@ def main(args: argparse.Namespace) -> int:
     bar = Progress(study.settings.trials, f"optimize {study.name}", "trials")
     bar.update(done)
     try:  # Ctrl-C and kill: cell.cli.main's handlers (KeyboardInterrupt, Terminated)
-        run_workers(study, out, o, args.workers or 1, args.scheduler, bar)
+        run_workers(study, out, o, args.workers or 1, client, bar)
     except KeyboardInterrupt as exc:
         from cell.plumbing.interrupts import stopped_by
 
