@@ -167,8 +167,11 @@ def main(argv: Sequence[str] | None = None) -> int:
 
             standard_streams()
             _matplotlib_home(made)
-            with reader_may_leave():
+            with reader_may_leave() as stdout:
                 code = _where() or _main(argv)
+            if stdout.failed is not None and code == 0:  # what it printed was lost: not done
+                reason = stdout.failed.strerror or os.strerror(stdout.failed.errno or 0)
+                code = _fail(f"standard output: cannot write: {reason.lower()}")
             if stops.settled():  # stopped while it finished: said so, its outputs whole
                 code = _said_stopped(None, stops.signum)
         finally:  # a stop before this line is raised, and caught below; after it, remembered
