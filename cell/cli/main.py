@@ -168,8 +168,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             standard_streams()
             _matplotlib_home(made)
             with reader_may_leave() as stdout:
-                code = _where() or _main(argv)
-            if stdout.failed is not None and code == 0:  # what it printed was lost: not done
+                code = _where() or _main(argv, stdout)
+            if stdout.failed is not None and stdout.product and code == 0:  # lost: not done
                 reason = stdout.failed.strerror or os.strerror(stdout.failed.errno or 0)
                 code = _fail(f"standard output: cannot write: {reason.lower()}")
             if stops.settled():  # stopped while it finished: said so, its outputs whole
@@ -299,7 +299,10 @@ def _where() -> int:
     return 0
 
 
-def _main(argv: Sequence[str] | None) -> int:
+def _main(argv: Sequence[str] | None, stdout: Any = None) -> int:
+    """Parse and run the command; ``stdout`` (the guarded standard output) is told whether what
+    is printed is the command's product: no ``--out`` (``cell fit``, ``cell compare`` without
+    it; a listing)."""
     parser = build_parser()
     try:
         args, extra = parser.parse_known_args(argv)
@@ -310,6 +313,8 @@ def _main(argv: Sequence[str] | None) -> int:
         return _fail(str(exc))
     except SystemExit as exc:  # --help, --version: printed, done
         return exc.code if isinstance(exc.code, int) else 0
+    if stdout is not None:
+        stdout.product = not getattr(args, "out", None)
     try:
         _check_targets(args)
         return _run(args)

@@ -8,11 +8,12 @@ with its own exit code, where the closed pipe used to stop it half-way (nothing 
 exit 0) or fail the interpreter's last flush (exit 120).
 
 A reader that left (``EPIPE``) is no error; standard output that cannot be written for another
-reason (a full device, ``ENOSPC``; an I/O error, ``EIO``) is: a command whose product is what it
-prints (``cell fit`` or ``cell compare`` without ``--out``) would have lost it and said nothing.
-Its stream is silenced the same way, so the command still ends whole, and
-:attr:`Guarded.failed` keeps the error for ``cell.cli.main`` to end the command with one line and
-exit 2.
+reason (a full device, ``ENOSPC``; an I/O error, ``EIO``) is, when what it prints is the
+command's product (:attr:`Guarded.product`: ``cell fit`` or ``cell compare`` without ``--out``),
+which it would have lost saying nothing.  The stream is silenced the same way, so the command
+still ends whole, and :attr:`Guarded.failed` keeps the error for ``cell.cli.main`` to end the
+command with one line and exit 2; beside files, what is printed is commentary and its loss no
+error.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ class Guarded:
         self.stream = stream
         self.gone = False
         self.failed: OSError | None = None
+        self.product = False  # what is written here is the command's product, not commentary
 
     def __getattr__(self, name: str) -> Any:  # isatty, fileno, encoding...: the stream's own
         return getattr(self.stream, name)
