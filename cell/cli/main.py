@@ -178,17 +178,25 @@ def main(argv: Sequence[str] | None = None) -> int:
     With ``argv`` None the process is the command's: stopped, it ends at once with its code
     (:func:`cell.plumbing.interrupts.exit_now`), whatever Ctrl-C or kill met on its way."""
     global _stops
-    _stops = stops = Stops().install()
+    _stops = stops = Stops().install()  # not armed yet: a stop now is remembered, raised by arm()
     made: list[str] = []  # the folder _matplotlib_home makes, named before it is made
+    code = 0
     try:
-        from cell.plumbing.streams import reader_may_leave, standard_streams
+        try:
+            stops.arm()
+            from cell.plumbing.streams import reader_may_leave, standard_streams
 
-        standard_streams()
-        _matplotlib_home(made)
-        with reader_may_leave():
-            code = _where() or _main(argv)
-        if stops.settled():  # stopped while it finished: said so, its outputs whole
-            code = _said_stopped(None, stops.signum)
+            standard_streams()
+            _matplotlib_home(made)
+            with reader_may_leave() as stdout:
+                code = _where() or _main(argv, stdout)
+            if stdout.failed is not None and stdout.product and code == 0:  # lost: not done
+                reason = stdout.failed.strerror or os.strerror(stdout.failed.errno or 0)
+                code = _fail(f"standard output: cannot write: {reason.lower()}")
+            if stops.settled():  # stopped while it finished: said so, its outputs whole
+                code = _said_stopped(None, stops.signum)
+        finally:  # a stop before this line is raised, and caught below; after it, remembered
+            stops.disarm()
     except BaseException as exc:  # a stop, or one that became another error on its way
         if not (interrupted(exc) or stops.settled()):
             raise
@@ -201,6 +209,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             with contextlib.suppress(OSError):  # made, not yet opened to its owner (umask)
                 os.rmdir(made[0])
         stops.restore()
+    if stops.signum is not None and code not in (INTERRUPTED, TERMINATED):
+        code = _said_stopped(None, stops.signum)  # came as the command ended: not yet said
     if code in (INTERRUPTED, TERMINATED) and argv is None:
         exit_now(code)
     return code
@@ -310,7 +320,10 @@ def _where() -> int:
     return 0
 
 
-def _main(argv: Sequence[str] | None) -> int:
+def _main(argv: Sequence[str] | None, stdout: Any = None) -> int:
+    """Parse and run the command; ``stdout`` (the guarded standard output) is told whether what
+    is printed is the command's product: no ``--out`` (``cell fit``, ``cell compare`` without
+    it; a listing)."""
     parser = build_parser()
     try:
         args, extra = parser.parse_known_args(argv)
@@ -321,6 +334,8 @@ def _main(argv: Sequence[str] | None) -> int:
         return _fail(str(exc))
     except SystemExit as exc:  # --help, --version: printed, done
         return exc.code if isinstance(exc.code, int) else 0
+    if stdout is not None:
+        stdout.product = not getattr(args, "out", None)
     try:
         _check_targets(args)
         return _run(args)

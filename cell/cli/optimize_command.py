@@ -49,44 +49,45 @@ def main(args: argparse.Namespace) -> int:
         from cell.plumbing.errors import ScenarioError
 
         raise ScenarioError(args.study, "objectives", [], "name at least one {measure, goal}")
-    from cell.experiments.optimize import open_study, run_workers
+    from cell.experiments.optimize import check_storage, connect, open_study, run_workers
 
-    out.mkdir(parents=True, exist_ok=True)
-    o = open_study(study, out, args.resume)
+    check_storage(study, out, args.resume)  # a foreign or damaged study.db: never written into
+    client = None
+    if args.scheduler is not None:
+        from cell.experiments.sweep.cluster import CONNECT_TIMEOUT_S
+
+        print(f"connecting to the dask scheduler at {args.scheduler} (giving up after "
+              f"{CONNECT_TIMEOUT_S:g} s)", file=sys.stderr)
+        client = connect(args.scheduler)  # unreachable: one line, before anything is written
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        o = open_study(study, out, args.resume)
+    except BaseException:
+        if client is not None:
+            client.close()
+        raise
     from cell.experiments.optimize import counted
     from cell.plumbing.progress import Progress
 
     done = counted(o, running=False)
     bar = Progress(study.settings.trials, f"optimize {study.name}", "trials")
     bar.update(done)
-    _kill_stops()
-    try:
-        run_workers(study, out, o, args.workers or 1, args.scheduler, bar)
-    except KeyboardInterrupt:
+    try:  # Ctrl-C and kill: cell.cli.main's handlers (KeyboardInterrupt, Terminated)
+        run_workers(study, out, o, args.workers or 1, client, bar)
+    except KeyboardInterrupt as exc:
+        from cell.plumbing.interrupts import stopped_by
+
         bar.close()
         kept = counted(o, running=False)
         print(f"cell optimize: stopped; {kept} finished trial{'s' if kept != 1 else ''} kept in "
               f"{out / 'study.db'}: the same command with --resume runs only the rest",
               file=sys.stderr)
-        return 130  # as the shell reports Ctrl-C
+        return stopped_by(exc, None)[0]  # 130 or 143, and main says its line
     bar.close()
     shown = shlex.quote(catalog.shown(study.source))
     written = write_results(study, o, out, f"cell optimize {shown} --out ...")
     print(f"wrote {out}: " + ", ".join(Path(p).name for p in written))
     return 0
-
-
-def _kill_stops() -> None:
-    """A kill (SIGTERM) stops the study as Ctrl-C does: finished trials kept, one line."""
-    import signal
-    import threading
-
-    def stop(signum: int, frame: Any) -> None:
-        signal.signal(signal.SIGTERM, signal.SIG_IGN)
-        raise KeyboardInterrupt
-
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, stop)
 
 
 def write_results(study: Study, o: Any, out: Path, command: str) -> list[Path]:

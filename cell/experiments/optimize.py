@@ -16,6 +16,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -74,23 +75,108 @@ def _constraints(trial: Any) -> list[float]:
     return list(trial.user_attrs.get("excess", []))
 
 
+#: The tables every Optuna storage holds: a database without them is not a study's.
+OPTUNA_TABLES = frozenset({"studies", "study_directions", "study_user_attributes", "trials",
+                           "version_info"})
+#: What an SQLite database file starts with.
+SQLITE_HEADER = b"SQLite format 3\x00"
+
+
+def check_storage(study: Study, out: Path, resume: bool) -> None:
+    """Refuse, before any work and writing nothing, a ``DIR/study.db`` that Optuna must not
+    open: a directory or other non-file, a file that is not an SQLite database (or a damaged
+    one), another program's database (without Optuna's tables), or a study database holding
+    another study (another name, several, or this one's name with another fingerprint: the
+    study file changed, or another version of cell); and any of them without ``resume``.
+    Read through SQLite read-only, so that not even a journal is written."""
+    import sqlite3
+    import stat
+    from urllib.parse import quote
+
+    from cell.plumbing.errors import shown_path
+
+    db = out / DB_NAME
+    shown = shown_path(db)
+    try:
+        mode = os.stat(db).st_mode
+    except FileNotFoundError:
+        return
+    except OSError as exc:
+        raise CellError(f"{shown}: cannot be read ({(exc.strerror or str(exc)).lower()})") from None
+    if stat.S_ISDIR(mode):
+        raise CellError(f"{shown}: a directory, not a study database; choose another --out")
+    if not stat.S_ISREG(mode):
+        raise CellError(f"{shown}: not a regular file, so not a study database; choose "
+                        "another --out")
+    if not resume:
+        raise CellError(f"{out}: holds a study already ({DB_NAME}); add --resume to continue "
+                        "it, or choose another --out")
+    try:
+        with open(db, "rb") as f:
+            head = f.read(len(SQLITE_HEADER))
+    except OSError as exc:
+        raise CellError(f"{shown}: cannot be read ({(exc.strerror or str(exc)).lower()})") from None
+    if head != SQLITE_HEADER:
+        what = "empty" if not head else "not an SQLite database"
+        raise CellError(f"{shown}: {what}, so not a study database; choose another --out")
+    try:
+        con = sqlite3.connect(f"file:{quote(str(db.resolve()))}?mode=ro", uri=True)
+    except sqlite3.Error as exc:
+        raise CellError(f"{shown}: cannot be opened as a database ({exc})") from None
+    try:
+        names = _stored_studies(con, study.name)
+    except sqlite3.Error as exc:
+        raise CellError(f"{shown}: a damaged database ({exc}); choose another --out") from None
+    finally:
+        con.close()
+    if names is None:
+        raise CellError(f"{shown}: another program's database (no Optuna study in it); "
+                        "choose another --out")
+    stored, mark = names
+    if stored not in ([], [study.name]):  # (none: a run killed as it made its study)
+        listed = ", ".join(repr(n) for n in stored[:3]) or "none"
+        raise CellError(f"{shown}: holds another study ({listed}), not {study.name!r}; choose "
+                        "another --out")
+    if mark is not None and mark != fingerprint(study):
+        raise CellError(f"{shown}: holds study {study.name!r} as another study file made it "
+                        "(it changed since, or another version of cell ran it); choose another --out")
+
+
+def _stored_studies(con: Any, name: str) -> tuple[list[str], str | None] | None:
+    """The names of the studies in an Optuna database and the fingerprint stored with the one
+    named ``name`` (None if it has none); None if the database is not Optuna's."""
+    quick = con.execute("PRAGMA quick_check").fetchone()
+    if quick is None or quick[0] != "ok":
+        import sqlite3
+
+        raise sqlite3.DatabaseError(quick[0] if quick else "no answer to its check")
+    tables = {r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+    if not OPTUNA_TABLES <= tables:
+        return None
+    stored = [r[0] for r in con.execute("SELECT study_name FROM studies ORDER BY study_id")]
+    row = con.execute("SELECT a.value_json FROM study_user_attributes a JOIN studies s "
+                      "ON a.study_id = s.study_id WHERE s.study_name = ? AND a.key = "
+                      "'fingerprint'", (name,)).fetchone()
+    mark = None
+    if row is not None:
+        try:
+            mark = json.loads(row[0])
+        except ValueError:
+            mark = str(row[0])
+    return stored, str(mark) if mark is not None else None
+
+
 def open_study(study: Study, out: Path, resume: bool) -> Any:
     """The Optuna study in ``out``: new, or (``resume``) the one there, which must be this
-    study's; trials a killed run left running are marked failed (and run again)."""
+    study's (:func:`check_storage`); trials a killed run left running are marked failed (and
+    run again)."""
     import optuna
 
+    check_storage(study, out, resume)  # (the command checked it before its work: again now)
     optuna.logging.set_verbosity(optuna.logging.ERROR)  # refused trials: in trials.csv, with the reason
-    url, exists = storage_url(out), (out / DB_NAME).exists()
-    if exists and not resume:
-        raise CellError(f"{out}: holds a study already; add --resume to continue it, or choose "
-                        "another --out")
-    o = optuna.create_study(study_name=study.name, storage=url, load_if_exists=True,
+    o = optuna.create_study(study_name=study.name, storage=storage_url(out), load_if_exists=True,
                             directions=directions(study))
-    mark = fingerprint(study)
-    if o.user_attrs.get("fingerprint", mark) != mark:
-        raise CellError(f"{out}: holds another study (or this one changed, or another version "
-                        "of cell); choose another --out")
-    o.set_user_attr("fingerprint", mark)
+    o.set_user_attr("fingerprint", fingerprint(study))
     for t in o.get_trials(deepcopy=False, states=(optuna.trial.TrialState.RUNNING,)):
         o._storage.set_trial_state_values(t._trial_id, optuna.trial.TrialState.FAIL)
     return o
@@ -194,19 +280,25 @@ def worker(source: str, out: str) -> int:
     return work(study, o)
 
 
-def run_workers(study: Study, out: Path, o: Any, workers: int, scheduler: str | None,
+def connect(scheduler: str) -> Any:
+    """A client of the dask scheduler at ``scheduler``, or the one line that says why not
+    (as ``cell sweep --scheduler`` says it: :func:`cell.experiments.sweep.cluster.connect`)."""
+    from cell.experiments.sweep.cluster import connect as reach
+
+    return reach(scheduler)
+
+
+def run_workers(study: Study, out: Path, o: Any, workers: int, client: Any,
                 progress: Any) -> None:
-    """Run the trials: in this process (one worker), in local processes, or on dask."""
-    if scheduler is None and workers <= 1:
+    """Run the trials: in this process (one worker), in local processes, or on the dask
+    cluster of ``client`` (:func:`connect`; closed here)."""
+    if client is None and workers <= 1:
         work(study, o, on_trial=progress.update)
         return
     import concurrent.futures as cf
     import time
 
-    if scheduler is not None:
-        from distributed import Client
-
-        client = Client(scheduler, timeout="20s")
+    if client is not None:
         futures = [client.submit(worker, str(study.source.resolve()), str(out.resolve()),
                                  pure=False) for _ in range(max(workers, 1))]
         waiter: Callable[[], bool] = lambda: all(f.done() for f in futures)  # noqa: E731
@@ -225,10 +317,10 @@ def run_workers(study: Study, out: Path, o: Any, workers: int, scheduler: str | 
             progress.update(now - seen)
             seen = now
         progress.update(counted(o, running=False) - seen)
-        for j in (futures if scheduler is not None else jobs):
+        for j in (futures if client is not None else jobs):
             j.result()
     finally:
-        if scheduler is not None:
+        if client is not None:
             client.close()
         else:
             pool.shutdown(cancel_futures=True)

@@ -10,6 +10,8 @@ import contextlib
 import os
 import signal
 import sys
+import threading
+import time
 from typing import Any
 
 
@@ -48,29 +50,101 @@ class Terminated(KeyboardInterrupt):
 
 
 class Stops:
-    """SIGINT and SIGTERM while a command runs: the first raises (KeyboardInterrupt, or
-    :class:`Terminated`) and is remembered, so that the command ends as stopped even if
-    what it raised was swallowed or became another error on its way (ffmpeg, which the
-    same Ctrl-C stopped first, breaking its pipe); another is only remembered.  Installed
-    only in the main thread; :meth:`restore` puts the previous handlers back."""
+    """SIGINT and SIGTERM while a command runs: the first is remembered and, while the
+    command is *armed* (:meth:`arm`: inside the block that turns a stop into its line and
+    code), raised (KeyboardInterrupt, or :class:`Terminated`), so that the command ends as
+    stopped even if what it raised was swallowed or became another error on its way (ffmpeg,
+    which the same Ctrl-C stopped first, breaking its pipe); another is only remembered.
+
+    Outside that block (just installed, not yet armed; disarmed as the block ends) a stop is
+    only remembered: raised there, nothing would catch it and Python would print its
+    traceback.  :meth:`arm` raises one remembered before it; the caller says one remembered
+    after :meth:`disarm`.  A stop raised where Python drops what is raised (a destructor, a
+    weakref callback: "Exception ignored in") is raised again (:meth:`lost`).
+
+    Installed only in the main thread; :meth:`restore` puts the previous handlers back."""
 
     SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
     def __init__(self) -> None:
         self.signum: int | None = None
+        self.armed = False
+        self.owed = False  # the stop was raised where Python dropped it: to be raised again
+        self.lock = threading.Lock()  # owed and armed, between this thread and _again's
         self.previous: dict[int, Any] = {}
+        self.hook: Any = None
 
     def install(self) -> Stops:
         with contextlib.suppress(ValueError, OSError):  # not the main thread: left as it is
             for number in self.SIGNALS:
                 self.previous[number] = signal.signal(number, self)
+            self.hook, sys.unraisablehook = sys.unraisablehook, self.unraisable
         return self
 
     def __call__(self, signum: int, frame: object) -> None:
-        if self.signum is not None:
+        if self.signum is not None and not self.owed:
             return
-        self.signum = signum
-        raise Terminated if signum == signal.SIGTERM else KeyboardInterrupt
+        self.owed = False
+        if self.signum is None:
+            self.signum = signum
+        if self.armed:
+            raise self.exception()
+
+    def exception(self) -> KeyboardInterrupt:
+        """What the remembered stop raises: :class:`Terminated` for kill, else KeyboardInterrupt."""
+        return Terminated() if self.signum == signal.SIGTERM else KeyboardInterrupt()
+
+    def arm(self) -> None:
+        """From now on a stop raises; one that came before raises now."""
+        self.armed = True
+        if self.signum is not None:
+            raise self.exception()
+
+    def disarm(self) -> None:
+        """From now on a stop is only remembered."""
+        with self.lock:
+            self.armed = False
+
+    def unraisable(self, unraisable: Any) -> None:
+        """``sys.unraisablehook`` while installed: a stop Python dropped is not printed (a
+        traceback before ``cell: interrupted``) but raised again (:meth:`lost`); anything
+        else goes to the hook there was."""
+        if not self.lost(unraisable.exc_value):
+            (self.hook or sys.__unraisablehook__)(unraisable)
+
+    def lost(self, exc: BaseException | None) -> bool:
+        """Whether ``exc``, an exception Python dropped (raised in a destructor or a weakref
+        callback, where nothing can catch it), was this stop; if so it is owed: another thread
+        sends the signal again once the main thread has left this hook, and the handler raises
+        it in the main thread, at the next instruction that lets it (or, if that is in another
+        destructor, it is dropped and owed again)."""
+        if exc is None or not interrupted(exc) or self.signum is None or not self.armed:
+            return False
+        self.owed = True
+        main = threading.main_thread().ident
+        threading.Thread(target=self._again, args=(main,), daemon=True,
+                         name="cell-stop-again").start()
+        return True
+
+    def _again(self, main: int | None) -> None:
+        for _ in range(1000):  # (a second or so: else owed to the next signal, said at the end)
+            if not self._in_hook(main):
+                with self.lock:  # raised only while armed: disarm() and restore() wait for it
+                    if self.owed and self.armed and self.signum is not None and main \
+                            and hasattr(signal, "pthread_kill"):  # (not on Windows)
+                        signal.pthread_kill(main, self.signum)  # wakes it, if it waits
+                return
+            time.sleep(0.001)
+
+    def _in_hook(self, thread: int | None) -> bool:
+        """Whether ``thread`` is in :meth:`unraisable` (what the handler raised there would be
+        dropped once more, and reported as the hook's own failure)."""
+        frame = sys._current_frames().get(thread or 0)
+        while frame is not None:
+            if frame.f_code is Stops.unraisable.__code__:
+                return True
+            frame = frame.f_back
+        return False
 
     def settled(self) -> bool:
         """Whether a stop signal came (one the process has received but whose handler has not
@@ -83,9 +157,14 @@ class Stops:
         return self.signum is not None
 
     def restore(self) -> None:
+        with self.lock:
+            self.owed = False
+        self.settled()  # a signal sent again just now: handled here, not by the next handler
         with contextlib.suppress(ValueError, OSError, TypeError):
             for number, handler in self.previous.items():
                 signal.signal(number, signal.SIG_DFL if handler is None else handler)
+        if self.previous and sys.unraisablehook == self.unraisable:
+            sys.unraisablehook = self.hook
         self.previous = {}
 
 

@@ -6,23 +6,38 @@ beside them is commentary.  If the reader of stdout or stderr leaves (``cell run
 stream at the null device and the command carries on: its files are written whole and it ends
 with its own exit code, where the closed pipe used to stop it half-way (nothing written,
 exit 0) or fail the interpreter's last flush (exit 120).
+
+A reader that left (``EPIPE``) is no error; standard output that cannot be written for another
+reason (a full device, ``ENOSPC``; an I/O error, ``EIO``) is, when what it prints is the
+command's product (:attr:`Guarded.product`: ``cell fit`` or ``cell compare`` without ``--out``),
+which it would have lost saying nothing.  The stream is silenced the same way, so the command
+still ends whole, and :attr:`Guarded.failed` keeps the error for ``cell.cli.main`` to end the
+command with one line and exit 2; beside files, what is printed is commentary and its loss no
+error.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import sys
 from collections.abc import Iterator
 from typing import Any, TextIO
 
+#: Errors that mean the reader of a stream went away (``| head``): no error of the command's.
+READER_GONE = frozenset({errno.EPIPE, errno.ECONNRESET, errno.ESHUTDOWN})
+
 
 class Guarded:
-    """A text stream whose writes and flushes survive a reader that has gone (see the module)."""
+    """A text stream whose writes and flushes survive a reader that has gone (see the module);
+    :attr:`failed`, the error that silenced it if that was not the reader leaving."""
 
     def __init__(self, stream: TextIO):
         self.stream = stream
         self.gone = False
+        self.failed: OSError | None = None
+        self.product = False  # what is written here is the command's product, not commentary
 
     def __getattr__(self, name: str) -> Any:  # isatty, fileno, encoding...: the stream's own
         return getattr(self.stream, name)
@@ -31,20 +46,23 @@ class Guarded:
         if not self.gone:
             try:
                 return self.stream.write(text)
-            except (OSError, ValueError):  # the reader left, the device is full, closed
-                self._silence()
+            except (OSError, ValueError) as exc:  # the reader left, the device is full, closed
+                self._silence(exc)
         return len(text)
 
     def flush(self) -> None:
         if not self.gone:
             try:
                 self.stream.flush()
-            except (OSError, ValueError):
-                self._silence()
+            except (OSError, ValueError) as exc:
+                self._silence(exc)
 
-    def _silence(self) -> None:
-        """Send the stream, and what its buffer still holds, to the null device from now on."""
+    def _silence(self, exc: BaseException) -> None:
+        """Send the stream, and what its buffer still holds, to the null device from now on;
+        ``exc``, what it met, kept in :attr:`failed` unless the reader left."""
         self.gone = True
+        if isinstance(exc, OSError) and exc.errno not in READER_GONE:
+            self.failed = exc
         with contextlib.suppress(OSError, ValueError, AttributeError):  # no descriptor: just drop
             devnull = os.open(os.devnull, os.O_WRONLY)
             try:
@@ -82,13 +100,14 @@ def standard_streams() -> None:
 
 
 @contextlib.contextmanager
-def reader_may_leave() -> Iterator[None]:
-    """``sys.stdout`` and ``sys.stderr`` guarded for the block, and flushed at its end."""
+def reader_may_leave() -> Iterator[Guarded]:
+    """``sys.stdout`` and ``sys.stderr`` guarded for the block, and flushed at its end; gives
+    the guarded standard output (its :attr:`~Guarded.failed` read after the block)."""
     saved = sys.stdout, sys.stderr
     out, err = Guarded(saved[0]), Guarded(saved[1])
     sys.stdout, sys.stderr = out, err
     try:
-        yield
+        yield out
         out.flush()
         err.flush()
     finally:

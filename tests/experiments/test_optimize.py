@@ -126,3 +126,107 @@ def test_bad_study_files_get_one_line_and_exit_2(tmp_path: Path, capsys, case: s
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and str(path) in err[0] and where in err[0], err
     assert not out.exists()
+
+
+
+def test_a_killed_optimize_ends_as_every_command_does(tmp_path: Path, unrendered, monkeypatch,
+                                                      capsys) -> None:
+    """kill (SIGTERM) during the trials: 143 and ``cell: terminated`` last (it said 130 and
+    ``cell: interrupted``, its own handler's), the finished trial kept for --resume."""
+    import os
+
+    import cell.experiments.optimize as optimize
+
+    real, calls = optimize.replicate, []
+
+    def replicate(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            os.kill(os.getpid(), signal.SIGTERM)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(optimize, "replicate", replicate)
+    path = _study(tmp_path, FIXED.replace("TRIALS", "4"))
+    out = tmp_path / "out"
+    assert main(["optimize", str(path), "--out", str(out)]) == 143
+    assert capsys.readouterr().err.splitlines()[-1] == "cell: terminated"
+    assert _completed(out / "study.db") == 1 and not (out / "trials.csv").exists()
+
+
+SMALL = f"""base: {BASE}
+set: {{run.parts: 20}}
+vary:
+  belts.input_nominal_in_s: [2.0, 3.0]
+objectives: [{{measure: parts_missed, goal: minimize}}]
+trials: 1
+replications: 1
+"""
+
+
+def _sqlite(path: Path, *statements: str) -> None:
+    import sqlite3
+
+    con = sqlite3.connect(path)
+    for s in statements:
+        con.execute(s)
+    con.commit()
+    con.close()
+
+
+def _optuna_study(path: Path, name: str, fingerprint: str | None = None) -> None:
+    import optuna
+
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    o = optuna.create_study(study_name=name, storage=f"sqlite:///{path}")
+    if fingerprint is not None:
+        o.set_user_attr("fingerprint", fingerprint)
+
+
+#: What ``DIR/study.db`` is, made independently of cell (random bytes, a directory, another
+#: program's SQLite database, a damaged one, another Optuna study, this study's name from
+#: another study file): each refused in one line naming study.db, exit 2, nothing written.
+STORES = {
+    "random bytes": lambda p: p.write_bytes(bytes(range(256)) * 40),
+    "empty file": lambda p: p.write_bytes(b""),
+    "directory": lambda p: (p.mkdir(), (p / "keep.txt").write_text("mine")),
+    "another program's SQLite": lambda p: _sqlite(
+        p, "CREATE TABLE people (name TEXT, age INTEGER)", "INSERT INTO people VALUES ('ann', 41)"),
+    "damaged SQLite": lambda p: p.write_bytes(b"SQLite format 3\x00" + bytes(4080)),
+    "another study": lambda p: _optuna_study(p, "someone-elses"),
+    "this name, another study file": lambda p: _optuna_study(p, "study", "0" * 64),
+}
+
+
+def _snapshot(folder: Path) -> dict[str, bytes | None]:
+    return {str(p.relative_to(folder)): (p.read_bytes() if p.is_file() else None)
+            for p in sorted(folder.rglob("*"))}
+
+
+@pytest.mark.parametrize("case", list(STORES), ids=list(STORES))
+def test_a_foreign_or_damaged_study_db_is_refused_and_left_as_it_was(tmp_path: Path, capsys,
+                                                                      case: str) -> None:
+    path = _study(tmp_path, SMALL)
+    out = tmp_path / "out"
+    out.mkdir()
+    STORES[case](out / "study.db")
+    (out / "trials.csv").write_text("trial,parts_missed\n0,3\n")  # the study's own results
+    before = _snapshot(out)
+    assert main(["optimize", str(path), "--out", str(out), "--resume"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(out) in err[0] and "study.db" in err[0], err
+    assert _snapshot(out) == before
+
+
+def test_an_unreachable_scheduler_is_one_line_before_anything_is_written(tmp_path: Path,
+                                                                         capsys) -> None:
+    import socket
+
+    with socket.socket() as s:  # a port nothing listens on (bound, never listening)
+        s.bind(("127.0.0.1", 0))
+        address = f"tcp://127.0.0.1:{s.getsockname()[1]}"
+        path = _study(tmp_path, SMALL)
+        out = tmp_path / "out"
+        assert main(["optimize", str(path), "--out", str(out), "--scheduler", address]) == 2
+    err = [x for x in capsys.readouterr().err.strip().splitlines() if not x.startswith("connecting")]
+    assert len(err) == 1 and f"--scheduler {address}" in err[0], err
+    assert not out.exists()

@@ -198,6 +198,18 @@ def test_disk_full_while_writing_keeps_the_old_output(tmp_path: Path, monkeypatc
             before=before)
 
 
+def test_run_force_never_replaces_a_directory_of_the_users(tmp_path: Path) -> None:
+    """--force replaces the files a run writes, never a directory that has one's name (it
+    deleted the user's folder and what it held): refused, naming it, before any work."""
+    out = tmp_path / "old"
+    (out / "parts.csv").mkdir(parents=True)
+    (out / "parts.csv" / "mine.txt").write_text("the user's own data\n")
+    (out / "summary.csv").write_text("scenario\nan earlier run\n")
+    before = tree(out)
+    refused(cli(*COMMANDS["run"][0], "--out", out, "--force"), str(out), "parts.csv",
+            nothing_in=out, before=before)
+
+
 def test_figures_disk_full_keeps_the_old_set(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A figure set whose last PNG meets a full disk: the old set stays whole (drawing stubbed)."""
     import cell.reporting.figures.thesis_figures

@@ -123,3 +123,25 @@ def test_every_command_outlives_its_reader(tmp_path):
                                "--out", str(tmp_path / "cmp")], tmp_path, False)
     assert (res.returncode, res.stderr.count("Exception ignored")) == (0, 0), res.stderr
     assert (tmp_path / "cmp" / "report.md").is_file()
+
+
+TRACE = "interarrival_s\n" + "".join(f"{22 + (i * 7919 % 13) / 5:.3f}\n" for i in range(60))
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
+@pytest.mark.parametrize("args", [["fit", "{trace}"],
+                                  ["compare", "baseline", "non_adaptive", "--replications", "2",
+                                   "--set", "run.parts=10"]], ids=["fit", "compare"])
+def test_a_product_on_stdout_that_cannot_be_written_is_an_error(tmp_path, args):
+    """stdout on a full device (ENOSPC): the command's product is lost, so exit 2 and one line
+    naming standard output (it exited 0); a reader that left (EPIPE) stays no error."""
+    trace = tmp_path / "trace.csv"
+    trace.write_text(TRACE)
+    argv = [sys.executable, "-m", "cell", *(a.replace("{trace}", str(trace)) for a in args)]
+    with open("/dev/full", "w") as full:
+        res = subprocess.run(argv, stdout=full, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    lines = [x for x in res.stderr.splitlines() if "%)" not in x]  # compare's progress lines
+    assert res.returncode == 2 and len(lines) == 1 and "standard output" in lines[0], res.stderr
+    if args[0] == "fit":
+        res = _with_closed_reader([a.replace("{trace}", str(trace)) for a in args], tmp_path, False)
+        assert (res.returncode, res.stderr) == (0, "")

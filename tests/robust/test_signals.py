@@ -134,3 +134,38 @@ def test_a_refusal_that_came_of_a_stop_is_the_stop(monkeypatch, capsys):
                         _swallowed_then(signal.SIGINT, CellError("a.mp4: ffmpeg stopped")))
     assert main(["scenarios"]) == 130
     assert capsys.readouterr().err == "cell: interrupted\n"
+
+
+class _StoppedInADestructor:
+    """An object whose destructor gets the signal and lets its handler run there, where Python
+    drops whatever is raised ("Exception ignored in": matplotlib's many weakref callbacks
+    made a Ctrl-C during ``cell figures`` print a traceback, now and then)."""
+
+    def __init__(self, number: int):
+        self.number = number
+
+    def __del__(self):
+        os.kill(os.getpid(), self.number)
+        for _ in range(1000):  # the handler runs here, and what it raises is dropped
+            pass
+
+
+@pytest.mark.parametrize("number", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_a_stop_raised_in_a_destructor_still_stops_the_command_and_says_only_its_line(
+        monkeypatch, capsys, number):
+    import threading
+
+    from cell.cli.main import main
+
+    went_on = []
+
+    def command(args):
+        _StoppedInADestructor(number)  # made and freed at once
+        threading.Event().wait(20)  # the stop, raised again, ends this wait
+        went_on.append(True)
+        return 0
+
+    monkeypatch.setattr("cell.cli.scenarios_command.main", command)
+    assert main(["scenarios"]) == LINES[number][0]
+    assert capsys.readouterr().err == LINES[number][1] + "\n"
+    assert went_on == []

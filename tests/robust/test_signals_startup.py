@@ -163,3 +163,41 @@ def test_importing_the_package_installs_nothing():
 
     assert not startup.INSTALLED
     assert signal.getsignal(signal.SIGTERM) is not startup.stop_now
+
+
+#: A ``sitecustomize`` that sends this process SIGINT or SIGTERM (``raise_signal``: delivered
+#: at once, its Python handler run at the next instruction that lets it) at one event of one
+#: method of cell's stop handling (``STOP_AT``: "install return", "disarm call", "restore
+#: call"), marking that it did: the edges of the block of ``cell.cli.main.main`` that turns a
+#: stop into its line, found by the code's own events, not by a delay.
+EDGE = """
+import os, signal, sys
+name, event = os.environ["STOP_AT"].split()
+def at(frame, what, arg):
+    code = frame.f_code
+    if what == event and code.co_name == name and code.co_filename.endswith("interrupts.py"):
+        sys.setprofile(None)
+        open(os.environ["STOP_MARK"], "w").close()
+        signal.raise_signal(int(os.environ["STOP_SIGNAL"]))
+sys.setprofile(at)
+"""
+
+
+@pytest.mark.parametrize(("at", "number"), [("install return", signal.SIGINT),
+                                           ("disarm call", signal.SIGTERM),
+                                           ("restore call", signal.SIGINT)])
+def test_a_signal_at_the_edges_of_the_commands_own_handling(tmp_path, number, at):
+    """As cell's handlers come (before main's block is in force), as the block ends, and as
+    they go: the line and the code, never a traceback (the handler raised where nothing
+    caught it: a flaky test_a_signal_from_the_first_millisecond_on)."""
+    (tmp_path / "hook").mkdir()
+    (tmp_path / "hook" / "sitecustomize.py").write_text(EDGE)
+    mark = tmp_path / "there"
+    env = {**os.environ, "PYTHONPATH": str(tmp_path / "hook"), "STOP_AT": at,
+           "STOP_MARK": str(mark), "STOP_SIGNAL": str(int(number)), "TMPDIR": str(tmp_path)}
+    proc = subprocess.run([sys.executable, "-m", "cell", "scenarios"], cwd=tmp_path, env=env,
+                          stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                          timeout=120)
+    assert mark.exists(), proc.stderr
+    assert (proc.returncode, proc.stderr) == (LINES[number][0], LINES[number][1] + "\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["hook", "there"]

@@ -150,7 +150,9 @@ _LEFTOVER = re.compile(r"\.(.+)\.[^.]+\.tmp\Z")  # a killed atomic_path's tempor
 
 
 def foreign_entries(directory: Path, names: Iterable[str], limit: int = 4) -> list[str]:
-    """Up to ``limit`` entries of ``directory`` that are none of ``names`` (shown as paths)."""
+    """Up to ``limit`` entries of ``directory`` that are none of ``names`` (shown as paths): also
+    one that has a name of ``names`` but is not a regular file (a directory ``parts.csv/``, a
+    link, a pipe), which the command would not have written and must not replace."""
     names, found = tuple(names), list[str]()
     todo: list[tuple[Path, list[str]]] = [(directory, [])]
     while todo and len(found) < limit:
@@ -160,9 +162,13 @@ def foreign_entries(directory: Path, names: Iterable[str], limit: int = 4) -> li
             leftover = _LEFTOVER.match(entry.name)
             if entry.is_dir(follow_symlinks=False) and allowed(parts, names, directory=True):
                 todo.append((Path(entry.path), parts))
-            elif not (entry.name in _JUNK or allowed(parts, names)
-                      or leftover and allowed(prefix + [leftover.group(1)], names)):
+            elif entry.name in _JUNK:
+                continue
+            elif not (allowed(parts, names) or leftover and allowed(prefix + [leftover.group(1)], names)):
                 found.append(_show("/".join(parts)))
+            elif not entry.is_file(follow_symlinks=False):
+                kind = "/" if entry.is_dir(follow_symlinks=False) else " (not a regular file)"
+                found.append(_show("/".join(parts)) + kind)
     return found[:limit]
 
 
