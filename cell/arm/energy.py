@@ -26,7 +26,7 @@ transfer's energy from its six stretches' times is then a few numpy passes over 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -62,9 +62,6 @@ class Energy:
     electrical_j: float
     """What the drives draw: the standing draw, plus supplied work over the efficiency, less
     recovered braking (``recover_braking``)."""
-
-    def __add__(self, other: Energy) -> Energy:
-        return Energy(*(getattr(self, f.name) + getattr(other, f.name) for f in fields(self)))
 
     @property
     def standing_share(self) -> float:
