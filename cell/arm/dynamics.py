@@ -62,6 +62,32 @@ class Drives:
 
 
 @dataclass(frozen=True)
+class Electrical:
+    """What the stepper drives draw from their supply (``cell.arm.energy``; every value assumed).
+
+    Each drive's phases carry the current its drive sets whatever the load (a stepper's torque
+    comes from the rotor's lag behind the field, not from more current): the standing draw
+    ``phases_on`` V²/R per drive while energised.  Shaft work is counted on top at
+    ``motion_efficiency``; braking work is dissipated unless ``recover_braking``.
+    """
+
+    supply_v: float = 12.0
+    """Drive supply voltage (unipolar L/R drive: the phase current is V/R)."""
+    winding_ohm: Five = (36.0, 36.0, 36.0, 36.0, 36.0)
+    """Resistance of one phase winding of each drive's motor."""
+    phases_on: float = 1.5
+    """Mean number of phases energised (half-stepping: one and two in turn)."""
+    motion_efficiency: Five = (0.5, 0.5, 0.5, 0.5, 0.5)
+    """Supply energy per joule of positive shaft work beyond the standing draw: 1/η."""
+    recover_braking: bool = False
+    """Whether braking work returns to the supply (at ``motion_efficiency``) or is dissipated."""
+
+    def standing_w(self) -> Array:
+        """(5,) each drive's standing draw in watts: phases_on · V² / R."""
+        return self.phases_on * self.supply_v ** 2 / np.asarray(self.winding_ohm, float)
+
+
+@dataclass(frozen=True)
 class DynamicsModel:
     """The arm's rigid-body model: links, drives and gravity (a ``microbot_dynamics.yaml``)."""
 
@@ -70,6 +96,7 @@ class DynamicsModel:
     gravity_m_s2: float = 9.80665
     links: Links = field(default_factory=Links)
     drives: Drives = field(default_factory=Drives)
+    electrical: Electrical = field(default_factory=Electrical)
 
 
 def _cross(a: Array, b: Array) -> Array:

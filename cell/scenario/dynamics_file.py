@@ -12,7 +12,7 @@ from typing import Annotated
 
 from pydantic import Field, ValidationError
 
-from cell.arm.dynamics import Drives, DynamicsModel, Links
+from cell.arm.dynamics import Drives, DynamicsModel, Electrical, Links
 from cell.plumbing.cache import file_key, memo
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.fields import Section, error_from_validation
@@ -25,6 +25,7 @@ PositiveFive = tuple[Positive, Positive, Positive, Positive, Positive]
 NonNegativeFive = tuple[NonNegative, NonNegative, NonNegative, NonNegative, NonNegative]
 Xyz = tuple[Metres, Metres, Metres]
 Moments = tuple[NonNegative, NonNegative, NonNegative]
+Efficiency = Annotated[float, Field(strict=True, allow_inf_nan=False, gt=0.0, le=1.0)]
 
 
 class LinksFile(Section):
@@ -46,6 +47,18 @@ class DrivesFile(Section):
     viscous_nm_s_rad: NonNegativeFive = Drives.viscous_nm_s_rad
 
 
+class ElectricalFile(Section):
+    """What the stepper drives draw from their supply (every value an assumption)."""
+
+    supply_v: Positive = Electrical.supply_v
+    winding_ohm: PositiveFive = Electrical.winding_ohm
+    phases_on: float = Field(Electrical.phases_on, strict=True, allow_inf_nan=False, ge=0.0,
+                             le=2.0)
+    motion_efficiency: tuple[Efficiency, Efficiency, Efficiency, Efficiency, Efficiency] = \
+        Electrical.motion_efficiency
+    recover_braking: bool = Field(Electrical.recover_braking, strict=True)
+
+
 class DynamicsFile(Section):
     """A rigid-body model file."""
 
@@ -54,6 +67,7 @@ class DynamicsFile(Section):
     gravity_m_s2: float = Field(9.80665, strict=True, allow_inf_nan=False, ge=0.0, le=100.0)
     links: LinksFile = LinksFile()
     drives: DrivesFile = DrivesFile()
+    electrical: ElectricalFile = ElectricalFile()
 
 
 def load_dynamics(path: str | Path) -> DynamicsModel:
@@ -78,4 +92,7 @@ def _load(path: Path) -> DynamicsModel:
     return DynamicsModel(f.name, f.description, f.gravity_m_s2,
                          Links(f.links.mass_kg, f.links.com_m, f.links.inertia_kg_m2),
                          Drives(f.drives.gear_ratio, f.drives.rotor_inertia_kg_m2,
-                                f.drives.stall_torque_nm, f.drives.viscous_nm_s_rad))
+                                f.drives.stall_torque_nm, f.drives.viscous_nm_s_rad),
+                         Electrical(f.electrical.supply_v, f.electrical.winding_ohm,
+                                    f.electrical.phases_on, f.electrical.motion_efficiency,
+                                    f.electrical.recover_braking))
