@@ -35,7 +35,7 @@ import numpy as np
 from pydantic import Field, ValidationError
 
 from cell.plumbing.errors import ScenarioError
-from cell.scenario.fields import Section, error_from_validation
+from cell.scenario.fields import Section, error_from_validation, model_at
 from cell.scenario.schema import Scenario, known_key, load_scenario
 from cell.sim.records import RunSummary
 
@@ -47,6 +47,9 @@ RESERVED = {"run.seed": "every replication gets its own stream from the study's 
 #: Measures only some built-in policies give (NaN for the others).
 POLICY_MEASURES = {"thesis_slack_s": ("non-adaptive",), "ip_thesis_memoryless": ("adaptive",),
                    "cycle_vs_nominal_memoryless_pct": ("adaptive",)}
+#: The most points a sensitivity design (Morris's or Sobol's) may have: as many as an
+#: optimisation's trials.
+MAX_POINTS = 100_000
 _INDEX = re.compile(r"^(?P<key>[A-Za-z0-9_.]+)\[(?P<i>\d+)\]$")
 _CONSTRAINT = re.compile(r"^\s*(?P<m>[A-Za-z_][A-Za-z0-9_]*)\s*(?P<op><=|>=)\s*(?P<v>[-+0-9.eE]+)\s*$")
 
@@ -70,6 +73,17 @@ def measures_of(row: Mapping[str, Any]) -> dict[str, float]:
     return out
 
 
+def _count(default: Any, low: int, high: int | None = None) -> Any:
+    """A whole number, strict as every count of a scenario is: ``'10'`` (text) and ``1e3`` (a
+    number written as a float) are refused, not read as 10 and 1000."""
+    return Field(default, strict=True, ge=low, le=high)
+
+
+def _real(default: Any = ..., *, gt: float | None = None, lt: float | None = None) -> Any:
+    """A number (ints accepted, text and booleans refused), as a scenario's numbers are."""
+    return Field(default, strict=True, gt=gt, lt=lt)
+
+
 class ObjectiveSettings(Section):
     measure: str
     """A measure of the run summary, or a varied key."""
@@ -77,18 +91,32 @@ class ObjectiveSettings(Section):
 
 
 class SelectSettings(Section):
-    candidates: int = Field(5, ge=2)
+    candidates: int = _count(5, 2)
     """How many of the best trials KN re-runs."""
-    delta: float = Field(gt=0)
+    delta: float = _real(gt=0)
     """The indifference zone, in the measure's units."""
-    pcs: float = Field(0.95, gt=0.5, lt=1)
+    pcs: float = _real(0.95, gt=0.5, lt=1)
     """The probability of correct selection asked."""
-    n0: int = Field(10, ge=2)
+    n0: int = _count(10, 2)
     """First-stage replications of each candidate."""
-    max: int = Field(200, ge=2)
+    max: int = _count(200, 2)
     """At most this many replications of each candidate."""
     measure: str | None = None
     """The measure to select on (default: the first objective that is a measure)."""
+
+
+class MorrisSettings(Section):
+    trajectories: int = _count(10, 2)
+    """R: the design has R × (keys + 1) points (at most MAX_POINTS)."""
+    levels: int = _count(4, 2)
+    """P: the grid each key's range is cut into."""
+
+
+class SobolSettings(Section):
+    samples: int = _count(64, 2)
+    """N, a power of 2: the design has N × (keys + 2) points (at most MAX_POINTS)."""
+    keys: int | None = _count(None, 2)
+    """The keys Morris ranks first that get Sobol indices (default: every key)."""
 
 
 class StudySettings(Section):
@@ -99,19 +127,18 @@ class StudySettings(Section):
     vary: dict[str, Any]
     objectives: list[ObjectiveSettings] = Field(default_factory=list)
     constraints: list[str] = Field(default_factory=list)
-    trials: int = Field(50, ge=1, le=100_000)
-    replications: int = Field(10, ge=1, le=10_000)
-    seed: int = Field(1984, ge=0)
+    trials: int = _count(50, 1, 100_000)
+    replications: int = _count(10, 1, 10_000)
+    seed: int = _count(1984, 0)
     select: SelectSettings | None = None
     measures: list[str] = Field(default_factory=list)
     """cell sensitivity: the measures whose indices are reported."""
     policies: list[str] = Field(default_factory=list)
     """cell sensitivity: each policy gets its own indices, on the same points."""
-    morris: dict[str, int] = Field(default_factory=dict)
+    morris: MorrisSettings = MorrisSettings()
     """cell sensitivity: {trajectories: R, levels: P}."""
-    sobol: dict[str, Any] = Field(default_factory=dict)
+    sobol: SobolSettings = SobolSettings()
     """cell sensitivity: {samples: N (a power of 2), keys: K (the K keys Morris ranks first)}."""
-
 
 
 @dataclass(frozen=True)
@@ -208,9 +235,14 @@ def load_study(path: str | Path, corners: bool = True) -> Study:
     for key, value in settings.fixed.items():
         if not known_key(key):
             raise ScenarioError(path, f"set.{key}", value, "unknown key: no such setting in a scenario")
+    for i, policy in enumerate(settings.policies):
+        if policy in settings.policies[:i]:
+            raise ScenarioError(path, f"policies[{i}]", policy, "listed twice: each policy once")
     if not settings.vary:
         raise ScenarioError(path, "vary", settings.vary, "name at least one key to vary")
-    params = tuple(_param(path, base, key, spec) for key, spec in settings.vary.items())
+    fixed = base.with_overrides(settings.fixed, file=path, paths_from=path.parent) \
+        if settings.fixed else base
+    params = tuple(_param(path, fixed, key, spec) for key, spec in settings.vary.items())
     study = Study(path, settings, base, params, ())
     if corners:
         _check_corners(study)
@@ -238,6 +270,7 @@ def load_study(path: str | Path, corners: bool = True) -> Study:
 
 
 def _param(path: Path, base: Scenario, key: str, spec: Any) -> Param:
+    """One key of ``vary``, checked against ``base`` (the base scenario with ``set``)."""
     where = f"vary.{key}"
     m = _INDEX.match(key)
     plain = m["key"] if m else key
@@ -245,11 +278,20 @@ def _param(path: Path, base: Scenario, key: str, spec: Any) -> Param:
         raise ScenarioError(path, where, spec, "unknown key: no such setting in a scenario")
     if plain in RESERVED:
         raise ScenarioError(path, where, spec, f"cannot be varied: {RESERVED[plain]}")
-    current = base.get(plain)
+    current, absent = _setting(base, plain)
     if m is not None:
         if not isinstance(current, (list, tuple)) or int(m["i"]) >= len(current):
             raise ScenarioError(path, where, spec, f"{plain} has no entry {m['i']}")
         current = current[int(m["i"])]
+    whole = isinstance(current, int) and not isinstance(current, bool) or \
+        absent is not None and _whole_setting(plain)
+    param = _range(path, where, key, spec, whole)
+    if absent is not None:
+        _refuse_alone(path, base, param, absent)
+    return param
+
+
+def _range(path: Path, where: str, key: str, spec: Any, whole: bool) -> Param:
     if isinstance(spec, Mapping) and "choice" in spec:
         choices = spec["choice"]
         if set(spec) != {"choice"} or not isinstance(choices, list) or not choices:
@@ -270,10 +312,45 @@ def _param(path: Path, base: Scenario, key: str, spec: Any) -> Param:
         raise ScenarioError(path, where, [low, high], "an empty range: low must be a number below high")
     if step is not None and (not _number(step) or not 0 < step <= high - low):
         raise ScenarioError(path, where, step, "step must be a number in (0, high - low]")
+    if step is not None and whole and not float(step).is_integer():
+        raise ScenarioError(path, f"{where}.step", step, f"{key.split('.')[-1]} is a whole "
+                            "number: the step must be one too (1, 2, ...)")
     if not isinstance(log, bool) or log and (low <= 0 or step is not None):
         raise ScenarioError(path, where, spec, "log: true needs 0 < low and no step")
-    whole = isinstance(current, int) and not isinstance(current, bool)
     return Param(key, float(low), float(high), log, None if step is None else float(step), whole)
+
+
+def _setting(base: Scenario, dotted: str) -> tuple[Any, str | None]:
+    """A setting's value in ``base`` and None; or None and the section on its way that
+    ``base`` leaves out (``failures``, absent unless given); an entry a mapping setting does
+    not hold (``arrivals.params.loc``) is None."""
+    obj: Any = base
+    parts = dotted.split(".")
+    for i, part in enumerate(parts):
+        if obj is None:
+            return None, ".".join(parts[:i])
+        obj = obj.get(part) if isinstance(obj, Mapping) else getattr(obj, part)
+    return obj, None
+
+
+def _whole_setting(dotted: str) -> bool:
+    """Whether the schema holds ``dotted`` as a whole number (``failures.repair.crews``)."""
+    parts = dotted.split(".")
+    section = model_at(Scenario, parts[:-1])
+    field = section.model_fields.get(parts[-1]) if section is not None else None
+    return field is not None and field.annotation is int
+
+
+def _refuse_alone(path: Path, base: Scenario, p: Param, absent: str) -> None:
+    """A key of a section the base leaves out is varied: the key alone must make the section
+    (``failures.repair.crews`` does; a failure mode needs both its times), else refused."""
+    value = p.choices[0] if p.is_choice else _value(p, p.low)
+    try:
+        base.with_overrides({p.key: value}, file=path)
+    except ScenarioError as exc:
+        raise ScenarioError(path, f"vary.{p.key}", value, f"the base scenario (with set:) has no "
+                            f"{absent} section, and this key alone does not make one ({exc.key}: "
+                            f"{exc.why}): give the section in the base or under set:") from None
 
 
 def _number(v: Any) -> bool:
