@@ -34,23 +34,21 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field, ValidationError
 
+from cell.experiments.varied import INDEXED, Param, param, value_at
 from cell.plumbing.errors import ScenarioError
-from cell.scenario.fields import Section, error_from_validation, model_at
+from cell.scenario.fields import Section, error_from_validation
 from cell.scenario.schema import Scenario, known_key, load_scenario
 from cell.sim.records import RunSummary
 
 #: Measures computed from a summary row: name -> (what, function of the row).
 DERIVED = {"spacing_outside_pct": "spacings outside 45 ± 0.25 in, % of the spacings on the output belt",
            "parts_missed_pct": "parts lost on the wall clock, % of the parts arrived"}
-#: Keys a study may not vary: each replication's stream comes from the study's seed.
-RESERVED = {"run.seed": "every replication gets its own stream from the study's 'seed'"}
 #: Measures only some built-in policies give (NaN for the others).
 POLICY_MEASURES = {"thesis_slack_s": ("non-adaptive",), "ip_thesis_memoryless": ("adaptive",),
                    "cycle_vs_nominal_memoryless_pct": ("adaptive",)}
 #: The most points a sensitivity design (Morris's or Sobol's) may have: as many as an
 #: optimisation's trials.
 MAX_POINTS = 100_000
-_INDEX = re.compile(r"^(?P<key>[A-Za-z0-9_.]+)\[(?P<i>\d+)\]$")
 _CONSTRAINT = re.compile(r"^\s*(?P<m>[A-Za-z_][A-Za-z0-9_]*)\s*(?P<op><=|>=)\s*(?P<v>[-+0-9.eE]+)\s*$")
 
 
@@ -142,24 +140,6 @@ class StudySettings(Section):
 
 
 @dataclass(frozen=True)
-class Param:
-    """One varied key: a number in [low, high] (``log``, ``step``, whole if the setting is)
-    or a choice among ``choices``."""
-
-    key: str
-    low: float = math.nan
-    high: float = math.nan
-    log: bool = False
-    step: float | None = None
-    whole: bool = False
-    choices: tuple[Any, ...] = ()
-
-    @property
-    def is_choice(self) -> bool:
-        return bool(self.choices)
-
-
-@dataclass(frozen=True)
 class Constraint:
     measure: str
     op: str
@@ -192,7 +172,7 @@ class Study:
         over: dict[str, Any] = dict(self.settings.fixed)
         lists: dict[str, list[Any]] = {}
         for key, value in values.items():
-            m = _INDEX.match(key)
+            m = INDEXED.match(key)
             if m is None:
                 over[key] = value
                 continue
@@ -242,7 +222,7 @@ def load_study(path: str | Path, corners: bool = True) -> Study:
         raise ScenarioError(path, "vary", settings.vary, "name at least one key to vary")
     fixed = base.with_overrides(settings.fixed, file=path, paths_from=path.parent) \
         if settings.fixed else base
-    params = tuple(_param(path, fixed, key, spec) for key, spec in settings.vary.items())
+    params = tuple(param(path, fixed, key, spec) for key, spec in settings.vary.items())
     study = Study(path, settings, base, params, ())
     if corners:
         _check_corners(study)
@@ -267,94 +247,6 @@ def load_study(path: str | Path, corners: bool = True) -> Study:
         raise ScenarioError(path, "select.measure", settings.select.measure,
                             "no run reports it: name a measure of the run summary")
     return study
-
-
-def _param(path: Path, base: Scenario, key: str, spec: Any) -> Param:
-    """One key of ``vary``, checked against ``base`` (the base scenario with ``set``)."""
-    where = f"vary.{key}"
-    m = _INDEX.match(key)
-    plain = m["key"] if m else key
-    if not known_key(plain):
-        raise ScenarioError(path, where, spec, "unknown key: no such setting in a scenario")
-    if plain in RESERVED:
-        raise ScenarioError(path, where, spec, f"cannot be varied: {RESERVED[plain]}")
-    current, absent = _setting(base, plain)
-    if m is not None:
-        if not isinstance(current, (list, tuple)) or int(m["i"]) >= len(current):
-            raise ScenarioError(path, where, spec, f"{plain} has no entry {m['i']}")
-        current = current[int(m["i"])]
-    whole = isinstance(current, int) and not isinstance(current, bool) or \
-        absent is not None and _whole_setting(plain)
-    param = _range(path, where, key, spec, whole)
-    if absent is not None:
-        _refuse_alone(path, base, param, absent)
-    return param
-
-
-def _range(path: Path, where: str, key: str, spec: Any, whole: bool) -> Param:
-    if isinstance(spec, Mapping) and "choice" in spec:
-        choices = spec["choice"]
-        if set(spec) != {"choice"} or not isinstance(choices, list) or not choices:
-            raise ScenarioError(path, where, spec, "a choice is {choice: [value, ...]}, not empty")
-        return Param(key, choices=tuple(choices))
-    if isinstance(spec, list) and not (len(spec) == 2 and all(_number(v) for v in spec)):
-        if not spec:
-            raise ScenarioError(path, where, spec, "an empty choice: list at least one value")
-        return Param(key, choices=tuple(spec))
-    if isinstance(spec, list):
-        spec = {"low": spec[0], "high": spec[1]}
-    if not isinstance(spec, Mapping) or set(spec) - {"low", "high", "log", "step"} \
-            or not {"low", "high"} <= set(spec):
-        raise ScenarioError(path, where, spec, "write [low, high], {low: L, high: H, log: true} "
-                            "or {low: L, high: H, step: S} for a number, {choice: [...]} for a choice")
-    low, high, step, log = spec["low"], spec["high"], spec.get("step"), spec.get("log", False)
-    if not (_number(low) and _number(high)) or not low < high:
-        raise ScenarioError(path, where, [low, high], "an empty range: low must be a number below high")
-    if step is not None and (not _number(step) or not 0 < step <= high - low):
-        raise ScenarioError(path, where, step, "step must be a number in (0, high - low]")
-    if step is not None and whole and not float(step).is_integer():
-        raise ScenarioError(path, f"{where}.step", step, f"{key.split('.')[-1]} is a whole "
-                            "number: the step must be one too (1, 2, ...)")
-    if not isinstance(log, bool) or log and (low <= 0 or step is not None):
-        raise ScenarioError(path, where, spec, "log: true needs 0 < low and no step")
-    return Param(key, float(low), float(high), log, None if step is None else float(step), whole)
-
-
-def _setting(base: Scenario, dotted: str) -> tuple[Any, str | None]:
-    """A setting's value in ``base`` and None; or None and the section on its way that
-    ``base`` leaves out (``failures``, absent unless given); an entry a mapping setting does
-    not hold (``arrivals.params.loc``) is None."""
-    obj: Any = base
-    parts = dotted.split(".")
-    for i, part in enumerate(parts):
-        if obj is None:
-            return None, ".".join(parts[:i])
-        obj = obj.get(part) if isinstance(obj, Mapping) else getattr(obj, part)
-    return obj, None
-
-
-def _whole_setting(dotted: str) -> bool:
-    """Whether the schema holds ``dotted`` as a whole number (``failures.repair.crews``)."""
-    parts = dotted.split(".")
-    section = model_at(Scenario, parts[:-1])
-    field = section.model_fields.get(parts[-1]) if section is not None else None
-    return field is not None and field.annotation is int
-
-
-def _refuse_alone(path: Path, base: Scenario, p: Param, absent: str) -> None:
-    """A key of a section the base leaves out is varied: the key alone must make the section
-    (``failures.repair.crews`` does; a failure mode needs both its times), else refused."""
-    value = p.choices[0] if p.is_choice else _value(p, p.low)
-    try:
-        base.with_overrides({p.key: value}, file=path)
-    except ScenarioError as exc:
-        raise ScenarioError(path, f"vary.{p.key}", value, f"the base scenario (with set:) has no "
-                            f"{absent} section, and this key alone does not make one ({exc.key}: "
-                            f"{exc.why}): give the section in the base or under set:") from None
-
-
-def _number(v: Any) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
 def _constraint(path: Path, i: int, text: Any, measures: Sequence[str]) -> Constraint:
@@ -388,16 +280,12 @@ def _check_corners(study: Study) -> None:
     from cell.sim.assembly import assemble
 
     for p in study.params:
-        for v in (p.choices if p.is_choice else (_value(p, p.low), _value(p, p.high))):
+        for v in (p.choices if p.is_choice else (value_at(p, p.low), value_at(p, p.high))):
             try:
                 assemble(study.scenario({p.key: v}))
             except ScenarioError as exc:
                 raise ScenarioError(study.source, f"vary.{p.key}", v, f"at this value "
                                     f"{exc.key} = {exc.value}: {exc.why}") from None
-
-
-def _value(p: Param, x: float) -> Any:
-    return int(round(x)) if p.whole else x
 
 
 def replicate(study: Study, values: Mapping[str, Any], replications: Sequence[int],
