@@ -48,23 +48,21 @@ def main(args: argparse.Namespace) -> int:
 
 
 def _sizes(study: Any, source: Path) -> dict[str, int]:
+    """The designs' sizes, each within MAX_POINTS points (one rule for Morris and Sobol)."""
+    from cell.experiments.study import MAX_POINTS
     from cell.plumbing.errors import ScenarioError
 
     m, s = study.settings.morris, study.settings.sobol
-    for where, d, known in (("morris", m, {"trajectories", "levels"}),
-                            ("sobol", s, {"samples", "keys"})):
-        for k, v in d.items():
-            if k not in known:
-                raise ScenarioError(source, f"{where}.{k}", v,
-                                    f"unknown key (known: {', '.join(sorted(known))})")
-            if not isinstance(v, int) or isinstance(v, bool) or v < 2:
-                raise ScenarioError(source, f"{where}.{k}", v, "must be a whole number, at least 2")
-    samples = s.get("samples", 64)
-    if samples & (samples - 1):
-        raise ScenarioError(source, "sobol.samples", samples, "must be a power of 2 (Sobol sequence)")
-    keys = min(s.get("keys", len(study.params)), len(study.params))
-    return {"trajectories": m.get("trajectories", 10), "levels": m.get("levels", 4),
-            "samples": samples, "sobol_keys": keys}
+    if s.samples & (s.samples - 1):
+        raise ScenarioError(source, "sobol.samples", s.samples, "must be a power of 2 (Sobol sequence)")
+    keys = min(s.keys or len(study.params), len(study.params))
+    for key, count, points in (("morris.trajectories", m.trajectories, len(study.params) + 1),
+                               ("sobol.samples", s.samples, keys + 2)):
+        if count * points > MAX_POINTS:
+            raise ScenarioError(source, key, count, f"{count:,} x {points} = {count * points:,} "
+                                f"points: at most {MAX_POINTS:,} a design")
+    return {"trajectories": m.trajectories, "levels": m.levels, "samples": s.samples,
+            "sobol_keys": keys}
 
 
 def run(study: Any, workers: int, sizes: dict[str, int]) -> dict[str, Any]:

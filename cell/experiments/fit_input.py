@@ -238,7 +238,7 @@ def read_lifetimes(path: str | Path, column: str, censor_column: str | None = No
     0, false or no (it failed, or the repair ended, then); all False without the column.
     Sorted times are accepted (life data often come sorted).  Problems as :func:`read_column`."""
     p = Path(path)
-    named = [(column, "--column")] + ([(censor_column, "--censored")] if censor_column else [])
+    named = [(column, "--column")] + ([(censor_column, "--censored")] if censor_column is not None else [])
     lines, found = _read_columns(p, named)
     cells = found[0]
     import pandas as pd
@@ -251,7 +251,7 @@ def read_lifetimes(path: str | Path, column: str, censor_column: str | None = No
                             _why_unusable(cells.iloc[i], values[i], times=False, dated=False,
                                           most=math.inf))
     censored = np.zeros(values.size, dtype=bool)
-    if censor_column:
+    if censor_column is not None:  # '' names no column: refused by _read_columns, not ignored
         flags = found[1].str.lower()
         known = flags.isin(CENSORED_WORDS | OBSERVED_WORDS).to_numpy()
         if not known.all():

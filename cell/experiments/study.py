@@ -34,6 +34,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field, ValidationError
 
+from cell.experiments.varied import INDEXED, Param, param, value_at
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.fields import Section, error_from_validation
 from cell.scenario.schema import Scenario, known_key, load_scenario
@@ -42,12 +43,12 @@ from cell.sim.records import RunSummary
 #: Measures computed from a summary row: name -> (what, function of the row).
 DERIVED = {"spacing_outside_pct": "spacings outside 45 ± 0.25 in, % of the spacings on the output belt",
            "parts_missed_pct": "parts lost on the wall clock, % of the parts arrived"}
-#: Keys a study may not vary: each replication's stream comes from the study's seed.
-RESERVED = {"run.seed": "every replication gets its own stream from the study's 'seed'"}
 #: Measures only some built-in policies give (NaN for the others).
 POLICY_MEASURES = {"thesis_slack_s": ("non-adaptive",), "ip_thesis_memoryless": ("adaptive",),
                    "cycle_vs_nominal_memoryless_pct": ("adaptive",)}
-_INDEX = re.compile(r"^(?P<key>[A-Za-z0-9_.]+)\[(?P<i>\d+)\]$")
+#: The most points a sensitivity design (Morris's or Sobol's) may have: as many as an
+#: optimisation's trials.
+MAX_POINTS = 100_000
 _CONSTRAINT = re.compile(r"^\s*(?P<m>[A-Za-z_][A-Za-z0-9_]*)\s*(?P<op><=|>=)\s*(?P<v>[-+0-9.eE]+)\s*$")
 
 
@@ -76,6 +77,17 @@ def parts_missed_pct(missed: Any, arrived: Any) -> Any:
     return 100 * np.asarray(missed, dtype=float) / np.maximum(np.asarray(arrived, dtype=float), 1.0)
 
 
+def _count(default: Any, low: int, high: int | None = None) -> Any:
+    """A whole number, strict as every count of a scenario is: ``'10'`` (text) and ``1e3`` (a
+    number written as a float) are refused, not read as 10 and 1000."""
+    return Field(default, strict=True, ge=low, le=high)
+
+
+def _real(default: Any = ..., *, gt: float | None = None, lt: float | None = None) -> Any:
+    """A number (ints accepted, text and booleans refused), as a scenario's numbers are."""
+    return Field(default, strict=True, gt=gt, lt=lt)
+
+
 class ObjectiveSettings(Section):
     measure: str
     """A measure of the run summary, or a varied key."""
@@ -83,18 +95,32 @@ class ObjectiveSettings(Section):
 
 
 class SelectSettings(Section):
-    candidates: int = Field(5, ge=2)
+    candidates: int = _count(5, 2)
     """How many of the best trials KN re-runs."""
-    delta: float = Field(gt=0, allow_inf_nan=False)
+    delta: float = Field(strict=True, gt=0, allow_inf_nan=False)
     """The indifference zone, in the measure's units (a finite number)."""
-    pcs: float = Field(0.95, gt=0.5, lt=1)
+    pcs: float = _real(0.95, gt=0.5, lt=1)
     """The probability of correct selection asked."""
-    n0: int = Field(10, ge=2)
+    n0: int = _count(10, 2)
     """First-stage replications of each candidate."""
-    max: int = Field(200, ge=2)
+    max: int = _count(200, 2)
     """At most this many replications of each candidate."""
     measure: str | None = None
     """The measure to select on (default: the first objective that is a measure)."""
+
+
+class MorrisSettings(Section):
+    trajectories: int = _count(10, 2)
+    """R: the design has R × (keys + 1) points (at most MAX_POINTS)."""
+    levels: int = _count(4, 2)
+    """P: the grid each key's range is cut into."""
+
+
+class SobolSettings(Section):
+    samples: int = _count(64, 2)
+    """N, a power of 2: the design has N × (keys + 2) points (at most MAX_POINTS)."""
+    keys: int | None = _count(None, 2)
+    """The keys Morris ranks first that get Sobol indices (default: every key)."""
 
 
 class StudySettings(Section):
@@ -105,37 +131,18 @@ class StudySettings(Section):
     vary: dict[str, Any]
     objectives: list[ObjectiveSettings] = Field(default_factory=list)
     constraints: list[str] = Field(default_factory=list)
-    trials: int = Field(50, ge=1, le=100_000)
-    replications: int = Field(10, ge=1, le=10_000)
-    seed: int = Field(1984, ge=0)
+    trials: int = _count(50, 1, 100_000)
+    replications: int = _count(10, 1, 10_000)
+    seed: int = _count(1984, 0)
     select: SelectSettings | None = None
     measures: list[str] = Field(default_factory=list)
     """cell sensitivity: the measures whose indices are reported."""
     policies: list[str] = Field(default_factory=list)
     """cell sensitivity: each policy gets its own indices, on the same points."""
-    morris: dict[str, int] = Field(default_factory=dict)
+    morris: MorrisSettings = MorrisSettings()
     """cell sensitivity: {trajectories: R, levels: P}."""
-    sobol: dict[str, Any] = Field(default_factory=dict)
+    sobol: SobolSettings = SobolSettings()
     """cell sensitivity: {samples: N (a power of 2), keys: K (the K keys Morris ranks first)}."""
-
-
-
-@dataclass(frozen=True)
-class Param:
-    """One varied key: a number in [low, high] (``log``, ``step``, whole if the setting is)
-    or a choice among ``choices``."""
-
-    key: str
-    low: float = math.nan
-    high: float = math.nan
-    log: bool = False
-    step: float | None = None
-    whole: bool = False
-    choices: tuple[Any, ...] = ()
-
-    @property
-    def is_choice(self) -> bool:
-        return bool(self.choices)
 
 
 @dataclass(frozen=True)
@@ -171,7 +178,7 @@ class Study:
         over: dict[str, Any] = dict(self.settings.fixed)
         lists: dict[str, list[Any]] = {}
         for key, value in values.items():
-            m = _INDEX.match(key)
+            m = INDEXED.match(key)
             if m is None:
                 over[key] = value
                 continue
@@ -214,9 +221,14 @@ def load_study(path: str | Path, corners: bool = True) -> Study:
     for key, value in settings.fixed.items():
         if not known_key(key):
             raise ScenarioError(path, f"set.{key}", value, "unknown key: no such setting in a scenario")
+    for i, policy in enumerate(settings.policies):
+        if policy in settings.policies[:i]:
+            raise ScenarioError(path, f"policies[{i}]", policy, "listed twice: each policy once")
     if not settings.vary:
         raise ScenarioError(path, "vary", settings.vary, "name at least one key to vary")
-    params = tuple(_param(path, base, key, spec) for key, spec in settings.vary.items())
+    fixed = base.with_overrides(settings.fixed, file=path, paths_from=path.parent) \
+        if settings.fixed else base
+    params = tuple(param(path, fixed, key, spec) for key, spec in settings.vary.items())
     study = Study(path, settings, base, params, ())
     if corners:
         _check_corners(study)
@@ -243,49 +255,6 @@ def load_study(path: str | Path, corners: bool = True) -> Study:
                                 "no run reports it: name a measure of the run summary")
         _refuse_unset(study, "select.measure", settings.select.measure)
     return study
-
-
-def _param(path: Path, base: Scenario, key: str, spec: Any) -> Param:
-    where = f"vary.{key}"
-    m = _INDEX.match(key)
-    plain = m["key"] if m else key
-    if not known_key(plain):
-        raise ScenarioError(path, where, spec, "unknown key: no such setting in a scenario")
-    if plain in RESERVED:
-        raise ScenarioError(path, where, spec, f"cannot be varied: {RESERVED[plain]}")
-    current = base.get(plain)
-    if m is not None:
-        if not isinstance(current, (list, tuple)) or int(m["i"]) >= len(current):
-            raise ScenarioError(path, where, spec, f"{plain} has no entry {m['i']}")
-        current = current[int(m["i"])]
-    if isinstance(spec, Mapping) and "choice" in spec:
-        choices = spec["choice"]
-        if set(spec) != {"choice"} or not isinstance(choices, list) or not choices:
-            raise ScenarioError(path, where, spec, "a choice is {choice: [value, ...]}, not empty")
-        return Param(key, choices=tuple(choices))
-    if isinstance(spec, list) and not (len(spec) == 2 and all(_number(v) for v in spec)):
-        if not spec:
-            raise ScenarioError(path, where, spec, "an empty choice: list at least one value")
-        return Param(key, choices=tuple(spec))
-    if isinstance(spec, list):
-        spec = {"low": spec[0], "high": spec[1]}
-    if not isinstance(spec, Mapping) or set(spec) - {"low", "high", "log", "step"} \
-            or not {"low", "high"} <= set(spec):
-        raise ScenarioError(path, where, spec, "write [low, high], {low: L, high: H, log: true} "
-                            "or {low: L, high: H, step: S} for a number, {choice: [...]} for a choice")
-    low, high, step, log = spec["low"], spec["high"], spec.get("step"), spec.get("log", False)
-    if not (_number(low) and _number(high)) or not low < high:
-        raise ScenarioError(path, where, [low, high], "an empty range: low must be a number below high")
-    if step is not None and (not _number(step) or not 0 < step <= high - low):
-        raise ScenarioError(path, where, step, "step must be a number in (0, high - low]")
-    if not isinstance(log, bool) or log and (low <= 0 or step is not None):
-        raise ScenarioError(path, where, spec, "log: true needs 0 < low and no step")
-    whole = isinstance(current, int) and not isinstance(current, bool)
-    return Param(key, float(low), float(high), log, None if step is None else float(step), whole)
-
-
-def _number(v: Any) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
 def _constraint(path: Path, i: int, text: Any, measures: Sequence[str]) -> Constraint:
@@ -325,16 +294,12 @@ def _check_corners(study: Study) -> None:
     from cell.sim.assembly import assemble
 
     for p in study.params:
-        for v in (p.choices if p.is_choice else (_value(p, p.low), _value(p, p.high))):
+        for v in (p.choices if p.is_choice else (value_at(p, p.low), value_at(p, p.high))):
             try:
                 assemble(study.scenario({p.key: v}))
             except ScenarioError as exc:
                 raise ScenarioError(study.source, f"vary.{p.key}", v, f"at this value "
                                     f"{exc.key} = {exc.value}: {exc.why}") from None
-
-
-def _value(p: Param, x: float) -> Any:
-    return int(round(x)) if p.whole else x
 
 
 def replicate(study: Study, values: Mapping[str, Any], replications: Sequence[int],

@@ -26,11 +26,18 @@ STREAM_KEYS = {name: (2100 + 2 * i, 2101 + 2 * i) for i, name in enumerate(EQUIP
 #: Draws made per ``ppf`` call.
 BLOCK = 256
 SECONDS_PER_HOUR = 3600.0
+#: The shortest mean time between the stops of one cause (a failure mode, planned maintenance,
+#: motor wear), a time longer than the run counted as the run: a run then stops at most about
+#: twice a simulated second for each cause (see :func:`mean_within`), however it is specified.
+MIN_MEAN_S = 1.0
+#: Points of the integral :func:`mean_within` sums.
+GRID = 2048
 
 
-def check_failures(f: Any, file: object) -> None:
+def check_failures(f: Any, file: object, run_s: float = math.inf) -> None:
     """Refuse times that scipy rejects, can be negative, or have no finite positive mean,
-    and planned stops longer than their interval."""
+    planned stops longer than their interval, and stops so frequent that a run of ``run_s``
+    seconds would be an event storm (:func:`check_frequency`)."""
     if f is None:
         return
     for name in EQUIPMENT:
@@ -39,12 +46,71 @@ def check_failures(f: Any, file: object) -> None:
             continue
         for which in ("time_to_failure", "time_to_repair"):
             check_time(getattr(mode, which), f"failures.{name}.{which}", file)
+        check_frequency(frozen(mode.time_to_failure), run_s, file,
+                        f"failures.{name}.time_to_failure.params", dict(mode.time_to_failure.params),
+                        "fails every")
     m = f.maintenance
     if m is not None:
         if m.duration_min * 60.0 >= m.every_h * SECONDS_PER_HOUR:
             raise ScenarioError(file, "failures.maintenance.duration_min", m.duration_min,
                                 f"a planned stop must be shorter than its interval "
                                 f"(failures.maintenance.every_h = {m.every_h:g} h)")
+        every_s = m.every_h * SECONDS_PER_HOUR
+        if min(every_s, run_s) < floor_s(run_s):
+            raise ScenarioError(file, "failures.maintenance.every_h", m.every_h,
+                                f"a planned stop every {every_s:.3g} s: at least "
+                                f"{floor_s(run_s):g} s apart, or a run is mostly stops")
+
+
+def check_wear(w: Any, file: object, run_s: float = math.inf) -> None:
+    """Refuse motor lives so short that a run would be an event storm: the robot's time to a
+    worn motor, five motors in series all at the peak stress (S = 1, where the life is
+    shortest: η0 S0^p), held to :func:`check_frequency`'s rule."""
+    if not w.enabled:
+        return
+    import scipy.stats
+
+    motor_s = w.rated_life_h * w.reference_stress ** w.exponent * SECONDS_PER_HOUR
+    robot = scipy.stats.weibull_min(w.shape, scale=motor_s / 5.0 ** (1.0 / w.shape))
+    check_frequency(robot, run_s, file, "wear.rated_life_h", w.rated_life_h,
+                    f"wears a motor out (one of five, each of life {w.rated_life_h:g} h x "
+                    f"{w.reference_stress:g}^{w.exponent:g} at the peak stress) every")
+
+
+def floor_s(run_s: float) -> float:
+    """The shortest mean time between stops a run of ``run_s`` seconds accepts: MIN_MEAN_S, or
+    half the run if it is shorter than two of them (a run that short stops a few times at most)."""
+    return min(MIN_MEAN_S, run_s / 2.0)
+
+
+def mean_within(dist: Any, run_s: float) -> float:
+    """E[min(X, T)] = ∫_0^T P(X > t) dt: the mean of a time X, a time longer than the run's T
+    counted as T; from above, within 2 %.
+
+    It bounds the stops a run brings, whatever X's shape: the renewal process of
+    Y = min(X, T) stops at least as often in [0, T] as X's, and its stop after T comes by
+    2 T, so by Wald's identity E[N(T)] < 2 T / E[Y].  A distribution whose mean is long
+    only through rare enormous draws, nearly every draw a microsecond, has a short E[Y].
+    The integral is the upper sum of the decreasing P(X > t) over GRID points spaced
+    geometrically from T 1e-15 to T (each step 1.7 % of t, so the sum is within 2 % of the
+    integral), plus T 1e-15 for the stretch below."""
+    t = np.geomspace(run_s * 1e-15, run_s, GRID)
+    sf = np.asarray(dist.sf(t[:-1]), dtype=float)
+    return float(t[0] + np.sum(np.diff(t) * np.nan_to_num(sf, nan=1.0)))
+
+
+def check_frequency(dist: Any, run_s: float, file: object, key: str, value: Any, what: str) -> None:
+    """Refuse a time between stops (a time to failure, a motor's life) whose mean within the
+    run (:func:`mean_within`) is shorter than :func:`floor_s`: a run of ``run_s`` s would stop
+    more than about twice a simulated second for this cause alone, an event storm."""
+    if min(float(dist.ppf(0.5)), run_s) >= 2.0 * floor_s(run_s):
+        return  # E[min(X, T)] >= min(median, T) / 2 >= the floor: no need to count
+    within = mean_within(dist, run_s)
+    if within < floor_s(run_s):
+        raise ScenarioError(file, key, value,
+                            f"{what} {within:.3g} s on average (a time longer than the run's "
+                            f"{run_s:.4g} s counted as the run): at least {floor_s(run_s):g} s, "
+                            "or a run is mostly stops")
 
 
 def frozen(spec: Any) -> Any:

@@ -4,6 +4,7 @@ hours-long run would bring stay within the bound on parts (checked where a scena
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -41,13 +42,37 @@ class RunLength:
         return f"{self.number} {self.unit}{'s' if self.count != 1 else ''}"
 
 
-def check_hours(s: Any, default_parts: int, file: object) -> None:
-    """``run.hours`` and ``run.parts`` are exclusive; the parts an hours-long run brings
-    stay within the bound on parts."""
+#: The keys of ``run`` that set its length; a scenario gives one or the other.
+LENGTH_KEYS = ("parts", "hours")
+
+
+def lengths_given(layer: Mapping[str, Any], dotted: bool) -> set[str]:
+    """The length keys a layer gives a value (``hours: null`` gives none): a file's mapping, or
+    ``dotted`` overrides (``run.hours``, or ``run`` given as a mapping)."""
+    run = layer.get("run")
+    given = {k for k in LENGTH_KEYS if isinstance(run, Mapping) and run.get(k) is not None}
+    if dotted:
+        given |= {k for k in LENGTH_KEYS if layer.get(f"run.{k}") is not None}
+    return given
+
+
+def keep_one_length(raw: dict[str, Any], given: set[str]) -> None:
+    """A layer (a file over the defaults, ``--set`` over a file) that gives the run's length one
+    way sets it: the other key, from the layers below, goes from ``raw``.  A layer that gives
+    both keeps both, for :func:`check_hours` to refuse."""
+    run = raw.get("run")
+    if len(given) == 1 and isinstance(run, Mapping):
+        (other,) = set(LENGTH_KEYS) - given
+        raw["run"] = {k: v for k, v in run.items() if k != other}
+
+
+def check_hours(s: Any, file: object) -> None:
+    """``run.hours`` and ``run.parts`` are exclusive (both *given*, whatever their values); the
+    parts an hours-long run brings stay within the bound on parts."""
     hours = s.run.hours
     if hours is None:
         return
-    if s.run.parts != default_parts:
+    if "parts" in s.run.model_fields_set:
         raise ScenarioError(file, "run.hours", hours, f"give run.hours or run.parts "
                             f"({s.run.parts}), not both")
     from cell.scenario.sections import MAX_PARTS
@@ -64,3 +89,11 @@ def expected_parts(s: Any) -> float:
     if s.run.hours is None:
         return float(s.run.parts)
     return float(s.run.hours * SECONDS_PER_HOUR / mean_interarrival(s.arrivals, s.base_dir))
+
+
+def expected_seconds(s: Any) -> float:
+    """The run's length in simulated time: ``run.hours``, or ``run.parts`` mean inter-arrival
+    times (what bounds the stops a run can bring: :mod:`cell.scenario.failure_spec`)."""
+    if s.run.hours is not None:
+        return float(s.run.hours * SECONDS_PER_HOUR)
+    return float(s.run.parts * mean_interarrival(s.arrivals, s.base_dir))

@@ -22,6 +22,7 @@ from pydantic import BaseModel, PrivateAttr, ValidationError
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.fields import Section, error_from_validation, model_at, unwrap_optional
 from cell.scenario.overrides import apply_overrides, merge
+from cell.scenario.run_length import keep_one_length, lengths_given
 from cell.scenario.sections import (  # noqa: F401 - the schema, re-exported
     MAX_GRID_POINTS,
     MAX_LENGTH_IN,
@@ -92,12 +93,12 @@ class Scenario(Section):
 
     def to_dict(self) -> dict[str, Any]:
         """Plain YAML-able data (tuples as lists); ``failures`` and ``run.hours`` only when
-        given (so a scenario without them reads as it did before they existed)."""
+        given (so a scenario without them reads as it did before they existed), and with
+        ``run.hours`` no ``run.parts`` (the run's length is given one way)."""
         d = _plain(self.model_dump())
         if d.get("failures") is None:
             d.pop("failures", None)
-        if d["run"].get("hours") is None:
-            d["run"].pop("hours", None)
+        d["run"].pop("hours" if d["run"].get("hours") is None else "parts", None)
         return d
 
     def with_overrides(self, overrides: Mapping[str, Any], file: object = None,
@@ -106,6 +107,7 @@ class Scenario(Section):
         a file the overrides name by a relative path is looked for from ``paths_from``
         (None: from this scenario's folder, as its own files are)."""
         raw = apply_overrides(self.to_dict(), overrides, file or self._source, is_section)
+        keep_one_length(raw, lengths_given(overrides, dotted=True))
         if paths_from is not None:
             _anchor_paths(overrides, raw, paths_from)
         return validate(raw, file or self._source, source=self._source)
@@ -257,13 +259,16 @@ def _cross_checks(s: Scenario, file: object) -> None:
 
 
 def _length_and_failures(s: Scenario, file: object) -> None:
-    """``run.hours`` against ``run.parts``, and the ``failures:`` section's times."""
-    if s.run.hours is not None or s.failures is not None:
-        from cell.scenario.failure_spec import check_failures
-        from cell.scenario.run_length import check_hours
+    """``run.hours`` against ``run.parts``; the ``failures:`` section's times and the motors'
+    wear, against the run's length (what bounds the stops it brings)."""
+    if s.run.hours is not None or s.failures is not None or s.wear.enabled:
+        from cell.scenario.failure_spec import check_failures, check_wear
+        from cell.scenario.run_length import check_hours, expected_seconds
 
-        check_hours(s, _DEFAULTS.run.parts, file)
-        check_failures(s.failures, file)
+        check_hours(s, file)
+        run_s = expected_seconds(s)
+        check_failures(s.failures, file, run_s)
+        check_wear(s.wear, file, run_s)
     if s.wear.enabled and s.failures is not None and s.failures.robot is None:
         raise ScenarioError(file, "wear.enabled", True,
                             "with a failures: section, wear needs failures.robot (its "
@@ -283,8 +288,10 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
     if given.get("name") in (None, ""):  # a file without a name goes by the file's
         given = {**given, "name": path.stem}
     raw = merge(_DEFAULTS.to_dict(), given, (), is_section)
+    keep_one_length(raw, lengths_given(given, dotted=False))
     try:
         changed = apply_overrides(raw, overrides or {}, path, is_section)
+        keep_one_length(changed, lengths_given(overrides or {}, dotted=True))
         _anchor_paths(overrides or {}, changed, Path.cwd())  # a file named on the command line: from here
         return validate(changed, path, source=str(path))
     except ScenarioError as exc:  # a value from --set: the line says so

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pandas as pd
 import pytest
 
 from .harness import cli, refused
@@ -42,6 +43,12 @@ CASES = [
     ("part in hand", f"{{robot: {{time_to_failure: {R}, time_to_repair: {R}, part_in_hand: drop}}}}",
      ("failures.robot.part_in_hand", "drop")),
     ("repair missing", f"{{robot: {{time_to_failure: {R}}}}}", ("failures.robot.time_to_repair",)),
+    # no bound on simulated work: a failure a microsecond would stop a 5-part run 1e8 times
+    ("failures every microsecond", robot("{distribution: expon, params: {scale: 0.000001}}"),
+     ("failures.robot.time_to_failure.params", "1e-06")),
+    ("planned stops every few milliseconds", robot(R, ", maintenance: {every_h: 0.000001, "
+                                                   "duration_min: 0.00000001}"),
+     ("failures.maintenance.every_h", "1e-06")),
 ]
 
 
@@ -70,3 +77,42 @@ def test_hours_in_which_no_part_comes_are_refused(tmp_path: Path) -> None:
     out = tmp_path / "out"
     refused(cli("run", "baseline", "--set", "run.hours=0.001", "--out", out),
             "run.hours", "no part comes", nothing_in=out)
+
+
+def test_a_mean_long_only_through_rare_enormous_draws_is_refused_as_a_storm(tmp_path: Path) -> None:
+    """A lognormal of σ = 8 and median 1e-13 s has a mean of e^32 x 1e-13 = 7.9 s (above the 1 s
+    floor), yet nearly every draw is shorter than a nanosecond: what bounds the stops of a run is
+    the mean with times beyond the run cut at its length, not the mean."""
+    import scipy.stats
+
+    ttf = scipy.stats.lognorm(8.0, scale=1e-13)
+    assert ttf.mean() > 1.0 and ttf.cdf(1e-9) > 0.5
+    out = tmp_path / "out"
+    value = robot("{distribution: lognorm, params: {s: 8, scale: 1.0e-13}}")
+    refused(cli("run", "baseline", "--set", "run.parts=5", "--set", f"failures={value}", "--out", out),
+            "failures.robot.time_to_failure.params", "1e-13", nothing_in=out)
+
+
+def test_a_motor_life_of_milliseconds_is_refused(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    wear = "wear={enabled: true, rated_life_h: 1.0e-5}"
+    refused(cli("run", "baseline", "--set", "run.parts=5", "--set", wear, "--out", out),
+            "wear.rated_life_h", "1e-05", nothing_in=out)
+
+
+def test_failures_a_second_apart_run(tmp_path: Path) -> None:
+    """The floor's own value (a mean time to failure of 1 s, a repair of a millisecond) runs."""
+    out = tmp_path / "out"
+    value = robot("{distribution: expon, params: {scale: 1}}").replace("600", "0.001")
+    res = cli("run", "baseline", "--set", "run.parts=5", "--set", f"failures={value}", "--out", out)
+    res.case.judged("ran")
+    assert res.code == 0, res.err
+    assert len(pd.read_csv(out / "failures.csv")) > 20  # about 80 s of motion: some 50 failures
+
+
+def test_hours_and_parts_given_together_in_a_file_are_refused_whatever_the_parts(tmp_path: Path) -> None:
+    """Both given is refused even when run.parts is its default, 500 (once compared with it)."""
+    scenario = tmp_path / "both.yaml"
+    scenario.write_text("run: {parts: 500, hours: 1}\n", encoding="utf-8")
+    out = tmp_path / "out"
+    refused(cli("run", scenario, "--out", out), str(scenario), "run.hours", "500", nothing_in=out)
