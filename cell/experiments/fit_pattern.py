@@ -15,7 +15,8 @@ Three statistics of the log, in its order:
 
 Each p-value is a permutation test's: under the null hypothesis the gaps are independent and
 identically distributed, so every order of them is equally likely; the statistic of the log
-is ranked among those of :data:`PERMUTATIONS` random orders of the same gaps (seeded: the
+is ranked among those of :data:`PERMUTATIONS` random orders of the same gaps (fewer for a long
+log, :func:`orders`; seeded: the
 same log gives the same p-values), p = (1 + those at least as large) / (1 + permutations).
 That holds exactly whatever the gaps' distribution (the chi-square's own p-value assumes a
 Poisson process, and would alarm far too often on the thesis's near-regular Weibull), with
@@ -44,8 +45,12 @@ from cell.scenario.sections import RateProfile
 #: The false-alarm rate of the combined decision (Holm over the tests run).
 LEVEL = 0.05
 #: Random orders of the gaps each statistic is ranked among; 1 + this is a multiple of 60,
-#: so that LEVEL / 3 and LEVEL / 2 are whole multiples of the p-values' step.
+#: so that LEVEL / 3 and LEVEL / 2 are whole multiples of the p-values' step.  Fewer for a
+#: long log (:func:`orders`): no fewer than 119, the gaps times the orders at most :data:`WORK`.
 PERMUTATIONS = 1199
+WORK = 3_000_000
+#: A longer log is tested on its first this many gaps (the work stays bounded: seconds).
+MAX_TESTED = 20_000
 #: Periods tried when none is given (a shift, a day), in hours.
 CANDIDATE_PERIODS_H = (8.0, 24.0)
 #: Periods the log must span for an inferred period to be tried (one, for a period given).
@@ -267,16 +272,28 @@ def clocks(span_s: float, first_h: float, period_h: float | None,
     return tried, why
 
 
+def orders(n: int) -> int:
+    """Random orders for a log of ``n`` gaps: :data:`PERMUTATIONS`, fewer (in steps of 60)
+    where ``n`` times them would pass :data:`WORK`, at least 119."""
+    return max(120, min(PERMUTATIONS + 1, 60 * (WORK // (60 * max(n, 1))))) - 1
+
+
 def find_pattern(gaps: Sequence[float], first_h: float = 0.0, period_h: float | None = None,
                  start_h: float | None = None, kept: Sequence[bool] | None = None,
-                 permutations: int = PERMUTATIONS, level: float = LEVEL) -> Pattern:
+                 permutations: int | None = None, level: float = LEVEL) -> Pattern:
     """Test a log's gaps, in order (the first arrival ``first_h`` hours into its clock), for a
     trend, a time-of-day pattern and correlated gaps (see the module's docstring); ``kept``:
-    the gaps fitted (None: all), the others (stoppages) staying where they are."""
+    the gaps fitted (None: all), the others (stoppages) staying where they are; the first
+    :data:`MAX_TESTED` gaps of a longer log; ``permutations``: by default :func:`orders`."""
     x = np.asarray(gaps, dtype=float)
-    log = _Log.of(x, None if kept is None else np.asarray(kept, dtype=bool))
+    mask = None if kept is None else np.asarray(kept, dtype=bool)
+    cut = f"tested on the first {MAX_TESTED:,} of the {x.size:,} gaps" if x.size > MAX_TESTED else ""
+    x, mask = x[:MAX_TESTED], None if mask is None else mask[:MAX_TESTED]
+    permutations = orders(x.size) if permutations is None else permutations
+    log = _Log.of(x, mask)
     flow = x[log.kept]
     tried, why = clocks(float(x.sum()), first_h, period_h, start_h)
+    why = "; ".join(w for w in (why, cut) if w)
     bins = [_Bins.of(c, first_h) for c in tried]
     observed = _statistics(x[None, :], log, bins)[0]
     beaten = np.zeros(3)

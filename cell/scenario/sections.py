@@ -203,15 +203,13 @@ WEIBULL_SHAPE = 1.0 / 0.2038
 
 
 class RateProfile(Section):
-    """A rate that changes over a repeating period, piecewise constant (docs/usage.md, "Arrivals
-    whose rate changes"); drawn by time-scaling the base distribution with the integrated rate."""
+    """A rate piecewise constant over a repeating period (docs/usage.md, "Arrivals whose rate changes")."""
 
     period_h: float = _num(..., gt=0.0, le=MAX_HOURS)
     """Hours after which the profile repeats: a shift (8), a day (24), a week (168)."""
     rates: list[Positive] = Field(..., strict=True)
-    """Relative rates of the pieces, each > 0; normalised so that their time-weighted mean
-    is 1: ``[1.2, 1.2, 1, 1, 1, 1, 1, 1]`` is a rate 20 % higher in the first two hours than
-    in the other six, and the long-run mean inter-arrival time stays the distribution's."""
+    """Relative rates of the pieces, each > 0, normalised to a time-weighted mean of 1 (the long-run
+    mean gap stays the distribution's): ``[1.2, 1.2, 1, 1, 1, 1, 1, 1]``, 20 % faster for 2 h."""
     starts_h: list[NonNegative] | None = None
     """Hour of the period at which each piece starts (the first at 0, increasing, each
     before ``period_h``).  Empty: equal pieces."""
@@ -237,8 +235,7 @@ class ArrivalSettings(Section):
     """A CSV of observed inter-arrival times (column ``interarrival_s``), used in
     order instead of the distribution; relative to the scenario file."""
     profile: RateProfile | None = None
-    """A rate that changes over a shift, a day or a week; absent: a constant rate (a
-    stationary renewal process)."""
+    """A rate that changes over a shift, a day or a week; absent: a constant rate."""
 
 
 # --------------------------------------------------------------------------- controller

@@ -16,7 +16,7 @@ from scipy import stats
 from cell.cli.fit_command import add_arguments
 from cell.cli.fit_command import main as cmd_fit
 from cell.cli.main import main
-from cell.experiments.fit_pattern import LEVEL, find_pattern, holm
+from cell.experiments.fit_pattern import LEVEL, MAX_TESTED, WORK, find_pattern, holm, orders
 from cell.experiments.sweep.runner import simulate_summary
 from cell.scenario.schema import load_scenario
 from cell.sim.simulation import simulate
@@ -91,6 +91,30 @@ def test_a_poisson_log_with_the_shift_pattern_is_found():
     assert pattern.by_time
     rates = np.array(pattern.rates)
     assert rates[:2].mean() / rates[2:].mean() == pytest.approx(1.2, abs=0.08)
+
+
+def test_stoppages_left_out_keep_their_place_and_leave_the_hours_counts():
+    """Stoppages in the Poisson shift log: no part comes in five stretches of 40 min to 2 h,
+    all in fast hours (the shift's clock runs on); their gaps left out (``kept``), the hours'
+    times leave them out, so the estimated rates are still the shift's 1.2 to 1."""
+    rng = np.random.default_rng(9)
+    t = shift_times(np.cumsum(rng.exponential(22.6, 6000)))
+    for start_h, hours in ((0.2, 0.7), (8.1, 1.8), (16.5, 1.2), (24.3, 1.0), (32.0, 1.9)):
+        t = t[(t < start_h * HOUR) | (t > (start_h + hours) * HOUR)]
+    gaps = np.diff(t, prepend=0.0)
+    kept = gaps < 1200.0
+    assert (~kept).sum() == 5
+    pattern = find_pattern(gaps, 0.0, period_h=8.0, kept=kept, permutations=599)
+    rates = np.array(pattern.rates)
+    assert pattern.by_time and rates[:2].mean() / rates[2:].mean() == pytest.approx(1.2, abs=0.08)
+
+
+def test_the_work_is_bounded_and_the_level_exact_whatever_the_length():
+    for n in (20, 2600, 5000, 19_999, 10**6):
+        b = orders(min(n, MAX_TESTED))
+        assert (b + 1) % 60 == 0 and (b == 119 or b * min(n, MAX_TESTED) <= WORK)
+    long_log = np.random.default_rng(3).exponential(20.0, MAX_TESTED + 500)
+    assert f"{MAX_TESTED:,} of the {MAX_TESTED + 500:,}" in find_pattern(long_log).not_run
 
 
 # --------------------------------------------------------------------------- the shift log
