@@ -13,7 +13,10 @@ fits the gaps between them; gaps far out of the body of the data are flagged, an
 ``--max-gap S`` or ``--drop-outliers`` leaves them out.  ``--as time_to_failure`` (or
 ``time_to_repair``) fits times to failure or repair instead, right-censored where
 ``--censored COLUMN`` says so (:mod:`cell.experiments.fit_censored`), and writes that block of
-the ``failures:`` section.
+the ``failures:`` section.  A log of arrivals is first tested for a trend, a rate that changes
+with the time of day and correlated gaps (:mod:`cell.experiments.fit_pattern`); when the rate
+changes, the block written is the rate profile the counts estimate with the base distribution
+fitted to the gaps in operational time (``--iid``: one iid fit, the tests' result beside it).
 """
 
 from __future__ import annotations
@@ -26,7 +29,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from cell.cli.fit_check import BLOCKS
-from cell.cli.fit_write import Data, fitted_block, write
+from cell.cli.fit_write import Data, fitted_block, in_operational_time, write
 from cell.plumbing.errors import ScenarioError
 
 HELP = "fit a distribution to observed inter-arrival times (or times to failure or repair); write its block"
@@ -43,7 +46,13 @@ DESCRIPTION = ("Fit scipy.stats distributions to observed inter-arrival times by
                "them, and leaving them out would lengthen the mean; log the times more finely, or replay "
                "the gaps as a trace (arrivals.trace_csv takes zeros). With --as time_to_failure or "
                "time_to_repair the column holds such times, right-censored where --censored COLUMN says "
-               "1, true or yes, and the block written is that one of the failures: section.")
+               "1, true or yes, and the block written is that one of the failures: section. A log of "
+               "arrivals (not with --as or --gaps) is tested for a trend (Laplace), counts by hour of a "
+               "period (chi-square; --period-h, --period-start, or inferred) and correlated successive "
+               "gaps (lag-1), each by permutation, Holm-corrected: an iid log is said to have a pattern "
+               "at most 5 % of the time. When the rate changes with the hour, the arrivals: block holds "
+               "the estimated profile and the distribution of the gaps in operational time; --iid "
+               "writes one iid fit instead, with the tests' result beside it.")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -76,6 +85,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--as", dest="block", choices=BLOCKS, default="arrivals",
                         help="the block to write: arrivals (default), or time_to_failure or "
                              "time_to_repair of the failures: section (times, not gaps)")
+    parser.add_argument("--period-h", type=float, default=None, metavar="H",
+                        help="test the counts by hour of a period of H hours (8: a shift, 24: a "
+                             "day; default: each of 8 and 24 the log spans twice)")
+    parser.add_argument("--period-start", default=None, metavar="HH:MM",
+                        help="where a period starts on the log's clock (default: the whole hour "
+                             "the log begins in)")
+    parser.add_argument("--iid", action="store_true",
+                        help="write one iid fit even when the rate changes over the period (the "
+                             "tests' results beside it)")
     parser.add_argument("--censored", default=None, metavar="COLUMN",
                         help="with --as: the column saying which times are right-censored (1, true "
                              "or yes: still working then; 0, false or no: failed, or repaired, then)")
@@ -145,11 +163,35 @@ def _families(args: argparse.Namespace, lifetimes: bool) -> list[str]:
     return families
 
 
+def _pattern_options(args: argparse.Namespace, lifetimes: bool) -> float | None:
+    """--period-h, --period-start (as hours) and --iid checked: a period of hours within a
+    scenario's bounds, a start HH:MM within the day, none with --as or --gaps (no log order)."""
+    from cell.scenario.sections import MAX_HOURS
+
+    given = [(o, v) for o, v in (("--period-h", args.period_h), ("--period-start", args.period_start),
+                                 ("--iid", args.iid or None)) if v is not None]
+    if given and (lifetimes or args.gaps):
+        option, value = given[0]
+        raise ScenarioError(option, option, value, "tests a log of arrivals in its order: not with "
+                            + ("--as" if lifetimes else "--gaps (sorted gaps have no order)"))
+    if args.period_h is not None and not (math.isfinite(args.period_h) and 0 < args.period_h <= MAX_HOURS):
+        raise ScenarioError("--period-h", "--period-h", args.period_h,
+                            f"must be a number of hours > 0, at most {MAX_HOURS:g}")
+    if args.period_start is None:
+        return None
+    text = str(args.period_start)
+    hh, sep, mm = text.partition(":")
+    if not (sep and hh.isdigit() and mm.isdigit() and len(mm) == 2 and int(hh) < 24 and int(mm) < 60):
+        raise ScenarioError("--period-start", "--period-start", text, "must be a clock time HH:MM, "
+                            "00:00 to 23:59")
+    return int(hh) + int(mm) / 60.0
+
+
 def _read(args: argparse.Namespace, trace: Path, lifetimes: bool) -> Data:
     """The values to fit, from the trace, and the notes and warnings on them."""
     from cell.experiments.fit import MIN_VALUES
     from cell.experiments.fit_gaps import far_out, fence, flag, flagged, leave_out
-    from cell.experiments.fit_input import read_column, read_lifetimes
+    from cell.experiments.fit_input import first_clock_h, read_column, read_lifetimes
     from cell.scenario.arrivals import MAX_INTERARRIVAL_S
 
     if lifetimes and not args.times:
@@ -159,13 +201,17 @@ def _read(args: argparse.Namespace, trace: Path, lifetimes: bool) -> Data:
         return Data(values, censored if censored.any() else None, count, _subsampled(values.size, "times"))
     values = read_column(trace, args.column, times=args.times, sorted_ok=args.gaps or lifetimes,
                          most=math.inf if lifetimes else MAX_INTERARRIVAL_S)
+    ordered = None if lifetimes or args.gaps else values
+    first_h = first_clock_h(trace, args.column, args.times) if ordered is not None else 0.0
     noun = "gaps" if args.times else "values"
     count = f"{values.size} gaps between {values.size + 1} arrival times" if args.times else \
         f"{values.size} values"
     notes: list[str] = []
     asked = args.max_gap is not None or args.drop_outliers
+    kept = None
     if asked:
         limit = args.max_gap if args.max_gap is not None else fence(values)
+        kept = values <= limit
         how = f"--max-gap {args.max_gap:g}" if args.max_gap is not None else \
             "--drop-outliers: beyond Q3 + 3 IQR"
         values, left = leave_out(values, limit, how)
@@ -176,7 +222,8 @@ def _read(args: argparse.Namespace, trace: Path, lifetimes: bool) -> Data:
                                 f"leaves {values.size} {noun}: at least {MIN_VALUES} are needed to fit")
     tail = far_out(values)
     said = flag(tail, noun) if flagged(tail) and not (lifetimes or asked) else ""
-    return Data(values, None, count, [n for n in notes if n] + _subsampled(values.size, noun), said)
+    return Data(values, None, count, [n for n in notes if n] + _subsampled(values.size, noun), said,
+                ordered, kept, first_h)
 
 
 def _subsampled(n: int, noun: str) -> list[str]:
@@ -204,9 +251,18 @@ def main(args: argparse.Namespace) -> int:
     out, figure = _outputs(args, trace)
     lifetimes = args.block != "arrivals"
     families = _families(args, lifetimes)
+    start_h = _pattern_options(args, lifetimes)
     data = _read(args, trace, lifetimes)
     replay = "" if lifetimes else _replay(trace, out, args.column, args.times)
-    result = fitted_block(args, trace, out, data, families, replay)
+    pattern = None
+    if data.ordered is not None:
+        from cell.experiments.fit_pattern import find_pattern
+
+        pattern = find_pattern(data.ordered, data.first_h, args.period_h, start_h, data.kept)
+        profile = pattern.profile()
+        if pattern.by_time and not args.iid and profile is not None:
+            data = in_operational_time(data, profile)
+    result = fitted_block(args, trace, out, data, families, replay, pattern)
     write(args, data, result, out, figure)
     if data.flag:
         print(f"cell: warning: {data.flag}", file=sys.stderr)

@@ -13,6 +13,8 @@ from cell.plumbing.errors import ScenarioError
 
 if TYPE_CHECKING:
     from cell.experiments.fit import Fit
+    from cell.experiments.fit_pattern import Pattern
+    from cell.scenario.sections import RateProfile
 
 #: Where a time to failure or repair goes.
 EQUIPMENT = "robot, input_belt, output_belt or sensor"
@@ -28,6 +30,13 @@ class Data(NamedTuple):
     notes: list[str]
     flag: str = ""
     """The warning on gaps far out of the body of the data ("" for none)."""
+    ordered: Any = None
+    """The log's gaps in its order, none left out (None: times to failure or repair, or
+    sorted gaps: no order to test)."""
+    kept: Any = None
+    """Which of ``ordered`` are fitted (None: all)."""
+    first_h: float = 0.0
+    """Where on its clock the log begins, h (:func:`~cell.experiments.fit_input.first_clock_h`)."""
 
 
 class Result(NamedTuple):
@@ -54,16 +63,17 @@ def _fits(args: argparse.Namespace, trace: Path, data: Data, families: list[str]
         raise ScenarioError(trace, args.column, data.what, str(exc)) from None
 
 
-def refusals(fits: list[Fit], key: str, file: object) -> dict[int, str]:
+def refusals(fits: list[Fit], key: str, file: object, extra: str = "") -> dict[int, str]:
     """Why a scenario would refuse each fit's block (by ``id``; "" where it accepts it): the
     quick checks first (:func:`~cell.experiments.fit_choice.unusable`), then the scenario's own
-    validation of the block as it would be written."""
+    validation of the block as it would be written (with ``extra``, its profile line)."""
     from cell.experiments.fit_choice import unusable
     from cell.experiments.fit_output import block_yaml
     from cell.scenario.arrivals import MAX_INTERARRIVAL_S
 
     most = MAX_INTERARRIVAL_S if key == "arrivals" else math.inf
-    return {id(f): unusable(f, most) or scenario_refuses(block_yaml(f, key, str(file)), key, file)
+    return {id(f): unusable(f, most) or scenario_refuses(block_yaml(f, key, str(file)) + extra, key,
+                                                         file)
             for f in fits}
 
 
@@ -92,22 +102,60 @@ def _table(fits: list[Fit], data: Data, chosen: Fit, refused: dict[int, str], wh
     return "\n".join([table, *data.notes, *([why] if why else [])])
 
 
+def in_operational_time(data: Data, profile: RateProfile) -> Data:
+    """The data as the gaps a profile's base distribution draws: the log's gaps in operational
+    time (:func:`~cell.experiments.fit_pattern.operational_gaps`), those left out left out."""
+    from cell.experiments.fit_pattern import operational_gaps
+
+    gaps = operational_gaps(data.ordered, profile)
+    values = gaps if data.kept is None else gaps[data.kept]
+    what = f"{data.what}, in operational time (the rate profile's)"
+    return data._replace(values=values, what=what)
+
+
+def _pattern_said(pattern: Pattern | None, iid: bool) -> tuple[list[str], str]:
+    """The lines on what the tests found (for the table and the block), and the caution when
+    an iid fit is written for a log that is not iid ("" otherwise)."""
+    if pattern is None:
+        return [], ""
+    lines = pattern.lines()
+    if pattern.by_time and not iid:
+        return lines + ["written: the rate profile the counts estimate (arrivals.profile) and "
+                        "the distribution of the gaps in operational time; --iid writes one iid "
+                        "fit instead"], ""
+    if not pattern.found:
+        return lines, ""
+    found = ", ".join(f.name for f in pattern.findings if f.rejected)
+    return lines, (f"the log is not iid ({found}): one iid fit does not stand for it"
+                   + ("" if iid or pattern.by_time else "; a rate profile models a rate that "
+                      "changes with the time of day, not a trend or correlated gaps"))
+
+
 def fitted_block(args: argparse.Namespace, trace: Path, out: Path | None, data: Data,
-                 families: list[str], replay: str) -> Result:
+                 families: list[str], replay: str, pattern: Pattern | None = None) -> Result:
     """Fit, choose the fit to write, and make its block (with its caution and notes) and the
-    table; ``replay`` is how to replay the data instead (for the caution; "" for none)."""
+    table; ``replay`` is how to replay the data instead (for the caution; "" for none);
+    ``pattern``: what the tests of the log found, and with a rate that changes over the
+    period (and no ``--iid``) the profile written with the fit of the gaps in operational
+    time (``data`` then holds those gaps)."""
     from cell.experiments.fit_choice import caution, choose, first_accepted
     from cell.experiments.fit_output import block_yaml
+    from cell.experiments.fit_pattern import profile_yaml
 
+    iid = bool(getattr(args, "iid", False))
+    profile = pattern.profile() if pattern is not None and pattern.by_time and not iid else None
+    found, not_iid = _pattern_said(pattern, iid)
     fits = _fits(args, trace, data, families)
     key = args.block
-    refused = refusals(fits, key, out if out is not None else "the printed block")
+    extra = profile_yaml(profile) if profile is not None else ""
+    refused = refusals(fits, key, out if out is not None else "the printed block", extra)
     try:
         chosen, why = choose(fits, data.values, lambda f: refused[id(f)]) if data.censored is None \
             else first_accepted(fits, lambda f: refused[id(f)])
     except ValueError as exc:
         raise ScenarioError(trace, "--families", ",".join(families), str(exc)) from None
     warning = caution(chosen, data.values) if data.censored is None else ""
+    warning = "; ".join(w for w in (warning, not_iid) if w)
     if warning and replay:
         warning += f". To run the data themselves, replay them: {replay}"
     notes = list(data.notes)
@@ -115,8 +163,10 @@ def fitted_block(args: argparse.Namespace, trace: Path, out: Path | None, data: 
         notes.append(f"in seconds: put it under failures.EQUIPMENT ({EQUIPMENT}), with its "
                      f"{'time_to_repair' if key == 'time_to_failure' else 'time_to_failure'}")
     source = f"{trace}, column {args.column} ({data.what})"
-    block = block_yaml(chosen, key, source, caution=warning, notes=notes, method=_method(chosen, data))
-    return Result(fits, chosen, warning, block, _table(fits, data, chosen, refused, why))
+    block = block_yaml(chosen, key, source, caution=warning, notes=[*found, *notes],
+                       method=_method(chosen, data)) + extra
+    table = "\n".join([_table(fits, data, chosen, refused, why), *found])
+    return Result(fits, chosen, warning, block, table)
 
 
 def write(args: argparse.Namespace, data: Data, result: Result, out: Path | None,

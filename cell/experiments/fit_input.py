@@ -60,6 +60,22 @@ def read_column(path: str | Path, column: str = "interarrival_s", *, times: bool
     return values
 
 
+def first_clock_h(path: str | Path, column: str, times: bool) -> float:
+    """Where on its own clock a log begins, in hours: the first time stamp's wall-clock time
+    (an ISO date-time, as written, whatever its offset), or the first time in seconds / 3600
+    (numbers); 0 for a column of gaps (the log's clock then starts at its first arrival)."""
+    import pandas as pd
+
+    if not times:
+        return 0.0
+    cell = str(_read_cells(Path(path), column)[1].iloc[0])
+    first = pd.to_numeric(pd.Series([cell]), errors="coerce").iloc[0]
+    if math.isfinite(first):
+        return float(first) / 3600.0
+    stamp = pd.Timestamp(cell)
+    return (stamp - stamp.normalize()).total_seconds() / 3600.0
+
+
 def _refuse_rising(p: Path, column: str, cells: Any, values: NDArray[np.float64],
                    finite: NDArray[np.bool_]) -> None:
     """Refuse as arrival times a column of :data:`MIN_VALUES` or more finite gaps that never

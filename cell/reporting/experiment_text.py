@@ -129,7 +129,7 @@ def markdown(summary: pd.DataFrame, differences: pd.DataFrame, replications: pd.
         "paired difference: `differences.csv`."]), ""]
     if caveat:
         lines += [f"**Caveat:** {caveat}.", ""]
-    lines += _variation(summary, sweep)
+    lines += _variation(summary, sweep) + _stationarity(sweep)
     if table_7_1:
         lines += ["Table 7.1 beside the thesis's: [`table_7_1.md`](table_7_1.md); its numbers: "
                   "[`table_7_1.csv`](table_7_1.csv).", ""]
@@ -194,6 +194,18 @@ def _variation(summary: pd.DataFrame, sweep: Sweep) -> list[str]:
         return [f"**No variation between replications:**{why}; the figures are single values, "
                 "without intervals, and a difference is exact.", ""]
     return []
+
+
+def _stationarity(sweep: Sweep) -> list[str]:
+    """A line when the arrivals of some points change their rate over a period (a profile)."""
+    from cell.scenario.rate_profile import describe
+
+    profiles = [p.scenario.arrivals.profile for p in sweep.points]
+    varying = [p for p in profiles if p is not None]
+    if not varying:
+        return []
+    some = "" if len(varying) == len(profiles) else f" ({len(varying)} of {len(profiles)} points)"
+    return [f"**Arrivals not stationary** (`arrivals.profile`){some}: {describe(varying[0])}.", ""]
 
 
 def _precision(replications: pd.DataFrame, summary: pd.DataFrame, sweep: Sweep,

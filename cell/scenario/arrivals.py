@@ -7,7 +7,9 @@ here with numpy, to the bit as scipy does (:func:`closed_form_ppf`), so a run of
 them needs no scipy.  The stream is a child of the run's
 SeedSequence that nothing else uses, so every policy run with the same seed sees
 the same parts (common random numbers).  A CSV trace of observed times replaces
-the distribution when given.
+the distribution when given.  With ``arrivals.profile`` the rate changes over a repeating
+period: the same draws, laid out in operational time and mapped to the run's time through
+the integrated rate (:mod:`cell.scenario.rate_profile`).
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from numpy.typing import NDArray
 
 from cell.plumbing.cache import Remembered, file_key, memo
 from cell.plumbing.errors import ScenarioError
+from cell.scenario.rate_profile import ProfileSpec, check_profile, scaled_gaps
 from cell.scenario.trace_file import column_cells
 
 #: The feeder's child stream of the root SeedSequence (other streams take other keys).
@@ -44,6 +47,8 @@ class ArrivalSpec(Protocol):
     def mean_s(self) -> float | None: ...
     @property
     def cv(self) -> float | None: ...
+    @property
+    def profile(self) -> ProfileSpec | None: ...
 
 
 def root_seed(seed: int | np.random.SeedSequence) -> np.random.SeedSequence:
@@ -70,11 +75,19 @@ def interarrival_times(arrivals: ArrivalSpec, n: int, seed: int | np.random.Seed
     """The first ``n`` inter-arrival times (s) of a run: eq. 6.9 by default.
 
     With ``arrivals.trace_csv`` the trace's times are used in order, repeating
-    from its start if the run needs more than it holds.
+    from its start if the run needs more than it holds.  With ``arrivals.profile`` the
+    distribution's draws are time-scaled by the profile's integrated rate
+    (:func:`~cell.scenario.rate_profile.scaled_gaps`).
     """
     if arrivals.trace_csv is not None:
         trace = read_trace(Path(base_dir) / arrivals.trace_csv)
         return np.resize(trace, n).astype(float)
+    times = _stationary_times(arrivals, n, seed)
+    return times if arrivals.profile is None else scaled_gaps(times, arrivals.profile)
+
+
+def _stationary_times(arrivals: ArrivalSpec, n: int,
+                      seed: int | np.random.SeedSequence) -> NDArray[np.float64]:
     u = stream(seed, FEEDER_STREAM).random(n)
     facts = _known_facts(arrivals)
     params = facts[0] if facts is not None else parameters(arrivals)
@@ -238,7 +251,8 @@ def by_mean_and_cv(family: str, mean: float, cv: float) -> dict[str, float]:
 
 
 def mean_interarrival(arrivals: ArrivalSpec, base_dir: Path | str = ".") -> float:
-    """The mean inter-arrival time (s): the distribution's, or the trace's."""
+    """The mean inter-arrival time (s): the distribution's, or the trace's; with a profile,
+    the long run's (its rates are normalised to a mean of 1)."""
     if arrivals.trace_csv is not None:
         return float(np.mean(read_trace(Path(base_dir) / arrivals.trace_csv)))
     facts = _known_facts(arrivals)
@@ -252,7 +266,10 @@ def check_arrivals(arrivals: ArrivalSpec, base_dir: Path, file: object) -> None:
     can be negative or have no finite mean, and an unusable trace.
 
     What passed is remembered (:mod:`cell.plumbing.cache`, on disk too), so a later start
-    checks the same arrivals without importing scipy.stats."""
+    checks the same arrivals without importing scipy.stats.  A profile is checked by
+    :func:`~cell.scenario.rate_profile.check_profile`."""
+    if arrivals.profile is not None:
+        check_profile(arrivals.profile, arrivals.trace_csv, file)
     if arrivals.trace_csv is None and _known_facts(arrivals) is not None:
         return
     family = {"distribution": arrivals.distribution}

@@ -92,13 +92,16 @@ class Scenario(Section):
         return obj
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain YAML-able data (tuples as lists); ``failures`` and ``run.hours`` only when
-        given (so a scenario without them reads as it did before they existed), and with
-        ``run.hours`` no ``run.parts`` (the run's length is given one way)."""
+        """Plain YAML-able data (tuples as lists); ``failures``, ``run.hours`` and
+        ``arrivals.profile`` only when given (so a scenario without them reads as it did
+        before they existed), and with ``run.hours`` no ``run.parts`` (the run's length is
+        given one way)."""
         d = _plain(self.model_dump())
         if d.get("failures") is None:
             d.pop("failures", None)
         d["run"].pop("hours" if d["run"].get("hours") is None else "parts", None)
+        if d["arrivals"].get("profile") is None:
+            d["arrivals"].pop("profile", None)
         return d
 
     def with_overrides(self, overrides: Mapping[str, Any], file: object = None,

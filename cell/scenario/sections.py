@@ -202,6 +202,21 @@ WEIBULL_SHAPE = 1.0 / 0.2038
 """Eq. 6.9's exponent is 1/shape."""
 
 
+class RateProfile(Section):
+    """A rate piecewise constant over a repeating period (docs/usage.md, "Arrivals whose rate changes")."""
+
+    period_h: float = _num(..., gt=0.0, le=MAX_HOURS)
+    """Hours after which the profile repeats: a shift (8), a day (24), a week (168)."""
+    rates: list[Positive] = Field(..., strict=True)
+    """Relative rates of the pieces, each > 0, normalised to a time-weighted mean of 1 (the long-run
+    mean gap stays the distribution's): ``[1.2, 1.2, 1, 1, 1, 1, 1, 1]``, 20 % faster for 2 h."""
+    starts_h: list[NonNegative] | None = None
+    """Hour of the period at which each piece starts (the first at 0, increasing, each
+    before ``period_h``).  Empty: equal pieces."""
+    run_start_h: float = _num(0.0, ge=0.0, le=MAX_HOURS)
+    """The hour of the period at which the run starts (below ``period_h``): 0, its start."""
+
+
 class ArrivalSettings(Section):
     """Inter-arrival times of parts (thesis §6.2 d, eq. 6.9)."""
 
@@ -219,6 +234,8 @@ class ArrivalSettings(Section):
     trace_csv: str | None = None
     """A CSV of observed inter-arrival times (column ``interarrival_s``), used in
     order instead of the distribution; relative to the scenario file."""
+    profile: RateProfile | None = None
+    """A rate that changes over a shift, a day or a week; absent: a constant rate."""
 
 
 # --------------------------------------------------------------------------- controller

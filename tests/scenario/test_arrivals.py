@@ -80,7 +80,7 @@ def test_a_mean_just_over_the_limit_is_shown_over_it(tmp_path):
     """A mean of 1,000,000.02 s is refused against the 1e6 s limit; the message shows it
     with enough digits to be over the limit, not '1e+06 s; at most 1e+06 s'."""
     spec = SimpleNamespace(distribution="expon", params={"loc": MAX_INTERARRIVAL_S, "scale": 0.02},
-                           trace_csv=None, mean_s=None, cv=None)
+                           trace_csv=None, mean_s=None, cv=None, profile=None)
     with pytest.raises(ScenarioError) as err:
         check_arrivals(spec, tmp_path, "s.yaml")
     assert "would be 1000000.02 s; at most 1e+06 s" in err.value.why
@@ -100,7 +100,8 @@ def test_parameters_of_another_family_are_named_with_the_fix(tmp_path, distribut
     """Changing only the distribution (--set arrivals.distribution=gamma on the baseline) leaves
     the Weibull's c: the line says whose parameters they are and what to give, not scipy's
     '_parse_args() got an unexpected keyword argument'."""
-    spec = SimpleNamespace(distribution=distribution, params=params, trace_csv=None, mean_s=None, cv=None)
+    spec = SimpleNamespace(distribution=distribution, params=params, trace_csv=None, mean_s=None,
+                           cv=None, profile=None)
     with pytest.raises(ScenarioError) as err:
         check_arrivals(spec, tmp_path, "s.yaml")
     assert err.value.key == "arrivals.params" and words in err.value.why, err.value.why
