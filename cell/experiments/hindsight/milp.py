@@ -1,0 +1,228 @@
+"""The hindsight optimum's upper side: a MILP over one trace, solved with HiGHS
+(:func:`scipy.optimize.milp`); docs/model.md, "The hindsight optimum".
+
+Every event of the input belt is a point (belt travel, instant): part i's drop (x_i, T_i) and its
+arrival at B (x_i + L, B_i).  A belt whose speed stays within its floor and ceiling passes through
+a set of such points exactly when any two of them, taken in order of travel, are at least the
+travel over the ceiling and at most the travel over the floor apart in time.  The order of a
+drop and an earlier part's arrival at B is a binary (fixed where the parts' windows settle it).
+The feeder drops part i at its arrival a_i, or, held, the instant the belt has carried the part
+before a part's size clear (a binary says which).  Until the first pick the belt runs at its
+nominal speed (nobody has changed it).  Part 0 reaches B with the robot free and is picked; two
+picks are at least the shortest cycle the plan check lets through apart (what a cycle may take,
+the input belt at the fastest the robot can follow, the output belt at nominal from G); any
+other part may be let go (a cycle may be made as long as the policy likes).
+
+This is a relaxation of the model: the belt may change speed at any instant here, where the
+controller changes it only at lift-off and at the cycle's end, and tracks at one speed from B
+to LO.  So its optimum is at least every controller's count; a schedule run through the
+simulation that reaches it proves it the optimum (:mod:`cell.experiments.hindsight.search`).
+Every run of a controller is one of its points, and every point keeps the windows and the
+cycle of :mod:`cell.sim.bound`, so its optimum is at most ``parts_bound``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+from scipy.optimize import Bounds, LinearConstraint, milp
+from scipy.sparse import coo_array
+
+if TYPE_CHECKING:
+    from cell.sim.policies.base import CellConstants
+
+#: How far past a part's size clear a held part may be dropped (in): the feeder's wait ends
+#: at least EPS_S (1e-6 s) on, at up to 12 in/s.
+HOLD_IN = 1e-4
+#: Slack on the physics' equalities (in, s): the simulation's own roundings (EPS_S 1e-6 s on
+#: the belt, 1e-9 in on the feeder's clearance) are below it, so every run stays a point.
+SLACK = 1e-5
+
+
+def check_cycle_s(k: CellConstants) -> float:
+    """The shortest B → B cycle a plan may have (:mod:`cell.sim.policies.check`'s floors):
+    R I at the fastest input belt the robot can follow, R III at the output belt's nominal
+    speed (the controller sets it so at G), R II and R IV at the motors' peak."""
+    t = k.timing
+    followed, _ = t.fastest_followed(max(k.input_max, k.v_nom), k.output_max)
+    return float(sum(t.shortest_parts(followed, k.u_nom)))
+
+
+@dataclass
+class MilpResult:
+    """What the solver found for one trace."""
+
+    status: str
+    """``optimal`` (proved), ``time_limit`` (stopped: ``upper`` is its dual bound) or
+    ``failed`` (no answer: ``upper`` is None)."""
+    upper: int | None
+    """The most parts any schedule could deliver (after the warm-up), as proved."""
+    picked: list[bool] = field(default_factory=list)
+    """The solver's best schedule: part i picked (empty if none)."""
+    at_b_s: list[float] = field(default_factory=list)
+    """Its instants at which each part reaches B."""
+    count: int = 0
+    """Its parts picked after the warm-up."""
+    solve_s: float = 0.0
+    binaries: int = 0
+
+
+class _Model:
+    """Variables with bounds, and rows ``sum(coef * var) + const >= 0`` that hold when some
+    binaries take given values (big-M from the variables' bounds)."""
+
+    def __init__(self) -> None:
+        self.lb: list[float] = []
+        self.ub: list[float] = []
+        self.integer: list[int] = []
+        self.rows: list[tuple[dict[int, float], float]] = []
+
+    def var(self, lb: float, ub: float, integer: bool = False) -> int:
+        self.lb.append(lb)
+        self.ub.append(ub)
+        self.integer.append(int(integer))
+        return len(self.lb) - 1
+
+    def low(self, expr: dict[int, float], const: float) -> float:
+        return const + sum(c * (self.lb[v] if c > 0 else self.ub[v]) for v, c in expr.items())
+
+    def geq(self, expr: dict[int, float], const: float,
+            when: tuple[tuple[int, int], ...] = ()) -> None:
+        """``expr + const >= 0``, or only when each (binary, value) of ``when`` holds."""
+        expr = dict(expr)
+        if when:
+            m = max(0.0, -self.low(expr, const)) + 1.0
+            for b, value in when:  # off by (1 - b) or b: expr + M * off >= 0
+                if value:
+                    const += m
+                    expr[b] = expr.get(b, 0.0) - m
+                else:
+                    expr[b] = expr.get(b, 0.0) + m
+        self.rows.append((expr, const))
+
+    def between(self, expr: dict[int, float], lo: float, hi: float,
+                when: tuple[tuple[int, int], ...] = ()) -> None:
+        """``lo <= expr <= hi`` (under ``when``)."""
+        self.geq(expr, -lo, when)
+        self.geq({v: -c for v, c in expr.items()}, hi, when)
+
+
+def _windows(k: CellConstants, come: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each part's latest drop D_i and latest arrival at B (:mod:`cell.sim.bound`'s windows)."""
+    vlo = min(k.input_min, k.v_nom)
+    latest = np.empty_like(come)
+    last = -math.inf
+    for i, a in enumerate(come.tolist()):
+        last = max(a, last + k.part_size / vlo)
+        latest[i] = last
+    return latest, latest + k.input_length / vlo
+
+
+def solve(k: CellConstants, come_s: list[float] | np.ndarray, warmup: int = 0,
+          time_limit_s: float = 60.0) -> MilpResult:
+    """The relaxation's optimum for parts coming at ``come_s`` (the feeder's schedule), counted
+    from part ``warmup`` on."""
+    started = time.perf_counter()
+    come = np.asarray(come_s, dtype=float)
+    n = come.size
+    if n == 0:
+        return MilpResult("optimal", 0)
+    vlo, vhi, v0 = min(k.input_min, k.v_nom), max(k.input_max, k.v_nom), k.v_nom
+    L, size, cyc = k.input_length, k.part_size, check_cycle_s(k) - SLACK
+    d_late, b_late = _windows(k, come)
+    m = _Model()
+    x0 = v0 * come[0]
+    x = [m.var(x0 + size * i - SLACK, x0 + vhi * (d_late[i] - come[0]) + SLACK) for i in range(n)]
+    T = [m.var(come[i], d_late[i] + SLACK) for i in range(n)]
+    B = [m.var(come[i] + L / vhi - SLACK, b_late[i] + SLACK) for i in range(n)]
+    y = [m.var(0, 1, True) for _ in range(n)]
+    first_b = come[0] + L / v0
+    m.between({x[0]: 1.0}, x0, x0)
+    m.between({T[0]: 1.0}, come[0], come[0])
+    m.between({B[0]: 1.0}, first_b, first_b)
+    m.geq({y[0]: 1.0}, -1.0)
+
+    def slopes(s2: dict[int, float], t2: dict[int, float], when: tuple[tuple[int, int], ...] = (),
+               ds: float = 0.0) -> None:
+        """Travel ``s2 + ds`` >= 0 and time ``t2`` within it over the ceiling and the floor."""
+        m.geq(s2, ds + SLACK, when)
+        e = {**t2}
+        for v, c in s2.items():
+            e[v] = e.get(v, 0.0) - c / vhi
+        m.geq(e, -ds / vhi + SLACK, when)
+        e = {v: -c for v, c in t2.items()}
+        for v, c in s2.items():
+            e[v] = e.get(v, 0.0) + c / vlo
+        m.geq(e, ds / vlo + SLACK, when)
+
+    for i in range(n):
+        slopes({}, {B[i]: 1.0, T[i]: -1.0}, ds=L)  # its own drop to B
+        if i:
+            slopes({x[i]: 1.0, x[i - 1]: -1.0}, {T[i]: 1.0, T[i - 1]: -1.0})
+            m.geq({x[i]: 1.0, x[i - 1]: -1.0}, -size + SLACK)
+            slopes({x[i]: 1.0, x[i - 1]: -1.0}, {B[i]: 1.0, B[i - 1]: -1.0})
+            held = m.var(0, 1, True)  # dropped on arrival, or held until the belt is clear
+            m.geq({T[i]: -1.0}, come[i] + SLACK, ((held, 0),))
+            m.geq({x[i]: -1.0, x[i - 1]: 1.0}, size + HOLD_IN, ((held, 1),))
+    for i in range(n):  # drop j (> i) before or after part i's arrival at B
+        for j in range(i + 1, n):
+            before = {x[i]: 1.0, x[j]: -1.0}, {B[i]: 1.0, T[j]: -1.0}
+            after = {x[j]: 1.0, x[i]: -1.0}, {T[j]: 1.0, B[i]: -1.0}
+            if come[j] >= b_late[i] + SLACK:  # this drop after it (and so every later one)
+                slopes(*after, ds=-L)
+                break
+            if d_late[j] <= come[i] + L / vhi - SLACK:
+                slopes(*before, ds=L)
+                if i == 0:
+                    m.between({x[j]: 1.0, T[j]: -v0}, -SLACK, SLACK)
+                continue
+            o = m.var(0, 1, True)
+            slopes(*before, when=((o, 1),), ds=L)
+            slopes(*after, when=((o, 0),), ds=-L)
+            if i == 0:  # before the first pick the belt runs at its nominal speed
+                m.between({x[j]: 1.0, T[j]: -v0}, -SLACK, SLACK, ((o, 1),))
+    for p in range(n):  # two picks a cycle apart
+        for q in range(p + 1, n):
+            if come[q] + L / vhi - b_late[p] >= cyc:
+                break
+            m.geq({B[q]: 1.0, B[p]: -1.0}, -cyc, ((y[p], 1), (y[q], 1)))
+    return _solve(m, y, B, warmup, time_limit_s, started)
+
+
+def _solve(m: _Model, y: list[int], B: list[int], warmup: int, time_limit_s: float,
+           started: float) -> MilpResult:
+    nv = len(m.lb)
+    rows, cols, vals, lows = [], [], [], []
+    for r, (expr, const) in enumerate(m.rows):
+        for v, coef in expr.items():
+            if coef:
+                rows.append(r)
+                cols.append(v)
+                vals.append(coef)
+        lows.append(-const)
+    a = coo_array((vals, (rows, cols)), shape=(len(m.rows), nv)).tocsr()
+    c = np.zeros(nv)
+    c[y[warmup:]] = -1.0
+    res = milp(c, constraints=LinearConstraint(a, np.array(lows), np.inf),
+               integrality=np.array(m.integer), bounds=Bounds(np.array(m.lb), np.array(m.ub)),
+               options={"time_limit": max(time_limit_s, 0.01), "mip_rel_gap": 0.0})
+    out = MilpResult("failed", None, binaries=sum(m.integer),
+                     solve_s=time.perf_counter() - started)
+    dual = getattr(res, "mip_dual_bound", None)
+    dual = math.nan if dual is None else float(dual)
+    if res.status == 0:
+        out.status = "optimal"
+    elif res.status == 1 and math.isfinite(dual):
+        out.status = "time_limit"
+    else:
+        return out
+    if res.x is not None:
+        picked = [bool(res.x[v] > 0.5) for v in y]
+        out.picked, out.at_b_s = picked, [float(res.x[v]) for v in B]
+        out.count = sum(picked[warmup:])
+    out.upper = out.count if out.status == "optimal" else int(math.floor(-dual + 1e-6))
+    return out

@@ -1,0 +1,100 @@
+"""The hindsight optimum (docs/model.md, "The hindsight optimum"): the MILP's proved bound sits
+above every controller and below ``parts_bound``, the schedule found by search through the
+simulation below the MILP, and a burst where the bound is loose has its optimum by hand."""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from cell.experiments.hindsight import hindsight
+from cell.experiments.hindsight.milp import check_cycle_s, solve
+from cell.scenario.schema import Scenario, load_scenario
+from cell.sim.assembly import assemble
+from cell.sim.simulation import simulate
+
+
+def _scenario(folder: Path, gaps: list[float], policy: str = "adaptive") -> Scenario:
+    """The baseline cell fed ``gaps`` (inter-arrival times, s) as ``arrivals.trace_csv``."""
+    text = "interarrival_s\n" + "".join(f"{g!r}\n" for g in gaps)
+    path = folder / f"{hashlib.sha1(text.encode()).hexdigest()[:16]}.csv"
+    path.write_text(text)
+    return load_scenario("baseline", {"run.parts": len(gaps), "arrivals.trace_csv": str(path),
+                                      "controller.policy": policy})
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return tmp_path_factory.mktemp("traces")
+
+
+#: A burst: ten parts in the same instant, 5 s into the run.
+BURST = [5.0] + [0.0] * 9
+
+
+def test_a_burst_of_ten_parts_has_bound_six_and_optimum_one(folder: Path) -> None:
+    """By hand, in the baseline cell (input belt 1.5 to 12 in/s, 3.0 nominal; L = 135.516 in
+    from the feeder to B; parts 2 in; the shortest cycle a plan may have 17.566 s, the bound's
+    16.63 s).  The feeder drops the ten parts a part's size apart, each as the belt has carried
+    the last 2 in clear: part i is 2 i in behind part 0, whatever the belt does.
+    parts_bound: every window opens at 5 + L / 12 = 16.29 s; part i's closes at
+    5 + 2 i / 1.5 + L / 1.5 = 95.34 + 1.33 i s.  Picks 16.63 s apart from 16.29: 16.29, 32.92,
+    49.55, 66.18, 82.81 (parts 0-4) and 99.44 <= 95.34 + 6.67 (part 5); part 6 at 116.07 is past
+    every later window's end (at most 95.34 + 12.0): 6.
+    Optimum: part 0 reaches B with the robot free (at 5 + L / 3, the belt untouched so far) and
+    is picked.  The next pick is at least 17.566 s later; by then the belt, at 1.5 in/s at
+    least, has carried 26.3 in past B, more than the 18 in to part 9: parts 1-9 all reach B
+    while the robot is away.  1."""
+    s = _scenario(folder, BURST)
+    out = hindsight(s, budget_s=20.0).summary
+    assert out["parts_bound"] == 6
+    assert out["parts_upper"] == 1 and out["milp_status"] == "optimal"
+    assert out["parts_optimum"] == 1 and out["exact"]
+    assert 17.56 < check_cycle_s(assemble(s).k) < 17.57
+    # every controller is at or below it, the adaptive and the fixed cycle alike
+    for policy in ("adaptive", "non-adaptive"):
+        assert simulate(_scenario(folder, BURST, policy)).summary.parts_delivered <= 1
+
+
+def test_a_part_of_the_burst_after_a_gap_the_belt_can_make_is_caught(folder: Path) -> None:
+    """Two bursts of three, 60 s apart: the second's parts are 2 in apart again, so at most one
+    of each burst, and the belt (1.5 to 12 in/s) can bring the second burst's first part to B
+    17.566 s after the first pick: 2.  The MILP proves it and a simulated schedule reaches it."""
+    gaps = [5.0, 0.0, 0.0, 60.0, 0.0, 0.0]
+    out = hindsight(_scenario(folder, gaps), budget_s=20.0).summary
+    assert (out["parts_upper"], out["parts_optimum"], out["exact"]) == (2, 2, True)
+
+
+gap = st.one_of(st.just(0.0), st.floats(0.5, 45.0), st.floats(15.0, 30.0))
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(gaps=st.lists(gap, min_size=8, max_size=12).filter(lambda g: sum(g) > 1.0))
+def test_controllers_sit_below_the_milp_and_the_milp_below_the_bound(folder: Path,
+                                                                     gaps: list[float]) -> None:
+    """On drawn traces of 8-12 parts, bursts among them: every built-in controller's count (the
+    real simulation, the same trace) <= the MILP's proved optimum <= parts_bound, and the
+    search's simulated schedule <= the MILP's optimum."""
+    s = _scenario(folder, gaps)
+    out = hindsight(s, budget_s=20.0).summary
+    assert out["milp_status"] == "optimal"
+    upper = out["parts_upper"]
+    for policy in ("adaptive", "non-adaptive"):
+        run = simulate(_scenario(folder, gaps, policy)).summary
+        assert run.parts_delivered <= upper <= run.parts_bound == out["parts_bound"]
+    assert out["parts_optimum"] <= upper
+    assert out["exact"] == (out["parts_optimum"] == upper)
+
+
+def test_the_warm_up_is_left_out_of_the_count_as_from_the_bound(folder: Path) -> None:
+    """With the first three parts a warm-up, the MILP counts the others only: on parts that
+    come a cycle apart, all of them (the bound's count too)."""
+    s = _scenario(folder, [30.0] * 8).with_overrides({"run.warmup_parts": 3})
+    out = hindsight(s, budget_s=20.0).summary
+    assert (out["parts_upper"], out["parts_optimum"], out["parts_bound"]) == (5, 5, 5)
+    k = assemble(s).k
+    assert solve(k, [30.0 * (i + 1) for i in range(8)], warmup=0).upper == 8
