@@ -98,3 +98,60 @@ def test_the_warm_up_is_left_out_of_the_count_as_from_the_bound(folder: Path) ->
     assert (out["parts_upper"], out["parts_optimum"], out["parts_bound"]) == (5, 5, 5)
     k = assemble(s).k
     assert solve(k, [30.0 * (i + 1) for i in range(8)], warmup=0).upper == 8
+
+
+# --------------------------------------------------------------------------- the command
+def test_the_command_writes_the_schedule_and_the_summary(folder: Path, tmp_path: Path,
+                                                         capsys: pytest.CaptureFixture[str]) -> None:
+    """``cell hindsight``: schedule.csv part by part (its picks are the optimum's count) and
+    summary.csv; the schedule is the same bytes run again."""
+    import pandas as pd
+
+    from cell.cli.main import main
+
+    trace = folder / "burst.csv"
+    trace.write_text("interarrival_s\n" + "".join(f"{g}\n" for g in BURST))
+    args = ["hindsight", "baseline", "--set", "run.parts=10", "--set", f"arrivals.trace_csv={trace}"]
+    assert main([*args, "--out", str(tmp_path / "a"), "--budget", "20"]) == 0
+    assert main([*args, "--out", str(tmp_path / "b")]) == 0
+    summary = pd.read_csv(tmp_path / "a" / "summary.csv")
+    schedule = pd.read_csv(tmp_path / "a" / "schedule.csv")
+    row = summary.iloc[0]
+    assert (row["parts_optimum"], bool(row["exact"]), row["parts_bound"]) == (1, True, 6)
+    assert row["budget_s"] == 20.0 and row["solve_s"] >= 0.0
+    assert list(schedule["part"]) == list(range(1, 11))
+    assert int(schedule["picked"].sum()) == 1 and int(schedule["milp_picked"].sum()) == 1
+    assert (tmp_path / "a" / "schedule.csv").read_bytes() == \
+        (tmp_path / "b" / "schedule.csv").read_bytes()
+
+
+@pytest.mark.parametrize("extra,key", [
+    (["--budget", "0"], "--budget"),
+    (["--set", "failures.maintenance={every_h: 8, duration_min: 20}"], "failures"),
+    (["--set", "run.warmup_parts=auto"], "run.warmup_parts")])
+def test_bad_input_is_one_line_exit_2_and_nothing_written(tmp_path: Path, extra: list[str],
+                                                          key: str,
+                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    from cell.cli.main import main
+
+    out = tmp_path / "out"
+    assert main(["hindsight", "baseline", "--set", "run.parts=8", "--out", str(out), *extra]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and key in err[0]
+    assert not out.exists()
+
+
+def test_a_run_too_long_for_the_milp_gives_the_search_against_the_bound(
+        folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Past the MILP's size the search's schedule is given, exact only where it reaches the
+    bound (here, parts a cycle apart: all of them)."""
+    import cell.experiments.hindsight as hs
+
+    monkeypatch.setattr(hs, "MILP_MAX_PARTS", 5)
+    found = hs.hindsight(_scenario(folder, [30.0] * 8), budget_s=20.0)
+    s = found.summary
+    assert (s["milp_status"], s["upper_from"], s["parts_upper"]) == ("too_large", "parts_bound", 8)
+    assert s["parts_optimum"] == 8 and s["exact"]
+    assert any("too large" in note for note in found.notes)
+    found = hs.hindsight(_scenario(folder, BURST), budget_s=20.0)
+    assert (found.summary["parts_optimum"], found.summary["exact"]) == (1, False)
