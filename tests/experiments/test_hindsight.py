@@ -86,8 +86,27 @@ def test_controllers_sit_below_the_milp_and_the_milp_below_the_bound(folder: Pat
     for policy in ("adaptive", "non-adaptive"):
         run = simulate(_scenario(folder, gaps, policy)).summary
         assert run.parts_delivered <= upper <= run.parts_bound == out["parts_bound"]
+        assert run.parts_delivered <= out["parts_optimum"]  # its own run is a schedule too
     assert out["parts_optimum"] <= upper
     assert out["exact"] == (out["parts_optimum"] == upper)
+
+
+def test_a_pick_is_a_cycle_at_its_own_tracking_speed_from_the_next(folder: Path) -> None:
+    """Parts every 15 s, faster than any cycle: the MILP packs its picks as close as a plan may.
+    The first part is tracked at the nominal 3 in/s (nobody has changed the belt), so the next
+    pick is at least the cycle at 3 in/s later, 18.084 s (R I 2.7293 s, docs/model.md's nominal
+    cycle with R II and R IV at their peak), not the 17.566 s at the tracking limit; every later
+    gap at least 17.566 s."""
+    k = assemble(_scenario(folder, [15.0] * 12)).k
+    t = k.timing
+    first = sum(t.shortest_parts(k.v_nom, k.u_nom))
+    assert abs(first - 18.0841) < 1e-3
+    result = solve(k, [15.0 * (i + 1) for i in range(12)])
+    picks = [b for b, p in zip(result.at_b_s, result.picked) if p]
+    gaps = [b - a for a, b in zip(picks, picks[1:])]
+    assert gaps[0] >= first - 1e-4
+    assert min(gaps) >= check_cycle_s(k) - 1e-4
+    assert min(gaps[1:]) < first - 0.1  # the later ones at the tracking limit's, shorter
 
 
 def test_the_warm_up_is_left_out_of_the_count_as_from_the_bound(folder: Path) -> None:

@@ -5,7 +5,8 @@ through the simulation (:mod:`.search`) and a proved upper bound (:mod:`.milp`).
 :func:`hindsight` draws the run's arrivals as ``cell run`` does (the same seed, the same code),
 solves the MILP within the time budget when the run is small enough, and runs the search's
 schedules (greedy; the MILP's picks at its instants; the MILP's picks as soon as they can come)
-through the simulation, the best kept.  ``exact`` is true when that schedule reaches the proved
+through the simulation, beside the built-in controllers' own runs (schedules too), the best
+kept.  ``exact`` is true when that schedule reaches the proved
 bound: then it is the optimum.
 """
 
@@ -19,14 +20,17 @@ from typing import Any
 import numpy as np
 
 from cell.experiments.hindsight.milp import MilpResult, solve
-from cell.experiments.hindsight.search import SPEED_STEPS, run_schedule
+from cell.experiments.hindsight.search import SPEED_STEPS, Targets, run_schedule
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.schema import Scenario
 from cell.sim.assembly import assemble
 from cell.sim.bound import parts_bound
 from cell.sim.horizon import run_arrivals
 from cell.sim.records import PartRecord
+from cell.sim.simulation import simulate
 
+#: The built-in controllers, whose own runs are schedules the search keeps if they are best.
+BUILT_IN = ("adaptive", "non-adaptive")
 #: The longest run the MILP is tried on (parts): its binaries grow about fivefold with them.
 MILP_MAX_PARTS = 60
 #: The time budget of one run's hindsight (s), unless given.
@@ -90,14 +94,19 @@ def hindsight(s: Scenario, budget_s: float = BUDGET_S) -> Hindsight:
     searched = time.perf_counter()
     tries: list[tuple[str, Any]] = [("greedy", None)]
     if milp.picked:
-        tries += [("milp", (milp.picked, milp.at_b_s)),
-                  ("milp_soonest", (milp.picked, [-math.inf] * n))]
+        tries += [("milp", Targets(milp.picked, milp.at_b_s, milp.drop_in)),
+                  ("milp_times", Targets(milp.picked, milp.at_b_s)),
+                  ("milp_soonest", Targets(milp.picked, [-math.inf] * n))]
+    tries += [(name, name) for name in BUILT_IN]
     best_name, best = "", None
     for name, targets in tries:
         if best is not None and time.perf_counter() - started > budget_s:
             notes.append(f"the budget ({budget_s:g} s) ran out before the search's {name} schedule")
             break
-        result = run_schedule(s, cell, come, seed, targets)
+        if isinstance(targets, str):  # a built-in controller's own run: a schedule too
+            result = simulate(s.with_overrides({"controller.policy": targets}), seed)
+        else:
+            result = run_schedule(s, cell, come, seed, targets)
         if best is None or result.summary.parts_delivered > best.summary.parts_delivered:
             best_name, best = name, result
     assert best is not None and best.records is not None

@@ -8,17 +8,21 @@ travel over the ceiling and at most the travel over the floor apart in time.  Th
 drop and an earlier part's arrival at B is a binary (fixed where the parts' windows settle it).
 The feeder drops part i at its arrival a_i, or, held, the instant the belt has carried the part
 before a part's size clear (a binary says which).  Until the first pick the belt runs at its
-nominal speed (nobody has changed it).  Part 0 reaches B with the robot free and is picked; two
-picks are at least the shortest cycle the plan check lets through apart (what a cycle may take,
-the input belt at the fastest the robot can follow, the output belt at nominal from G); any
-other part may be let go (a cycle may be made as long as the policy likes).
+nominal speed (nobody has changed it).  A part picked is tracked from B to LO (4 in of belt) at
+one slowness u (s/in), no slower than the floor and no faster than the tracking limit, and the
+next pick is at least the cycle a plan may have at that speed later (what a cycle may take: R I
+at the belt's pace, convex in u, so written as its tangents; R III at the output belt's
+nominal speed from G; R II and R IV at the motors' peak).  Any other part may be let go (a cycle
+may be made as long as the policy likes).
 
-This is a relaxation of the model: the belt may change speed at any instant here, where the
-controller changes it only at lift-off and at the cycle's end, and tracks at one speed from B
-to LO.  So its optimum is at least every controller's count; a schedule run through the
-simulation that reaches it proves it the optimum (:mod:`cell.experiments.hindsight.search`).
-Every run of a controller is one of its points, and every point keeps the windows and the
-cycle of :mod:`cell.sim.bound`, so its optimum is at most ``parts_bound``.
+This is a relaxation of the model in two ways: the belt may change speed at any instant after
+lift-off here, where the controller changes it only at lift-off and at the cycle's end; and an
+event within a pick's 4 in from B to LO is held to the McCormick envelope of travel times
+slowness, not to one speed exactly.  So its optimum is at least every controller's count; a
+schedule run through the simulation that reaches it proves it the optimum
+(:mod:`cell.experiments.hindsight.search`).  Every run of a controller is one of its points,
+and every point keeps the windows and the cycle of :mod:`cell.sim.bound`, so its optimum is at
+most ``parts_bound``.
 """
 
 from __future__ import annotations
@@ -65,6 +69,8 @@ class MilpResult:
     """The solver's best schedule: part i picked (empty if none)."""
     at_b_s: list[float] = field(default_factory=list)
     """Its instants at which each part reaches B."""
+    drop_in: list[float] = field(default_factory=list)
+    """Its belt travel (in) at each part's drop."""
     count: int = 0
     """Its parts picked after the warm-up."""
     solve_s: float = 0.0
@@ -111,6 +117,25 @@ class _Model:
         self.geq({v: -c for v, c in expr.items()}, hi, when)
 
 
+def _cycle_lines(k: CellConstants, u_lo: float, u_hi: float,
+                 points: int = 16) -> tuple[float, list[tuple[float, float]]]:
+    """The cycle's floor as R I's (B → LO, LO → F) at belt slowness u plus the rest: R I is a
+    sum of max(length u, motor floor) over its moves, convex in u, so it is at least each of its
+    tangents (a + b u, the slope taken on the right: a subgradient) at ``points`` slownesses."""
+    t = k.timing
+    rest = t.r2_min_s + sum(t.r3_time(k.u_nom)) + t.r4_min_s
+
+    def r1(u: float) -> float:
+        return float(sum(t.r1_time(1.0 / u)))
+
+    lines = []
+    for at in np.linspace(u_lo, u_hi, points).tolist():
+        h = 1e-7 * at
+        b = (r1(at + h) - r1(at)) / h
+        lines.append((r1(at) - b * at - 1e-9, b))
+    return rest, lines
+
+
 def _windows(k: CellConstants, come: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Each part's latest drop D_i and latest arrival at B (:mod:`cell.sim.bound`'s windows)."""
     vlo = min(k.input_min, k.v_nom)
@@ -140,7 +165,12 @@ def solve(k: CellConstants, come_s: list[float] | np.ndarray, warmup: int = 0,
     T = [m.var(come[i], d_late[i] + SLACK) for i in range(n)]
     B = [m.var(come[i] + L / vhi - SLACK, b_late[i] + SLACK) for i in range(n)]
     y = [m.var(0, 1, True) for _ in range(n)]
+    followed = k.timing.fastest_followed(vhi, k.output_max)[0]
+    lo_in = k.timing.r1_pre.length_in
+    # the belt's slowness (s/in) from B to LO, were the part picked: at most the tracking limit
+    u = [m.var(1.0 / followed, 1.0 / min(vlo, followed)) for _ in range(n)]
     first_b = come[0] + L / v0
+    m.between({u[0]: 1.0}, 1.0 / v0, 1.0 / v0)  # the first at the belt's nominal speed
     m.between({x[0]: 1.0}, x0, x0)
     m.between({T[0]: 1.0}, come[0], come[0])
     m.between({B[0]: 1.0}, first_b, first_b)
@@ -168,12 +198,42 @@ def solve(k: CellConstants, come_s: list[float] | np.ndarray, warmup: int = 0,
             held = m.var(0, 1, True)  # dropped on arrival, or held until the belt is clear
             m.geq({T[i]: -1.0}, come[i] + SLACK, ((held, 0),))
             m.geq({x[i]: -1.0, x[i - 1]: 1.0}, size + HOLD_IN, ((held, 1),))
+    def tracked(p: int, s_e: dict[int, float], s_const: float, t_e: int,
+                after: tuple[tuple[int, int], ...] = ()) -> None:
+        """An event at travel ``s_e + s_const`` and instant ``t_e``, after part p reaches B
+        (under ``after``): with p picked, the belt's first ``lo_in`` beyond B (to LO) at no
+        more than the tracking limit."""
+        d = {**s_e, x[p]: s_e.get(x[p], 0.0) - 1.0}  # its travel beyond B: d + d0
+        d0 = s_const - L
+        inside = m.var(0, 1, True)
+        m.geq({v: -c for v, c in d.items()}, lo_in - d0 + SLACK, ((inside, 1),))
+        m.geq(d, d0 - lo_in + SLACK, ((inside, 0),))
+        when_in = ((y[p], 1), (inside, 1), *after)
+        # inside: t_e - B_p = (d + d0) u_p, bounded by its McCormick envelope (d + d0 in
+        # [0, lo_in], u_p in [1/followed, u_hi])
+        u_lo, u_hi = 1.0 / followed, m.ub[u[p]]
+        for a_d, a_u, c0, sign in ((u_lo, 0.0, 0.0, 1.0), (u_hi, lo_in, -lo_in * u_hi, 1.0),
+                                   (u_lo, lo_in, -lo_in * u_lo, -1.0), (u_hi, 0.0, 0.0, -1.0)):
+            # sign * (t_e - B_p - a_d (d + d0) - a_u u_p - c0) >= 0
+            e = {t_e: sign, B[p]: -sign, u[p]: -sign * a_u}
+            for v, c in d.items():
+                e[v] = e.get(v, 0.0) - sign * a_d * c
+            m.geq(e, sign * (-a_d * d0 - c0) + SLACK, when_in)
+        # beyond LO: the first lo_in at slowness u_p, the rest at the ceiling at most
+        e = {t_e: 1.0, B[p]: -1.0, u[p]: -lo_in}
+        for v, c in d.items():
+            e[v] = e.get(v, 0.0) - c / vhi
+        m.geq(e, -(d0 - lo_in) / vhi + SLACK, ((y[p], 1), (inside, 0)))
+
     for i in range(n):  # drop j (> i) before or after part i's arrival at B
+        for q in range(i + 1, min(n, i + 1 + int(lo_in // size))):
+            tracked(i, {x[q]: 1.0}, L, B[q])  # parts close behind it, reaching B
         for j in range(i + 1, n):
             before = {x[i]: 1.0, x[j]: -1.0}, {B[i]: 1.0, T[j]: -1.0}
             after = {x[j]: 1.0, x[i]: -1.0}, {T[j]: 1.0, B[i]: -1.0}
             if come[j] >= b_late[i] + SLACK:  # this drop after it (and so every later one)
                 slopes(*after, ds=-L)
+                tracked(i, {x[j]: 1.0}, 0.0, T[j])
                 break
             if d_late[j] <= come[i] + L / vhi - SLACK:
                 slopes(*before, ds=L)
@@ -183,17 +243,21 @@ def solve(k: CellConstants, come_s: list[float] | np.ndarray, warmup: int = 0,
             o = m.var(0, 1, True)
             slopes(*before, when=((o, 1),), ds=L)
             slopes(*after, when=((o, 0),), ds=-L)
+            tracked(i, {x[j]: 1.0}, 0.0, T[j], ((o, 0),))
             if i == 0:  # before the first pick the belt runs at its nominal speed
                 m.between({x[j]: 1.0, T[j]: -v0}, -SLACK, SLACK, ((o, 1),))
-    for p in range(n):  # two picks a cycle apart
+    rest, lines = _cycle_lines(k, 1.0 / followed, m.ub[u[0]])
+    for p in range(n):  # two picks a cycle apart, R I's at the belt's pace from B
         for q in range(p + 1, n):
             if come[q] + L / vhi - b_late[p] >= cyc:
                 break
-            m.geq({B[q]: 1.0, B[p]: -1.0}, -cyc, ((y[p], 1), (y[q], 1)))
-    return _solve(m, y, B, warmup, time_limit_s, started)
+            for a, b in lines:  # B_q - B_p >= rest + a + b u_p
+                m.geq({B[q]: 1.0, B[p]: -1.0, u[p]: -b}, -(rest + a) + SLACK,
+                      ((y[p], 1), (y[q], 1)))
+    return _solve(m, y, B, x, warmup, time_limit_s, started)
 
 
-def _solve(m: _Model, y: list[int], B: list[int], warmup: int, time_limit_s: float,
+def _solve(m: _Model, y: list[int], B: list[int], x: list[int], warmup: int, time_limit_s: float,
            started: float) -> MilpResult:
     nv = len(m.lb)
     rows, cols, vals, lows = [], [], [], []
@@ -223,6 +287,7 @@ def _solve(m: _Model, y: list[int], B: list[int], warmup: int, time_limit_s: flo
     if res.x is not None:
         picked = [bool(res.x[v] > 0.5) for v in y]
         out.picked, out.at_b_s = picked, [float(res.x[v]) for v in B]
+        out.drop_in = [float(res.x[v]) for v in x]
         out.count = sum(picked[warmup:])
     out.upper = out.count if out.status == "optimal" else int(math.floor(-dual + 1e-6))
     return out

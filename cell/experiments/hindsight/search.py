@@ -7,12 +7,13 @@ optionally, the parts to aim for and when (the MILP's schedule).  It keeps its o
 input belt's schedule (every change is its own, and the feeder's rule is the model's), so at each
 decision it knows where every part is and will be.  It then chooses the next part to pick, q:
 the next of its targets that it can still reach, or (greedy) the first part it can; the belt's
-speed after lift-off w (from a finite set: :data:`SPEED_STEPS` speeds from the floor to the
-ceiling, evenly in 1/v) and after the cycle w' (the fastest the robot can follow, the nominal
-speed or the floor), and the cycle's end E (R IV made longer), so that every part before q
-reaches B while the robot is away and q after it is back.  Among those it takes the w, w', E
-that bring q to B nearest the target's instant (greedy: soonest).  Whatever it plans, the
-simulation carries out and counts.
+speed after lift-off w (first from a finite set, :data:`SPEED_STEPS` speeds from the floor to
+the ceiling, evenly in 1/v, then refined by bisection), after the cycle w' (the fastest the robot
+can follow, the nominal speed or the floor), the cycle's end E (R IV made longer) and, when it
+follows a schedule's drops, how much longer R I tracks before lift-off (:data:`HOLDS_S`), so
+that every part before q reaches B while the robot is away and q after it is back.  Among those
+it takes the plan that brings q to B nearest the target's instant with the drops nearest the
+target's (greedy: q soonest).  Whatever it plans, the simulation carries out and counts.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from __future__ import annotations
 import math
 from bisect import bisect_right
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -34,6 +36,9 @@ SPEED_STEPS = 24
 #: A part aimed to reach B while the robot is away (or back) misses the cycle's end by this
 #: much at least (s): far above the simulation's rounding (EPS_S, 1e-6 s).
 MARGIN_S = 1e-3
+#: How much longer than its shortest the search may make R I before lift-off (s), so that the
+#: belt keeps its speed longer, when it follows a schedule's drops.
+HOLDS_S = (0.0, 1.0, 2.5, 5.0, 8.0)
 #: The parts after the one at B the search looks at for the next pick.
 LOOK_PARTS = 40
 
@@ -90,6 +95,16 @@ class Drops:
         return xs
 
 
+@dataclass(frozen=True)
+class Targets:
+    """A schedule to follow (the MILP's): the parts to pick, when each reaches B (-inf: as soon
+    as it can), and, if given, the belt's travel at each drop."""
+
+    picked: Sequence[bool]
+    at_b_s: Sequence[float]
+    drop_in: Sequence[float] | None = None
+
+
 class HindsightPolicy(Policy):
     """A policy that knows the trace (``come_s``) and aims for ``targets`` (parts to pick and
     their instants at B; None: greedy, each next part as soon as it can)."""
@@ -97,7 +112,7 @@ class HindsightPolicy(Policy):
     name = "hindsight"
 
     def __init__(self, k: CellConstants, come_s: Sequence[float],
-                 targets: tuple[Sequence[bool], Sequence[float]] | None = None):
+                 targets: Targets | None = None):
         super().__init__(k, None)
         t = k.timing
         self.followed = t.fastest_followed(max(k.input_max, k.v_nom), k.output_max)[0]
@@ -116,44 +131,98 @@ class HindsightPolicy(Policy):
         later = range(p + 1, min(n, p + 1 + LOOK_PARTS))
         if self.targets is None:
             return [(q, -math.inf) for q in later]
-        picked, at_b = self.targets
+        picked, at_b = self.targets.picked, self.targets.at_b_s
         return [(q, at_b[q]) for q in later if picked[q]] + [(q, -math.inf) for q in later]
+
+    def _off(self, xs: list[float], now: float, arrive: float, at: float) -> float:
+        """How far a plan is from the targets (in of belt): the next pick's instant at B, and
+        the drops before it, against the schedule followed; the instant alone without one."""
+        if at == -math.inf:
+            return arrive
+        off = abs(arrive - at) * self.k.v_nom
+        drop_in = self.targets.drop_in if self.targets is not None else None
+        if drop_in is not None:
+            come = self.drops.come
+            off += sum(abs(xs[j] - drop_in[j]) for j in range(len(xs)) if now < come[j] <= arrive)
+        return off
+
+    def _arrival(self, p: int, now: float, lo: float, w: float, end: float, w_next: float,
+                 q: int) -> tuple[float, float, list[float]]:
+        """When parts q - 1 (or -inf) and q reach B with the belt at w from LO and at w_next
+        from ``end``, and where the parts up to q are dropped."""
+        belt = self.belt.planned(lo, w, end, w_next)
+        xs = self.drops.positions(belt, q, now)
+        before = belt.time_at(xs[q - 1] + self.k.input_length) if q > p + 1 else -math.inf
+        return before, belt.time_at(xs[q] + self.k.input_length), xs
 
     def plan(self, view: CellView) -> Plan:
         p, now = view.part, view.now  # type: ignore[attr-defined]
         k, v = self.k, view.input_speed()
         r1a, r1b = k.timing.r1_time(v)
         r3a, r3b = self.r3
-        lo, e_min = now + r1a, now + r1a + r1b + self.r2 + r3a + r3b + self.r4
         aim, length = k.lookahead_margin_s, k.input_length
-        best: tuple[float, float, float, float] | None = None
+        follow = self.targets is not None and self.targets.drop_in is not None
+        best: tuple[float, float, float, float, int, float, float] | None = None
         for q, at in self._aims(p):
-            for w in self.speeds:
-                fast = self.belt.planned(lo, w, math.inf, w)
-                xs = self.drops.positions(fast, q, now)
-                end = e_min if q == p + 1 else max(e_min, fast.time_at(xs[q - 1] + length) + MARGIN_S)
-                for w_next in self.after:
-                    belt = self.belt.planned(lo, w, end + aim, w_next)
-                    arrive = belt.time_at(self.drops.positions(belt, q, now)[q] + length)
-                    if arrive < end + aim + MARGIN_S:
-                        continue
-                    score = abs(arrive - at) if at > -math.inf else arrive
-                    if best is None or score < best[0]:
-                        best = (score, w, end, w_next)
+            for hold in (HOLDS_S if follow and at > -math.inf else (0.0,)):
+                lo = now + r1a + hold
+                e_min = lo + r1b + self.r2 + r3a + r3b + self.r4
+                for w in self.speeds:
+                    fast = self.belt.planned(lo, w, math.inf, w)
+                    xs = self.drops.positions(fast, q, now)
+                    end = e_min if q == p + 1 else \
+                        max(e_min, fast.time_at(xs[q - 1] + length) + MARGIN_S)
+                    for w_next in self.after:
+                        _, arrive, xs = self._arrival(p, now, lo, w, end + aim, w_next, q)
+                        if arrive < end + aim + MARGIN_S:
+                            continue
+                        score = self._off(xs, now, arrive, at)
+                        if best is None or score < best[0]:
+                            best = (score, w, end, w_next, q, at, hold)
             if best is not None:
                 break
-        w, end, w_next = (v, e_min, self.followed) if best is None else best[1:]
+        hold = 0.0 if best is None else best[6]
+        lo, e_min = now + r1a + hold, now + r1a + hold + r1b + self.r2 + r3a + r3b + self.r4
+        if best is None:
+            w, end, w_next = v, e_min, self.followed
+        else:
+            score, w, end, w_next, q, at, _ = best
+            better = self._refine(p, now, lo, w, end, w_next, q, max(at, end + aim + MARGIN_S))
+            _, arrive, xs = self._arrival(p, now, lo, better, end + aim, w_next, q)
+            if self._off(xs, now, arrive, at) <= score:
+                w = better
         self.belt = self.belt.planned(lo, w, end + aim, w_next)
         self.drops.positions(self.belt, p + 1, now)
-        to_g = r1a + r1b + self.r2
-        return Plan(r1_pre=r1a, r1_post=r1b, r2=self.r2, r3_pre=r3a, r3_post=r3b,
+        to_g = r1a + hold + r1b + self.r2
+        return Plan(r1_pre=r1a + hold, r1_post=r1b, r2=self.r2, r3_pre=r3a, r3_post=r3b,
                     r4=self.r4 + (end - e_min), input_speed=v, input_after_lo=w,
                     input_next=w_next, output_to_g=k.u_nom, to_g=to_g,
                     cycle=to_g + r3a + r3b + self.r4 + (end - e_min))
 
+    def _refine(self, p: int, now: float, lo: float, w: float, end: float, w_next: float, q: int,
+                goal: float) -> float:
+        """The belt speed after LO, between the floor and the ceiling, that brings part q to B
+        nearest ``goal`` and no sooner, the parts before it still past B by ``end`` (bisection:
+        a faster belt brings each part sooner); ``w`` if none does better."""
+        aim = self.k.lookahead_margin_s
+
+        def ok(speed: float) -> bool:
+            before, arrive, _ = self._arrival(p, now, lo, speed, end + aim, w_next, q)
+            return before < end and arrive >= goal
+
+        if not ok(w):
+            return w
+        slow, fast = w, self.speeds[-1]
+        if ok(fast):
+            return fast
+        for _ in range(40):  # ok(slow), not ok(fast)
+            mid = 0.5 * (slow + fast)
+            slow, fast = (mid, fast) if ok(mid) else (slow, mid)
+        return slow
+
 
 def run_schedule(scenario: Scenario, cell: AssembledCell, come_s: Sequence[float], seed: Any,
-                 targets: tuple[Sequence[bool], Sequence[float]] | None = None) -> SimResult:
+                 targets: Targets | None = None) -> SimResult:
     """The hindsight policy's run through the simulation (its plans checked like any other's)."""
     policy = HindsightPolicy(cell.k, come_s, targets)
     return simulate(AssembledCell(scenario, cell.timing, cell.k, policy), seed)
