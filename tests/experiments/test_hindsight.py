@@ -11,8 +11,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from cell.experiments.hindsight import hindsight
 from cell.experiments.hindsight.milp import check_cycle_s, solve
+from cell.experiments.hindsight.optimum import hindsight
 from cell.scenario.schema import Scenario, load_scenario
 from cell.sim.assembly import assemble
 from cell.sim.simulation import simulate
@@ -164,7 +164,7 @@ def test_a_run_too_long_for_the_milp_gives_the_search_against_the_bound(
         folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Past the MILP's size the search's schedule is given, exact only where it reaches the
     bound (here, parts a cycle apart: all of them)."""
-    import cell.experiments.hindsight as hs
+    import cell.experiments.hindsight.optimum as hs
 
     monkeypatch.setattr(hs, "MILP_MAX_PARTS", 5)
     found = hs.hindsight(_scenario(folder, [30.0] * 8), budget_s=20.0)

@@ -147,38 +147,39 @@ def _windows(k: CellConstants, come: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return latest, latest + k.input_length / vlo
 
 
-def solve(k: CellConstants, come_s: list[float] | np.ndarray, warmup: int = 0,
-          time_limit_s: float = 60.0) -> MilpResult:
-    """The relaxation's optimum for parts coming at ``come_s`` (the feeder's schedule), counted
-    from part ``warmup`` on."""
-    started = time.perf_counter()
-    come = np.asarray(come_s, dtype=float)
-    n = come.size
-    if n == 0:
-        return MilpResult("optimal", 0)
-    vlo, vhi, v0 = min(k.input_min, k.v_nom), max(k.input_max, k.v_nom), k.v_nom
-    L, size, cyc = k.input_length, k.part_size, check_cycle_s(k) - SLACK
-    d_late, b_late = _windows(k, come)
-    m = _Model()
-    x0 = v0 * come[0]
-    x = [m.var(x0 + size * i - SLACK, x0 + vhi * (d_late[i] - come[0]) + SLACK) for i in range(n)]
-    T = [m.var(come[i], d_late[i] + SLACK) for i in range(n)]
-    B = [m.var(come[i] + L / vhi - SLACK, b_late[i] + SLACK) for i in range(n)]
-    y = [m.var(0, 1, True) for _ in range(n)]
-    followed = k.timing.fastest_followed(vhi, k.output_max)[0]
-    lo_in = k.timing.r1_pre.length_in
-    # the belt's slowness (s/in) from B to LO, were the part picked: at most the tracking limit
-    u = [m.var(1.0 / followed, 1.0 / min(vlo, followed)) for _ in range(n)]
-    first_b = come[0] + L / v0
-    m.between({u[0]: 1.0}, 1.0 / v0, 1.0 / v0)  # the first at the belt's nominal speed
-    m.between({x[0]: 1.0}, x0, x0)
-    m.between({T[0]: 1.0}, come[0], come[0])
-    m.between({B[0]: 1.0}, first_b, first_b)
-    m.geq({y[0]: 1.0}, -1.0)
+class _Trace:
+    """The MILP of one trace: its variables (per part: drop travel x, drop instant T, instant at
+    B, picked y, tracking slowness u) and the rows of the model's rules."""
 
-    def slopes(s2: dict[int, float], t2: dict[int, float], when: tuple[tuple[int, int], ...] = (),
+    When = tuple[tuple[int, int], ...]
+
+    def __init__(self, k: CellConstants, come: np.ndarray):
+        self.k, self.come, n = k, come, come.size
+        self.vlo, self.vhi, self.v0 = min(k.input_min, k.v_nom), max(k.input_max, k.v_nom), k.v_nom
+        self.L, self.size = k.input_length, k.part_size
+        self.d_late, self.b_late = _windows(k, come)
+        self.followed = k.timing.fastest_followed(self.vhi, k.output_max)[0]
+        self.lo_in = k.timing.r1_pre.length_in
+        m = self.m = _Model()
+        x0, L, vhi = self.v0 * come[0], self.L, self.vhi
+        self.x = [m.var(x0 + self.size * i - SLACK, x0 + vhi * (self.d_late[i] - come[0]) + SLACK)
+                  for i in range(n)]
+        self.T = [m.var(come[i], self.d_late[i] + SLACK) for i in range(n)]
+        self.B = [m.var(come[i] + L / vhi - SLACK, self.b_late[i] + SLACK) for i in range(n)]
+        self.y = [m.var(0, 1, True) for _ in range(n)]
+        # the belt's slowness (s/in) from B to LO, were the part picked: at most the tracking limit
+        self.u = [m.var(1.0 / self.followed, 1.0 / min(self.vlo, self.followed)) for _ in range(n)]
+        first_b = come[0] + L / self.v0
+        m.between({self.u[0]: 1.0}, 1.0 / self.v0, 1.0 / self.v0)  # the first at nominal speed
+        m.between({self.x[0]: 1.0}, x0, x0)
+        m.between({self.T[0]: 1.0}, come[0], come[0])
+        m.between({self.B[0]: 1.0}, first_b, first_b)
+        m.geq({self.y[0]: 1.0}, -1.0)
+
+    def slopes(self, s2: dict[int, float], t2: dict[int, float], when: When = (),
                ds: float = 0.0) -> None:
         """Travel ``s2 + ds`` >= 0 and time ``t2`` within it over the ceiling and the floor."""
+        m, vhi, vlo = self.m, self.vhi, self.vlo
         m.geq(s2, ds + SLACK, when)
         e = {**t2}
         for v, c in s2.items():
@@ -189,72 +190,100 @@ def solve(k: CellConstants, come_s: list[float] | np.ndarray, warmup: int = 0,
             e[v] = e.get(v, 0.0) + c / vlo
         m.geq(e, ds / vlo + SLACK, when)
 
-    for i in range(n):
-        slopes({}, {B[i]: 1.0, T[i]: -1.0}, ds=L)  # its own drop to B
-        if i:
-            slopes({x[i]: 1.0, x[i - 1]: -1.0}, {T[i]: 1.0, T[i - 1]: -1.0})
-            m.geq({x[i]: 1.0, x[i - 1]: -1.0}, -size + SLACK)
-            slopes({x[i]: 1.0, x[i - 1]: -1.0}, {B[i]: 1.0, B[i - 1]: -1.0})
-            held = m.var(0, 1, True)  # dropped on arrival, or held until the belt is clear
-            m.geq({T[i]: -1.0}, come[i] + SLACK, ((held, 0),))
-            m.geq({x[i]: -1.0, x[i - 1]: 1.0}, size + HOLD_IN, ((held, 1),))
-    def tracked(p: int, s_e: dict[int, float], s_const: float, t_e: int,
-                after: tuple[tuple[int, int], ...] = ()) -> None:
+    def feeder(self) -> None:
+        """Each part's drop and arrival at B on the belt; the feeder's rule (a binary a part)."""
+        x, T, B, m, size = self.x, self.T, self.B, self.m, self.size
+        for i in range(self.come.size):
+            self.slopes({}, {B[i]: 1.0, T[i]: -1.0}, ds=self.L)  # its own drop to B
+            if i:
+                self.slopes({x[i]: 1.0, x[i - 1]: -1.0}, {T[i]: 1.0, T[i - 1]: -1.0})
+                m.geq({x[i]: 1.0, x[i - 1]: -1.0}, -size + SLACK)
+                self.slopes({x[i]: 1.0, x[i - 1]: -1.0}, {B[i]: 1.0, B[i - 1]: -1.0})
+                held = m.var(0, 1, True)  # dropped on arrival, or held until the belt is clear
+                m.geq({T[i]: -1.0}, self.come[i] + SLACK, ((held, 0),))
+                m.geq({x[i]: -1.0, x[i - 1]: 1.0}, size + HOLD_IN, ((held, 1),))
+
+    def tracked(self, p: int, s_e: dict[int, float], s_const: float, t_e: int,
+                after: When = ()) -> None:
         """An event at travel ``s_e + s_const`` and instant ``t_e``, after part p reaches B
-        (under ``after``): with p picked, the belt's first ``lo_in`` beyond B (to LO) at no
-        more than the tracking limit."""
-        d = {**s_e, x[p]: s_e.get(x[p], 0.0) - 1.0}  # its travel beyond B: d + d0
-        d0 = s_const - L
+        (under ``after``): with p picked, the belt's first ``lo_in`` beyond B (to LO) at its
+        slowness u_p."""
+        m, u, B, lo_in = self.m, self.u, self.B, self.lo_in
+        d = {**s_e, self.x[p]: s_e.get(self.x[p], 0.0) - 1.0}  # its travel beyond B: d + d0
+        d0 = s_const - self.L
         inside = m.var(0, 1, True)
         m.geq({v: -c for v, c in d.items()}, lo_in - d0 + SLACK, ((inside, 1),))
         m.geq(d, d0 - lo_in + SLACK, ((inside, 0),))
-        when_in = ((y[p], 1), (inside, 1), *after)
-        # inside: t_e - B_p = (d + d0) u_p, bounded by its McCormick envelope (d + d0 in
-        # [0, lo_in], u_p in [1/followed, u_hi])
-        u_lo, u_hi = 1.0 / followed, m.ub[u[p]]
+        # inside: t_e - B_p = (d + d0) u_p, held to its McCormick envelope (d + d0 in
+        # [0, lo_in], u_p in [u_lo, u_hi])
+        u_lo, u_hi = m.lb[u[p]], m.ub[u[p]]
         for a_d, a_u, c0, sign in ((u_lo, 0.0, 0.0, 1.0), (u_hi, lo_in, -lo_in * u_hi, 1.0),
                                    (u_lo, lo_in, -lo_in * u_lo, -1.0), (u_hi, 0.0, 0.0, -1.0)):
             # sign * (t_e - B_p - a_d (d + d0) - a_u u_p - c0) >= 0
             e = {t_e: sign, B[p]: -sign, u[p]: -sign * a_u}
             for v, c in d.items():
                 e[v] = e.get(v, 0.0) - sign * a_d * c
-            m.geq(e, sign * (-a_d * d0 - c0) + SLACK, when_in)
+            m.geq(e, sign * (-a_d * d0 - c0) + SLACK, ((self.y[p], 1), (inside, 1), *after))
         # beyond LO: the first lo_in at slowness u_p, the rest at the ceiling at most
         e = {t_e: 1.0, B[p]: -1.0, u[p]: -lo_in}
         for v, c in d.items():
-            e[v] = e.get(v, 0.0) - c / vhi
-        m.geq(e, -(d0 - lo_in) / vhi + SLACK, ((y[p], 1), (inside, 0)))
+            e[v] = e.get(v, 0.0) - c / self.vhi
+        m.geq(e, -(d0 - lo_in) / self.vhi + SLACK, ((self.y[p], 1), (inside, 0)))
 
-    for i in range(n):  # drop j (> i) before or after part i's arrival at B
-        for q in range(i + 1, min(n, i + 1 + int(lo_in // size))):
-            tracked(i, {x[q]: 1.0}, L, B[q])  # parts close behind it, reaching B
-        for j in range(i + 1, n):
-            before = {x[i]: 1.0, x[j]: -1.0}, {B[i]: 1.0, T[j]: -1.0}
-            after = {x[j]: 1.0, x[i]: -1.0}, {T[j]: 1.0, B[i]: -1.0}
-            if come[j] >= b_late[i] + SLACK:  # this drop after it (and so every later one)
-                slopes(*after, ds=-L)
-                tracked(i, {x[j]: 1.0}, 0.0, T[j])
-                break
-            if d_late[j] <= come[i] + L / vhi - SLACK:
-                slopes(*before, ds=L)
-                if i == 0:
-                    m.between({x[j]: 1.0, T[j]: -v0}, -SLACK, SLACK)
-                continue
-            o = m.var(0, 1, True)
-            slopes(*before, when=((o, 1),), ds=L)
-            slopes(*after, when=((o, 0),), ds=-L)
-            tracked(i, {x[j]: 1.0}, 0.0, T[j], ((o, 0),))
-            if i == 0:  # before the first pick the belt runs at its nominal speed
-                m.between({x[j]: 1.0, T[j]: -v0}, -SLACK, SLACK, ((o, 1),))
-    rest, lines = _cycle_lines(k, 1.0 / followed, m.ub[u[0]])
-    for p in range(n):  # two picks a cycle apart, R I's at the belt's pace from B
-        for q in range(p + 1, n):
-            if come[q] + L / vhi - b_late[p] >= cyc:
-                break
-            for a, b in lines:  # B_q - B_p >= rest + a + b u_p
-                m.geq({B[q]: 1.0, B[p]: -1.0, u[p]: -b}, -(rest + a) + SLACK,
-                      ((y[p], 1), (y[q], 1)))
-    return _solve(m, y, B, x, warmup, time_limit_s, started)
+    def orders(self) -> None:
+        """Each drop against each earlier part's arrival at B: before or after it (a binary
+        where the windows leave it open); before the first pick, the belt at nominal."""
+        x, T, B, m, come, L = self.x, self.T, self.B, self.m, self.come, self.L
+        n, v0 = come.size, self.v0
+        for i in range(n):
+            for q in range(i + 1, min(n, i + 1 + int(self.lo_in // self.size))):
+                self.tracked(i, {x[q]: 1.0}, L, B[q])  # parts close behind it, reaching B
+            for j in range(i + 1, n):
+                before = {x[i]: 1.0, x[j]: -1.0}, {B[i]: 1.0, T[j]: -1.0}
+                after = {x[j]: 1.0, x[i]: -1.0}, {T[j]: 1.0, B[i]: -1.0}
+                if come[j] >= self.b_late[i] + SLACK:  # after it (and so every later drop)
+                    self.slopes(*after, ds=-L)
+                    self.tracked(i, {x[j]: 1.0}, 0.0, T[j])
+                    break
+                if self.d_late[j] <= come[i] + L / self.vhi - SLACK:
+                    self.slopes(*before, ds=L)
+                    if i == 0:
+                        m.between({x[j]: 1.0, T[j]: -v0}, -SLACK, SLACK)
+                    continue
+                o = m.var(0, 1, True)
+                self.slopes(*before, when=((o, 1),), ds=L)
+                self.slopes(*after, when=((o, 0),), ds=-L)
+                self.tracked(i, {x[j]: 1.0}, 0.0, T[j], ((o, 0),))
+                if i == 0:  # before the first pick the belt runs at its nominal speed
+                    m.between({x[j]: 1.0, T[j]: -v0}, -SLACK, SLACK, ((o, 1),))
+
+    def picks(self) -> None:
+        """Two picks a cycle apart, R I's at the belt's pace from B (its tangents)."""
+        B, u, y, come = self.B, self.u, self.y, self.come
+        cyc = check_cycle_s(self.k) - SLACK
+        rest, lines = _cycle_lines(self.k, self.m.lb[u[0]], self.m.ub[u[0]])
+        for p in range(come.size):
+            for q in range(p + 1, come.size):
+                if come[q] + self.L / self.vhi - self.b_late[p] >= cyc:
+                    break
+                for a, b in lines:  # B_q - B_p >= rest + a + b u_p
+                    self.m.geq({B[q]: 1.0, B[p]: -1.0, u[p]: -b}, -(rest + a) + SLACK,
+                               ((y[p], 1), (y[q], 1)))
+
+
+def solve(k: CellConstants, come_s: list[float] | np.ndarray, warmup: int = 0,
+          time_limit_s: float = 60.0) -> MilpResult:
+    """The relaxation's optimum for parts coming at ``come_s`` (the feeder's schedule), counted
+    from part ``warmup`` on."""
+    started = time.perf_counter()
+    come = np.asarray(come_s, dtype=float)
+    if come.size == 0:
+        return MilpResult("optimal", 0)
+    trace = _Trace(k, come)
+    trace.feeder()
+    trace.orders()
+    trace.picks()
+    return _solve(trace.m, trace.y, trace.B, trace.x, warmup, time_limit_s, started)
 
 
 def _solve(m: _Model, y: list[int], B: list[int], x: list[int], warmup: int, time_limit_s: float,
