@@ -36,7 +36,7 @@ from cell.plumbing.interrupts import Stops, exit_now, interrupted, stopped_by
 
 #: Subcommands in the order ``cell --help`` lists them; each is cell.cli.<name>_command.
 COMMANDS = ("run", "sweep", "compare", "optimize", "sensitivity", "fit", "figures", "animate",
-            "path", "mintime", "scenarios", "schema", "docs", "bench")
+            "path", "mintime", "hindsight", "scenarios", "schema", "docs", "bench")
 
 #: Errors of the operating system that a command's output can meet however well it checks.
 OUTPUT_ERRNOS = frozenset({errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOSPC, errno.EDQUOT,

@@ -13,7 +13,8 @@ from cell.cli.main import build_parser, main
 from tests.prose import in_order
 
 SUBCOMMANDS = ["path", "run", "sweep", "compare", "figures", "mintime", "bench", "fit",
-               "animate", "scenarios", "schema", "docs", "optimize", "sensitivity"]
+               "animate", "scenarios", "schema", "docs", "optimize", "sensitivity",
+               "hindsight"]
 
 
 def test_help_lists_the_subcommands():
@@ -37,7 +38,7 @@ def test_parser_knows_every_subcommand():
                 "mintime": ["x", "--out", "y"], "sweep": ["x", "--out", "y"],
                 "fit": ["x"], "animate": ["x", "--out", "y.gif"],
                 "compare": ["a", "b"], "optimize": ["x", "--out", "y"],
-                "sensitivity": ["x", "--out", "y"]}.get(name, [])
+                "sensitivity": ["x", "--out", "y"], "hindsight": ["x", "--out", "y"]}.get(name, [])
         assert parser.parse_args([name, *argv]).command == name
 
 
