@@ -43,6 +43,7 @@ from cell.scenario.sections import (  # noqa: F401 - the schema, re-exported
     MoveSettings,
     PartSettings,
     PathSettings,
+    QualitySettings,
     RobotSettings,
     RunSettings,
     SensorSettings,
@@ -71,6 +72,8 @@ class Scenario(Section):
     failures: FailureSettings | None = None
     """Breakdowns and repairs (docs/model.md, "When equipment fails"); absent: none."""
     sensor: SensorSettings = SensorSettings()
+    quality: QualitySettings = QualitySettings()
+    """Which parts OEE counts as good; absent: every part set down."""
 
     _source: str = PrivateAttr(default="<defaults>")
 
@@ -91,13 +94,16 @@ class Scenario(Section):
         return obj
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain YAML-able data (tuples as lists); ``failures`` and ``run.hours`` only when
-        given (so a scenario without them reads as it did before they existed)."""
+        """Plain YAML-able data (tuples as lists); ``failures``, ``run.hours`` and a
+        ``quality`` rule other than the default only when given (so a scenario without them
+        reads as it did before they existed)."""
         d = _plain(self.model_dump())
         if d.get("failures") is None:
             d.pop("failures", None)
         if d["run"].get("hours") is None:
             d["run"].pop("hours", None)
+        if d["quality"] == QualitySettings().model_dump():
+            d.pop("quality")
         return d
 
     def with_overrides(self, overrides: Mapping[str, Any], file: object = None,

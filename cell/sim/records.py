@@ -292,15 +292,37 @@ class RunSummary:
     """Share of the run the robot was down (failed: waiting for a crew or under repair)."""
     robot_maintenance_fraction: float = NAN
     """Share of the run the robot was in planned maintenance."""
+    planned_time_s: float = NAN
+    """OEE's planned busy time (ISO 22400-2), s: the run less its planned stops (the robot's
+    maintenance)."""
     availability: float = NAN
-    """OEE's A: time the cell was not down (robot or belts) over the time not planned off
-    (the run less planned maintenance)."""
+    """OEE's A: actual production time (the robot in motion) / planned busy time; the rest of
+    the planned time is ``loss_downtime``, ``loss_starved`` and ``loss_blocked``."""
     performance: float = NAN
-    """OEE's P: the robot's fastest cycle × parts delivered / the cell's run time."""
+    """OEE's P (the standard's effectiveness): the nominal cycle × parts produced (set down or
+    scrapped in a failure) / actual production time; above 1 when the robot beats it."""
     quality: float = NAN
-    """OEE's Q: parts set down within the spacing tolerance / parts delivered."""
+    """OEE's Q: good parts / parts produced, by ``quality.rule`` (``set_down``: every part set
+    down is good, a part scrapped in a failure is not; ``spacing``: set down within the
+    spacing tolerance)."""
     oee: float = NAN
-    """availability × performance × quality."""
+    """availability × performance × quality = nominal cycle × good parts / planned busy
+    time; with the five losses it sums to 1.  Parts and time of the whole run, warm-up
+    included."""
+    loss_downtime: float = NAN
+    """The planned busy time's share the robot was down (failed or worn; a crew's wait
+    included)."""
+    loss_starved: float = NAN
+    """The share the robot was up and still with no part to pick (the input belt's stops
+    included)."""
+    loss_blocked: float = NAN
+    """The share the robot was up and still while the output belt stood."""
+    loss_speed: float = NAN
+    """The share lost to the pace: (actual production time − nominal cycle × parts produced)
+    / planned busy time = A (1 − P); negative when the robot beats its nominal cycle."""
+    loss_quality: float = NAN
+    """The share lost to parts produced but not good: nominal cycle × (produced − good) /
+    planned busy time = A P (1 − Q)."""
     service_level: float = NAN
     """Parts delivered / parts arrived."""
     parts_lost_downtime: int = 0
