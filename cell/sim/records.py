@@ -293,36 +293,25 @@ class RunSummary:
     robot_maintenance_fraction: float = NAN
     """Share of the run the robot was in planned maintenance."""
     planned_time_s: float = NAN
-    """OEE's planned busy time (ISO 22400-2), s: the run less its planned stops (the robot's
-    maintenance)."""
+    """OEE's planned busy time, s: the run less planned stops (ISO 22400-2; docs/model.md)."""
     availability: float = NAN
-    """OEE's A: actual production time (the robot in motion) / planned busy time; the rest of
-    the planned time is ``loss_downtime``, ``loss_starved`` and ``loss_blocked``."""
+    """OEE's A: the robot's time in motion / planned busy time."""
     performance: float = NAN
-    """OEE's P (the standard's effectiveness): the nominal cycle × parts produced (set down or
-    scrapped in a failure) / actual production time; above 1 when the robot beats it."""
+    """OEE's P: nominal cycle × parts produced (set down or scrapped) / time in motion."""
     quality: float = NAN
-    """OEE's Q: good parts / parts produced, by ``quality.rule`` (``set_down``: every part set
-    down is good, a part scrapped in a failure is not; ``spacing``: set down within the
-    spacing tolerance)."""
+    """OEE's Q: good parts / parts produced, by ``quality.rule``."""
     oee: float = NAN
-    """availability × performance × quality = nominal cycle × good parts / planned busy
-    time; with the five losses it sums to 1.  Parts and time of the whole run, warm-up
-    included."""
+    """A × P × Q = nominal cycle × good parts / planned busy time (the whole run's)."""
     loss_downtime: float = NAN
-    """The planned busy time's share the robot was down (failed or worn; a crew's wait
-    included)."""
+    """Share of the planned busy time the robot was down (failed or worn)."""
     loss_starved: float = NAN
-    """The share the robot was up and still with no part to pick (the input belt's stops
-    included)."""
+    """Share the robot was up and still with no part to pick."""
     loss_blocked: float = NAN
-    """The share the robot was up and still while the output belt stood."""
+    """Share the robot was up and still while the output belt stood."""
     loss_speed: float = NAN
-    """The share lost to the pace: (actual production time − nominal cycle × parts produced)
-    / planned busy time = A (1 − P); negative when the robot beats its nominal cycle."""
+    """Share lost to pace, A (1 − P) (negative: faster than the nominal cycle)."""
     loss_quality: float = NAN
-    """The share lost to parts produced but not good: nominal cycle × (produced − good) /
-    planned busy time = A P (1 − Q)."""
+    """Share lost to parts produced but not good, A P (1 − Q); with OEE the losses sum to 1."""
     service_level: float = NAN
     """Parts delivered / parts arrived."""
     parts_lost_downtime: int = 0
