@@ -50,7 +50,8 @@ def losses_line(means: Mapping[str, tuple[float, float]], a: str, b: str, width:
              if name in means for pa, pb in [means[name]]]
     if not shown:
         return None
-    return f"  {'OEE losses':<{width}}  {a} against {b}: " + "; ".join(shown)
+    return (f"  {'OEE losses':<{width}}  shares of the planned busy time, {a} against {b}: "
+            + "; ".join(shown))
 
 #: How a measure's difference becomes parts per 1,000: ``("of", measure)``, a count over
 #: another measure's mean (per run); ``("per_hour", None)``, parts per hour over the arrivals
