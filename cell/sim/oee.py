@@ -132,8 +132,6 @@ def fast_shares(column: Callable[[str], np.ndarray], end_s: float) -> dict[str, 
 
 
 
-#: ``quality.rule``: which parts produced are good (docs/model.md, "OEE as plants define it").
-QUALITY_RULES = ("set_down", "spacing")
 #: The work unit's states over the planned busy time (ISO 22400-2), in order of precedence.
 UNIT_STATES = ("down", "busy", "blocked", "starved")
 #: summary.csv's OEE losses, each a share of the planned busy time; with ``oee`` they sum to 1.
@@ -166,7 +164,7 @@ def unit_seconds(column: Callable[[str], np.ndarray], downtime: Any, end_s: floa
 
 def produced_and_good(column: Callable[[str], np.ndarray], rule: str) -> tuple[int, int]:
     """The run's produced quantity (parts set down, and parts scrapped from the hand in a
-    failure) and good quantity under ``rule`` (:data:`QUALITY_RULES`), every part counted."""
+    failure) and good quantity under ``rule`` (the scenario's ``quality.rule``), every part counted."""
     limits = column("limits").astype(np.int_)
     set_down = int(np.count_nonzero(np.isfinite(column("touchdown"))))
     produced = set_down + int(np.count_nonzero(limits & LIMIT_BIT["scrapped"]))
@@ -181,8 +179,8 @@ def oee_figures(seconds: dict[str, float], cycle_s: float, produced: int, good: 
                 ) -> dict[str, float]:
     """Availability, performance, quality, OEE and the five losses (shares of the planned
     busy time) from the work unit's seconds (:func:`unit_seconds`), the planned cycle and the
-    quantities.  A figure with no value (no time planned, no motion, nothing produced) is
-    NaN; the losses are then still shares of the planned time, OEE with them."""
+    quantities.  A figure with no value is NaN: performance without motion, quality and OEE
+    when nothing was produced, everything without planned time."""
     pbt, apt = seconds["planned"], seconds["busy"]
     nan = math.nan
     if not pbt > 0:
