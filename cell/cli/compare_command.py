@@ -234,7 +234,7 @@ def judgement(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
         still_sides,
     )
     from cell.experiments.sweep.windows import setting, windows_apart
-    from cell.reporting.compare_verdict import OEE, SCALES, Judged, decide
+    from cell.reporting.compare_verdict import OEE, OEE_LOSSES, SCALES, Judged, decide, losses_line
     from cell.reporting.formatting import HEADLINES
     from cell.scenario.run_length import RunLength
 
@@ -261,12 +261,26 @@ def judgement(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
                                  apart if differ else None, bool(demand), judged, scales)
         if line is not None:
             lines.append(line)
+    losses = losses_line(_pairs(summary, OEE_LOSSES, la, lb), la, lb, width)
+    if losses is not None:
+        lines.append(losses)
     if replications is not None:
         for title, side, size, line in rate_free(replications, sweep, la, lb, width):
             lines.append(line)
             if demand and title not in SHOWN_ONLY:
                 judged.append(Judged(title, side, size))
     return lines, decide(judged, la, lb, practical, bool(demand))
+
+
+def _pairs(summary: pd.DataFrame, measures: tuple[str, ...], la: str, lb: str
+           ) -> dict[str, tuple[float, float]]:
+    """Each measure's (A's mean, B's mean), for those both sides have."""
+    out = {}
+    for m in measures:
+        rows = summary[summary["measure"] == m].set_index("scenario")["mean"]
+        if {la, lb} <= set(rows.index):
+            out[m] = (float(rows[la]), float(rows[lb]))
+    return out
 
 
 def _both(summary: pd.DataFrame, measure: str, la: str, lb: str) -> float:

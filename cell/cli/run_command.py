@@ -28,6 +28,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="replace the files of a run already in --out")
     p.add_argument("--format", choices=("csv", "parquet"), default="csv",
                    help="write the three files as CSV (default) or Parquet")
+    p.add_argument("--thesis", action="store_true",
+                   help="print the thesis's accounting (IP, R IV, its bookkeeping) after the "
+                        "plant's measures (a thesis scenario prints it unasked)")
 
 
 #: The files of a run, written as one set.
@@ -101,18 +104,26 @@ def _on_part(parts: Any, progress: Any, n: int) -> Callable[[Any], None]:
 
 
 def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) -> None:
-    """The run's summary on stdout, OEE with failures, and the files written."""
-    from cell.reporting.run_summary import format_summary, oee_line, thesis_figures
+    """The run's summary on stdout: the plant's measures first (throughput, OEE and its
+    losses, parts lost), the thesis's accounting when asked for or for a thesis scenario;
+    the stops with failures; the files written."""
+    from cell.reporting.run_summary import (
+        format_summary,
+        shows_thesis,
+        stops_line,
+        thesis_figures,
+    )
 
-    print(format_summary(result.summary, thesis_figures(scenario)))
+    accounting = shows_thesis(scenario, args.thesis)
     r = result.summary
+    print(format_summary(r, thesis_figures(scenario) if accounting else None, accounting))
     print(f"robot busy (in motion) {r.robot_busy_fraction:.3f} of the run, beside its offered "
           f"load (fastest cycle / mean inter-arrival) {r.offered_load:.3f}")
     written = RUN_FILES if args.format == "csv" else PARQUET_FILES
     if not _stops_anything(scenario):
         print(f"wrote {shown}/{written[0]}, {written[1]} and {written[2]}")
         return
-    print(oee_line(r))
+    print(stops_line(r))
     print(f"wrote {shown}/{written[0]}, {written[1]}, {written[2]}, states.csv and failures.csv")
 
 

@@ -34,10 +34,24 @@ from cell.reporting.formatting import Headline
 #: thousand does not decide a verdict.
 PRACTICAL_PER_1000 = 1.0
 
-#: OEE in the verdict (availability × performance × quality; :mod:`cell.sim.oee`): a share of
-#: the planned time, higher is better.
-OEE = Headline("oee", "OEE (availability × performance × quality)",
+#: OEE in the verdict (ISO 22400-2: availability × performance × quality; :mod:`cell.sim.oee`):
+#: a share of the planned busy time, higher is better.
+OEE = Headline("oee", "OEE (ISO 22400-2, A × P × Q)",
                "{a} reaches an OEE {x} {dir} than {b}", ("higher", "lower"), "higher")
+#: Where each side's planned busy time went, shown under OEE (summary.csv's names), not judged.
+OEE_LOSSES = ("loss_downtime", "loss_starved", "loss_blocked", "loss_speed", "loss_quality")
+
+
+def losses_line(means: Mapping[str, tuple[float, float]], a: str, b: str, width: int
+                ) -> str | None:
+    """The OEE losses' means, A's against B's, as shares of the planned busy time (those
+    measured); None if none was."""
+    shown = [f"{name} {pa:.1%} against {pb:.1%}" for name in OEE_LOSSES
+             if name in means for pa, pb in [means[name]]]
+    if not shown:
+        return None
+    return (f"  {'OEE losses':<{width}}  shares of the planned busy time, {a} against {b}: "
+            + "; ".join(shown))
 
 #: How a measure's difference becomes parts per 1,000: ``("of", measure)``, a count over
 #: another measure's mean (per run); ``("per_hour", None)``, parts per hour over the arrivals

@@ -30,8 +30,10 @@ LIMIT_WORDS = {
     "limit_r4_peak": "R IV at the base's peak rate",
     "parts_held": "parts held at the feeder",
 }
-#: The robot's state columns shown when the summary has them (the failures' branch adds them).
-STATE_COLUMNS = {"robot_busy_fraction": "busy", "availability": "availability", "oee": "OEE"}
+#: OEE (ISO 22400-2) and the losses that make most of 1 − availability, shown when the summary
+#: has them.
+STATE_COLUMNS = {"availability": "availability", "loss_starved": "starved",
+                 "loss_downtime": "down", "oee": "OEE"}
 #: A trend in the parts lost is put down to a limit whose counts follow it this closely (|r|).
 FOLLOWS = 0.8
 

@@ -56,20 +56,16 @@ def table(reps: pd.DataFrame) -> pd.DataFrame:
     """One row per (exponent, policy, cycle): means over the replications."""
     r = reps.copy()
     hours = r["wear_hours"]
-    up = hours - r["wear_down_h"]
     r["parts_per_h"] = r["parts_delivered"] / hours
     r["down_h_per_year"] = r["wear_down_h"] / hours * YEAR_H
     r["expected_down_h_per_year"] = (1 - r["wear_availability"]) * YEAR_H
     r["stops_per_year"] = r["wear_failures"] / hours * YEAR_H
-    r["availability"] = up / hours
-    # OEE (Nakajima): A = up / planned; P = ideal cycle × count / up time, the ideal cycle
-    # being the arrivals' mean (the most the line brings); Q = set down within the spacing.
-    r["performance"] = r["mean_interarrival_s"] * r["parts_delivered"] / (up * 3600.0)
-    r["quality"] = 1 - r["spacing_outside_tol"] / r["parts_delivered"]
-    r["oee"] = r["availability"] * r["performance"] * r["quality"]
+    # OEE and its losses are each run's own (ISO 22400-2, cell.sim.oee), averaged below
     r["cycle_s"] = np.where(r["policy"] == ADAPTIVE, np.nan, r["ideal_cycle_s"])
     keep = ["parts_per_h", "parts_missed", "down_h_per_year", "expected_down_h_per_year",
-            "stops_per_year", "availability", "performance", "quality", "oee", "wear_mtbf_h",
+            "stops_per_year", "availability", "performance", "quality", "oee",
+            "loss_downtime", "loss_starved", "loss_blocked", "loss_speed", "loss_quality",
+            "wear_mtbf_h",
             "wear_life_base_h", "wear_life_shoulder_h", "wear_life_elbow_h",
             "wear_life_pitch_h", "wear_life_roll_h"]
     g = r.groupby(["wear_exponent", "policy", "cycle_s"], dropna=False, sort=True)
@@ -176,19 +172,23 @@ def reading(t: pd.DataFrame) -> list[str]:
 
 
 def quality_note(t: pd.DataFrame) -> str:
-    """Why the OEEs differ as much as they do: the factor that differs most."""
+    """Why the OEEs differ as much as they do: the factor that differs most (ISO 22400-2)."""
     fixed = t[t["policy"] == FIXED]
     short = fixed[fixed["cycle_s"] == fixed["cycle_s"].min()]
     ad = t[t["policy"] == ADAPTIVE]
     factors = {name: (float(short[name].mean()), float(ad[name].mean()))
-               for name in ("availability", "performance", "quality")}
-    worst = min(factors, key=lambda k: factors[k][0] / factors[k][1])
+               for name in ("availability", "performance", "quality", "loss_starved")}
+    worst = min(("availability", "performance", "quality"),
+                key=lambda k: factors[k][0] / factors[k][1])
     f, a = factors[worst]
+    why = {"availability": (": the fixed robot stands still with no part to pick (loss_starved "
+                            f"{factors['loss_starved'][0]:.3f} against "
+                            f"{factors['loss_starved'][1]:.3f}): the parts it lets go never reach "
+                            "its hand."),
+           "quality": ": parts scrapped in the hand are produced and not good."}
     return (f"**OEE.** The two robots' OEEs differ mostly by {worst}: {f:.3f} for the fixed "
-            f"robot at its shortest cycle against {a:.3f} for the adaptive one (availability "
-            f"{factors['availability'][0]:.4f} against {factors['availability'][1]:.4f})"
-            + (": the fixed robot never steers the output belt, so its parts are seldom set "
-               "down 45 ± 0.25 in apart." if worst == "quality" else "."))
+            f"robot at its shortest cycle against {a:.3f} for the adaptive one"
+            + why.get(worst, "."))
 
 
 def figure(t: pd.DataFrame) -> bytes:
@@ -236,9 +236,12 @@ def markdown(t: pd.DataFrame, reps: pd.DataFrame) -> str:
         f"{YEAR_H:.0f} h year; *expected* downtime is from each run's motor exposures "
         "(robot MTBF = 1 / Σ_j 1 / (η_j Γ(1 + 1/β)) over its five motors' lives η_j at that "
         "duty: only the worn motor is replaced, so each motor's place renews on its own), the "
-        "figure the reading uses; the runs' own stops are in `down_h_per_year`. OEE = availability × "
-        "performance (the arrivals' mean cycle × parts delivered / up time) × quality "
-        "(parts set down within 45 ± 0.25 in). `reliability.csv` has every figure.", "",
+        "figure the reading uses; the runs' own stops are in `down_h_per_year`. OEE as ISO "
+        "22400-2 defines it (docs/model.md, \"OEE as plants define it\"): availability (the "
+        "robot in motion over the planned time) × performance (the nominal cycle × parts "
+        "produced / time in motion) × quality (every part set down is good), the planned time "
+        "lost to downtime, starving, blocking, speed and quality in the `loss_` columns. "
+        "`reliability.csv` has every figure.", "",
         "![throughput against downtime](reliability.png)", "", "## Reading", ""]
     for sentence in reading(t):
         lines += [sentence, ""]

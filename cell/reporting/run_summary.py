@@ -177,24 +177,50 @@ def _share(value: float) -> str:
 
 def _no_quality(r: RunSummary) -> str:
     """Why quality (and OEE with it) has no value, if it has none."""
-    return "" if r.quality == r.quality else " (no part delivered: quality is undefined)"
+    return "" if r.quality == r.quality else " (nothing produced: quality is undefined)"
+
+
+#: The scenarios that are the thesis's own: ``cell run`` prints the thesis's accounting (IP,
+#: R IV, the thesis's bookkeeping) after the plant's measures for a scenario of one of these
+#: names (the built-in ones and their copies), and for any other when asked (``--thesis``).
+THESIS_SCENARIOS = ("baseline", "non_adaptive", "table_7_1", "table_7_1_mintime")
+
+
+def shows_thesis(s: Scenario, asked: bool = False) -> bool:
+    """Whether ``cell run`` prints the thesis's accounting: asked for, or a thesis scenario."""
+    return asked or s.name in THESIS_SCENARIOS
 
 
 def oee_line(r: RunSummary) -> str:
-    """A run with failures: its OEE and what it is made of, the stops, the parts they cost; a
-    figure with no value (quality when no part was delivered, and OEE with it) is ``n/a``
-    with the reason, never ``nan``."""
+    """OEE (ISO 22400-2) and what it is made of; a figure with no value (quality when nothing
+    was produced, and OEE with it) is ``n/a`` with the reason, never ``nan``."""
     def shown(v: float) -> str:
         return f"{v:.4f}" if math.isfinite(v) else "n/a"
 
     return (f"availability {shown(r.availability)}, performance {shown(r.performance)}, quality "
-            f"{shown(r.quality)}: OEE {shown(r.oee)}{_no_quality(r)}; robot failures "
-            f"{r.robot_failures}, parts lost to downtime {r.parts_lost_downtime}, scrapped "
-            f"{r.parts_scrapped}")
+            f"{shown(r.quality)}: OEE {shown(r.oee)}{_no_quality(r)}")
 
 
-def format_summary(r: RunSummary, thesis: dict[str, str] | None = None) -> str:
-    """The summary as a two-column table; the thesis's figures beside ours when given."""
+def waterfall_line(r: RunSummary) -> str:
+    """Where the planned busy time went: the five losses (summary.csv's names), then OEE."""
+    from cell.sim.oee import loss_waterfall
+
+    steps = loss_waterfall(r)
+    return ("; ".join(f"{name} {_share(share)}" for name, share in steps[:-1])
+            + f"; left: OEE {_share(steps[-1][1])}")
+
+
+def stops_line(r: RunSummary) -> str:
+    """A run with failures or wear: the robot's stops and the parts they cost."""
+    return (f"robot failures {r.robot_failures}, parts lost to downtime {r.parts_lost_downtime}, "
+            f"scrapped {r.parts_scrapped}")
+
+
+def format_summary(r: RunSummary, thesis: dict[str, str] | None = None,
+                   accounting: bool = True) -> str:
+    """The summary as a two-column table: the plant's measures (throughput, OEE and its
+    losses, parts lost), then, with ``accounting``, the thesis's (IP, R IV, the thesis's
+    bookkeeping), its published figures beside ours when given."""
     rows: list[tuple[str, str]] = []
 
     def add(label: str, value: Any, fmt: str = "{:.4f}", field: str = "") -> None:
@@ -206,33 +232,37 @@ def format_summary(r: RunSummary, thesis: dict[str, str] | None = None) -> str:
     add("ideal cycle, s", r.ideal_cycle_s)
     add("parts arrived / delivered", f"{r.parts_arrived} / {r.parts_delivered}", "{}")
     add("parts lost (wall clock)", r.parts_missed, "{:d}", "parts_missed")
-    add("parts lost (thesis's accounting)", r.parts_missed_thesis, "{:d}", "parts_missed_thesis")
     add("actual cycle, wall clock, s", r.actual_cycle_wallclock_s)
-    add("actual cycle, thesis's accounting, s", r.actual_cycle_thesis_s, field="actual_cycle_thesis_s")
     add("parts/hr, wall clock", r.parts_per_hr_wallclock)
-    add("parts/hr, thesis's accounting", r.parts_per_hr_thesis, field="parts_per_hr_thesis")
-    add("Vavg R IV, in/s", r.vavg_r4_in_s, field="vavg_r4_in_s")
-    add("IP, wall clock", r.ip_wallclock)
-    add("IP, thesis's accounting", r.ip_thesis, field="ip_thesis")
-    add("cycle (thesis's accounting) vs ideal, %", r.cycle_vs_nominal_pct, "{:+.2f}",
-        "cycle_vs_nominal_pct")
-    if r.ip_thesis_memoryless == r.ip_thesis_memoryless:
-        add("IP, next arrivals counted from each pick-up", r.ip_thesis_memoryless, field="ip_thesis")
+    add("OEE (ISO 22400-2)", oee_line(r), "{}")
+    add("planned busy time lost to", waterfall_line(r) + _no_quality(r), "{}")
     add("spacing min / max, in", f"{shown_figure(r.spacing_min_in, '{:.3f}')} / "
         f"{shown_figure(r.spacing_max_in, '{:.3f}')}")
     add("spacings outside 45 ± 0.25 in", r.spacing_outside_tol, "{:d}")
     hit = [f"{label} {getattr(r, field)}" for field, label in LIMIT_COUNTS.values()
            if getattr(r, field)]
     add("limits hit (parts)", "; ".join(hit) if hit else "none", "{}")
-    if r.availability < 1.0:  # something stopped: where the planned time went (OEE)
-        from cell.sim.oee import loss_waterfall
-
-        steps = loss_waterfall(r.availability, r.performance, r.quality)
-        add("planned time lost to", "; ".join(f"{name} {_share(share)}" for name, share in steps[:-1])
-            + f"; left: OEE {_share(steps[-1][1])}" + _no_quality(r), "{}")
     if r.warmup_parts:
         add("warm-up left out, parts", r.warmup_parts, "{:d}")
+    plant = len(rows)
+    if accounting:
+        add("parts lost (thesis's accounting)", r.parts_missed_thesis, "{:d}",
+            "parts_missed_thesis")
+        add("actual cycle, thesis's accounting, s", r.actual_cycle_thesis_s,
+            field="actual_cycle_thesis_s")
+        add("parts/hr, thesis's accounting", r.parts_per_hr_thesis, field="parts_per_hr_thesis")
+        add("Vavg R IV, in/s", r.vavg_r4_in_s, field="vavg_r4_in_s")
+        add("IP, wall clock", r.ip_wallclock)
+        add("IP, thesis's accounting", r.ip_thesis, field="ip_thesis")
+        add("cycle (thesis's accounting) vs ideal, %", r.cycle_vs_nominal_pct, "{:+.2f}",
+            "cycle_vs_nominal_pct")
+        if r.ip_thesis_memoryless == r.ip_thesis_memoryless:
+            add("IP, next arrivals counted from each pick-up", r.ip_thesis_memoryless,
+                field="ip_thesis")
     width = max(len(label) for label, _ in rows)
-    table = "\n".join(f"{label:<{width}}  {text}" for label, text in rows)
+    lines = [f"{label:<{width}}  {text}" for label, text in rows]
+    if not accounting:
+        return "\n".join(lines) + "\n(the thesis's accounting: --thesis)"
+    lines.insert(plant, "the thesis's accounting:")
     note = "" if thesis else "\n(the thesis's figures are shown only beside a run of its own scenario)"
-    return f"{table}\n{IP_LINE}{note}"
+    return "\n".join(lines) + f"\n{IP_LINE}{note}"

@@ -44,6 +44,7 @@ from cell.scenario.sections import (  # noqa: F401 - the schema, re-exported
     MoveSettings,
     PartSettings,
     PathSettings,
+    QualitySettings,
     RobotSettings,
     RunSettings,
     SensorSettings,
@@ -72,6 +73,8 @@ class Scenario(Section):
     failures: FailureSettings | None = None
     """Breakdowns and repairs (docs/model.md, "When equipment fails"); absent: none."""
     sensor: SensorSettings = SensorSettings()
+    quality: QualitySettings = QualitySettings()
+    """Which parts OEE counts as good; absent: every part set down."""
 
     _source: str = PrivateAttr(default="<defaults>")
 
@@ -92,16 +95,18 @@ class Scenario(Section):
         return obj
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain YAML-able data (tuples as lists); ``failures``, ``run.hours`` and
-        ``arrivals.profile`` only when given (so a scenario without them reads as it did
-        before they existed), and with ``run.hours`` no ``run.parts`` (the run's length is
-        given one way)."""
+        """Plain YAML-able data (tuples as lists); ``failures``, ``run.hours``,
+        ``arrivals.profile`` and a ``quality`` rule other than the default only when given (so a
+        scenario without them reads as it did before they existed), and with ``run.hours`` no
+        ``run.parts`` (the run's length is given one way)."""
         d = _plain(self.model_dump())
         if d.get("failures") is None:
             d.pop("failures", None)
         d["run"].pop("hours" if d["run"].get("hours") is None else "parts", None)
         if d["arrivals"].get("profile") is None:
             d["arrivals"].pop("profile", None)
+        if d["quality"] == QualitySettings().model_dump():
+            d.pop("quality")
         return d
 
     def with_overrides(self, overrides: Mapping[str, Any], file: object = None,

@@ -373,6 +373,17 @@ class FailureSettings(Section):
     repair: RepairSettings | None = None
     """Absent: every failure is repaired at once (as many crews as failures)."""
     maintenance: MaintenanceSettings | None = None
+# --------------------------------------------------------------------------- quality
+class QualitySettings(Section):
+    """Which parts OEE counts as good (ISO 22400-2's good quantity; docs/model.md, "OEE as
+    plants define it")."""
+
+    rule: Literal["set_down", "spacing"] = "set_down"
+    """``set_down``: every part set down on the output belt is good, a part scrapped from the
+    hand in a failure is not; ``spacing``: a part set down outside the spacing tolerance
+    (``belts``, §4.3 f) is not good either."""
+
+
 # --------------------------------------------------------------------------- sensor
 class SensorSettings(Section):
     """What the adaptive controller knows of the next part (docs/model.md, "The look-ahead")."""

@@ -1,13 +1,25 @@
 """The run's time accounted for: each piece of equipment's states, the robot's shares of
-them, and OEE = availability × performance × quality (Nakajima; SPEC §10; docs/model.md,
-"When equipment fails").
+them, and OEE as plants define it (ISO 22400-2; docs/model.md, "OEE as plants define it").
 
-* availability: the time the cell was not down (the robot or a belt failed; the sensor's
-  failures do not stop it) over the run less its planned maintenance;
-* performance: the robot's fastest cycle × parts delivered over that up time;
-* quality: parts set down within the spacing tolerance over parts delivered.
+The work unit is the robot; its belts bring it parts and take them away.  Its time:
 
-Time measures cover the whole run (a warm-up in parts is not cut from them).
+* planned busy time (PBT): the run less planned stops (the robot's maintenance; a calendar's
+  time off shift will be taken out here too);
+* inside PBT, each instant is downtime (the robot failed or worn: waiting for a crew or under
+  repair), actual production time (APT: the robot in motion), blocked (up and still while the
+  output belt stands: it cannot set a part down) or starved (up and still otherwise: no part to
+  pick, the input belt's stops included);
+* availability = APT / PBT, so 1 − A = loss_downtime + loss_starved + loss_blocked;
+* performance (the standard's effectiveness) = planned cycle (the nominal cycle,
+  controller.nominal_cycle_s as resolved) × produced quantity / APT, its loss
+  loss_speed = (APT − cycle × produced) / PBT (negative when the robot beats its nominal cycle);
+* quality = good quantity / produced quantity, by the scenario's ``quality.rule``: a part set
+  down is produced, a part scrapped from the hand in a failure is produced and not good, and
+  under ``spacing`` a part set down outside the spacing tolerance is not good either; its loss
+  loss_quality = cycle × (produced − good) / PBT;
+* OEE = A × P × Q = cycle × good / PBT, and OEE plus the five losses is 1.
+
+Time and counts cover the whole run (a warm-up in parts is cut from neither).
 """
 
 from __future__ import annotations
@@ -37,26 +49,39 @@ def _named(equipment: str) -> Callable[[str, str], bool]:
     return lambda name, cause: name == equipment
 
 
+def _robot_down(name: str, cause: str) -> bool:
+    return name == "robot" and cause != "maintenance"
+
+
+def _maintenance(name: str, cause: str) -> bool:
+    return name == "robot" and cause == "maintenance"
+
+
+def _busy(column: Callable[[str], np.ndarray], downtime: Any, end_s: float
+          ) -> tuple[np.ndarray, np.ndarray]:
+    """The robot's motion: as the failure clock logged it, or (nothing stopping the robot
+    mid-cycle) each picked part's cycle from its arrival at B."""
+    if downtime is not None:
+        motion = np.frombuffer(downtime.robot.motion, dtype=float).reshape(-1, 2)
+        since = downtime.robot._moving_since
+        if since == since:
+            motion = np.vstack([motion, [[since, end_s]]])
+        return motion[:, 0], motion[:, 1]
+    picked = column("picked") != 0
+    at_bot = column("at_bot")[picked]
+    return at_bot, at_bot + column("cycle")[picked]
+
+
 def timelines(column: Callable[[str], np.ndarray], downtime: Any, end_s: float,
               stops: Sequence[tuple[str, str, float, float, Any]] = ()
               ) -> dict[str, list[tuple[str, float, float]]]:
     """Each piece of equipment's (state, from, to) over [0, end_s]; ``column`` gives the run
     log's per-part values (every part, warm-up included); ``stops``: the run's (failures.csv's
     rows, as :meth:`cell.sim.failures.Downtime.all_stops` gives them)."""
-    arrival, at_bot = column("arrival"), column("at_bot")
-    if downtime is not None:
-        motion = np.frombuffer(downtime.robot.motion, dtype=float).reshape(-1, 2)
-        since = downtime.robot._moving_since
-        if since == since:
-            motion = np.vstack([motion, [[since, end_s]]])
-        busy = (motion[:, 0], motion[:, 1])
-    else:
-        picked = column("picked") != 0
-        busy = (at_bot[picked], at_bot[picked] + column("cycle")[picked])
     out = {"robot": states(end_s, [
-        ("down", *_spans(stops, lambda n, c: n == "robot" and c != "maintenance")),
-        ("maintenance", *_spans(stops, lambda n, c: n == "robot" and c == "maintenance")),
-        ("busy", *busy), ("waiting", arrival, at_bot)], "idle")}
+        ("down", *_spans(stops, _robot_down)), ("maintenance", *_spans(stops, _maintenance)),
+        ("busy", *_busy(column, downtime, end_s)), ("waiting", column("arrival"),
+                                                     column("at_bot"))], "idle")}
     for belt in ("input_belt", "output_belt"):
         out[belt] = states(end_s, [("down", *_spans(stops, _named(belt)))], "running")
     if downtime is not None and downtime.spec.sensor is not None:
@@ -105,13 +130,81 @@ def fast_shares(column: Callable[[str], np.ndarray], end_s: float) -> dict[str, 
     return out
 
 
+
+
+#: The work unit's states over the planned busy time (ISO 22400-2), in order of precedence.
+UNIT_STATES = ("down", "busy", "blocked", "starved")
+#: summary.csv's OEE losses, each a share of the planned busy time; with ``oee`` they sum to 1.
+LOSSES = ("loss_downtime", "loss_starved", "loss_blocked", "loss_speed", "loss_quality")
+
+
+def unit_seconds(column: Callable[[str], np.ndarray], downtime: Any, end_s: float,
+                 stops: Sequence[tuple[str, str, float, float, Any]],
+                 planned_off: Sequence[tuple[np.ndarray, np.ndarray]] = ()) -> dict[str, float]:
+    """Seconds of the robot (the work unit) in each of :data:`UNIT_STATES` and ``planned``
+    (the planned busy time: the run less its planned stops, the robot's maintenance and any
+    ``planned_off`` spans, such as a calendar's time off shift).  The states tile the planned
+    busy time."""
+    if downtime is None and not stops and not planned_off:  # nothing stops: direct sums
+        share = fast_shares(column, end_s)
+        busy = share["busy"] * end_s
+        return {"planned": end_s, "down": 0.0, "busy": busy, "blocked": 0.0,
+                "starved": max(end_s - busy, 0.0)}
+    off = [("off", s, e) for s, e in planned_off]
+    rows = states(end_s, [
+        *off, ("maintenance", *_spans(stops, _maintenance)),
+        ("down", *_spans(stops, _robot_down)), ("busy", *_busy(column, downtime, end_s)),
+        ("blocked", *_spans(stops, _named("output_belt")))], "starved")
+    seconds = dict.fromkeys(("off", "maintenance", *UNIT_STATES), 0.0)
+    for state, a, b in rows:
+        seconds[state] += b - a
+    seconds["planned"] = sum(seconds[k] for k in UNIT_STATES)
+    return seconds
+
+
+def produced_and_good(column: Callable[[str], np.ndarray], rule: str) -> tuple[int, int]:
+    """The run's produced quantity (parts set down, and parts scrapped from the hand in a
+    failure) and good quantity under ``rule`` (the scenario's ``quality.rule``), every part counted."""
+    limits = column("limits").astype(np.int_)
+    set_down = int(np.count_nonzero(np.isfinite(column("touchdown"))))
+    produced = set_down + int(np.count_nonzero(limits & LIMIT_BIT["scrapped"]))
+    good = set_down
+    if rule == "spacing":
+        good -= int(np.count_nonzero(np.isfinite(column("touchdown"))
+                                     & (limits & LIMIT_BIT["spacing_off"] != 0)))
+    return produced, good
+
+
+def oee_figures(seconds: dict[str, float], cycle_s: float, produced: int, good: int
+                ) -> dict[str, float]:
+    """Availability, performance, quality, OEE and the five losses (shares of the planned
+    busy time) from the work unit's seconds (:func:`unit_seconds`), the planned cycle and the
+    quantities.  A figure with no value is NaN: performance without motion, quality and OEE
+    when nothing was produced, everything without planned time."""
+    pbt, apt = seconds["planned"], seconds["busy"]
+    nan = math.nan
+    if not pbt > 0:
+        return {"planned_time_s": pbt, **dict.fromkeys(
+            ("availability", "performance", "quality", "oee", *LOSSES), nan)}
+    ideal_s = cycle_s * produced  # the planned cycle's time for what was produced
+    return {
+        "planned_time_s": pbt, "availability": apt / pbt,
+        "performance": ideal_s / apt if apt > 0 else nan,
+        "quality": good / produced if produced else nan,
+        "oee": cycle_s * good / pbt if produced else nan,
+        "loss_downtime": seconds["down"] / pbt, "loss_starved": seconds["starved"] / pbt,
+        "loss_blocked": seconds["blocked"] / pbt, "loss_speed": (apt - ideal_s) / pbt,
+        "loss_quality": cycle_s * (produced - good) / pbt}
+
+
 def measure(r: RunSummary, column: Callable[[str], np.ndarray], downtime: Any,
-            fastest_cycle_s: float, end_s: float,
-            stops: list[tuple[str, str, float, float, Any]]
+            nominal_cycle_s: float, end_s: float,
+            stops: list[tuple[str, str, float, float, Any]], quality_rule: str = "set_down"
             ) -> dict[str, list[tuple[str, float, float]]]:
-    """Fill the summary's time shares, OEE and reliability figures from the run's ``stops``
-    (failures.csv's rows: its failures', or wear's alone); the timelines (with failures or
-    wear only: without, the shares are summed directly, and no timeline is made)."""
+    """Fill the summary's time shares, OEE (ISO 22400-2) and reliability figures from the
+    run's ``stops`` (failures.csv's rows: its failures', or wear's alone); the timelines (with
+    failures or wear only: without, the shares are summed directly, and no timeline is
+    made)."""
     if downtime is None and not stops:
         lines: dict[str, list[tuple[str, float, float]]] = {}
         share = fast_shares(column, end_s)
@@ -121,25 +214,16 @@ def measure(r: RunSummary, column: Callable[[str], np.ndarray], downtime: Any,
     r.robot_busy_fraction, r.robot_waiting_fraction = share["busy"], share["waiting"]
     r.robot_idle_fraction, r.robot_down_fraction = share["idle"], share["down"]
     r.robot_maintenance_fraction = share["maintenance"]
-    if not stops:
-        cell_share = {"maintenance": 0.0, "down": 0.0, "up": 1.0 if end_s > 0 else math.nan}
-    else:
-        cell_share = fractions(states(end_s, [
-            ("maintenance", *_spans(stops, lambda n, c: n == "robot" and c == "maintenance")),
-            ("down", *_spans(stops, lambda n, c: n != "sensor" and c != "maintenance"))], "up"),
-            end_s, ("maintenance", "down", "up"))
-    planned = cell_share["up"] + cell_share["down"]  # the run less planned stops (exactly 1 × up
-    up_s = cell_share["up"] * end_s                   # when nothing failed, never above it)
-    r.availability = cell_share["up"] / planned if planned > 0 else math.nan
-    r.performance = fastest_cycle_s * r.parts_delivered / up_s if up_s > 0 else math.nan
-    good = r.parts_delivered - r.spacing_outside_tol
-    r.quality = good / r.parts_delivered if r.parts_delivered else math.nan
-    r.oee = r.availability * r.performance * r.quality
+    produced, good = produced_and_good(column, quality_rule)
+    figures = oee_figures(unit_seconds(column, downtime, end_s, stops), nominal_cycle_s,
+                          produced, good)
+    for name, value in figures.items():
+        setattr(r, name, value)
     r.service_level = r.parts_delivered / r.parts_arrived if r.parts_arrived else math.nan
     limits = column("limits").astype(np.int_)[r.warmup_parts:]
     r.parts_lost_downtime = int(np.count_nonzero(limits & LIMIT_BIT["lost_downtime"]))
     r.parts_scrapped = int(np.count_nonzero(limits & LIMIT_BIT["scrapped"]))
-    failures = sum(1 for name, cause, *_ in stops if name == "robot" and cause != "maintenance")
+    failures = sum(1 for name, cause, *_ in stops if _robot_down(name, cause))
     r.robot_failures = failures
     robot_up_s = end_s * (1.0 - share["down"] - share["maintenance"])
     r.mtbf_observed_s = robot_up_s / failures if failures else math.nan
@@ -147,18 +231,11 @@ def measure(r: RunSummary, column: Callable[[str], np.ndarray], downtime: Any,
     return lines
 
 
-#: The steps of OEE's loss waterfall (Nakajima), in order.
-WATERFALL = ("downtime (availability)", "speed and waiting (performance)",
-             "spacing off (quality)")
+#: The steps of OEE's loss waterfall (ISO 22400-2), summary.csv's columns, in order, then OEE.
+WATERFALL = (*LOSSES, "oee")
 
 
-def loss_waterfall(availability: float, performance: float, quality: float
-                   ) -> list[tuple[str, float]]:
-    """OEE's loss waterfall: the share of the planned time lost at each step, then OEE.
-
-    Downtime costs 1 − A of the planned time, the robot's pace costs A (1 − P) of it, parts
-    set down off spacing A P (1 − Q); what is left is OEE = A P Q, so the four shares sum
-    to 1."""
-    a, p, q = availability, performance, quality
-    return [(WATERFALL[0], 1.0 - a), (WATERFALL[1], a * (1.0 - p)),
-            (WATERFALL[2], a * p * (1.0 - q)), ("OEE", a * p * q)]
+def loss_waterfall(r: RunSummary) -> list[tuple[str, float]]:
+    """OEE's loss waterfall: the share of the planned busy time lost at each step
+    (:data:`LOSSES`), then OEE; they sum to 1."""
+    return [(name, getattr(r, name)) for name in WATERFALL]

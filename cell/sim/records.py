@@ -292,15 +292,26 @@ class RunSummary:
     """Share of the run the robot was down (failed: waiting for a crew or under repair)."""
     robot_maintenance_fraction: float = NAN
     """Share of the run the robot was in planned maintenance."""
+    planned_time_s: float = NAN
+    """OEE's planned busy time, s: the run less planned stops (ISO 22400-2; docs/model.md)."""
     availability: float = NAN
-    """OEE's A: time the cell was not down (robot or belts) over the time not planned off
-    (the run less planned maintenance)."""
+    """OEE's A: the robot's time in motion / planned busy time."""
     performance: float = NAN
-    """OEE's P: the robot's fastest cycle × parts delivered / the cell's run time."""
+    """OEE's P: nominal cycle × parts produced (set down or scrapped) / time in motion."""
     quality: float = NAN
-    """OEE's Q: parts set down within the spacing tolerance / parts delivered."""
+    """OEE's Q: good parts / parts produced, by ``quality.rule``."""
     oee: float = NAN
-    """availability × performance × quality."""
+    """A × P × Q = nominal cycle × good parts / planned busy time (the whole run's)."""
+    loss_downtime: float = NAN
+    """Share of the planned busy time the robot was down (failed or worn)."""
+    loss_starved: float = NAN
+    """Share the robot was up and still with no part to pick."""
+    loss_blocked: float = NAN
+    """Share the robot was up and still while the output belt stood."""
+    loss_speed: float = NAN
+    """Share lost to pace, A (1 − P) (negative: faster than the nominal cycle)."""
+    loss_quality: float = NAN
+    """Share lost to parts produced but not good, A P (1 − Q); with OEE the losses sum to 1."""
     service_level: float = NAN
     """Parts delivered / parts arrived."""
     parts_lost_downtime: int = 0

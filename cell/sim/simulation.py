@@ -287,7 +287,7 @@ def simulate(scenario: Scenario | AssembledCell,
     summary = _summary(cell, log, acct, t_all, n, env.now)
     stops = downtime.all_stops(env.now) if downtime is not None else \
         wear_clock.stop_rows(wear, env.now)  # failures.csv's rows
-    lines = oee.measure(summary, log.column, downtime, k.fastest_cycle_s, env.now, stops)
+    lines = oee.measure(summary, log.column, downtime, k.cycle_nom, env.now, stops, s.quality.rule)
     summary.seed = _seed_value(seed)
     summary.input_speed_max_in_s = conveyor.belt.max_speed_in_s
     summary.input_speed_min_in_s = conveyor.belt.min_speed_in_s

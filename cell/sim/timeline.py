@@ -5,7 +5,9 @@ The robot is ``down`` (failed: waiting for a crew or being repaired), in ``maint
 ``busy`` (in motion), ``waiting`` (up and still, a part on its way to B on the input belt)
 or ``idle`` (up and still, nothing on the input belt), in that order of precedence.  A belt
 is ``down`` or ``running`` (``stopped``, up at speed 0, is the word for a belt a controller
-halts; none of the built-in ones does); the sensor ``down`` or ``up``.
+halts; none of the built-in ones does); the sensor ``down`` or ``up``.  OEE's work unit
+(:mod:`cell.sim.oee`) splits the robot's up-and-still time further: ``blocked`` while the
+output belt is down, ``starved`` otherwise.
 """
 
 from __future__ import annotations

@@ -7,6 +7,7 @@ than the trace's own sampling error."""
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -123,6 +124,12 @@ def test_a_real_compare_says_oee_and_no_nan(capsys):
     out = capsys.readouterr().out
     row = next(line for line in out.splitlines() if line.strip().startswith("OEE"))
     assert "better" in row and "nan" not in out.lower()
+    # where each side's planned busy time went, by summary.csv's names, A's share first
+    losses = next(line for line in out.splitlines() if line.strip().startswith("OEE losses"))
+    shares = dict(re.findall(r"(loss_\w+) ([-\d.]+)% against", losses))
+    assert list(shares) == ["loss_downtime", "loss_starved", "loss_blocked", "loss_speed",
+                            "loss_quality"]
+    assert shares["loss_downtime"] == "0.0" and float(shares["loss_starved"]) > 0
 
 
 @pytest.mark.parametrize("practical", ["-1", "nan", "inf"])

@@ -62,7 +62,7 @@ def test_a_one_part_run_whose_robot_fails_shows_no_nan(tmp_path, capsys):
     assert summary["parts_delivered"].iloc[0] == 0 and np.isnan(summary["quality"].iloc[0])
     assert np.isnan(summary["oee"].iloc[0])  # in the CSV an empty cell
     assert "nan" not in said.lower()
-    oee = next(line for line in said.splitlines() if line.startswith("availability"))
+    oee = next(line for line in said.splitlines() if line.startswith("OEE"))
     assert "quality n/a" in oee and "OEE n/a" in oee
 
 
@@ -70,6 +70,7 @@ def test_the_summary_waterfall_of_a_run_without_deliveries_shows_no_nan():
     r = RunSummary(policy="adaptive", availability=0.5, performance=0.0, quality=math.nan,
                    oee=math.nan)
     assert "nan" not in format_summary(r).lower() and "nan" not in oee_line(r).lower()
+    assert "nan" not in format_summary(r, accounting=False).lower()
 
 
 def test_an_optimisation_with_one_replication_reports_no_nan(tmp_path, unrendered):

@@ -20,7 +20,8 @@ def test_a_run_of_one_delivery_prints_its_undefined_figures_as_dashes(tmp_path: 
     delivered; its wall-clock cycle, rate and IP are undefined in print and in the CSV alike."""
     (tmp_path / "trace.csv").write_text("interarrival_s\n" + "1e-9\n" * 30)
     (tmp_path / "s.yaml").write_text("arrivals:\n  trace_csv: trace.csv\nrun:\n  parts: 3\n")
-    assert main(["run", str(tmp_path / "s.yaml"), "--out", str(tmp_path / "out")]) == 0
+    assert main(["run", str(tmp_path / "s.yaml"), "--out", str(tmp_path / "out"),
+                 "--thesis"]) == 0
     shown = capsys.readouterr()
     assert "cell: warning: offered load" in shown.err
     assert not re.search(r"\bnan\b", shown.out, re.IGNORECASE), shown.out

@@ -214,7 +214,7 @@ def test_wear_mtbf_is_the_long_run_mean_time_between_wear_stops(renewal_runs) ->
 
 def test_wear_alone_stops_are_in_the_failures_the_states_and_the_summary(renewal_runs) -> None:
     """wear: without failures: each stop is a failures.csv row (robot, wear), the robot is
-    ``down`` in states.csv exactly then, and the summary's availability, down fraction and
+    ``down`` in states.csv exactly then, and the summary's downtime loss, down fraction and
     observed MTBF count the stops (nothing else stops this cell)."""
     run = renewal_runs[0]
     r, end = run.summary, run.summary.sim_end_s
@@ -231,7 +231,7 @@ def test_wear_alone_stops_are_in_the_failures_the_states_and_the_summary(renewal
     assert np.allclose([(s.from_s, s.to_s) for s in robot if s.state == "down"],
                        [(x.from_s, x.to_s) for x in stops])
     assert r.robot_down_fraction == pytest.approx(down_s / end)
-    assert r.availability == pytest.approx(1 - down_s / end) and r.availability < 1
+    assert r.loss_downtime == pytest.approx(down_s / end) and r.loss_downtime > 0
     assert r.robot_failures == len(stops)
     assert r.mtbf_observed_s == pytest.approx((end - down_s) / len(stops))
     assert r.oee == pytest.approx(r.availability * r.performance * r.quality)
