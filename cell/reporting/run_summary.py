@@ -176,17 +176,39 @@ def _no_quality(r: RunSummary) -> str:
     return "" if r.quality == r.quality else " (no part delivered: quality is undefined)"
 
 
-def oee_line(r: RunSummary) -> str:
-    """A run with failures: its OEE and what it is made of, the stops, the parts they cost; a
-    figure with no value (quality when no part was delivered, and OEE with it) is ``n/a``
-    with the reason, never ``nan``."""
+def oee_line(r: RunSummary, failures: Any = None) -> str:
+    """A run with failures: its OEE and what it is made of, the stops, the parts they cost,
+    and the robot's observed MTBF and MTTR when it failed; a figure with no value (quality
+    when no part was delivered, and OEE with it) is ``n/a`` with the reason, never ``nan``.
+
+    MTBF and MTTR are in the unit the scenario's ``failures`` section (``failures``) gives the
+    robot's time to failure and to repair in: hours where it says ``mean_h``, else seconds
+    (summary.csv keeps seconds whatever the unit)."""
     def shown(v: float) -> str:
         return f"{v:.4f}" if math.isfinite(v) else "n/a"
 
     return (f"availability {shown(r.availability)}, performance {shown(r.performance)}, quality "
             f"{shown(r.quality)}: OEE {shown(r.oee)}{_no_quality(r)}; robot failures "
-            f"{r.robot_failures}, parts lost to downtime {r.parts_lost_downtime}, scrapped "
-            f"{r.parts_scrapped}")
+            f"{r.robot_failures}{_mtbf(r, failures)}, parts lost to downtime "
+            f"{r.parts_lost_downtime}, scrapped {r.parts_scrapped}")
+
+
+def _mtbf(r: RunSummary, failures: Any) -> str:
+    """`` (MTBF 38.5 h, MTTR 0.52 h observed)`` in the units of ``failures.robot``'s times."""
+    if not r.robot_failures:
+        return ""
+    from cell.scenario.failure_spec import SECONDS_PER_HOUR, unit
+
+    robot = getattr(failures, "robot", None)
+    units = ("s", "s") if robot is None else (unit(robot.time_to_failure), unit(robot.time_to_repair))
+
+    def shown(v: float, u: str) -> str:
+        if not math.isfinite(v):
+            return "n/a"
+        return f"{v / SECONDS_PER_HOUR:.4g} h" if u == "h" else f"{v:.1f} s"
+
+    return (f" (MTBF {shown(r.mtbf_observed_s, units[0])}, MTTR {shown(r.mttr_observed_s, units[1])}"
+            " observed)")
 
 
 def format_summary(r: RunSummary, thesis: dict[str, str] | None = None) -> str:

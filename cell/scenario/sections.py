@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
-from pydantic import Field, field_validator
+from pydantic import Field, SerializerFunctionWrapHandler, field_validator, model_serializer
 
 from cell.scenario import registry
 from cell.scenario.fields import Section
@@ -301,13 +301,31 @@ class WearSettings(Section):
 
 # --------------------------------------------------------------------------- failures
 class TimeDistribution(Section):
-    """A time (s) as a scipy.stats distribution, named and parametrised as ``arrivals`` is."""
+    """A time (s) as a scipy.stats distribution, named and parametrised as ``arrivals`` is:
+    by scipy's ``params``, or by its mean (``mean_s`` or ``mean_h``) and, but for ``expon``,
+    its ``shape`` or ``cv``: ``weibull_min``, ``gamma``, ``lognorm`` (cell.scenario.spread)."""
 
     distribution: str = "expon"
-    """Any continuous distribution in scipy.stats, by name."""
+    """Any continuous distribution in scipy.stats, by name (by its mean: see above)."""
     params: dict[str, Annotated[float, Field(strict=True, allow_inf_nan=False)]] = Field(
         default_factory=dict)
     """Its parameters by scipy's names (``scale``, ``loc``, shapes), in seconds."""
+    mean_s: float | None = _num(None, gt=0.0, le=MAX_HOURS * 3600.0)
+    """The mean time in seconds (or ``mean_h``, not both)."""
+    mean_h: float | None = _num(None, gt=0.0, le=MAX_HOURS)
+    """The mean time in hours (or ``mean_s``, not both)."""
+    shape: float | None = _num(None, gt=0.0, le=1e4)
+    """With the mean: scipy's shape parameter, weibull_min's c, gamma's a, lognorm's s (or
+    ``cv``, not both; ``expon`` takes neither)."""
+    cv: float | None = _num(None, gt=0.0, le=10.0)
+    """With the mean: the coefficient of variation, sd / mean (or ``shape``, not both)."""
+
+    @model_serializer(mode="wrap")
+    def _given_only(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """Mean and spread only where given: a time by ``params`` dumps as before they were."""
+        d: dict[str, Any] = handler(self)
+        return {k: v for k, v in d.items() if k not in ("mean_s", "mean_h", "shape", "cv")
+                or v is not None}
 
 
 class EquipmentFailures(Section):
