@@ -11,6 +11,8 @@ import math
 
 #: Families whose shape and scale follow from a mean and a shape or coefficient of variation.
 BY_MEAN_AND_CV = ("gamma", "weibull_min", "lognorm", "expon")
+#: Each family's ``shape``, by scipy's name for it (the exponential has none).
+SHAPE_PARAM = {"gamma": "a", "weibull_min": "c", "lognorm": "s", "expon": None}
 
 
 def by_mean_and_cv(family: str, mean: float, cv: float) -> dict[str, float]:
