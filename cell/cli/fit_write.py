@@ -160,7 +160,7 @@ def fitted_block(args: argparse.Namespace, trace: Path, out: Path | None, data: 
         warning += f". To run the data themselves, replay them: {replay}"
     notes = list(data.notes)
     if key != "arrivals":
-        notes.append(f"in seconds: put it under failures.EQUIPMENT ({EQUIPMENT}), with its "
+        notes.append(f"put it under failures.EQUIPMENT ({EQUIPMENT}), with its "
                      f"{'time_to_repair' if key == 'time_to_failure' else 'time_to_failure'}")
     source = f"{trace}, column {args.column} ({data.what})"
     block = block_yaml(chosen, key, source, caution=warning, notes=[*found, *notes],

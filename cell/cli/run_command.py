@@ -123,7 +123,7 @@ def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) ->
     if not _stops_anything(scenario):
         print(f"wrote {shown}/{written[0]}, {written[1]} and {written[2]}")
         return
-    print(stops_line(r))
+    print(stops_line(r, scenario.failures))
     print(f"wrote {shown}/{written[0]}, {written[1]}, {written[2]}, states.csv and failures.csv")
 
 

@@ -55,18 +55,40 @@ def ks_line(fit: Fit) -> str:
 
 def block_yaml(fit: Fit, key: str, source: str, *, caution: str = "", notes: Sequence[str] = (),
                method: str = "") -> str:
-    """The scenario block ``key: {distribution, params}`` for ``fit``, with comments naming
-    ``source``, how it was fitted (``method``, by default :func:`ks_line`), each of ``notes``
-    and ``caution`` (as a ``CAUTION:`` line) when there is one, each wrapped."""
+    """The scenario block ``key: {distribution, params}`` for ``fit`` (a time to failure or
+    repair by its mean in hours and its shape where :func:`by_mean_lines` can), with comments
+    naming ``source``, how it was fitted (``method``, by default :func:`ks_line`), each of
+    ``notes`` and ``caution`` (as a ``CAUTION:`` line) when there is one, each wrapped."""
     source = " ".join(source.split())  # one comment line, whatever the name holds
     params = ", ".join(f"{k}: {_yaml_float(v, _digits(k, fit.params, 7))}" for k, v in fit.params.items())
     said = "".join(_comments(note) for note in notes if note)
     warned = _comments(f"CAUTION: {caution}") if caution else ""
+    given = by_mean_lines(fit) if key in FAILURE_BLOCKS else None
     return (f"# fitted by `cell fit` from {source}\n"
             f"# {method or ks_line(fit)}\n"
             f"{said}{warned}{key}:\n"
             f"  distribution: {fit.family}\n"
-            f"  params: {{{params}}}\n")
+            + (given or f"  params: {{{params}}}\n"))
+
+
+#: The blocks of the ``failures:`` section, written by their mean where the family allows.
+FAILURE_BLOCKS = ("time_to_failure", "time_to_repair")
+
+
+def by_mean_lines(fit: Fit) -> str | None:
+    """``mean_h`` and ``shape`` lines for a fit the ``failures:`` section can take by its mean
+    (weibull_min, gamma, lognorm with no location; expon by its mean alone), each to seven
+    digits; None for any other."""
+    from cell.scenario.spread import SHAPE_PARAM
+
+    if fit.family not in SHAPE_PARAM or fit.params.get("loc", 0.0) != 0.0:
+        return None
+    mean_s = float(fit.frozen().mean())
+    shape = SHAPE_PARAM[fit.family]
+    if not (math.isfinite(mean_s) and mean_s > 0) or (shape is not None and shape not in fit.params):
+        return None
+    lines = f"  mean_h: {_yaml_float(mean_s / 3600.0)}\n"
+    return lines + (f"  shape: {_yaml_float(fit.params[shape])}\n" if shape is not None else "")
 
 
 def arrivals_yaml(fit: Fit, source: str, caution: str = "") -> str:

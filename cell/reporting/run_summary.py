@@ -201,6 +201,24 @@ def oee_line(r: RunSummary) -> str:
             f"{shown(r.quality)}: OEE {shown(r.oee)}{_no_quality(r)}")
 
 
+def _mtbf(r: RunSummary, failures: Any) -> str:
+    """`` (MTBF 38.5 h, MTTR 0.52 h observed)`` in the units of ``failures.robot``'s times."""
+    if not r.robot_failures:
+        return ""
+    from cell.scenario.failure_spec import SECONDS_PER_HOUR, unit
+
+    robot = getattr(failures, "robot", None)
+    units = ("s", "s") if robot is None else (unit(robot.time_to_failure), unit(robot.time_to_repair))
+
+    def shown(v: float, u: str) -> str:
+        if not math.isfinite(v):
+            return "n/a"
+        return f"{v / SECONDS_PER_HOUR:.4g} h" if u == "h" else f"{v:.1f} s"
+
+    return (f" (MTBF {shown(r.mtbf_observed_s, units[0])}, MTTR {shown(r.mttr_observed_s, units[1])}"
+            " observed)")
+
+
 def waterfall_line(r: RunSummary) -> str:
     """Where the planned busy time went: the five losses (summary.csv's names), then OEE."""
     from cell.sim.oee import loss_waterfall
@@ -210,10 +228,13 @@ def waterfall_line(r: RunSummary) -> str:
             + f"; left: OEE {_share(steps[-1][1])}")
 
 
-def stops_line(r: RunSummary) -> str:
-    """A run with failures or wear: the robot's stops and the parts they cost."""
-    return (f"robot failures {r.robot_failures}, parts lost to downtime {r.parts_lost_downtime}, "
-            f"scrapped {r.parts_scrapped}")
+def stops_line(r: RunSummary, failures: Any = None) -> str:
+    """A run with failures or wear: the robot's stops, its observed MTBF and MTTR when it
+    failed, and the parts they cost.  MTBF and MTTR are in the unit the scenario's
+    ``failures`` section gives the robot's time to failure and to repair in: hours where it
+    says ``mean_h``, else seconds (summary.csv keeps seconds whatever the unit)."""
+    return (f"robot failures {r.robot_failures}{_mtbf(r, failures)}, parts lost to downtime "
+            f"{r.parts_lost_downtime}, scrapped {r.parts_scrapped}")
 
 
 def format_summary(r: RunSummary, thesis: dict[str, str] | None = None,

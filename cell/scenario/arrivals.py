@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 from cell.plumbing.cache import Remembered, file_key, memo
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.rate_profile import ProfileSpec, check_profile, scaled_gaps
+from cell.scenario.spread import BY_MEAN_AND_CV, by_mean_and_cv
 from cell.scenario.trace_file import column_cells
 
 #: The feeder's child stream of the root SeedSequence (other streams take other keys).
@@ -210,44 +211,12 @@ def _frozen(arrivals: ArrivalSpec) -> Any:
     return getattr(scipy.stats, arrivals.distribution)(**parameters(arrivals))
 
 
-#: Families whose shape and scale follow from a mean and a coefficient of variation.
-BY_MEAN_AND_CV = ("gamma", "weibull_min", "lognorm", "expon")
-
-
 def parameters(arrivals: ArrivalSpec) -> dict[str, float]:
     """The distribution's scipy parameters: ``params``, or those derived from ``mean_s``
     and ``cv`` (no location, except the shifted exponential's)."""
     if arrivals.mean_s is None or arrivals.cv is None:
         return dict(arrivals.params)
     return by_mean_and_cv(arrivals.distribution, arrivals.mean_s, arrivals.cv)
-
-
-def by_mean_and_cv(family: str, mean: float, cv: float) -> dict[str, float]:
-    """Shape and scale of ``family`` with this mean and coefficient of variation.
-
-    gamma: a = 1/cv², scale = mean·cv²; lognorm: s² = ln(1 + cv²), scale = mean/√(1 + cv²);
-    weibull_min: c solves Γ(1 + 2/c)/Γ(1 + 1/c)² = 1 + cv², scale = mean/Γ(1 + 1/c);
-    expon: shifted, loc = mean(1 − cv), scale = mean·cv (so cv ≤ 1).
-    """
-    if family == "gamma":
-        return {"a": 1.0 / cv**2, "scale": mean * cv**2}
-    if family == "lognorm":
-        return {"s": math.sqrt(math.log1p(cv**2)), "scale": mean / math.sqrt(1.0 + cv**2)}
-    if family == "expon":
-        if cv > 1:
-            raise ValueError("a shifted exponential has a coefficient of variation of at most 1")
-        return {"loc": mean * (1.0 - cv), "scale": mean * cv}
-    if family == "weibull_min":
-        from scipy.optimize import brentq
-        from scipy.special import gammaln
-
-        def excess(log_c: float) -> float:
-            c = math.exp(log_c)
-            return math.exp(gammaln(1 + 2 / c) - 2 * gammaln(1 + 1 / c)) - 1.0 - cv**2
-
-        c = math.exp(brentq(excess, math.log(0.05), math.log(1e4), xtol=1e-14))
-        return {"c": c, "scale": mean / math.exp(gammaln(1 + 1 / c))}
-    raise ValueError(f"mean_s and cv set the shape of {', '.join(BY_MEAN_AND_CV)} only")
 
 
 def mean_interarrival(arrivals: ArrivalSpec, base_dir: Path | str = ".") -> float:

@@ -17,6 +17,7 @@ import numpy as np
 
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.arrivals import stream
+from cell.scenario.spread import BY_MEAN_AND_CV, by_mean
 
 #: Pieces of equipment that can fail, in the order states.csv lists them.
 EQUIPMENT = ("robot", "input_belt", "output_belt", "sensor")
@@ -46,9 +47,9 @@ def check_failures(f: Any, file: object, run_s: float = math.inf) -> None:
             continue
         for which in ("time_to_failure", "time_to_repair"):
             check_time(getattr(mode, which), f"failures.{name}.{which}", file)
+        given, value = as_given(mode.time_to_failure)
         check_frequency(frozen(mode.time_to_failure), run_s, file,
-                        f"failures.{name}.time_to_failure.params", dict(mode.time_to_failure.params),
-                        "fails every")
+                        f"failures.{name}.time_to_failure.{given}", value, "fails every")
     m = f.maintenance
     if m is not None:
         if m.duration_min * 60.0 >= m.every_h * SECONDS_PER_HOUR:
@@ -113,11 +114,80 @@ def check_frequency(dist: Any, run_s: float, file: object, key: str, value: Any,
                             "or a run is mostly stops")
 
 
+def mean_seconds(spec: Any) -> float | None:
+    """The mean a time is given by, in seconds (``mean_s``, or ``mean_h`` × 3600); None for
+    a time given by its scipy ``params``."""
+    if spec.mean_h is not None:
+        return float(spec.mean_h) * SECONDS_PER_HOUR
+    return None if spec.mean_s is None else float(spec.mean_s)
+
+
+def scipy_params(spec: Any) -> dict[str, float]:
+    """A time's scipy parameters: its ``params``, or those of its mean and its shape or cv
+    (:func:`cell.scenario.spread.by_mean`; a ValueError where there are none)."""
+    mean = mean_seconds(spec)
+    if mean is None:
+        return dict(spec.params)
+    return by_mean(spec.distribution, mean, shape=spec.shape, cv=spec.cv)
+
+
+def as_given(spec: Any) -> tuple[str, Any]:
+    """The key a time was given by (``params``, ``mean_s`` or ``mean_h``) and its value, as a
+    message about the time names them."""
+    for key in ("mean_h", "mean_s"):
+        if getattr(spec, key) is not None:
+            return key, getattr(spec, key)
+    return "params", dict(spec.params)
+
+
+def unit(spec: Any) -> str:
+    """The unit a time was given in: ``h`` for ``mean_h``, ``s`` otherwise."""
+    return "h" if spec.mean_h is not None else "s"
+
+
 def frozen(spec: Any) -> Any:
-    """The scipy.stats distribution of a ``{distribution, params}`` setting."""
+    """The scipy.stats distribution of a time setting (:func:`scipy_params`)."""
     import scipy.stats
 
-    return getattr(scipy.stats, spec.distribution)(**dict(spec.params))
+    return getattr(scipy.stats, spec.distribution)(**scipy_params(spec))
+
+
+def check_by_mean(spec: Any, key: str, file: object) -> None:
+    """Refuse a time given half by its mean, or by its mean in two ways: ``mean_s`` with
+    ``mean_h``, ``shape`` with ``cv``, ``params`` with a mean, a shape or cv without a mean,
+    a family the mean cannot set, an exponential with a shape or cv, a mean alone for a
+    family that needs its spread too."""
+    mean_key, mean = as_given(spec)
+    spread = [(k, getattr(spec, k)) for k in ("shape", "cv") if getattr(spec, k) is not None]
+    if spec.mean_s is not None and spec.mean_h is not None:
+        raise ScenarioError(file, f"{key}.mean_h", spec.mean_h,
+                            f"give {key}.mean_s or {key}.mean_h, not both")
+    if len(spread) == 2:
+        raise ScenarioError(file, f"{key}.cv", spec.cv, f"give {key}.shape or {key}.cv, not both")
+    if mean_key == "params":
+        if spread:
+            raise ScenarioError(file, f"{key}.{spread[0][0]}", spread[0][1],
+                                f"goes with {key}.mean_s or {key}.mean_h (or give {key}.params "
+                                "alone)")
+        return
+    if spec.params:
+        raise ScenarioError(file, f"{key}.params", dict(spec.params),
+                            f"give {key}.params or {key}.{mean_key}, not both")
+    if spec.distribution not in BY_MEAN_AND_CV:
+        raise ScenarioError(file, f"{key}.distribution", spec.distribution,
+                            f"a time by its mean is one of {', '.join(BY_MEAN_AND_CV)}; give "
+                            f"{key}.params for {spec.distribution}")
+    if spec.distribution == "expon" and spread:
+        raise ScenarioError(file, f"{key}.{spread[0][0]}", spread[0][1],
+                            f"expon is set by {key}.{mean_key} alone")
+    if not spread and spec.distribution != "expon":
+        raise ScenarioError(file, f"{key}.{mean_key}", mean,
+                            f"{spec.distribution} needs {key}.shape or {key}.cv beside its mean")
+    try:
+        scipy_params(spec)
+    except ValueError as exc:
+        raise ScenarioError(file, f"{key}.{spread[0][0]}", spread[0][1],
+                            f"{spec.distribution}: {exc}") from None
 
 
 def check_time(spec: Any, key: str, file: object) -> float:
@@ -128,21 +198,23 @@ def check_time(spec: Any, key: str, file: object) -> float:
     if not isinstance(dist, scipy.stats.rv_continuous):
         raise ScenarioError(file, f"{key}.distribution", spec.distribution,
                             "not a continuous distribution in scipy.stats")
+    check_by_mean(spec, key, file)
+    given, value = as_given(spec)
     try:
         d = frozen(spec)
         mean, low = float(d.mean()), float(d.support()[0])
     except (TypeError, ValueError) as exc:
-        raise ScenarioError(file, f"{key}.params", dict(spec.params),
+        raise ScenarioError(file, f"{key}.{given}", value,
                             f"not accepted by scipy.stats.{spec.distribution}: {exc}") from None
     if math.isnan(mean) and math.isnan(low):  # scipy's answer for parameters out of range
-        raise ScenarioError(file, f"{key}.params", dict(spec.params),
+        raise ScenarioError(file, f"{key}.{given}", value,
                             f"scipy.stats.{spec.distribution} takes no such parameters (a zero "
                             "or negative scale?): the mean time would be undefined")
     if not math.isfinite(mean):  # infinite, or undefined (a Cauchy's)
-        raise ScenarioError(file, f"{key}.params", dict(spec.params),
+        raise ScenarioError(file, f"{key}.{given}", value,
                             f"scipy.stats.{spec.distribution} with these has no finite mean")
     if not low >= 0 or not mean > 0:
-        raise ScenarioError(file, f"{key}.params", dict(spec.params),
+        raise ScenarioError(file, f"{key}.{given}", value,
                             f"times must be non-negative with a positive mean (mean {mean:.6g} s)")
     return mean
 

@@ -20,6 +20,10 @@ from typing import Any
 from pydantic import BaseModel, PrivateAttr, ValidationError
 
 from cell.plumbing.errors import ScenarioError
+from cell.scenario.failure_sections import (  # noqa: F401 - the schema, re-exported
+    FailureSettings,
+    WearSettings,
+)
 from cell.scenario.fields import Section, error_from_validation, model_at, unwrap_optional
 from cell.scenario.overrides import apply_overrides, merge
 from cell.scenario.run_length import keep_one_length, lengths_given
@@ -35,7 +39,6 @@ from cell.scenario.sections import (  # noqa: F401 - the schema, re-exported
     ArrivalSettings,
     BeltSettings,
     ControllerSettings,
-    FailureSettings,
     HandSettings,
     JointLimitSettings,
     LayoutSettings,
@@ -48,7 +51,6 @@ from cell.scenario.sections import (  # noqa: F401 - the schema, re-exported
     RobotSettings,
     RunSettings,
     SensorSettings,
-    WearSettings,
 )
 
 

@@ -27,7 +27,7 @@ MAX_SEED = 2**128
 MAX_HOURS = 1e5
 
 
-def _num(default: Any = None, *, gt: float | None = None, ge: float | None = None,
+def finite(default: Any = None, *, gt: float | None = None, ge: float | None = None,
          le: float | None = None) -> Any:
     """A finite number field (ints accepted, booleans and text refused) with bounds."""
     return Field(default, strict=True, allow_inf_nan=False, gt=gt, ge=ge, le=le)
@@ -51,11 +51,11 @@ class LayoutSettings(Section):
 
     robot_base_in: Point = (-8.0, 8.0, 0.0)
     """Base axis on the table, global frame (§4.1)."""
-    shoulder_height_in: float = _num(7.68, gt=0.0, le=MAX_LENGTH_IN)
+    shoulder_height_in: float = finite(7.68, gt=0.0, le=MAX_LENGTH_IN)
     """Shoulder above the table (§6.1)."""
-    robot_yaw_deg: float = _num(-45.0, ge=-360.0, le=360.0)
+    robot_yaw_deg: float = finite(-45.0, ge=-360.0, le=360.0)
     """Robot frame = global rotated about z by this (eq. 6.1)."""
-    belt_width_in: float = _num(8.0, gt=0.0, le=MAX_LENGTH_IN)
+    belt_width_in: float = finite(8.0, gt=0.0, le=MAX_LENGTH_IN)
     """Both conveyors (§4.1); a part must fit on them; otherwise used for drawings only."""
 
 
@@ -84,13 +84,13 @@ class PathSettings(Section):
     """G, beginning of output tracking (§4.2)."""
     eot_in: Point = (0.0, 16.0, 3.0)
     """K, end of tracking on the output belt (§4.2)."""
-    pick_height_in: float = _num(1.0, gt=0.0, le=MAX_LENGTH_IN)
+    pick_height_in: float = finite(1.0, gt=0.0, le=MAX_LENGTH_IN)
     """Tool-centre height at lift-off LO: the cube's centre (§4.2, §6.2 f)."""
-    place_height_in: float = _num(1.0, gt=0.0, le=MAX_LENGTH_IN)
+    place_height_in: float = finite(1.0, gt=0.0, le=MAX_LENGTH_IN)
     """Tool-centre height at touch-down TD (§4.2)."""
-    lo_from_bot_in: float = _num(4.0, gt=0.0, le=MAX_LENGTH_IN)
+    lo_from_bot_in: float = finite(4.0, gt=0.0, le=MAX_LENGTH_IN)
     """Distance B → LO; the thesis does not place LO: mid-window (docs/model.md)."""
-    td_from_g_in: float = _num(4.0, gt=0.0, le=MAX_LENGTH_IN)
+    td_from_g_in: float = finite(4.0, gt=0.0, le=MAX_LENGTH_IN)
     """Distance G → TD: mid-window, as LO."""
     moves: MoveSettings = MoveSettings()
 
@@ -99,9 +99,9 @@ class PathSettings(Section):
 class PartSettings(Section):
     """The parts: oriented cubes (thesis §6.2 c, f)."""
 
-    size_in: float = _num(2.0, gt=0.0, le=MAX_LENGTH_IN)
+    size_in: float = finite(2.0, gt=0.0, le=MAX_LENGTH_IN)
     """Cube edge; also the finger opening while holding it (§6.2 f)."""
-    weight_oz: float = _num(4.0, ge=0.0, le=1e6)
+    weight_oz: float = finite(4.0, ge=0.0, le=1e6)
     """Load carried from LO to TD (§6.2 f)."""
 
 
@@ -127,13 +127,13 @@ class JointLimitSettings(Section):
 class HandSettings(Section):
     """Hand length against finger opening G, eq. 6.2 (corrected: docs/sources.md)."""
 
-    l1_in: float = _num(1.884, ge=0.0, le=MAX_LENGTH_IN)
+    l1_in: float = finite(1.884, ge=0.0, le=MAX_LENGTH_IN)
     """L1 of w11 = L1 + √(L2² − (G − G0)²/2)."""
-    l2_in: float = _num(1.700, gt=0.0, le=MAX_LENGTH_IN)
+    l2_in: float = finite(1.700, gt=0.0, le=MAX_LENGTH_IN)
     """L2 of eq. 6.2."""
-    g0_in: float = _num(1.520, ge=0.0, le=MAX_LENGTH_IN)
+    g0_in: float = finite(1.520, ge=0.0, le=MAX_LENGTH_IN)
     """G0 of eq. 6.2."""
-    open_in: float = _num(2.5, gt=0.0, le=MAX_LENGTH_IN)
+    open_in: float = finite(2.5, gt=0.0, le=MAX_LENGTH_IN)
     """Finger opening with no part; ASSUMED (the thesis gives no figure)."""
 
 
@@ -148,18 +148,18 @@ class MotorSettings(Section):
     (TeachMover 0.42) so that R IV at the nominal 75 % takes the thesis's 9.9855 s."""
     max_rate_full_load_rad_s: PositiveFive = (0.37, 0.15, 0.23, 1.31, 1.31)
     """TeachMover speeds carrying the full load (1 lb)."""
-    full_load_oz: float = _num(16.0, gt=0.0, le=1e6)
+    full_load_oz: float = finite(16.0, gt=0.0, le=1e6)
     """The load of those full-load figures."""
-    nominal_fraction: float = _num(0.75, gt=0.0, le=1.0)
+    nominal_fraction: float = finite(0.75, gt=0.0, le=1.0)
     """Nominal operation at 75 % of rated output, peak on request (§7.2)."""
 
 
 class RobotSettings(Section):
     """The MICROBOT arm (thesis §3, Table 3.1; link lengths from the TeachMover)."""
 
-    l2_in: float = _num(7.0, gt=0.0, le=MAX_LENGTH_IN)
+    l2_in: float = finite(7.0, gt=0.0, le=MAX_LENGTH_IN)
     """Upper arm (TeachMover)."""
-    l3_in: float = _num(7.0, gt=0.0, le=MAX_LENGTH_IN)
+    l3_in: float = finite(7.0, gt=0.0, le=MAX_LENGTH_IN)
     """Forearm (TeachMover)."""
     joint_limits_deg: JointLimitSettings = JointLimitSettings()
     hand: HandSettings = HandSettings()
@@ -173,25 +173,25 @@ class RobotSettings(Section):
 class BeltSettings(Section):
     """The two conveyors (thesis §4.3, §5.2)."""
 
-    input_nominal_in_s: float = _num(3.0, gt=0.0, le=MAX_SPEED_IN_S)
+    input_nominal_in_s: float = finite(3.0, gt=0.0, le=MAX_SPEED_IN_S)
     """Nominal input belt speed (§5.2)."""
-    output_nominal_in_s: float = _num(2.0, gt=0.0, le=MAX_SPEED_IN_S)
+    output_nominal_in_s: float = finite(2.0, gt=0.0, le=MAX_SPEED_IN_S)
     """Nominal output belt speed (§5.2)."""
-    spacing_in: float = _num(45.0, gt=0.0, le=MAX_LENGTH_IN)
+    spacing_in: float = finite(45.0, gt=0.0, le=MAX_LENGTH_IN)
     """Required spacing of parts on the output belt (§4.3 f)."""
-    spacing_tol_in: float = _num(0.25, ge=0.0, le=MAX_LENGTH_IN)
+    spacing_tol_in: float = finite(0.25, ge=0.0, le=MAX_LENGTH_IN)
     """Tolerance on that spacing (§4.3 f)."""
-    input_min_in_s: float = _num(1.5, gt=0.0, le=MAX_SPEED_IN_S)
+    input_min_in_s: float = finite(1.5, gt=0.0, le=MAX_SPEED_IN_S)
     """Slowest the adaptive controller may run the input belt; ASSUMED: half the nominal
     speed (§6.2 a gives belts unlimited range; docs/assumptions.md)."""
-    input_max_in_s: float = _num(12.0, gt=0.0, le=MAX_SPEED_IN_S)
+    input_max_in_s: float = finite(12.0, gt=0.0, le=MAX_SPEED_IN_S)
     """Fastest the input belt may run; ASSUMED (§6.2 a gives belts unlimited range)."""
-    output_min_in_s: float = _num(0.25, gt=0.0, le=MAX_SPEED_IN_S)
+    output_min_in_s: float = finite(0.25, gt=0.0, le=MAX_SPEED_IN_S)
     """Slowest the output belt may run; ASSUMED: a set-down part then clears a 2 in part's
     size before the next touch-down even at the robot's shortest cycle (docs/assumptions.md)."""
-    output_max_in_s: float = _num(12.0, gt=0.0, le=MAX_SPEED_IN_S)
+    output_max_in_s: float = finite(12.0, gt=0.0, le=MAX_SPEED_IN_S)
     """Fastest the output belt may run; ASSUMED, as the input's."""
-    input_length_in: float | None = _num(None, gt=0.0, le=MAX_LENGTH_IN * 10)
+    input_length_in: float | None = finite(None, gt=0.0, le=MAX_LENGTH_IN * 10)
     """Feeder drop point to B; the thesis gives none.  Empty: two nominal cycles of
     belt travel (2 × 3.0 × 22.5872 = 135.52 in), so the next part is usually on the
     belt when the controller looks ahead (§5.2)."""
@@ -205,7 +205,7 @@ WEIBULL_SHAPE = 1.0 / 0.2038
 class RateProfile(Section):
     """A rate piecewise constant over a repeating period (docs/usage.md, "Arrivals whose rate changes")."""
 
-    period_h: float = _num(..., gt=0.0, le=MAX_HOURS)
+    period_h: float = finite(..., gt=0.0, le=MAX_HOURS)
     """Hours after which the profile repeats: a shift (8), a day (24), a week (168)."""
     rates: list[Positive] = Field(..., strict=True)
     """Relative rates of the pieces, each > 0, normalised to a time-weighted mean of 1 (the long-run
@@ -213,7 +213,7 @@ class RateProfile(Section):
     starts_h: list[NonNegative] | None = None
     """Hour of the period at which each piece starts (the first at 0, increasing, each
     before ``period_h``).  Empty: equal pieces."""
-    run_start_h: float = _num(0.0, ge=0.0, le=MAX_HOURS)
+    run_start_h: float = finite(0.0, ge=0.0, le=MAX_HOURS)
     """The hour of the period at which the run starts (below ``period_h``): 0, its start."""
 
 
@@ -225,10 +225,10 @@ class ArrivalSettings(Section):
     params: dict[str, Annotated[float, Field(strict=True, allow_inf_nan=True)]] = Field(
         default_factory=lambda: {"c": WEIBULL_SHAPE, "loc": 17.6019, "scale": 5.4342})
     """Its parameters by scipy's names; the default is eq. 6.9."""
-    mean_s: float | None = _num(None, gt=0.0, le=MAX_TIME_S)
+    mean_s: float | None = finite(None, gt=0.0, le=MAX_TIME_S)
     """With ``cv``: the mean inter-arrival time; the family's shape and scale are then
     derived from the two (no location) and ``params`` is not used."""
-    cv: float | None = _num(None, gt=0.0, le=10.0)
+    cv: float | None = finite(None, gt=0.0, le=10.0)
     """With ``mean_s``: the coefficient of variation (sd / mean) of the inter-arrival time;
     ``gamma``, ``weibull_min``, ``lognorm`` and ``expon`` (shifted; cv ≤ 1) take it."""
     trace_csv: str | None = None
@@ -244,10 +244,10 @@ class ControllerSettings(Section):
 
     policy: str = "adaptive"
     """A registered policy: ``adaptive`` (§5.3), ``non-adaptive`` (§6.3), or a plug-in."""
-    nominal_cycle_s: float | None = _num(None, gt=0.0, le=MAX_TIME_S)
+    nominal_cycle_s: float | None = finite(None, gt=0.0, le=MAX_TIME_S)
     """The ideal transfer time of §5.3, the mean inter-arrival time.  Empty: the mean of
     the arrivals (the distribution's, or the trace's); the thesis quotes 22.5872 s."""
-    ideal_cycle_s: float | None = _num(None, gt=0.0, le=MAX_TIME_S)
+    ideal_cycle_s: float | None = finite(None, gt=0.0, le=MAX_TIME_S)
     """The robot's fixed cycle for the non-adaptive policy (Table 7.1, column 1);
     shortened in R IV only.  Empty: the nominal cycle."""
 
@@ -269,7 +269,7 @@ class RunSettings(Section):
     delivery intervals).  The thesis's terminating 500-part runs keep 0."""
     seed: int = Field(1984, strict=True, ge=0, lt=MAX_SEED)
     """Root of every random stream (numpy SeedSequence)."""
-    hours: float | None = _num(None, gt=0.0, le=MAX_HOURS)
+    hours: float | None = finite(None, gt=0.0, le=MAX_HOURS)
     """The run's length in hours instead of parts: the parts that come in that time, the run
     stopped at its end (parts still in the cell then are counted as such).  Give run.hours
     or run.parts, not both."""
@@ -280,7 +280,7 @@ class MinTimeSettings(Section):
 
     grid_points: int = Field(460, strict=True, ge=3, le=MAX_GRID_POINTS)
     """Grid points per regime (R II, R IV), s scaled to [0, 1]; 460 as the thesis's path."""
-    rate_fraction: float = _num(1.0, gt=0.0, le=1.0)
+    rate_fraction: float = finite(1.0, gt=0.0, le=1.0)
     """Joint velocity bounds = the motors' step rates at the regime's load (§6.1) times
     this: 1.0 is the peak, as in the thesis's minimum feasible cycle (§7.2)."""
     acceleration_bounds: bool = Field(False, strict=True)
@@ -293,86 +293,6 @@ class MinTimeSettings(Section):
     name), as in baseline.yaml; empty: no torque bounds."""
 
 
-# --------------------------------------------------------------------------- wear
-class WearSettings(Section):
-    """Motor wear from how hard each cycle drives the joints (SPEC §10; docs/wear.md): an
-    inverse power law in the step rate, carried by the cumulative exposure model, Weibull in
-    the exposure (Nelson 1990, *Accelerated Testing*).  Off by default: no value here is
-    known for the MICROBOT; each is an assumption to sweep."""
-
-    enabled: bool = Field(False, strict=True)
-    """Wear the motors and stop the robot when one wears out; off, nothing changes."""
-    exponent: float = _num(1.0, ge=0.0, le=20.0)
-    """p of η(S) = η0 (S0/S)^p, S a joint's step rate over its rated maximum.  1: life in
-    steps, the rolling-bearing case (L10h ∝ 1/speed); 0: life in hours of motion whatever
-    the speed (a stepper's winding heats with its near-constant current)."""
-    rated_life_h: float = _num(5000.0, gt=0.0, le=1e7)
-    """η0: a motor's Weibull characteristic life in hours of motion at ``reference_stress``."""
-    reference_stress: float = _num(0.75, gt=0.0, le=1.0)
-    """S0: the stress the rated life is quoted at; the motors' nominal 75 % (§7.2)."""
-    shape: float = _num(2.0, gt=0.0, le=20.0)
-    """β, the Weibull shape in the exposure: above 1, the motor wears out."""
-    repair_h: float = _num(4.0, ge=0.0, le=MAX_TIME_S / 3600.0)
-    """Hours the robot is down while a worn motor is replaced."""
-
-
-# --------------------------------------------------------------------------- failures
-class TimeDistribution(Section):
-    """A time (s) as a scipy.stats distribution, named and parametrised as ``arrivals`` is."""
-
-    distribution: str = "expon"
-    """Any continuous distribution in scipy.stats, by name."""
-    params: dict[str, Annotated[float, Field(strict=True, allow_inf_nan=False)]] = Field(
-        default_factory=dict)
-    """Its parameters by scipy's names (``scale``, ``loc``, shapes), in seconds."""
-
-
-class EquipmentFailures(Section):
-    """How one piece of equipment fails and is repaired (docs/model.md, "When equipment fails")."""
-
-    time_to_failure: TimeDistribution
-    """Time from a repair to the next failure, counted on ``clock``."""
-    time_to_repair: TimeDistribution
-    """Time a repair takes once a crew is on it."""
-    clock: Literal["operating", "calendar"] = "operating"
-    """``operating``: the failure clock runs only while the equipment works (the robot in
-    motion); ``calendar``: whenever it is up."""
-
-
-class RobotFailures(EquipmentFailures):
-    """The arm's failures; a failure stops it mid-move."""
-
-    part_in_hand: Literal["finish", "scrap"] = "finish"
-    """What becomes of a part held when the arm fails: set down after the repair, or scrapped."""
-
-
-class RepairSettings(Section):
-    """The repair crews: a failure waits for a free one (machine-repairman)."""
-
-    crews: int = Field(1, strict=True, ge=1, le=1000)
-    """Crews working at once."""
-
-
-class MaintenanceSettings(Section):
-    """Planned stops of the robot, each started once the robot is back at B."""
-
-    every_h: float = _num(..., gt=0.0, le=MAX_HOURS)
-    """Hours between the starts of planned stops (from the start of the run)."""
-    duration_min: float = _num(..., gt=0.0, le=MAX_HOURS * 60)
-    """Minutes each stop lasts."""
-
-
-class FailureSettings(Section):
-    """Breakdowns, repairs and planned stops; absent: nothing ever stops."""
-
-    robot: RobotFailures | None = None
-    input_belt: EquipmentFailures | None = None
-    output_belt: EquipmentFailures | None = None
-    sensor: EquipmentFailures | None = None
-    """The look-ahead: while it is down the controller reads no next part."""
-    repair: RepairSettings | None = None
-    """Absent: every failure is repaired at once (as many crews as failures)."""
-    maintenance: MaintenanceSettings | None = None
 # --------------------------------------------------------------------------- quality
 class QualitySettings(Section):
     """Which parts OEE counts as good (ISO 22400-2's good quantity; docs/model.md, "OEE as
@@ -393,17 +313,17 @@ class SensorSettings(Section):
     the transfer starts, even before the feeder drops it (an idealisation); ``sensor``: a
     physical sensor that reports parts as they pass it, with the error, delay and misses
     below.  Left out: ``ideal``, so the thesis's results reproduce (docs/model.md)."""
-    position_in: float | None = _num(None, ge=0.0, le=MAX_LENGTH_IN)
+    position_in: float | None = finite(None, ge=0.0, le=MAX_LENGTH_IN)
     """How far before B the sensor sees a part (in).  Empty: at the feeder's drop point
     (``belts.input_length_in``); it cannot be further up than that, nor behind B."""
-    noise_sd_in: float = _num(0.0, ge=0.0, le=MAX_LENGTH_IN)
+    noise_sd_in: float = finite(0.0, ge=0.0, le=MAX_LENGTH_IN)
     """Standard deviation of the error on the position it reports (in, normal)."""
-    latency_s: float = _num(0.0, ge=0.0, le=MAX_TIME_S)
+    latency_s: float = finite(0.0, ge=0.0, le=MAX_TIME_S)
     """How long after a part passes it the report reaches the controller (s): a known, fixed
     delay, which the controller dates the report back by; a part is seen that much later."""
-    miss_probability: float = _num(0.0, ge=0.0, le=1.0)
+    miss_probability: float = finite(0.0, ge=0.0, le=1.0)
     """The chance that a part passes unreported (each part drawn on its own)."""
-    margin_s: float | None = _num(None, ge=0.0, le=MAX_TIME_S)
+    margin_s: float | None = finite(None, ge=0.0, le=MAX_TIME_S)
     """How long after the robot is back the adaptive controller aims the next part at B, so
     that a part the sensor misjudges is not let go for arriving a moment early (s).  Empty:
     0 with the ideal look-ahead (the thesis's exact aim); with a sensor, three standard

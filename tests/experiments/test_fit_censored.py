@@ -5,6 +5,7 @@ likelihood (scipy.stats.CensoredData), written as the ``failures:`` section's bl
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 import numpy as np
@@ -100,7 +101,10 @@ def test_cmd_fit_writes_the_failures_block(tmp_path: Path, capsys):
     assert "scipy.stats.CensoredData" in text and "failures.EQUIPMENT" in text
     block = yaml.safe_load(text)
     assert set(block) == {"time_to_failure"} and block["time_to_failure"]["distribution"] == "weibull_min"
-    assert block["time_to_failure"]["params"]["scale"] == pytest.approx(SCALE, rel=0.15)
+    # by its mean in hours and its shape (issue 33 item 4): the Weibull's mean, scale Γ(1 + 1/c)
+    assert block["time_to_failure"]["mean_h"] * 3600 == pytest.approx(
+        SCALE * math.gamma(1 + 1 / C), rel=0.15)
+    assert block["time_to_failure"]["shape"] == pytest.approx(C, rel=0.08)
     assert scenario_refuses(text, "time_to_failure", out) == ""
     assert (tmp_path / "ttf.png").read_bytes()[:4] == b"\x89PNG"
 
@@ -112,7 +116,8 @@ def test_times_to_repair_without_censoring_are_fitted_as_usual(tmp_path: Path, c
                          "--families", "lognorm,expon")) == 0
     block = yaml.safe_load(capsys.readouterr().out)["time_to_repair"]
     assert block["distribution"] == "lognorm"
-    assert block["params"]["s"] == pytest.approx(0.5, rel=0.15) and block["params"]["loc"] == 0.0
+    assert block["shape"] == pytest.approx(0.5, rel=0.15) and "params" not in block
+    assert block["mean_h"] * 3600 == pytest.approx(float(x.mean()), rel=0.1)
 
 
 @pytest.mark.skipif(not is_section(("failures",)), reason="this build has no failures: section yet")
@@ -124,6 +129,38 @@ def test_a_failures_block_is_validated_under_the_failures_section():
     assert robot["time_to_failure"]["params"] == {"c": 1.5, "loc": 0.0, "scale": 900.0}
     assert robot["time_to_repair"]["distribution"] == "weibull_min"
     assert scenario_refuses(text, "time_to_failure", "f.yaml") == ""
+
+
+@pytest.mark.parametrize("family, params", [
+    ("weibull_min", {"c": 1.5, "loc": 0.0, "scale": 143_000.0}),
+    ("gamma", {"a": 2.5, "loc": 0.0, "scale": 90.0}),
+    ("lognorm", {"s": 0.8, "loc": 0.0, "scale": 600.0}), ("expon", {"loc": 0.0, "scale": 7_200.0})])
+def test_a_fitted_time_is_written_by_its_mean_in_hours_and_read_back_as_the_fit(family, params):
+    """The block by ``mean_h`` and ``shape`` (seven digits each) is the fitted distribution to
+    within the rounding: scipy's mean, sd and each parameter within 1e-6."""
+    from cell.experiments.fit import Fit
+    from cell.experiments.fit_output import block_yaml
+    from cell.scenario.failure_sections import TimeDistribution
+    from cell.scenario.failure_spec import frozen
+
+    fit = Fit(family, params, 0.05, 0.5, -100.0, 204.0)
+    text = block_yaml(fit, "time_to_failure", "log.csv")
+    block = yaml.safe_load(text)["time_to_failure"]
+    assert "params" not in block and ("shape" in block) == (family != "expon")
+    assert scenario_refuses(text, "time_to_failure", "f.yaml") == ""
+    written, fitted = frozen(TimeDistribution(**block)), fit.frozen()
+    assert written.mean() == pytest.approx(fitted.mean(), rel=1e-6)
+    assert written.std() == pytest.approx(fitted.std(), rel=1e-6)
+    assert written.kwds == pytest.approx({k: v for k, v in params.items() if k != "loc"}, rel=1e-6)
+
+
+def test_a_fit_with_a_location_keeps_scipy_form():
+    from cell.experiments.fit import Fit
+    from cell.experiments.fit_output import block_yaml
+
+    fit = Fit("weibull_min", {"c": 1.5, "loc": 30.0, "scale": 900.0}, 0.05, 0.5, -100.0, 204.0)
+    block = yaml.safe_load(block_yaml(fit, "time_to_repair", "log.csv"))["time_to_repair"]
+    assert block["params"] == {"c": 1.5, "loc": 30.0, "scale": 900.0} and "mean_h" not in block
 
 
 @pytest.mark.parametrize("argv, key, why", [
