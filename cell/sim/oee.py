@@ -44,11 +44,7 @@ def timelines(column: Callable[[str], np.ndarray], downtime: Any, end_s: float
     stops = downtime.all_stops(end_s) if downtime is not None else []
     arrival, at_bot = column("arrival"), column("at_bot")
     if downtime is not None:
-        motion = np.frombuffer(downtime.robot.motion, dtype=float).reshape(-1, 2)
-        since = downtime.robot._moving_since
-        if since == since:
-            motion = np.vstack([motion, [[since, end_s]]])
-        busy = (motion[:, 0], motion[:, 1])
+        busy = downtime.robot.busy(end_s)
     else:
         picked = column("picked") != 0
         busy = (at_bot[picked], at_bot[picked] + column("cycle")[picked])

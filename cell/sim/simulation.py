@@ -35,9 +35,9 @@ from cell.scenario.schema import Scenario
 from cell.sim import accounting, oee, wear_clock
 from cell.sim.assembly import AssembledCell, assemble
 from cell.sim.bound import parts_bound
-from cell.sim.controller import Controller, FallibleView, SensorView, View
+from cell.sim.controller import Controller, SensorView, View
 from cell.sim.conveyors import InputConveyor, OutputConveyor
-from cell.sim.failures import Downtime
+from cell.sim.failures import BeltStops, Downtime
 from cell.sim.feeder import Feeder
 from cell.sim.horizon import run_arrivals, run_until_done
 from cell.sim.policies.base import Accounting
@@ -266,19 +266,18 @@ def simulate(scenario: Scenario | AssembledCell,
     downtime = None if s.failures is None else Downtime(env, s.failures, seed)
     wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
     conveyor = InputConveyor(env, k.v_nom, k.input_length, belts.told(0),
-                             stoppable=downtime is not None)
-    output = OutputConveyor(env, k.u_nom, log.delivered_part, belts.told(1),
-                            stoppable=downtime is not None)
-    robot = Robot(env, output.placed, None if downtime is None else downtime.robot.cycle)
+                             None if downtime is None else BeltStops(downtime, "input_belt"))
+    output = OutputConveyor(env, k.u_nom, log.delivered_part, belts.told(1))
+    wear = wear_clock.alone(cell, seed, downtime)  # wear: without failures (or None)
+    robot = Robot(env, output.placed, None if downtime is None else downtime.robot, wear)
     feeder = Feeder(env, t_list, conveyor, n, k.part_size, log.flag)
     view = _view(cell, seed, n, feeder, conveyor, output)
     Controller(env, k, policy, view, conveyor, output, robot, log, s.controller.policy)
-    wear = wear_clock.alone(cell, robot, seed, downtime)  # wear: without failures (or None)
     if downtime is None and horizon is None:
         env.run()
     else:
         if downtime is not None:
-            downtime.attach(robot, conveyor, output, feeder, view, log)
+            downtime.attach(conveyor, output, view, log)
             downtime.start()
         run_until_done(env, log, n, horizon, output)
     conveyor.belt.close()
@@ -292,7 +291,7 @@ def simulate(scenario: Scenario | AssembledCell,
     summary.parts_bound = parts_bound(k, feeder.fed_s[summary.warmup_parts:n])
     result = SimResult(summary, rows, belts if keep_belts else None)
     result.downtime, result.timelines = downtime, lines
-    result.wear = wear_clock.measures(wear, downtime, env.now)
+    result.wear = wear_clock.measures(None if wear is None else wear.log, downtime, env.now)
     return result
 
 
@@ -302,8 +301,7 @@ def _view(cell: AssembledCell, seed: Any, n: int, feeder: Feeder, conveyor: Inpu
     what a physical sensor has reported (``sensor``)."""
     s, k = cell.scenario, cell.k
     if s.sensor.lookahead == "ideal":
-        fallible = s.failures is not None and s.failures.sensor is not None
-        return (FallibleView if fallible else View)(k, feeder.fed_s, n, conveyor, output)
+        return View(k, feeder.fed_s, n, conveyor, output)
     position = sensor_position(s.sensor, k.input_length, s.source)
     return SensorView(k, Sensor(s.sensor, position, conveyor, n, seed), n, conveyor, output)
 
