@@ -16,7 +16,7 @@ import simpy
 
 from cell.plumbing.errors import CellError
 from cell.sim.conveyors import EPS_S, InputConveyor, OutputConveyor
-from cell.sim.policies.base import CellConstants, Plan, Policy
+from cell.sim.policies.base import CellConstants, Policy
 from cell.sim.policies.check import check, plan_bounds, plan_failed
 from cell.sim.records import Part
 from cell.sim.robot import Robot
@@ -127,9 +127,6 @@ class Controller:
         self.conveyor, self.output, self.robot, self.log = conveyor, output, robot, log
         self.bounds = plan_bounds(k)
         """The plan check's bounds for this cell (:func:`cell.sim.policies.check.plan_bounds`)."""
-        self.passed: Plan | None = None
-        """The last plan that passed the check (a policy that returns it again is not checked
-        again)."""
         self.process = env.process(self.run())
 
     def rides_on(self, part: Part, now: float, floor_after_td: float) -> None:
@@ -141,27 +138,15 @@ class Controller:
         if floor_after_td == floor_after_td:
             self.output.replan(max(now, floor_after_td), self.k.output_min)
 
-    def ask(self, view: View) -> Plan:
-        """The policy's plan for the part at B, checked before the cell acts on it
-        (:func:`cell.sim.policies.check.check`); a plug-in's failure named."""
-        try:
-            plan = self.policy.plan(view)
-        except CellError:
-            raise
-        except Exception as exc:  # noqa: BLE001 - a plug-in's failure, named
-            raise plan_failed(self.name, exc) from exc
-        if plan is not self.passed:  # the non-adaptive robot's one plan: checked once
-            check(plan, self.bounds, self.name, self.k)
-            self.passed = plan
-        return plan
-
     def run(self):  # noqa: ANN201 (SimPy generator)
         """Once per part: the part at B taken the instant it gets there (its ``at_bot_s``),
-        the policy asked, the belts set and the robot told its order."""
+        the policy asked for its plan (checked, :func:`cell.sim.policies.check.check`), the
+        belts set and the robot told its order."""
         robot, view, k, log = self.robot, self.view, self.k, self.log
-        conveyor, output = self.conveyor, self.output
+        conveyor, output, plan_for, name = self.conveyor, self.output, self.policy.plan, self.name
         aim = k.lookahead_margin_s  # step 6.3 from when the next part is aimed at B
         floor_after_td = math.nan  # the last planned TD (the spacing contract; nan: none)
+        bounds, passed = self.bounds, None  # the last plan that passed the check
         while True:
             part: Part = yield conveyor.at_bot.get()
             now = part.at_bot_s
@@ -169,7 +154,15 @@ class Controller:
                 self.rides_on(part, now, floor_after_td)
                 continue
             view.part, view.now = part.index, now
-            plan = self.ask(view)
+            try:
+                plan = plan_for(view)
+            except CellError:
+                raise
+            except Exception as exc:  # noqa: BLE001 - a plug-in's failure, named
+                raise plan_failed(name, exc) from exc
+            if plan is not passed:  # checked before the cell acts on it; the fixed
+                check(plan, bounds, name, k)  # robot's one plan, once
+                passed = plan
             r1a, to_g, r3a, cycle = plan.r1_pre, plan.to_g, plan.r3_pre, plan.cycle
             if plan.steers_belts:
                 conveyor.replan(now + r1a, plan.input_after_lo, now + cycle + aim,

@@ -67,8 +67,7 @@ class Belt:
         return len(self._t)
 
     def speed(self, t: float) -> float:
-        """The speed at t (:func:`speed_at` less its ``max``: once a part, a fraction of 1 % of
-        ``make bench``'s ``parts_per_s_adaptive_5k``)."""
+        """The speed at t."""
         return self._v[bisect_right(self._t, t, 1) - 1]  # lo=1: the first change if t is before it
 
     def travel(self, t: float) -> float:
@@ -86,7 +85,7 @@ class Belt:
         """From instant t1 (now or later) run at v1, and from t2 > t1 at v2, dropping later plans: a
         new plan supersedes what was planned after t1 (the controller replans every cycle), a change
         within EPS_S of the last one replaces it, and the changes before t1 whose successors have
-        started are settled.  For speed, the controller's case first, unrolled (twice a part)."""
+        started are settled.  The controller's case first (twice a part)."""
         if not v1 > 0 or (t2 is not None and not v2 > 0):
             raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}")
         if self._halted is not None:  # stopped by a failure: the plan is for the restart
@@ -104,8 +103,7 @@ class Belt:
                 self._settle(n)
             x0, v0 = xs[-1], vs[-1]
             x1 = x0 + v0 * (t1 - t0)
-            if n == 2:  # for speed, the last plan's lists reused in place (and in plan_then): no
-                # new lists, 104.50k to 104.01k instructions a part (the adaptive run, cachegrind)
+            if n == 2:  # speed: docs/performance.md#belt-replan
                 ts[0] = t0; ts[1] = t1; ts[2] = t2  # noqa: E702 (one by one: ts[:] = ... cost 2.9k more)
                 xs[0] = x0; xs[1] = x1; xs[2] = x1 + v1 * (t2 - t1)  # noqa: E702
                 vs[0] = v0; vs[1] = v1; vs[2] = v2  # noqa: E702
@@ -128,8 +126,7 @@ class Belt:
 
     def plan_then(self, t1: float, v1: float, t2: float, v2: float, t3: float, v3: float) -> None:
         """:meth:`plan` (t1, v1, t2, v2) then :meth:`then` (t3, v3): the output belt's replan under the
-        spacing contract, unrolled (for speed: a call and three appends a part fewer, 2 % of CPU time;
-        a dropped floor not copied, never deleted: 117.3k to 115.6k instructions per part, cachegrind)."""
+        spacing contract, unrolled (speed: docs/performance.md#belt-replan)."""
         if self._halted is not None:  # stopped by a failure: the plan is for the restart
             self._plan_stopped(t1, v1, t2, v2, t3, v3)
             return
@@ -145,7 +142,7 @@ class Belt:
             x0, v0 = xs[n], vs[n]
             x1 = x0 + v0 * (t1 - t0)
             x2 = x1 + v1 * (t2 - t1)
-            if len(ts) == 4:  # the last plan's lists, reused in place (for speed)
+            if len(ts) == 4:  # the last plan's lists, reused in place
                 ts[0] = t0; ts[1] = t1; ts[2] = t2; ts[3] = t3  # noqa: E702
                 xs[0] = x0; xs[1] = x1; xs[2] = x2; xs[3] = x2 + v2 * (t3 - t2)  # noqa: E702
                 vs[0] = v0; vs[1] = v1; vs[2] = v2; vs[3] = v3  # noqa: E702
@@ -165,7 +162,7 @@ class Belt:
         if not v > 0 or not t > t0:
             raise ValueError(f"a belt's further change must come after its last and be "
                              f"positive, got {t!r}, {v!r}")
-        xs.append(xs[-1] + vs[-1] * (t - t0))  # _run_from's append, inline (once a part)
+        xs.append(xs[-1] + vs[-1] * (t - t0))
         ts.append(t)
         vs.append(v)
 
@@ -340,17 +337,18 @@ class InputConveyor:
         interrupts, and the part is timed again."""
         env, get, hand_over, belt = self.env, self.loaded.get, self.at_bot.put_after, self.belt
         x_fed, length, stops = self.x_fed, self.length_in, self.stops
+        clock = env.now  # speed: docs/performance.md#clock
         while True:
             part, dropped = yield get()
             i = part.index
-            now = env.now
+            now = dropped if dropped > clock else clock  # env.now: the drop, or the last arrival
             target = x_fed[i] + length
             if stops is None or not belt.stopped:
                 delay = belt.time_at(target) - now
                 if delay < 0.0:
                     delay = 0.0
                 if stops is None or stops.clear_until(now + delay):  # the arrival known now
-                    part.at_bot_s = self.due_s = now + delay
+                    part.at_bot_s = self.due_s = clock = now + delay
                     yield hand_over(part, delay)  # the controller takes it (and replans) first
                     del x_fed[i]
                     continue
@@ -368,7 +366,7 @@ class InputConveyor:
                     continue
                 finally:
                     self.timing = False
-            part.at_bot_s = self.due_s = env.now
+            part.at_bot_s = self.due_s = clock = env.now
             yield hand_over(part, 0.0)
             del x_fed[i]
 

@@ -126,14 +126,14 @@ class FailureClock:
         use = exposure.cycle(legs_s)
         if use is None or self.failing or not clear:
             return False
-        left = self.left
+        left = [b - u for b, u in zip(self.left, use)]
         for b, u in zip(left, use):
-            if not b > u * (1.0 + 1e-9) + 1e-12:  # (a margin for the legs' rounding)
+            if b <= u * 1e-9 + 1e-12:  # it may run out in this cycle (a margin for rounding)
                 return False
-        self.left = [b - u for b, u in zip(left, use)]
-        self.since = end_s
+        self.left, self.since = left, end_s
         self.plan = [(end_s, exposure.rates(MOVING_NOT))]
-        self._arm()
+        if self.due_s < math.inf or any(self.plan[0][1]):
+            self._arm()
         return True
 
     def _use_to(self, t: float) -> None:

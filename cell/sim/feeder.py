@@ -54,24 +54,20 @@ class Feeder:
         self.process = env.process(self.run())
 
     def run(self):  # noqa: ANN201 (SimPy generator)
-        """Once per part, with locals bound, the clock among them: each wait ends exactly
-        ``now + delay`` later, as SimPy times a timeout.  For speed: ``env.now`` is a property
-        (timed on the shared 2-core machine, 4 times a local's read), and the four reads a
-        part this, the controller and the robot save are 1-3 % of ``make bench``'s
-        ``parts_per_s_adaptive_5k`` (about 13 µs a part)."""
+        """Part i comes ``fed_s[i]`` into the run; dropped then, or held till the belt is clear."""
         env, drop, fed = self.env, self.conveyor.drop, self.fed_s
         timeout, travel, flag = env.timeout, self.conveyor.belt.travel, self.flag
-        after = Timer(env).after  # env.timeout's schedule, without a new event a part
+        after = Timer(env).after  # speed: docs/performance.md#mailbox
         size = self.part_size_in
         clear_at = -float("inf")
-        now = env.now  # the clock, kept here: each wait ends exactly ``now + delay`` later
+        now = env.now  # speed: docs/performance.md#clock
         for i in range(self.n_parts):
             f = fed[i]
             delay = f - now
-            if delay < 0.0:  # max(delay, 0): after a hold it may be due
+            if delay < 0.0:  # after a hold it may be due
                 delay = 0.0
             yield after(delay)
-            now += delay  # env.now, as the timer fell (two property reads a part saved)
+            now += delay  # env.now, as the timer fell
             x = travel(now)
             if x < clear_at - CLEAR_TOL_IN:  # held back till the belt has carried the last clear
                 belt = self.conveyor.belt

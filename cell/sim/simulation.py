@@ -118,7 +118,6 @@ class RunLog:
         best of 12, interleaved, on 2 shared cores)."""
         t, acct_part, flags_of = self.t, self.acct.part, self.flags.pop
         spacing_in, tol = self.spacing_in, self.tol_in + 1e-9
-        below = -tol
         note, pack = self.per_part.extend, _PACK_PER_PART
         row_of = self._row if self.rows is not None or self.sink is not None else None
         names_of = LIMIT_NAMES.get  # limit_names' cache, read first
@@ -135,8 +134,7 @@ class RunLog:
                 flags = flags_of(i, 0)
                 sp = p.spacing_in
                 off = sp - spacing_in  # NaN (none yet): neither test holds
-                if off > tol or off < below:  # abs(off) > tol, no builtin call: 0.11k of 104.9k
-                    # instructions a part (the adaptive run, cachegrind)
+                if abs(off) > tol:  # NaN (none yet): not off
                     flags |= SPACING_OFF
                 picked = not flags & RODE_OFF
                 plan = p.plan
