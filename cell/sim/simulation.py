@@ -35,9 +35,7 @@ from cell.scenario.schema import Scenario
 from cell.sim import accounting, oee, wear_clock
 from cell.sim.assembly import AssembledCell, assemble
 from cell.sim.bound import parts_bound
-from cell.sim.controller import Controller, SensorView, View
-from cell.sim.conveyors import InputConveyor, OutputConveyor
-from cell.sim.failures import BeltStops, Downtime
+from cell.sim.failures import Downtime
 from cell.sim.feeder import Feeder
 from cell.sim.horizon import run_arrivals, run_until_done
 from cell.sim.policies.base import Accounting
@@ -53,9 +51,8 @@ from cell.sim.records import (
     RunSummary,
     limit_names,
 )
-from cell.sim.robot import Robot
-from cell.sim.sensor import Sensor, sensor_position
 from cell.sim.sim_result import BeltLog, BeltSink, SimResult
+from cell.sim.station import Station
 
 __all__ = ["PER_PART", "BeltLog", "BeltSink", "PartSink", "RunLog", "SimResult", "simulate"]
 
@@ -263,45 +260,28 @@ def simulate(scenario: Scenario | AssembledCell,
                  (tm.r1_length_in, tm.r2.length_in, tm.r3_length_in, tm.r4.length_in))
     downtime = None if s.failures is None else Downtime(env, s.failures, seed)
     wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
-    conveyor = InputConveyor(env, k.v_nom, k.input_length, belts.told(0),
-                             None if downtime is None else BeltStops(downtime, "input_belt"))
-    output = OutputConveyor(env, k.u_nom, log.delivered_part, belts.told(1))
-    wear = wear_clock.alone(cell, seed, downtime)  # wear: without failures (or None)
-    robot = Robot(env, output.placed, None if downtime is None else downtime.robot, wear)
-    feeder = Feeder(env, t_list, conveyor, n, k.part_size, log.flag)
-    view = _view(cell, seed, n, feeder, conveyor, output)
-    Controller(env, k, policy, view, conveyor, output, robot, log, s.controller.policy)
+    station = Station(env, cell, seed, log.delivered_part, belts.told, downtime)
+    feeder = Feeder(env, t_list, station.input, n, k.part_size, log.flag)
+    station.control(feeder.fed_s, n, log)
     if downtime is None and horizon is None:
         env.run()
     else:
         if downtime is not None:
-            downtime.attach(conveyor, output, view, log)
             downtime.start()
-        run_until_done(env, log, n, horizon, output)
-    conveyor.belt.close()
-    output.belt.close(until=env.now)  # a floor planned after the last touch-down never ran
+        run_until_done(env, log, n, horizon, station.output)
+    station.close(env.now)
 
     summary = _summary(cell, log, acct, t_all, n, env.now)
     lines = oee.measure(summary, log.column, downtime, k.fastest_cycle_s, env.now)
     summary.seed = _seed_value(seed)
-    summary.input_speed_max_in_s = conveyor.belt.max_speed_in_s
-    summary.input_speed_min_in_s = conveyor.belt.min_speed_in_s
+    summary.input_speed_max_in_s = station.input.belt.max_speed_in_s
+    summary.input_speed_min_in_s = station.input.belt.min_speed_in_s
     summary.parts_bound = parts_bound(k, feeder.fed_s[summary.warmup_parts:n])
     result = SimResult(summary, rows, belts if keep_belts else None)
     result.downtime, result.timelines = downtime, lines
+    wear = station.wear
     result.wear = wear_clock.measures(None if wear is None else wear.log, downtime, env.now)
     return result
-
-
-def _view(cell: AssembledCell, seed: Any, n: int, feeder: Feeder, conveyor: InputConveyor,
-          output: OutputConveyor) -> View:
-    """What the controller sees: the feeder's schedule (``sensor.lookahead: ideal``), or only
-    what a physical sensor has reported (``sensor``)."""
-    s, k = cell.scenario, cell.k
-    if s.sensor.lookahead == "ideal":
-        return View(k, feeder.fed_s, n, conveyor, output)
-    position = sensor_position(s.sensor, k.input_length, s.source)
-    return SensorView(k, Sensor(s.sensor, position, conveyor, n, seed), n, conveyor, output)
 
 
 def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, n: int,
