@@ -103,12 +103,7 @@ class Belt:
                 self._settle(n)
             x0, v0 = xs[-1], vs[-1]
             x1 = x0 + v0 * (t1 - t0)
-            if n == 2:  # speed: docs/performance.md#belt-replan
-                ts[0] = t0; ts[1] = t1; ts[2] = t2  # noqa: E702 (one by one: ts[:] = ... cost 2.9k more)
-                xs[0] = x0; xs[1] = x1; xs[2] = x1 + v1 * (t2 - t1)  # noqa: E702
-                vs[0] = v0; vs[1] = v1; vs[2] = v2  # noqa: E702
-            else:
-                self._t, self._x, self._v = [t0, t1, t2], [x0, x1, x1 + v1 * (t2 - t1)], [v0, v1, v2]
+            self._t, self._x, self._v = [t0, t1, t2], [x0, x1, x1 + v1 * (t2 - t1)], [v0, v1, v2]
             return
         k = bisect_right(ts, t1 + EPS_S)
         if k == 0:  # would rewrite what is settled (and leave no schedule at all)
@@ -125,33 +120,11 @@ class Belt:
             self._run_from(t2, v2)
 
     def plan_then(self, t1: float, v1: float, t2: float, v2: float, t3: float, v3: float) -> None:
-        """:meth:`plan` (t1, v1, t2, v2) then :meth:`then` (t3, v3): the output belt's replan under the
-        spacing contract, unrolled (speed: docs/performance.md#belt-replan)."""
-        if self._halted is not None:  # stopped by a failure: the plan is for the restart
+        """:meth:`plan` (t1, v1, t2, v2) then :meth:`then` (t3, v3): the output belt's replan under
+        the spacing contract."""
+        if self._halted is not None:
             self._plan_stopped(t1, v1, t2, v2, t3, v3)
             return
-        ts = self._t
-        n = len(ts) - 1  # the change kept: a last floor not yet begun is dropped, as :meth:`plan`
-        if ts[n] > t1 + EPS_S and n > 0 and ts[n - 1] < t1:  # drops it (by not copying it, here)
-            n -= 1
-        t0 = ts[n]
-        if t0 < t1 < t2 < t3 and v1 > 0 and v2 > 0 and v3 > 0:
-            if n > 0:
-                self._settle(n)
-            xs, vs = self._x, self._v
-            x0, v0 = xs[n], vs[n]
-            x1 = x0 + v0 * (t1 - t0)
-            x2 = x1 + v1 * (t2 - t1)
-            if len(ts) == 4:  # the last plan's lists, reused in place
-                ts[0] = t0; ts[1] = t1; ts[2] = t2; ts[3] = t3  # noqa: E702
-                xs[0] = x0; xs[1] = x1; xs[2] = x2; xs[3] = x2 + v2 * (t3 - t2)  # noqa: E702
-                vs[0] = v0; vs[1] = v1; vs[2] = v2; vs[3] = v3  # noqa: E702
-            else:
-                self._t, self._x, self._v = [t0, t1, t2, t3], [x0, x1, x2, x2 + v2 * (t3 - t2)], \
-                    [v0, v1, v2, v3]
-            return
-        if n < len(ts) - 1:
-            del ts[-1], self._x[-1], self._v[-1]
         self.plan(t1, v1, t2, v2)
         self.then(t3, v3)
 
@@ -289,10 +262,10 @@ class InputConveyor:
         """True while a part's way to B is waited for in steps a stop can interrupt."""
         self.process = env.process(self.run())
 
-    def drop(self, part: Part, x: float, now: float) -> None:
-        """The feeder puts a part on the belt now (the clock's ``now``), the belt's travel being x."""
+    def drop(self, part: Part, x: float) -> None:
+        """The feeder puts a part on the belt now, the belt's travel being x."""
         self.x_fed[part.index] = x
-        self.loaded.put((part, now))
+        self.loaded.put(part)
 
     def changed(self) -> simpy.Event:
         """An event that succeeds when the belt's plan next changes (a replan, a stop or a
@@ -337,18 +310,17 @@ class InputConveyor:
         interrupts, and the part is timed again."""
         env, get, hand_over, belt = self.env, self.loaded.get, self.at_bot.put_after, self.belt
         x_fed, length, stops = self.x_fed, self.length_in, self.stops
-        clock = env.now  # speed: docs/performance.md#clock
         while True:
-            part, dropped = yield get()
+            part = yield get()
             i = part.index
-            now = dropped if dropped > clock else clock  # env.now: the drop, or the last arrival
+            now = env.now
             target = x_fed[i] + length
             if stops is None or not belt.stopped:
                 delay = belt.time_at(target) - now
                 if delay < 0.0:
                     delay = 0.0
                 if stops is None or stops.clear_until(now + delay):  # the arrival known now
-                    part.at_bot_s = self.due_s = clock = now + delay
+                    part.at_bot_s = self.due_s = now + delay
                     yield hand_over(part, delay)  # the controller takes it (and replans) first
                     del x_fed[i]
                     continue
@@ -366,7 +338,7 @@ class InputConveyor:
                     continue
                 finally:
                     self.timing = False
-            part.at_bot_s = self.due_s = clock = env.now
+            part.at_bot_s = self.due_s = env.now
             yield hand_over(part, 0.0)
             del x_fed[i]
 

@@ -30,7 +30,7 @@ class Loadable(Protocol):
 
     belt: Any
 
-    def drop(self, part: Part, x: float, now: float) -> None: ...
+    def drop(self, part: Part, x: float) -> None: ...
 
     def changed(self) -> simpy.Event: ...
 
@@ -60,14 +60,10 @@ class Feeder:
         after = Timer(env).after  # speed: docs/performance.md#mailbox
         size = self.part_size_in
         clear_at = -float("inf")
-        now = env.now  # speed: docs/performance.md#clock
         for i in range(self.n_parts):
             f = fed[i]
-            delay = f - now
-            if delay < 0.0:  # after a hold it may be due
-                delay = 0.0
-            yield after(delay)
-            now += delay  # env.now, as the timer fell
+            yield after(max(f - env.now, 0.0))  # after a hold it may be due
+            now = env.now
             x = travel(now)
             if x < clear_at - CLEAR_TOL_IN:  # held back till the belt has carried the last clear
                 belt = self.conveyor.belt
@@ -84,5 +80,5 @@ class Feeder:
                     flag(part, HELD_AT_FEEDER)
             else:
                 part = Part(i, f)
-            drop(part, x, now)
+            drop(part, x)
             clear_at = x + size

@@ -26,7 +26,7 @@ import numpy as np
 import simpy
 
 from cell.arm.motors import Segment
-from cell.sim.failures import MOVING_NOT, STOPPED
+from cell.sim.failure_clock import MOVING_NOT, STOPPED
 from cell.sim.mailbox import Mailbox
 from cell.sim.records import LET_GO
 

@@ -108,11 +108,8 @@ class RunLog:
 
     def _logger(self) -> Callable[[Part], None]:
         """``done(part)``: a part is done; it is completed and handed on now if every part
-        before it is, else kept till then.  The log's hot path, hand-written for speed (locals
-        bound, the in-order part completed in the same call), and its row made only if someone
-        keeps or streams the rows: ``make bench`` does neither, and making them costs 7 % of
-        its ``parts_per_s_adaptive_5k``, 26 % of ``parts_per_s_non_adaptive_5k`` (CPU time,
-        best of 12, interleaved, on 2 shared cores)."""
+        before it is, else kept till then; its row made only if someone keeps or streams the
+        rows (speed: docs/performance.md#run-log)."""
         t, acct_part, flags_of = self.t, self.acct.part, self.flags.pop
         spacing_in, tol = self.spacing_in, self.tol_in + 1e-9
         note, pack = self.per_part.extend, _PACK_PER_PART

@@ -166,7 +166,7 @@ class WearClock:
 
 
 class WearExposure:
-    """The robot's failure clock counting motor wear (:class:`cell.sim.failures.Exposure`):
+    """The robot's failure clock counting motor wear (:class:`cell.sim.failure_clock.Exposure`):
     five budgets, one a motor (the exposure at which it wears out), each used at its
     exposure per second of the leg the robot is in, told of each cycle's leg times as it
     starts (the cycle's whole exposure, :meth:`cell.sim.wear.CycleWear.of_times`, is what the
