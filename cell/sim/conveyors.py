@@ -364,11 +364,16 @@ class OutputConveyor:
         """Belt travel at the last touch-down (None before the first)."""
         self.last_td_s = math.nan
         """Instant of the last touch-down (read once ``last_td_x`` is set)."""
-        self.replan = self.belt.plan
-        """New speed plan from the controller (:meth:`Belt.plan`)."""
-        self.replan_then = self.belt.plan_then
-        """The same with the spacing contract's floor after it (:meth:`Belt.plan_then`)."""
         self.process = env.process(self.run())
+
+    def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
+        """New speed plan from the controller (:meth:`Belt.plan`)."""
+        self.belt.plan(t1, v1, t2, v2)
+
+    def replan_then(self, t1: float, v1: float, t2: float, v2: float, t3: float,
+                    v3: float) -> None:
+        """The same with the spacing contract's floor after it (:meth:`Belt.plan_then`)."""
+        self.belt.plan_then(t1, v1, t2, v2, t3, v3)
 
     def stop(self, now: float) -> None:
         """A failure stops the belt now (a part the robot sets down stays where it is put)."""

@@ -82,7 +82,8 @@ class RunLog:
 
     def __init__(self, t: list[float], acct: Accounting, sink: PartSink | None,
                  spacing_in: float, tol_in: float, rows: list[tuple[Any, ...]] | None = None,
-                 lengths: tuple[float, float, float, float] = (NAN, NAN, NAN, NAN)):
+                 lengths: tuple[float, float, float, float] = (NAN, NAN, NAN, NAN),
+                 finished: simpy.Event | None = None, n_parts: int = 0):
         self.t = t
         """T_1 … T_{n+1}: the last is only part n's "next arrival"."""
         self.acct, self.sink = acct, sink
@@ -99,6 +100,8 @@ class RunLog:
         self.per_part = bytearray()
         """What the summary needs of each part, :data:`PER_PART` values a part in that order,
         as packed doubles (``struct``'s pack is a third of ``array.extend``'s cost a part)."""
+        self.finished, self.n_parts = finished, n_parts
+        """Succeeded once all ``n_parts`` parts are handed on (None: nobody waits for that)."""
         self.missed = self.delivered_part = self._logger()
         """A part fell off at F / was set down: see :meth:`_logger`."""
 
@@ -115,7 +118,7 @@ class RunLog:
         note, pack = self.per_part.extend, _PACK_PER_PART
         row_of = self._row if self.rows is not None or self.sink is not None else None
         names_of = LIMIT_NAMES.get  # limit_names' cache, read first
-        waiting = self.waiting
+        waiting, finished, last = self.waiting, self.finished, self.n_parts
         following = 0  # the index of the part to hand on next
 
         def done(p: Part) -> None:
@@ -144,6 +147,8 @@ class RunLog:
                 i += 1
                 if not waiting or i not in waiting:
                     following = i
+                    if i == last and finished is not None:
+                        finished.succeed()
                     return
                 p = waiting.pop(i)
 
@@ -253,8 +258,11 @@ def simulate(scenario: Scenario | AssembledCell,
     acct = policy.accounting()
     env = simpy.Environment()
     tm = k.timing
+    # with failures the clocks never end: the run ends when its last part is done
+    finished = env.event() if s.failures is not None and horizon is None else None
     log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows,
-                 (tm.r1_length_in, tm.r2.length_in, tm.r3_length_in, tm.r4.length_in))
+                 (tm.r1_length_in, tm.r2.length_in, tm.r3_length_in, tm.r4.length_in),
+                 finished, n)
     downtime = None if s.failures is None else Downtime(env, s.failures, seed)
     wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
     station = Station(env, cell, seed, log.delivered_part, belts.told, downtime)
@@ -265,7 +273,7 @@ def simulate(scenario: Scenario | AssembledCell,
     else:
         if downtime is not None:
             downtime.start()
-        run_until_done(env, log, n, horizon, station.output)
+        run_until_done(env, log, horizon, finished)
     station.close(env.now)
 
     summary = _summary(cell, log, acct, t_all, n, env.now)
