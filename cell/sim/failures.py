@@ -32,6 +32,7 @@ from array import array
 from collections.abc import Callable
 from typing import Any
 
+import numpy as np
 import simpy
 
 from cell.scenario.failure_spec import EQUIPMENT, SECONDS_PER_HOUR, STREAM_KEYS, Draws
@@ -158,17 +159,11 @@ class RobotStops:
 
     def busy(self, end_s: float) -> tuple[Any, Any]:
         """(from, to) of the robot's motion up to ``end_s``."""
-        import numpy as np
-
         motion = np.frombuffer(self.motion, dtype=float).reshape(-1, 2)
         if self.moving_since == self.moving_since:
             motion = np.vstack([motion, [[self.moving_since, end_s]]])
         motion = np.minimum(motion, end_s)
         return motion[:, 0], motion[:, 1]
-
-    def lifted(self, part: Any) -> Any:
-        """The part at lift-off: still the cycle's (None: it rode off in a stop)."""
-        return self.part
 
     def set_down(self) -> Any:
         """The part at touch-down (None: scrapped in a stop); the hand is empty after."""
