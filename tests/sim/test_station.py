@@ -49,8 +49,8 @@ def test_what_can_fail_is_handed_in_and_rewires_nothing():
     expon = {"distribution": "expon", "params": {"scale": 300.0}}
     f = {name: {"time_to_failure": expon, "time_to_repair": expon}
          for name in ("robot", "input_belt", "output_belt", "sensor")}
-    f["maintenance"] = {"every_h": 0.5, "duration_min": 5.0}
-    cell = assemble(load_scenario("baseline", {"run.hours": 2.0, "failures": f}))
+    f["maintenance"] = {"every_h": 0.25, "duration_min": 5.0}
+    cell = assemble(load_scenario("baseline", {"run.hours": 1.0, "failures": f}))
     seed, k = cell.scenario.run.seed, cell.k
     t, n, _ = run_arrivals(cell.scenario, seed)
     env = simpy.Environment()
@@ -60,7 +60,7 @@ def test_what_can_fail_is_handed_in_and_rewires_nothing():
     feeder = Feeder(env, t.tolist(), station.input, n, k.part_size, log.flag)
     station.control(feeder.fed_s, n, log)
     downtime.start()
-    env.run(until=2 * 3600.0)
+    env.run(until=3600.0)
     assert len(downtime.all_stops(env.now)) > 3  # the equipment did fail
     for thing in (station.robot, station.input, station.output, station.controller, feeder):
         replaced = [name for name in vars(thing) if callable(getattr(type(thing), name, None))]
