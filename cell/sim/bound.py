@@ -42,11 +42,10 @@ def greedy_picks(come_s: Sequence[float] | Array, length_in: float, v_min: float
     """The most parts, coming at ``come_s`` (in order), that fit their windows at B with
     picks ``cycle_min_s`` apart (see the module's text).
 
-    For speed, the arrivals are first read whole: where each part comes at least a fastest cycle
-    after the one before, every part is picked at its earliest, and a hold at the feeder only
-    moves its window's end later, so the count is all of them (as the pass below counts, to the
-    part: tests/sim/test_bound.py).  ``make bench``'s adaptive run 105.55k to 104.77k instructions
-    a part (cachegrind); other arrivals pay the pass as before, and the reading."""
+    The arrivals are first read whole: where each part comes at least a fastest cycle after the
+    one before, every part is picked at its earliest, and a hold at the feeder only moves its
+    window's end later, so the count is all of them (as the pass below counts, to the part:
+    tests/sim/test_bound.py); other arrivals take the pass."""
     early, late, clear = length_in / v_max, length_in / v_min, part_size_in / v_min
     a = np.asarray(come_s, dtype=float)
     first = a + early  # each part's earliest pick (a + early <= a + late where early <= late)

@@ -17,17 +17,7 @@ import simpy
 from cell.plumbing.errors import CellError
 from cell.sim.conveyors import EPS_S, InputConveyor, OutputConveyor
 from cell.sim.policies.base import CellConstants, Policy
-from cell.sim.policies.check import (
-    ABS,
-    ALL_LIMITS,
-    MAX_S,
-    REL,
-    SUM_S,
-    plan_bounds,
-    plan_failed,
-    refuse,
-    tracking_floors,
-)
+from cell.sim.policies.check import check, plan_bounds, plan_failed
 from cell.sim.records import Part
 from cell.sim.robot import Robot
 from cell.sim.sensor import Sensor
@@ -77,11 +67,13 @@ class View:
 
     def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
         """(a, b) of the first part after this one that can still be caught: the ideal
-        look-ahead, which reads the feeder's schedule (``sensor.lookahead: ideal``)."""
+        look-ahead, which reads the feeder's schedule (``sensor.lookahead: ideal``); None
+        while the sensor is down (``failures.sensor``)."""
+        if not self.sensor_up:
+            return None
         now, fed_s, length, n = self.now, self.fed_s, self._length, self.n
         x_now = None
-        j = self.part + 1  # for speed, a while, not a ``range`` (making one is dear, and one part
-        # is looked at, mostly): the adaptive run 106.57k to 104.77k instructions a part, cachegrind
+        j = self.part + 1
         while j < n:
             f = fed_s[j]
             if f > now + lag:
@@ -96,15 +88,6 @@ class View:
                 return (lag, d)
             j += 1
         return None
-
-
-class FallibleView(View):
-    """The ideal look-ahead of a run whose sensor can fail (``failures.sensor``): nothing
-    while it is down.  Chosen when the run is assembled, so that a run without failures
-    does not ask (``make bench``: one test a part, a fraction of a percent)."""
-
-    def next_part(self, lag: float, v: float) -> tuple[float, float] | None:
-        return View.next_part(self, lag, v) if self.sensor_up else None
 
 
 class SensorView(View):
@@ -142,6 +125,8 @@ class Controller:
         self.name = name or getattr(policy, "name", "")
         """The policy's name, as the scenario gives it (for a bad plan's message)."""
         self.conveyor, self.output, self.robot, self.log = conveyor, output, robot, log
+        self.bounds = plan_bounds(k)
+        """The plan check's bounds for this cell (:func:`cell.sim.policies.check.plan_bounds`)."""
         self.process = env.process(self.run())
 
     def rides_on(self, part: Part, now: float, floor_after_td: float) -> None:
@@ -154,20 +139,17 @@ class Controller:
             self.output.replan(max(now, floor_after_td), self.k.output_min)
 
     def run(self):  # noqa: ANN201 (SimPy generator)
-        """Once per part, locals bound, the clock read from the part's arrival at B, the plan checked
-        inline (for speed: :meth:`.Feeder.run`, :mod:`cell.sim.policies.check`), each field read once
-        and the robot's order given its instant: with :func:`.adaptive_plan`'s inline steps, the
-        adaptive run 122.5k to 118.4k instructions per part, cachegrind (20,000 parts)."""
-        robot, view, plan_for = self.robot, self.view, self.policy.plan
-        replan_in, replan_out, u_nom = self.conveyor.replan, self.output.replan, self.k.u_nom
-        replan_out_floor, u_min, aim = self.output.replan_then, self.k.output_min, self.k.lookahead_margin_s
+        """Once per part: the part at B taken the instant it gets there (its ``at_bot_s``),
+        the policy asked for its plan (checked, :func:`cell.sim.policies.check.check`), the
+        belts set and the robot told its order."""
+        robot, view, k, log = self.robot, self.view, self.k, self.log
+        conveyor, output, plan_for, name = self.conveyor, self.output, self.policy.plan, self.name
+        aim = k.lookahead_margin_s  # step 6.3 from when the next part is aimed at B
         floor_after_td = math.nan  # the last planned TD (the spacing contract; nan: none)
-        a1, a2, a3, a4, a5, a6, c1, d1, c2, d2, c3, d3, c4, d4 = plan_bounds(self.k)
-        bad_bits, top, eps, name, passed = ~ALL_LIMITS, MAX_S, SUM_S, self.name, None
-        get, flag, order, r1 = self.conveyor.at_bot.get, self.log.flag, robot.order, tracking_floors(self.k)
+        bounds, passed = self.bounds, None  # the last plan that passed the check
         while True:
-            part: Part = yield get()
-            now = part.at_bot_s  # env.now: the part is taken the instant it reaches B
+            part: Part = yield conveyor.at_bot.get()
+            now = part.at_bot_s
             if not robot.free_at_s <= now + EPS_S:  # the robot is not back: the part rides on
                 self.rides_on(part, now, floor_after_td)
                 continue
@@ -178,38 +160,22 @@ class Controller:
                 raise
             except Exception as exc:  # noqa: BLE001 - a plug-in's failure, named
                 raise plan_failed(name, exc) from exc
-            if plan is not passed:  # checked at the boundary (cell.sim.policies.check)
-                try:  # an ``if``'s tests (CPython specialises their float comparisons, not a value's)
-                    r1a, r1b, r2, r3a, r3b, r4 = \
-                        plan.r1_pre, plan.r1_post, plan.r2, plan.r3_pre, plan.r3_post, plan.r4
-                    w, w_next, u, to_g, cycle, limits, steers, v = \
-                        plan.input_after_lo, plan.input_next, plan.output_to_g, plan.to_g, \
-                        plan.cycle, plan.limits, plan.steers_belts, plan.input_speed
-                    off_g, off_b = to_g - (r1a + r1b + r2), cycle - (to_g + r3a + r3b + r4)
-                    floor_at = plan.output_floor_at if steers else INF  # at or after TD
-                    if (a1 <= r1a and a2 <= r1b and a3 <= r2 and a4 <= r3a and a5 <= r3b and a6 <= r4
-                            and c1 <= v and v <= d1 and c2 <= w and w <= d2 and c3 <= w_next
-                            and w_next <= d3 and c4 <= u and u <= d4 and -eps <= off_g and off_g <= eps
-                            and -eps <= off_b and off_b <= eps and cycle < top and limits.__class__ is int
-                            and not limits & bad_bits and steers.__class__ is bool
-                            and floor_at >= to_g + r3a - eps  # and R I at the belt's pace (v checked):
-                            and (f := r1(v))[0] - ABS - REL * f[0] <= r1a and f[1] - ABS - REL * f[1] <= r1b):
-                        passed = plan
-                except Exception:  # noqa: BLE001 - a field missing or not a number: said below
-                    pass
-                if plan is not passed:
-                    refuse(plan, name, self.k)
-                    passed = plan
-            if steers:
-                replan_in(now + r1a, w, now + cycle + aim, w_next)  # 6.3 as the next part is aimed at B
-                if floor_at < INF:  # the spacing contract: the belt's floor after TD
-                    at_g = now + to_g
-                    replan_out_floor(now, u, at_g, u_nom, now + floor_at, u_min)
+            if plan is not passed:  # checked before the cell acts on it; the fixed
+                check(plan, bounds, name, k)  # robot's one plan, once
+                passed = plan
+            r1a, to_g, r3a, cycle = plan.r1_pre, plan.to_g, plan.r3_pre, plan.cycle
+            if plan.steers_belts:
+                conveyor.replan(now + r1a, plan.input_after_lo, now + cycle + aim,
+                                plan.input_next)
+                at_g = now + to_g
+                if plan.output_floor_at < INF:  # the spacing contract: the belt's floor after TD
+                    output.replan_then(now, plan.output_to_g, at_g, k.u_nom,
+                                       now + plan.output_floor_at, k.output_min)
                     floor_after_td = at_g + r3a
                 else:
-                    replan_out(now, u, now + to_g, u_nom)
+                    output.replan(now, plan.output_to_g, at_g, k.u_nom)
             part.plan = plan  # the part's regime times and belt speeds (read as its row is made)
-            if limits:
-                flag(part, limits)
+            if plan.limits:
+                log.flag(part, plan.limits)
             # B → TD summed as LO + (LO → TD), the order the robot's legs are timed in
-            order(part, r1a, r1a + (to_g - r1a + r3a), cycle, now)
+            robot.order(part, r1a, r1a + (to_g - r1a + r3a), cycle, now)

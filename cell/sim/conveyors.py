@@ -59,7 +59,7 @@ class Belt:
         """While stopped by a failure: the speed it ran at and the changes planned after."""
         self._anchor: tuple[float, float, float] = (0.0, 0.0, speed_in_s)
         """The last settled change (instant, travel, speed), in force when a replan from a later
-        instant has settled past the present (a stop starts from it; :class:`StoppableBelt`'s)."""
+        instant has settled past the present (a stop starts from it)."""
 
     @property
     def held(self) -> int:
@@ -67,8 +67,7 @@ class Belt:
         return len(self._t)
 
     def speed(self, t: float) -> float:
-        """The speed at t (:func:`speed_at` less its ``max``: once a part, a fraction of 1 % of
-        ``make bench``'s ``parts_per_s_adaptive_5k``)."""
+        """The speed at t."""
         return self._v[bisect_right(self._t, t, 1) - 1]  # lo=1: the first change if t is before it
 
     def travel(self, t: float) -> float:
@@ -86,9 +85,12 @@ class Belt:
         """From instant t1 (now or later) run at v1, and from t2 > t1 at v2, dropping later plans: a
         new plan supersedes what was planned after t1 (the controller replans every cycle), a change
         within EPS_S of the last one replaces it, and the changes before t1 whose successors have
-        started are settled.  For speed, the controller's case first, unrolled (twice a part)."""
+        started are settled.  The controller's case first (twice a part)."""
         if not v1 > 0 or (t2 is not None and not v2 > 0):
             raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}")
+        if self._halted is not None:  # stopped by a failure: the plan is for the restart
+            self._plan_stopped(t1, v1, t2, v2)
+            return
         ts, xs, vs = self._t, self._x, self._v
         t0 = ts[-1]
         if t0 > t1 + EPS_S and len(ts) > 1 and ts[-2] < t1:  # one change planned after t1
@@ -101,13 +103,7 @@ class Belt:
                 self._settle(n)
             x0, v0 = xs[-1], vs[-1]
             x1 = x0 + v0 * (t1 - t0)
-            if n == 2:  # for speed, the last plan's lists reused in place (and in plan_then): no
-                # new lists, 104.50k to 104.01k instructions a part (the adaptive run, cachegrind)
-                ts[0] = t0; ts[1] = t1; ts[2] = t2  # noqa: E702 (one by one: ts[:] = ... cost 2.9k more)
-                xs[0] = x0; xs[1] = x1; xs[2] = x1 + v1 * (t2 - t1)  # noqa: E702
-                vs[0] = v0; vs[1] = v1; vs[2] = v2  # noqa: E702
-            else:
-                self._t, self._x, self._v = [t0, t1, t2], [x0, x1, x1 + v1 * (t2 - t1)], [v0, v1, v2]
+            self._t, self._x, self._v = [t0, t1, t2], [x0, x1, x1 + v1 * (t2 - t1)], [v0, v1, v2]
             return
         k = bisect_right(ts, t1 + EPS_S)
         if k == 0:  # would rewrite what is settled (and leave no schedule at all)
@@ -124,31 +120,11 @@ class Belt:
             self._run_from(t2, v2)
 
     def plan_then(self, t1: float, v1: float, t2: float, v2: float, t3: float, v3: float) -> None:
-        """:meth:`plan` (t1, v1, t2, v2) then :meth:`then` (t3, v3): the output belt's replan under the
-        spacing contract, unrolled (for speed: a call and three appends a part fewer, 2 % of CPU time;
-        a dropped floor not copied, never deleted: 117.3k to 115.6k instructions per part, cachegrind)."""
-        ts = self._t
-        n = len(ts) - 1  # the change kept: a last floor not yet begun is dropped, as :meth:`plan`
-        if ts[n] > t1 + EPS_S and n > 0 and ts[n - 1] < t1:  # drops it (by not copying it, here)
-            n -= 1
-        t0 = ts[n]
-        if t0 < t1 < t2 < t3 and v1 > 0 and v2 > 0 and v3 > 0:
-            if n > 0:
-                self._settle(n)
-            xs, vs = self._x, self._v
-            x0, v0 = xs[n], vs[n]
-            x1 = x0 + v0 * (t1 - t0)
-            x2 = x1 + v1 * (t2 - t1)
-            if len(ts) == 4:  # the last plan's lists, reused in place (for speed)
-                ts[0] = t0; ts[1] = t1; ts[2] = t2; ts[3] = t3  # noqa: E702
-                xs[0] = x0; xs[1] = x1; xs[2] = x2; xs[3] = x2 + v2 * (t3 - t2)  # noqa: E702
-                vs[0] = v0; vs[1] = v1; vs[2] = v2; vs[3] = v3  # noqa: E702
-            else:
-                self._t, self._x, self._v = [t0, t1, t2, t3], [x0, x1, x2, x2 + v2 * (t3 - t2)], \
-                    [v0, v1, v2, v3]
+        """:meth:`plan` (t1, v1, t2, v2) then :meth:`then` (t3, v3): the output belt's replan under
+        the spacing contract."""
+        if self._halted is not None:
+            self._plan_stopped(t1, v1, t2, v2, t3, v3)
             return
-        if n < len(ts) - 1:
-            del ts[-1], self._x[-1], self._v[-1]
         self.plan(t1, v1, t2, v2)
         self.then(t3, v3)
 
@@ -159,7 +135,7 @@ class Belt:
         if not v > 0 or not t > t0:
             raise ValueError(f"a belt's further change must come after its last and be "
                              f"positive, got {t!r}, {v!r}")
-        xs.append(xs[-1] + vs[-1] * (t - t0))  # _run_from's append, inline (once a part)
+        xs.append(xs[-1] + vs[-1] * (t - t0))
         ts.append(t)
         vs.append(v)
 
@@ -175,9 +151,10 @@ class Belt:
             vs.append(v)
 
     def _settle(self, n: int) -> None:
-        """The first ``n`` changes are final: note their speeds and tell ``on_change``.  (Twice a
-        part, for speed: a slice, and the low tested only if not a new high; with the lookups'
-        ``lo=1`` and the bound's loop, adaptive 110.05k to 108.60k instructions a part, cachegrind.)"""
+        """The first ``n`` changes are final: note their speeds and tell ``on_change`` (the
+        last of them kept as the anchor a stop starts from)."""
+        if n:
+            self._anchor = (self._t[n - 1], self._x[n - 1], self._v[n - 1])
         vs = self._v
         hi, lo = self.max_speed_in_s, self.min_speed_in_s
         for v in vs[:n]:
@@ -197,13 +174,17 @@ class Belt:
         """Whether the belt stands (a failure, :meth:`stop`) until :meth:`restart`."""
         return self._halted is not None
 
-    def plan_stopped(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
-        """:meth:`plan` while stopped: the plan takes effect from the restart on."""
+    def _plan_stopped(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0,
+                      t3: float | None = None, v3: float = 0.0) -> None:
+        """:meth:`plan` (and :meth:`then`) while stopped: the plan takes effect from the
+        restart on."""
         assert self._halted is not None
         running, later = self._halted
         later = [(t, v) for t, v in later if t < t1 - EPS_S] + [(t1, v1)]
         if t2 is not None:
             later.append((t2, v2))
+        if t3 is not None:
+            later.append((t3, v3))
         self._halted = (running, later)
 
     def restart(self, t: float) -> None:
@@ -221,28 +202,6 @@ class Belt:
         for tp, vp in ahead:
             self._run_from(tp, vp)
 
-    def close(self, until: float | None = None) -> None:
-        """Hand every change still held (planned ones included) to ``on_change``; with ``until``
-        (the run's end), those planned to start then or later, which never took effect, dropped."""
-        if until is not None:
-            keep = max(bisect_left(self._t, until - EPS_S), 1)
-            del self._t[keep:], self._x[keep:], self._v[keep:]
-        self._settle(len(self._t))
-        del self._t[:], self._x[:], self._v[:]
-
-
-class StoppableBelt(Belt):
-    """A belt a failure can stop (``failures:``), keeping its last settled change for :meth:`stop`;
-    chosen at assembly (for speed: the anchor's tuple, two settles a part, was about 1 % of ``make
-    bench``'s ``parts_per_s_adaptive_5k`` on 2 shared cores, best of 7)."""
-
-    __slots__ = ()
-
-    def _settle(self, n: int) -> None:
-        if n:
-            self._anchor = (self._t[n - 1], self._x[n - 1], self._v[n - 1])
-        Belt._settle(self, n)
-
     def stop(self, t: float) -> None:
         """Stand from instant t (now) on: speed 0, parts stay where they are; what was
         planned after t is kept for :meth:`restart` (docs/model.md, "When equipment fails")."""
@@ -259,6 +218,15 @@ class StoppableBelt(Belt):
         self._run_from(t, 0.0)
         self._halted = (running, later)
 
+    def close(self, until: float | None = None) -> None:
+        """Hand every change still held (planned ones included) to ``on_change``; with ``until``
+        (the run's end), those planned to start then or later, which never took effect, dropped."""
+        if until is not None:
+            keep = max(bisect_left(self._t, until - EPS_S), 1)
+            del self._t[keep:], self._x[keep:], self._v[keep:]
+        self._settle(len(self._t))
+        del self._t[:], self._x[:], self._v[:]
+
 
 class InputConveyor:
     """Carries parts from the feeder, ``length_in`` upstream of B, to B.
@@ -274,11 +242,13 @@ class InputConveyor:
     """
 
     def __init__(self, env: simpy.Environment, speed_in_s: float, length_in: float,
-                 on_change: Callable[[float, float], Any] | None = None, stoppable: bool = False):
+                 on_change: Callable[[float, float], Any] | None = None, stops: Any = None):
         self.env = env
-        self.belt = (StoppableBelt if stoppable else Belt)(speed_in_s, on_change)
+        self.belt = Belt(speed_in_s, on_change)
         self.length_in = length_in
         """Feeder drop point to B (in)."""
+        self.stops = stops
+        """What can stop the belt (:class:`cell.sim.failures.BeltStops`; None: nothing)."""
         self.loaded: Mailbox = Mailbox(env)
         """Parts dropped on the belt by the feeder."""
         self.at_bot: Mailbox = Mailbox(env)
@@ -287,49 +257,73 @@ class InputConveyor:
         """Belt travel at the instant each part on the belt was dropped (by index)."""
         self.due_s = -math.inf
         """When the part on its way to B gets there (-inf: none is)."""
-        self.on_replan: Callable[[], None] | None = None
-        """Called after each replan (the feeder's, which times a held part's wait again)."""
+        self._changed: simpy.Event | None = None
         self.timing = False
-        """True while :meth:`run_stoppable` waits for a part to reach B (a stop re-times it)."""
-        self.process = env.process(self.run_stoppable() if stoppable else self.run())
+        """True while a part's way to B is waited for in steps a stop can interrupt."""
+        self.process = env.process(self.run())
 
-    def drop(self, part: Part, x: float, now: float) -> None:
-        """The feeder puts a part on the belt now (the clock's ``now``), the belt's travel being x."""
+    def drop(self, part: Part, x: float) -> None:
+        """The feeder puts a part on the belt now, the belt's travel being x."""
         self.x_fed[part.index] = x
-        self.loaded.put((part, now))
+        self.loaded.put(part)
+
+    def changed(self) -> simpy.Event:
+        """An event that succeeds when the belt's plan next changes (a replan, a stop or a
+        restart): what the feeder waits on, beside its timeout, while it holds a part."""
+        if self._changed is None:
+            self._changed = self.env.event()
+        return self._changed
+
+    def _tell(self) -> None:
+        changed, self._changed = self._changed, None
+        if changed is not None:
+            changed.succeed()
 
     def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
         """New speed plan from the controller (:meth:`Belt.plan`), as a part reaches B."""
         if t1 < self.due_s:  # the plan's start, not env.now (a property: :meth:`.Robot.run`)
             raise RuntimeError("the input belt was replanned while a part was on its way to B")
         self.belt.plan(t1, v1, t2, v2)
-        if self.on_replan is not None:
-            self.on_replan()
+        if self._changed is not None:
+            self._tell()
+
+    def stop(self, now: float) -> None:
+        """A failure stops the belt now: the part on its way to B is timed again."""
+        self.belt.stop(now)
+        self._retime()
+
+    def restart(self, now: float) -> None:
+        """The belt runs again from now."""
+        self.belt.restart(now)
+        self._retime()
+
+    def _retime(self) -> None:
+        if self.timing:
+            self.process.interrupt()
+        self._tell()
 
     def run(self):  # noqa: ANN201 (SimPy generator)
-        get, hand_over, clock = self.loaded.get, self.at_bot.put_after, self.env.now
-        time_at, x_fed, length = self.belt.time_at, self.x_fed, self.length_in
-        while True:
-            part, dropped = yield get()
-            i = part.index
-            now = dropped if dropped > clock else clock  # env.now: dropped, or the last arrival (Robot.run)
-            delay = time_at(x_fed[i] + length) - now
-            if delay < 0.0:  # max(delay, 0) without the builtin call
-                delay = 0.0
-            # the instant the part reaches B, as the event queue will have it
-            part.at_bot_s = self.due_s = clock = now + delay
-            # the controller takes the part (and replans) before this process resumes
-            yield hand_over(part, delay)
-            del x_fed[i]
-
-    def run_stoppable(self):  # noqa: ANN201 (SimPy generator)
-        """:meth:`run` for a belt that can stop: the part's arrival at B is timed again
-        (the process interrupted) whenever the belt stops or starts."""
+        """Each part handed to the controller due at the instant it reaches B: one event,
+        which wakes the controller and then this process, so the controller plans (and may
+        replan the belt) before the next part is timed.  If the belt may stop before the
+        part gets there (``stops``), the wait is a timeout that a stop or a restart
+        interrupts, and the part is timed again."""
         env, get, hand_over, belt = self.env, self.loaded.get, self.at_bot.put_after, self.belt
+        x_fed, length, stops = self.x_fed, self.length_in, self.stops
         while True:
-            part, _ = yield get()
+            part = yield get()
             i = part.index
-            target = self.x_fed[i] + self.length_in
+            now = env.now
+            target = x_fed[i] + length
+            if stops is None or not belt.stopped:
+                delay = belt.time_at(target) - now
+                if delay < 0.0:
+                    delay = 0.0
+                if stops is None or stops.clear_until(now + delay):  # the arrival known now
+                    part.at_bot_s = self.due_s = now + delay
+                    yield hand_over(part, delay)  # the controller takes it (and replans) first
+                    del x_fed[i]
+                    continue
             while True:
                 self.timing = True
                 try:
@@ -346,12 +340,7 @@ class InputConveyor:
                     self.timing = False
             part.at_bot_s = self.due_s = env.now
             yield hand_over(part, 0.0)
-            del self.x_fed[i]
-
-    def retime(self) -> None:
-        """The belt stopped or started: time the part on its way to B again."""
-        if self.timing:
-            self.process.interrupt()
+            del x_fed[i]
 
 
 class OutputConveyor:
@@ -365,9 +354,9 @@ class OutputConveyor:
 
     def __init__(self, env: simpy.Environment, speed_in_s: float,
                  delivered: Callable[[Part], Any],
-                 on_change: Callable[[float, float], Any] | None = None, stoppable: bool = False):
+                 on_change: Callable[[float, float], Any] | None = None):
         self.env = env
-        self.belt = (StoppableBelt if stoppable else Belt)(speed_in_s, on_change)
+        self.belt = Belt(speed_in_s, on_change)
         self.placed: Mailbox = Mailbox(env)
         """Parts set down by the robot, each due at its touch-down, with that instant."""
         self.delivered = delivered
@@ -375,16 +364,24 @@ class OutputConveyor:
         """Belt travel at the last touch-down (None before the first)."""
         self.last_td_s = math.nan
         """Instant of the last touch-down (read once ``last_td_x`` is set)."""
-        self.replan = self.belt.plan
-        """New speed plan from the controller (:meth:`Belt.plan`)."""
-        self.replan_then = self._replan_then if stoppable else self.belt.plan_then
-        """The same with the spacing contract's floor after it (:meth:`Belt.plan_then`)."""
         self.process = env.process(self.run())
 
-    def _replan_then(self, t1: float, v1: float, t2: float, v2: float, t3: float, v3: float) -> None:
-        """With failures: :attr:`replan` (which :mod:`cell.sim.failures` wraps), then the floor."""
-        self.replan(t1, v1, t2, v2)
-        self.belt.then(t3, v3)
+    def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
+        """New speed plan from the controller (:meth:`Belt.plan`)."""
+        self.belt.plan(t1, v1, t2, v2)
+
+    def replan_then(self, t1: float, v1: float, t2: float, v2: float, t3: float,
+                    v3: float) -> None:
+        """The same with the spacing contract's floor after it (:meth:`Belt.plan_then`)."""
+        self.belt.plan_then(t1, v1, t2, v2, t3, v3)
+
+    def stop(self, now: float) -> None:
+        """A failure stops the belt now (a part the robot sets down stays where it is put)."""
+        self.belt.stop(now)
+
+    def restart(self, now: float) -> None:
+        """The belt runs again from now."""
+        self.belt.restart(now)
 
     def run(self):  # noqa: ANN201 (SimPy generator)
         get, travel, delivered = self.placed.get, self.belt.travel, self.delivered

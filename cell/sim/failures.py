@@ -1,7 +1,7 @@
 """Breakdowns, repairs and planned stops in the simulated cell (docs/model.md, "When
 equipment fails").
 
-Each piece of equipment with a ``failures:`` entry has a failure clock (:class:`Countdown`):
+Each piece of equipment with a ``failures:`` entry has a failure clock (:mod:`cell.sim.failure_clock`):
 a budget, drawn from its time to failure, consumed at a rate that depends on what the
 equipment is doing (1 while it works on the ``operating`` clock; 1 while it is up on the
 ``calendar`` clock).  When it runs out the equipment fails: it waits for a repair crew (a
@@ -13,111 +13,32 @@ default (:class:`Distributed`) is a time to failure; a wear model gives one budg
 (the exposure at which it wears out) and a rate per leg of each cycle (its exposure per
 second), told of every cycle's leg times as it starts (:meth:`Exposure.cycle`).
 
-The robot (:class:`RobotStops`) runs each order as six legs, B → LO, LO → F, F → G,
-G → TD, TD → K, K → B, each a timeout that a stop interrupts (SimPy's machine-shop
-pattern); it is held while it is down or in maintenance, and in B → LO (G → TD) while the
-input (output) belt, which it tracks there, stands.
+A stop costs what it is.  Each clock has one event, at the instant its first budget runs
+out, moved only when what the equipment will do changes; the robot's clock is told each
+cycle's six legs, B → LO, LO → F, F → G, G → TD, TD → K, K → B, as the cycle starts
+(:meth:`~cell.sim.failure_clock.FailureClock.cycle`).  A cycle that nothing can stop before
+it ends (no equipment down, no failure or planned stop due) runs as it would with no failures
+at all; one that
+something may stop runs leg by leg, each a timeout that a stop interrupts (SimPy's
+machine-shop pattern, :meth:`cell.sim.robot.Robot.run`): the robot is held while it is down
+or in maintenance, and in B → LO (G → TD) while the input (output) belt, which it tracks
+there, stands.  An interrupt is sent only when equipment fails or comes back.
 """
 
 from __future__ import annotations
 
 import math
 from array import array
-from collections.abc import Callable, Sequence
-from typing import Any, Protocol
+from collections.abc import Callable
+from typing import Any
 
+import numpy as np
 import simpy
 
 from cell.scenario.failure_spec import EQUIPMENT, SECONDS_PER_HOUR, STREAM_KEYS, Draws
 from cell.sim.conveyors import EPS_S
+from cell.sim.failure_clock import MOVING_NOT, STOPPED, Distributed, Exposure, FailureClock
 from cell.sim.records import LET_GO, LOST_DOWNTIME, SCRAPPED
-
-#: Legs of a cycle (the stretches a wear model times: cell.arm.steptable's segments).
-LEGS = ("r1_pre", "r1_post", "r2", "r3_pre", "r3_post", "r4")
-#: What the failure clock is told the robot is doing: a leg (0-5) in motion, or
-MOVING_NOT, STOPPED = -1, -2
-"""up and not in motion (at B, or held by a belt), or stopped (down, in maintenance)."""
-
-
-class Exposure(Protocol):
-    """What a failure clock counts down (the hook for wear, :mod:`cell.sim.wear`)."""
-
-    cause: str
-    """failures.csv's ``cause`` of a failure it brings: ``failure`` or ``wear``."""
-
-    def thresholds(self) -> list[float]:
-        """The budget of each component (a motor) at the start."""
-
-    def renew(self, component: int) -> float:
-        """A new budget for a component once repaired (replaced)."""
-
-    def rates(self, leg: int) -> Sequence[float]:
-        """Each component's budget used per second while the equipment does ``leg``."""
-
-    def cycle(self, legs_s: Sequence[float]) -> None:
-        """A cycle starts whose legs (:data:`LEGS`) take these times."""
-
-
-class Distributed:
-    """A time to failure drawn from a distribution, on the operating or calendar clock."""
-
-    cause = "failure"
-
-    def __init__(self, draw: Callable[[], float], clock: str):
-        self.draw, self.calendar = draw, clock == "calendar"
-
-    def thresholds(self) -> list[float]:
-        return [self.draw()]
-
-    def renew(self, component: int) -> float:
-        return self.draw()
-
-    def rates(self, leg: int) -> Sequence[float]:
-        return (1.0,) if leg >= 0 or (self.calendar and leg == MOVING_NOT) else (0.0,)
-
-    def cycle(self, legs_s: Sequence[float]) -> None:
-        return None
-
-
-class Countdown:
-    """An equipment's failure clock (SimPy process): fails it when a budget runs out."""
-
-    def __init__(self, env: simpy.Environment, exposure: Exposure,
-                 fail: Callable[[int, str], Any], leg: int):
-        self.env, self.exposure, self.fail = env, exposure, fail
-        self.leg = leg
-        self.left = exposure.thresholds()
-        self.counting = False
-        self.process = env.process(self.run())
-
-    def set_leg(self, leg: int) -> None:
-        """What the equipment does now (a leg, MOVING_NOT or STOPPED)."""
-        if leg != self.leg:
-            self.leg = leg
-            if self.counting and self.env.active_process is not self.process:
-                self.process.interrupt()
-
-    def run(self):  # noqa: ANN201 (SimPy generator)
-        env = self.env
-        while True:
-            first = -1
-            while first < 0:
-                rates = self.exposure.rates(self.leg)
-                waits = [b / r if r > 0 else math.inf for b, r in zip(self.left, rates)]
-                wait = min(waits)
-                start = env.now
-                self.counting = True
-                try:
-                    yield env.event() if wait == math.inf else env.timeout(wait)
-                    first = waits.index(wait)
-                except simpy.Interrupt:
-                    pass
-                finally:
-                    self.counting = False
-                used = env.now - start
-                self.left = [max(b - used * r, 0.0) for b, r in zip(self.left, rates)]
-            yield from self.fail(first, self.exposure.cause)
-            self.left[first] = self.exposure.renew(first)
 
 
 class Equipment:
@@ -131,11 +52,11 @@ class Equipment:
         self.exposure: Exposure = Distributed(Draws(spec.time_to_failure, seed, ttf), spec.clock)
         self.down = False
         self.cell_env = cell.env
-        self.clock: Countdown | None = None
+        self.clock: FailureClock | None = None
         self.leg = leg
 
     def start(self) -> None:
-        self.clock = Countdown(self.cell_env, self.exposure, self.fail, self.leg)
+        self.clock = FailureClock(self.cell_env, self.exposure, self.fail, self.leg)
 
     def fail(self, component: int, cause: str):  # noqa: ANN201 (SimPy generator)
         env, crews = self.cell_env, self.cell.crews
@@ -153,100 +74,113 @@ class Equipment:
 
 
 class RobotStops:
-    """The robot's side of failures: its legs, its stops, and why a part was lost."""
+    """What can stop the robot (handed to :class:`cell.sim.robot.Robot`): its failures and
+    planned stops, and the belts it tracks; its failure clock, its motion, and why a part
+    was lost.  The robot's cycle is the robot's (:meth:`cell.sim.robot.Robot.run`); this
+    says whether anything can stop it (:meth:`begin`), holds it (:meth:`held`), and
+    interrupts it when something does (:meth:`touch`)."""
 
     def __init__(self, cell: Downtime, scrap: bool):
         self.cell, self.env, self.scrap = cell, cell.env, scrap
         self.robot: Any = None
+        """The robot stopped (set by the robot it is handed to)."""
         self.stop: str | None = None
         """``down`` or ``maintenance`` while the robot is stopped."""
         self.in_cycle = False
+        """True while a cycle runs leg by leg (one something may stop)."""
         self.at_leg = -1
         self.part: Any = None
         """The part of the cycle under way, until it is set down (or lost)."""
         self.planned_free = -math.inf
         """When the cycle under way would have ended without a stop."""
-        self.clocks: list[Countdown] = []
+        self.clocks: list[FailureClock] = []
         self.motion = array("d")
         """Motion intervals, (from, to) pairs."""
-        self._moving_since = math.nan
+        self.moving_since = math.nan
+        """When the motion under way began (NaN: the robot is not moving)."""
         self.maintenance_due: simpy.Event | None = None
-        self.proc: Any = None
-        """The process of the cycle under way (what a stop interrupts)."""
+        self.maintenance_at = math.inf
+        """When the next planned stop comes."""
 
     def loss(self, now: float) -> int:
         """A part at B with the robot not back: lost to downtime if a stop kept it away."""
         return LOST_DOWNTIME if self.stop is not None or now + EPS_S >= self.planned_free \
             else LET_GO
 
-    def touch(self) -> None:
-        """Something that can hold the robot changed: its legs look again."""
-        proc = self.proc
-        if self.in_cycle and proc is not None and proc.is_alive and \
-                self.env.active_process is not proc:
-            proc.interrupt()
-
-    def _doing(self, leg: int, free_at: float) -> None:
-        now = self.env.now
-        if leg >= 0 and self._moving_since != self._moving_since:
-            self._moving_since = now
-        elif leg < 0 and self._moving_since == self._moving_since:
-            self.motion.extend((self._moving_since, now))
-            self._moving_since = math.nan
-        self.robot.free_at_s = free_at
-        for clock in self.clocks:
-            clock.set_leg(leg)
-
-    def cycle(self, part: Any, to_lo: float, to_td: float):  # noqa: ANN201 (SimPy generator)
-        """One order, leg by leg (the robot's process runs it)."""
+    def begin(self, part: Any, to_lo: float, to_td: float) -> tuple[float, ...] | None:
+        """A cycle starts now: None if nothing can stop the robot before it is back at B
+        (no equipment down, no stop planned or due till then: the robot runs it as if
+        nothing could fail), else its legs (:data:`LEGS`), to run one by one."""
         env, cell = self.env, self.cell
+        now = env.now
         plan = part.plan  # the regimes as parts.csv has them (R I, R III: their two legs summed)
         r1, r2, cycle = plan.r1_pre + plan.r1_post, plan.r2, plan.cycle
         r3_pre = to_td - (r1 + r2)
         r3_post = plan.r3_pre + plan.r3_post - r3_pre
         legs = (to_lo, r1 - to_lo, r2, r3_pre, r3_post, cycle - to_td - r3_post)
-        self.planned_free, self.in_cycle, self.part = env.now + cycle, True, part
-        self.proc = env.active_process
+        end = now + cycle
+        self.planned_free = end
+        clear = self.stop is None and self.maintenance_due is None and \
+            self.maintenance_at > end and cell.clear_until(end)
         for clock in self.clocks:
-            clock.exposure.cycle(legs)
-        rest = cycle
-        for i, leg in enumerate(legs):
-            rest -= leg
-            self.at_leg, left = i, leg
-            belt = cell.input_belt if i == 0 else cell.output_belt if i == 3 else None
-            while left > 0.0:
-                start = env.now
-                try:
-                    if self.stop is not None or (belt is not None and belt.stopped):
-                        self._doing(STOPPED if self.stop is not None else MOVING_NOT, math.inf)
-                        yield env.event()  # until whatever holds the robot lets go
-                    # a planned stop due: the robot will not be free for a part at B
-                    self._doing(i, start + left + max(rest, 0.0)
-                                if self.maintenance_due is None else math.inf)
-                    yield env.timeout(left)
-                    left = 0.0
-                except simpy.Interrupt:
-                    if self._moving_since == self._moving_since:
-                        left = max(left - (env.now - start), 0.0)
-            p = self.part
-            if p is not None and i == 0:
-                p.pick_s = env.now
-            elif p is not None and i == 3:
-                cell.output.placed.put((p, env.now))  # touch-down: taken now, its instant
-                self.part = None
-        self.in_cycle, self.part = False, None
-        self.at_rest()
+            clear = clock.cycle(legs, end, clear)
+        if clear:
+            self.motion.extend((now, end))
+            return None
+        self.in_cycle, self.part = True, part
+        return legs
+
+    def held(self, leg: int) -> bool:
+        """Whether the robot is held now in ``leg``: stopped, or tracking a stopped belt."""
+        belt = self.cell.input_belt if leg == 0 else self.cell.output_belt if leg == 3 else None
+        return self.stop is not None or (belt is not None and belt.stopped)
+
+    def touch(self) -> None:
+        """Something that can hold the robot changed: its legs look again."""
+        proc = self.robot.process if self.robot is not None else None
+        if self.in_cycle and proc is not None and proc.is_alive and \
+                self.env.active_process is not proc:
+            proc.interrupt()
+
+    def doing(self, leg: int, free_at: float) -> None:
+        """What the robot does from now on (a leg, MOVING_NOT or STOPPED), and when it will
+        be free for a part at B."""
+        now = self.env.now
+        if leg >= 0 and self.moving_since != self.moving_since:
+            self.moving_since = now
+        elif leg < 0 and self.moving_since == self.moving_since:
+            self.motion.extend((self.moving_since, now))
+            self.moving_since = math.nan
+        robot = self.robot
+        if not robot.orders.items:  # an order given as this cycle ends keeps its own
+            robot.free_at_s = free_at
+        for clock in self.clocks:
+            clock.follow(leg)
+
+    def busy(self, end_s: float) -> tuple[Any, Any]:
+        """(from, to) of the robot's motion up to ``end_s``."""
+        motion = np.frombuffer(self.motion, dtype=float).reshape(-1, 2)
+        if self.moving_since == self.moving_since:
+            motion = np.vstack([motion, [[self.moving_since, end_s]]])
+        motion = np.minimum(motion, end_s)
+        return motion[:, 0], motion[:, 1]
+
+    def set_down(self) -> Any:
+        """The part at touch-down (None: scrapped in a stop); the hand is empty after."""
+        part, self.part = self.part, None
+        return part
 
     def at_rest(self) -> None:
         """Back at B (or repaired there): free, unless a planned stop is due."""
+        self.in_cycle, self.part = False, None
         due = self.maintenance_due
         if due is not None and self.stop is None:
             self.maintenance_due = None
             self.stop = "maintenance"
-            self._doing(STOPPED, math.inf)
+            self.doing(STOPPED, math.inf)
             due.succeed()
         elif self.stop is None:
-            self._doing(MOVING_NOT, self.env.now)
+            self.doing(MOVING_NOT, self.env.now)
 
     def fails(self) -> Any:
         """The robot fails now: held where it is; the part before lift-off rides off, the
@@ -264,7 +198,7 @@ class RobotStops:
         if self.in_cycle:
             self.touch()
         else:
-            self._doing(STOPPED, math.inf)
+            self.doing(STOPPED, math.inf)
         return part.index + 1 if part is not None else ""  # parts.csv's number
 
     def repaired(self) -> None:
@@ -278,19 +212,32 @@ class RobotStops:
         env = self.env
         k = 1
         while True:
+            self.maintenance_at = k * every_s
             yield env.timeout(max(k * every_s - env.now, 0.0))
+            self.maintenance_at = math.inf
             if self.in_cycle or self.stop is not None:
                 self.maintenance_due = env.event()
                 self.robot.free_at_s = math.inf  # no new part once back at B
                 yield self.maintenance_due
             else:
                 self.stop = "maintenance"
-                self._doing(STOPPED, math.inf)
+                self.doing(STOPPED, math.inf)
             key = self.cell.begin("robot", "maintenance", "")
             yield env.timeout(duration_s)
             self.cell.end(key)
             self.repaired()
             k = max(k + 1, math.floor(env.now / every_s) + 1)
+
+
+class BeltStops:
+    """What can stop a belt (handed to its conveyor): its failures."""
+
+    def __init__(self, cell: Downtime, name: str):
+        self.cell, self.name = cell, name
+
+    def clear_until(self, t: float) -> bool:
+        """Whether the belt runs now and cannot fail before ``t``."""
+        return self.cell.clear_until(t, self.name)
 
 
 class Downtime:
@@ -312,31 +259,20 @@ class Downtime:
         self.input_belt: Any = None
         self.output_belt: Any = None
         self.equipment: list[Equipment] = []
+        self._belt_clocks: list[Equipment] = []
         self._open: dict[int, tuple[str, str, float, Any]] = {}
         self._next = 0
 
-    def attach(self, robot: Any, conveyor: Any, output: Any, feeder: Any, view: Any,
-               log: Any) -> None:
-        """Wire the failures into the cell's processes (before the run starts)."""
+    def attach(self, conveyor: Any, output: Any, view: Any, log: Any) -> None:
+        """The equipment its failures stop, and the log of parts they lose (before the
+        run starts): kept, never rewired (each piece stops and restarts by its own methods)."""
         f, rs = self.spec, self.robot
         self.log, self.output = log, output
         self.input_belt, self.output_belt = conveyor.belt, output.belt
-        rs.robot = robot
-        robot.loss = rs.loss
-        conveyor.replan = _while_stopped(conveyor.belt, conveyor.replan)
-        output.replan = _while_stopped(output.belt, output.replan)
 
         def belt(which: Any, stop: bool) -> Callable[[], Any]:
             def change() -> str:
-                b = which.belt
-                if stop:
-                    b.stop(self.env.now)
-                else:
-                    b.restart(self.env.now)
-                if which is conveyor:
-                    conveyor.retime()
-                    if not stop and feeder.holding:
-                        feeder.process.interrupt()
+                (which.stop if stop else which.restart)(self.env.now)
                 rs.touch()
                 return ""
             return change
@@ -363,16 +299,24 @@ class Downtime:
             self.equipment.append(e)
 
     def start(self) -> None:
-        """Start the failure clocks and the planned stops (after :meth:`attach`; a wear model
-        may replace the robot's ``exposure`` in between)."""
+        """Start the failure clocks and the planned stops (after :meth:`attach`)."""
         rs = self.robot
         for e in self.equipment:
             e.start()
             if e.name == "robot" and e.clock is not None:
                 rs.clocks.append(e.clock)
+            elif e.name in ("input_belt", "output_belt"):
+                self._belt_clocks.append(e)
         m = self.spec.maintenance
         if m is not None:
             self.env.process(rs.maintenance(m.every_h * SECONDS_PER_HOUR, m.duration_min * 60.0))
+
+    def clear_until(self, t: float, name: str | None = None) -> bool:
+        """Whether the belts (or the one named) run now and cannot fail before ``t``."""
+        for e in self._belt_clocks:
+            if (name is None or e.name == name) and (e.down or e.clock.due_s <= t):  # type: ignore[union-attr]
+                return False
+        return True
 
     def begin(self, name: str, cause: str, part: Any) -> int:
         """A stop begins now; its key (for :meth:`end`)."""
@@ -388,13 +332,3 @@ class Downtime:
         """Every stop, those still under way ending at ``end_s``, in order of start."""
         out = self.stops + [(n, c, a, end_s, p) for n, c, a, p in self._open.values()]
         return sorted(out, key=lambda row: (row[2], EQUIPMENT.index(row[0])))
-
-
-def _while_stopped(belt: Any, replan: Callable[..., None]) -> Callable[..., None]:
-    """A belt's replan that, while the belt stands, plans for the restart instead."""
-    def plan(t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
-        if belt.stopped:
-            belt.plan_stopped(t1, v1, t2, v2)
-        else:
-            replan(t1, v1, t2, v2)
-    return plan

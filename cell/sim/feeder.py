@@ -12,7 +12,6 @@ carries nothing clear, so the feeder holds every part that comes until it runs a
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import Any, Protocol
 
 import numpy as np
@@ -30,9 +29,10 @@ class Loadable(Protocol):
     """Where the feeder drops parts: the input conveyor."""
 
     belt: Any
-    on_replan: Callable[[], None] | None
 
-    def drop(self, part: Part, x: float, now: float) -> None: ...
+    def drop(self, part: Part, x: float) -> None: ...
+
+    def changed(self) -> simpy.Event: ...
 
 
 class Feeder:
@@ -51,55 +51,34 @@ class Feeder:
         self.part_size_in = part_size_in
         self.flag = flag
         """Told (part, limit bits) of a part held back."""
-        self.holding = False
-        """True while a part waits for the belt to clear (a replan interrupts the wait)."""
         self.process = env.process(self.run())
 
-    def belt_replanned(self) -> None:
-        """The input belt was replanned while a part is held back: its wait is timed again
-        (the conveyor's ``on_replan`` while the feeder holds a part, None otherwise)."""
-        if self.holding:
-            self.process.interrupt()
-
     def run(self):  # noqa: ANN201 (SimPy generator)
-        """Once per part, with locals bound, the clock among them: each wait ends exactly
-        ``now + delay`` later, as SimPy times a timeout.  For speed: ``env.now`` is a property
-        (timed on the shared 2-core machine, 4 times a local's read), and the four reads a
-        part this, the controller and the robot save are 1-3 % of ``make bench``'s
-        ``parts_per_s_adaptive_5k`` (about 13 µs a part)."""
+        """Part i comes ``fed_s[i]`` into the run; dropped then, or held till the belt is clear."""
         env, drop, fed = self.env, self.conveyor.drop, self.fed_s
         timeout, travel, flag = env.timeout, self.conveyor.belt.travel, self.flag
-        after = Timer(env).after  # env.timeout's schedule, without a new event a part
+        after = Timer(env).after  # speed: docs/performance.md#mailbox
         size = self.part_size_in
         clear_at = -float("inf")
-        now = env.now  # the clock, kept here: each wait ends exactly ``now + delay`` later
         for i in range(self.n_parts):
             f = fed[i]
-            delay = f - now
-            if delay < 0.0:  # max(delay, 0): after a hold it may be due
-                delay = 0.0
-            yield after(delay)
-            now += delay  # env.now, as the timer fell (two property reads a part saved)
+            yield after(max(f - env.now, 0.0))  # after a hold it may be due
+            now = env.now
             x = travel(now)
-            if x < clear_at - CLEAR_TOL_IN:
+            if x < clear_at - CLEAR_TOL_IN:  # held back till the belt has carried the last clear
                 belt = self.conveyor.belt
-                self.holding = True
-                self.conveyor.on_replan = self.belt_replanned
                 while x < clear_at - CLEAR_TOL_IN:
-                    try:
-                        if belt.stopped:  # a failure: wait for the restart to interrupt
-                            yield env.event()
-                        yield timeout(max(belt.time_at(clear_at) - env.now, EPS_S))
-                    except simpy.Interrupt:  # the belt was replanned: time the wait again
-                        pass
+                    changed = self.conveyor.changed()  # a replan, a stop, a restart: timed again
+                    if belt.stopped:  # a failure: wait for the restart
+                        yield changed
+                    else:
+                        yield timeout(max(belt.time_at(clear_at) - env.now, EPS_S)) | changed
                     x = travel(env.now)
-                self.holding = False
-                self.conveyor.on_replan = None
                 now = env.now
                 part = Part(i, now, now - f)
                 if flag is not None:
                     flag(part, HELD_AT_FEEDER)
             else:
                 part = Part(i, f)
-            drop(part, x, now)
+            drop(part, x)
             clear_at = x + size

@@ -8,7 +8,6 @@ the end sharp, and the parts still in the cell are counted as such.  ``run.parts
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -40,21 +39,11 @@ def run_arrivals(s: Any, seed: Any) -> tuple[np.ndarray, int, float | None]:
     return t[:n + 1], n, horizon
 
 
-def run_until_done(env: Any, log: Any, n: int, horizon: float | None, output: Any) -> None:
-    """Run to the horizon, or (failure clocks never end) until the last part is done."""
+def run_until_done(env: Any, log: Any, horizon: float | None, finished: Any) -> None:
+    """Run to the horizon, or (failure clocks never end) until the last part is done
+    (``finished``, the run log's event)."""
     if horizon is not None:
         env.run(until=horizon)
         log.flush()
         return
-    finished = env.event()
-
-    def counting(done: Callable[[Any], None]) -> Callable[[Any], None]:
-        def counted(p: Any) -> None:
-            done(p)
-            if log.handed_on == n and not finished.triggered:
-                finished.succeed()
-        return counted
-
-    log.missed = counting(log.missed)
-    log.delivered_part = output.delivered = counting(log.delivered_part)
     env.run(until=finished)

@@ -21,13 +21,10 @@ Same-instant hand-offs are served in the order they were made.  :class:`Timer` i
 Why private attributes, and which. Every part passes through four mailboxes and one timer;
 scheduling an event by pushing it onto SimPy's queue exactly as ``Environment.schedule`` does,
 and reusing a box's events rather than making one per hand-off, is what keeps the model near
-SimPy's own speed. ``make bench``'s ``parts_per_s_adaptive_5k`` (baseline, 5,000 parts, best of
-5; reports/bench.json: 65,800 parts/s on the machine of 2026-12-01) falls to about 40 % with
-:class:`StoreMailbox` and :class:`TimeoutTimer` (``simpy.Store``, ``env.timeout``) in their
-place, ``parts_per_s_non_adaptive_5k`` to about 30 % (side by side on 2 shared cores, CPU time:
-26,000-28,000 against 59,000-77,000 adaptive parts/s, 32,000-41,000 against 111,000-124,000
-non-adaptive); ``tests/sim/test_mailbox.py`` runs the whole model both ways and finds every
-part's record the same to the last bit. The accesses, all in this module (``grep -rnE
+SimPy's own speed (speed: docs/performance.md#mailbox); ``tests/sim/test_mailbox.py`` runs the
+whole model with :class:`StoreMailbox` and :class:`TimeoutTimer` (``simpy.Store``,
+``env.timeout``) in their place and finds every part's record the same to the last bit.
+The accesses, all in this module (``grep -rnE
 "\\._(now|queue|eid|ok|value)\\b" cell/`` finds no other):
 
 * ``env._queue``, ``env._eid``: the event heap and its counter, pushed onto as

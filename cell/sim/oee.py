@@ -62,11 +62,7 @@ def _busy(column: Callable[[str], np.ndarray], downtime: Any, end_s: float
     """The robot's motion: as the failure clock logged it, or (nothing stopping the robot
     mid-cycle) each picked part's cycle from its arrival at B."""
     if downtime is not None:
-        motion = np.frombuffer(downtime.robot.motion, dtype=float).reshape(-1, 2)
-        since = downtime.robot._moving_since
-        if since == since:
-            motion = np.vstack([motion, [[since, end_s]]])
-        return motion[:, 0], motion[:, 1]
+        return downtime.robot.busy(end_s)
     picked = column("picked") != 0
     at_bot = column("at_bot")[picked]
     return at_bot, at_bot + column("cycle")[picked]

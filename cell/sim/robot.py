@@ -25,6 +25,7 @@ R IV are at least their fastest.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING, Any
 
@@ -32,6 +33,7 @@ import numpy as np
 import simpy
 
 from cell.arm.motors import Segment
+from cell.sim.failure_clock import MOVING_NOT, STOPPED
 from cell.sim.mailbox import Mailbox
 from cell.sim.records import LET_GO
 
@@ -171,15 +173,14 @@ class Robot:
     B → B later.
 
     The robot owns its state: ``free_at_s``, when it will be back at B, is set the
-    moment it is told an order.  One event per order besides the order itself: a
-    regime's moves are summed, never simulated one by one; lift-off is written when
-    the order is taken, and the part is handed to the output conveyor due at
-    touch-down (:meth:`cell.sim.mailbox.Mailbox.put_after`), the set-down being the
-    event that wakes the conveyor.  The way back (TD → K → B) needs no event, since
-    no order comes before ``free_at_s``.
+    moment it is told an order.  What can stop it is handed to it: ``stops``
+    (:class:`cell.sim.failures.RobotStops`: failures, planned stops, the belts it
+    tracks) and ``wear`` (:class:`cell.sim.wear_clock.WearStops`: a worn motor
+    replaced once the cycle is done); None: nothing can.
     """
 
-    def __init__(self, env: simpy.Environment, output: Mailbox, cycle: Any = None):
+    def __init__(self, env: simpy.Environment, output: Mailbox, stops: Any = None,
+                 wear: Any = None):
         self.env = env
         self.orders: Mailbox = Mailbox(env)
         """Cycles to run, from the controller: (part, B → LO, B → TD, the instant) tuples."""
@@ -187,43 +188,66 @@ class Robot:
         """Where parts are set down (the output conveyor's mailbox)."""
         self.free_at_s = 0.0
         """When the robot is (or will be) back at B, ready for a part."""
-        self.cycle = cycle
-        """With failures (:mod:`cell.sim.failures`): runs each order's legs one by one, so that a
-        stop can interrupt them; None: the fast path, one event an order."""
-        self.process = env.process(self.run() if cycle is None else self.run_stoppable())
+        self.stops = stops
+        """What can stop the robot mid-cycle (None: nothing)."""
+        self.wear = wear
+        """Its motors' wear, stopping it once back at B when one wears out (None: no wear)."""
+        if stops is not None:
+            stops.robot = self
+        self.process = env.process(self.run())
 
     def loss(self, now: float) -> int:
         """The limit bit of a part that reaches B while the robot is not back: let go
-        (with failures: lost to downtime, if a stop kept the robot away)."""
-        return LET_GO
+        (lost to downtime, if a stop kept the robot away)."""
+        return LET_GO if self.stops is None else self.stops.loss(now)
 
     def order(self, part: Any, to_lo_s: float, to_td_s: float, cycle_s: float,
               now: float) -> None:
         """Start a cycle now, at the clock's ``now`` (the robot must be free): lift-off
-        ``to_lo_s``, touch-down ``to_td_s`` and back at B ``cycle_s`` from now.  (The instant
-        given, not read: ``env.now`` is a property, see :meth:`cell.sim.feeder.Feeder.run`.)"""
+        ``to_lo_s``, touch-down ``to_td_s`` and back at B ``cycle_s`` from now (and a worn
+        motor's replacement after, if one wears out in it)."""
+        if self.wear is not None:
+            cycle_s = self.wear.cycle_s(part, to_lo_s, to_td_s, cycle_s, now)
         self.free_at_s = now + cycle_s
         self.orders.put((part, to_lo_s, to_td_s, now))
 
     def run(self):  # noqa: ANN201 (SimPy generator)
-        """Each order taken the instant it is given, so its instant is the clock's (for
-        speed: the order carries it, one ``env.now`` read a part saved, see
-        :meth:`cell.sim.feeder.Feeder.run`).  The part goes to the output conveyor with its
-        touch-down's instant, as the feeder's drop goes to the input conveyor with its own, and
-        the input belt's replan is checked against the plan's start: no ``env.now`` (a property)
-        read a part at all, the adaptive run 118.4k to 117.3k instructions per part, cachegrind
-        (20,000 parts)."""
-        set_down, get = self.output.put_after, self.orders.get
-        while True:  # taken the instant it is given: the order's instant is the clock's
-            part, to_lo_s, to_td_s, now = yield get()
-            part.pick_s = now + to_lo_s
-            set_down((part, now + to_td_s), to_td_s)  # due at TD, B + (B → TD) as SimPy times
-            # it, with that instant (the output conveyor's clock)
-
-    def run_stoppable(self):  # noqa: ANN201 (SimPy generator)
-        """Each order in a process of its own, which a stop interrupts (an interrupt that
-        comes once it is over is dropped, as SimPy drops them for a finished process)."""
-        env, get, cycle = self.env, self.orders.get, self.cycle
+        """Each order taken the instant it is given (the order carries that instant).  When
+        nothing can stop the robot before it is back at B, its lift-off and touch-down are
+        known now: the lift-off is written and the part handed to the output conveyor due at
+        its touch-down, one event; the way back needs none, since no order comes before
+        ``free_at_s``.  Otherwise the cycle's legs run one by one, each a timeout that a
+        stop interrupts (SimPy's machine shop), the robot held while ``stops`` holds it."""
+        env, get, stops = self.env, self.orders.get, self.stops
+        set_down, placed = self.output.put_after, self.output.put
         while True:
-            part, to_lo_s, to_td_s, _ = yield get()
-            yield env.process(cycle(part, to_lo_s, to_td_s))
+            part, to_lo_s, to_td_s, now = yield get()
+            legs = None if stops is None else stops.begin(part, to_lo_s, to_td_s)
+            if legs is None:  # nothing can stop it: the cycle's instants are known now
+                part.pick_s = now + to_lo_s
+                set_down((part, now + to_td_s), to_td_s)
+                continue
+            rest = part.plan.cycle
+            for i, leg in enumerate(legs):
+                rest -= leg
+                stops.at_leg, left = i, leg
+                while left > 0.0:
+                    start = env.now
+                    try:
+                        if stops.held(i):
+                            stops.doing(STOPPED if stops.stop is not None else MOVING_NOT,
+                                        math.inf)
+                            yield env.event()  # until whatever holds the robot lets go
+                        # a planned stop due: the robot will not be free for a part at B
+                        stops.doing(i, start + left + max(rest, 0.0)
+                                    if stops.maintenance_due is None else math.inf)
+                        yield env.timeout(left)
+                        left = 0.0
+                    except simpy.Interrupt:
+                        if stops.moving_since == stops.moving_since:
+                            left = max(left - (env.now - start), 0.0)
+                if i == 0 and stops.part is not None:  # lifted (not lost in a stop)
+                    part.pick_s = env.now
+                elif i == 3 and stops.part is not None:  # touch-down: taken now, its instant
+                    placed((stops.set_down(), env.now))
+            stops.at_rest()

@@ -35,8 +35,6 @@ from cell.scenario.schema import Scenario
 from cell.sim import accounting, oee, wear_clock
 from cell.sim.assembly import AssembledCell, assemble
 from cell.sim.bound import parts_bound
-from cell.sim.controller import Controller, FallibleView, SensorView, View
-from cell.sim.conveyors import InputConveyor, OutputConveyor
 from cell.sim.failures import Downtime
 from cell.sim.feeder import Feeder
 from cell.sim.horizon import run_arrivals, run_until_done
@@ -53,9 +51,8 @@ from cell.sim.records import (
     RunSummary,
     limit_names,
 )
-from cell.sim.robot import Robot
-from cell.sim.sensor import Sensor, sensor_position
 from cell.sim.sim_result import BeltLog, BeltSink, SimResult
+from cell.sim.station import Station
 
 __all__ = ["PER_PART", "BeltLog", "BeltSink", "PartSink", "RunLog", "SimResult", "simulate"]
 
@@ -85,7 +82,8 @@ class RunLog:
 
     def __init__(self, t: list[float], acct: Accounting, sink: PartSink | None,
                  spacing_in: float, tol_in: float, rows: list[tuple[Any, ...]] | None = None,
-                 lengths: tuple[float, float, float, float] = (NAN, NAN, NAN, NAN)):
+                 lengths: tuple[float, float, float, float] = (NAN, NAN, NAN, NAN),
+                 finished: simpy.Event | None = None, n_parts: int = 0):
         self.t = t
         """T_1 … T_{n+1}: the last is only part n's "next arrival"."""
         self.acct, self.sink = acct, sink
@@ -102,6 +100,8 @@ class RunLog:
         self.per_part = bytearray()
         """What the summary needs of each part, :data:`PER_PART` values a part in that order,
         as packed doubles (``struct``'s pack is a third of ``array.extend``'s cost a part)."""
+        self.finished, self.n_parts = finished, n_parts
+        """Succeeded once all ``n_parts`` parts are handed on (None: nobody waits for that)."""
         self.missed = self.delivered_part = self._logger()
         """A part fell off at F / was set down: see :meth:`_logger`."""
 
@@ -111,18 +111,14 @@ class RunLog:
 
     def _logger(self) -> Callable[[Part], None]:
         """``done(part)``: a part is done; it is completed and handed on now if every part
-        before it is, else kept till then.  The log's hot path, hand-written for speed (locals
-        bound, the in-order part completed in the same call), and its row made only if someone
-        keeps or streams the rows: ``make bench`` does neither, and making them costs 7 % of
-        its ``parts_per_s_adaptive_5k``, 26 % of ``parts_per_s_non_adaptive_5k`` (CPU time,
-        best of 12, interleaved, on 2 shared cores)."""
+        before it is, else kept till then; its row made only if someone keeps or streams the
+        rows (speed: docs/performance.md#run-log)."""
         t, acct_part, flags_of = self.t, self.acct.part, self.flags.pop
         spacing_in, tol = self.spacing_in, self.tol_in + 1e-9
-        below = -tol
         note, pack = self.per_part.extend, _PACK_PER_PART
         row_of = self._row if self.rows is not None or self.sink is not None else None
         names_of = LIMIT_NAMES.get  # limit_names' cache, read first
-        waiting = self.waiting
+        waiting, finished, last = self.waiting, self.finished, self.n_parts
         following = 0  # the index of the part to hand on next
 
         def done(p: Part) -> None:
@@ -135,8 +131,7 @@ class RunLog:
                 flags = flags_of(i, 0)
                 sp = p.spacing_in
                 off = sp - spacing_in  # NaN (none yet): neither test holds
-                if off > tol or off < below:  # abs(off) > tol, no builtin call: 0.11k of 104.9k
-                    # instructions a part (the adaptive run, cachegrind)
+                if abs(off) > tol:  # NaN (none yet): not off
                     flags |= SPACING_OFF
                 picked = not flags & RODE_OFF
                 plan = p.plan
@@ -152,6 +147,8 @@ class RunLog:
                 i += 1
                 if not waiting or i not in waiting:
                     following = i
+                    if i == last and finished is not None:
+                        finished.succeed()
                     return
                 p = waiting.pop(i)
 
@@ -261,53 +258,37 @@ def simulate(scenario: Scenario | AssembledCell,
     acct = policy.accounting()
     env = simpy.Environment()
     tm = k.timing
+    # with failures the clocks never end: the run ends when its last part is done
+    finished = env.event() if s.failures is not None and horizon is None else None
     log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows,
-                 (tm.r1_length_in, tm.r2.length_in, tm.r3_length_in, tm.r4.length_in))
+                 (tm.r1_length_in, tm.r2.length_in, tm.r3_length_in, tm.r4.length_in),
+                 finished, n)
     downtime = None if s.failures is None else Downtime(env, s.failures, seed)
     wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
-    conveyor = InputConveyor(env, k.v_nom, k.input_length, belts.told(0),
-                             stoppable=downtime is not None)
-    output = OutputConveyor(env, k.u_nom, log.delivered_part, belts.told(1),
-                            stoppable=downtime is not None)
-    robot = Robot(env, output.placed, None if downtime is None else downtime.robot.cycle)
-    feeder = Feeder(env, t_list, conveyor, n, k.part_size, log.flag)
-    view = _view(cell, seed, n, feeder, conveyor, output)
-    Controller(env, k, policy, view, conveyor, output, robot, log, s.controller.policy)
-    wear = wear_clock.alone(cell, robot, seed, downtime)  # wear: without failures (or None)
+    station = Station(env, cell, seed, log.delivered_part, belts.told, downtime)
+    feeder = Feeder(env, t_list, station.input, n, k.part_size, log.flag)
+    station.control(feeder.fed_s, n, log)
     if downtime is None and horizon is None:
         env.run()
     else:
         if downtime is not None:
-            downtime.attach(robot, conveyor, output, feeder, view, log)
             downtime.start()
-        run_until_done(env, log, n, horizon, output)
-    conveyor.belt.close()
-    output.belt.close(until=env.now)  # a floor planned after the last touch-down never ran
+        run_until_done(env, log, horizon, finished)
+    station.close(env.now)
 
     summary = _summary(cell, log, acct, t_all, n, env.now)
+    wear = None if station.wear is None else station.wear.log  # wear: without failures
     stops = downtime.all_stops(env.now) if downtime is not None else \
         wear_clock.stop_rows(wear, env.now)  # failures.csv's rows
     lines = oee.measure(summary, log.column, downtime, k.cycle_nom, env.now, stops, s.quality.rule)
     summary.seed = _seed_value(seed)
-    summary.input_speed_max_in_s = conveyor.belt.max_speed_in_s
-    summary.input_speed_min_in_s = conveyor.belt.min_speed_in_s
+    summary.input_speed_max_in_s = station.input.belt.max_speed_in_s
+    summary.input_speed_min_in_s = station.input.belt.min_speed_in_s
     summary.parts_bound = parts_bound(k, feeder.fed_s[summary.warmup_parts:n])
     result = SimResult(summary, rows, belts if keep_belts else None)
     result.downtime, result.timelines, result.stop_rows = downtime, lines, stops
     result.wear = wear_clock.measures(wear, downtime, env.now)
     return result
-
-
-def _view(cell: AssembledCell, seed: Any, n: int, feeder: Feeder, conveyor: InputConveyor,
-          output: OutputConveyor) -> View:
-    """What the controller sees: the feeder's schedule (``sensor.lookahead: ideal``), or only
-    what a physical sensor has reported (``sensor``)."""
-    s, k = cell.scenario, cell.k
-    if s.sensor.lookahead == "ideal":
-        fallible = s.failures is not None and s.failures.sensor is not None
-        return (FallibleView if fallible else View)(k, feeder.fed_s, n, conveyor, output)
-    position = sensor_position(s.sensor, k.input_length, s.source)
-    return SensorView(k, Sensor(s.sensor, position, conveyor, n, seed), n, conveyor, output)
 
 
 def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, n: int,

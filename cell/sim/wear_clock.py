@@ -103,29 +103,36 @@ def stop_rows(wear: WearLog | None, end_s: float) -> list[tuple[str, str, float,
     return [("robot", "wear", a, min(b, end_s), "") for a, b, _ in wear.stops if a < end_s]
 
 
-def attach(table: StepTable, timing: RobotTiming, settings: WearSettingsLike, robot: Any,
-           seed: int | np.random.SeedSequence) -> WearLog:
-    """Wear ``robot``'s motors by every cycle it is ordered to run (the stretch times read
-    from the part's record and the order); when a motor wears out, the robot stops for
-    ``repair_h`` once that cycle is done (back at B), and the motor is replaced."""
-    clock = WearClock(CycleWear(table, timing, model_of(settings)), stream(seed, WEAR_STREAM))
-    log = WearLog(clock, float(settings.repair_h) * HOUR_S)
-    run, stops, repair_s, original = clock.cycle, log.stops, log.repair_s, robot.order
+class WearStops:
+    """Wear without failures, handed to the robot (:class:`cell.sim.robot.Robot`): each cycle
+    it is ordered to run wears its motors (the stretch times read from the part's record and
+    the order); when a motor wears out, the robot stops for ``repair_h`` once that cycle is
+    done (back at B), and the motor is replaced."""
 
-    def order(part: Any, to_lo_s: float, to_td_s: float, cycle_s: float, now: float) -> None:
+    def __init__(self, clock: WearClock, log: WearLog):
+        self.clock, self.log = clock, log
+
+    def cycle_s(self, part: Any, to_lo_s: float, to_td_s: float, cycle_s: float,
+                now: float) -> float:
+        """The cycle's time until the robot is free again: ``cycle_s``, and the repair after
+        it if a motor wears out in it."""
         plan = part.plan  # the regimes as parts.csv has them (R I, R III: their legs summed)
         r1, r2, r3 = plan.r1_pre + plan.r1_post, plan.r2, plan.r3_pre + plan.r3_post
         r3_pre = round(to_td_s - (r1 + r2), 9)  # B → TD less R I and R II
-        joint = run((to_lo_s, r1 - to_lo_s, r2, r3_pre, r3 - r3_pre, plan.r4))
+        joint = self.clock.cycle((to_lo_s, r1 - to_lo_s, r2, r3_pre, r3 - r3_pre, plan.r4))
         if joint >= 0:
-            back = now + cycle_s
-            stops.append((back, back + repair_s, joint))
-            clock.replace(joint)
+            back, repair_s = now + cycle_s, self.log.repair_s
+            self.log.stops.append((back, back + repair_s, joint))
+            self.clock.replace(joint)
             cycle_s += repair_s
-        original(part, to_lo_s, to_td_s, cycle_s, now)
+        return cycle_s
 
-    robot.order = order
-    return log
+
+def wear_stops(table: StepTable, timing: RobotTiming, settings: WearSettingsLike,
+               seed: int | np.random.SeedSequence) -> WearStops:
+    """The robot's motors, worn by every cycle (``wear:`` without failures)."""
+    clock = WearClock(CycleWear(table, timing, model_of(settings)), stream(seed, WEAR_STREAM))
+    return WearStops(clock, WearLog(clock, float(settings.repair_h) * HOUR_S))
 
 
 class WearClock:
@@ -175,17 +182,22 @@ class WearClock:
 
 
 class WearExposure:
-    """The robot's failure clock counting motor wear (:class:`cell.sim.failures.Exposure`):
+    """The robot's failure clock counting motor wear (:class:`cell.sim.failure_clock.Exposure`):
     five budgets, one a motor (the exposure at which it wears out), each used at its
     exposure per second of the leg the robot is in, told of each cycle's leg times as it
-    starts.  Within a leg the rate is the leg's mean, so a motor wears out at the leg's
-    end exposure exactly and in between by linear interpolation."""
+    starts (the cycle's whole exposure, :meth:`cell.sim.wear.CycleWear.of_times`, is what the
+    clock takes at once when no motor can wear out in it).  Within a leg the rate is the leg's
+    mean, so a motor wears out at the leg's end exposure exactly and in between by linear
+    interpolation."""
 
     cause = "wear"
 
     def __init__(self, wear: CycleWear, rng: np.random.Generator):
         self.wear, self.rng = wear, rng
-        self._rates: list[list[float]] = [[0.0] * 5 for _ in STRETCHES]
+        self._legs: Sequence[float] = (0.0,) * len(STRETCHES)
+        """The leg times of the cycle under way."""
+        self._rates: dict[int, list[float]] = {}
+        """Each leg's exposure per second, as the clock asks for them (this cycle's)."""
         self.total = [0.0] * 5
         """Each motor's exposure over the run's cycles (for its life at this duty)."""
 
@@ -196,16 +208,20 @@ class WearExposure:
         return float(draw_thresholds(self.rng, 1, self.wear.model)[0])
 
     def rates(self, leg: int) -> Sequence[float]:
-        return self._rates[leg] if leg >= 0 else (0.0,) * 5
+        if leg < 0:
+            return (0.0,) * 5
+        rates = self._rates.get(leg)
+        if rates is None:  # asked only of a cycle the clock counts leg by leg
+            t = self._legs[leg]
+            e = self.wear.stretches[leg].at_time(t)
+            rates = self._rates[leg] = [x / t for x in e] if t > 0 else [0.0] * 5
+        return rates
 
-    def cycle(self, legs_s: Sequence[float]) -> None:
-        rates = self._rates
-        total = self.total
-        for i, (w, t) in enumerate(zip(self.wear.stretches, legs_s, strict=True)):
-            e = w.at_time(t)
-            rates[i] = [x / t for x in e] if t > 0 else [0.0] * 5
-            total = [a + b for a, b in zip(total, e)]
-        self.total = total
+    def cycle(self, legs_s: Sequence[float]) -> Sequence[float]:
+        self._legs, self._rates = legs_s, {}
+        use = self.wear.of_times(legs_s)
+        self.total = [a + b for a, b in zip(self.total, use)]
+        return use
 
 
 def _exposure(table: StepTable, timing: RobotTiming, settings: WearSettingsLike,
@@ -248,12 +264,11 @@ def count_on(downtime: Any, cell: Any, seed: int | np.random.SeedSequence) -> No
     downtime.robot_exposure = _exposure(cell.table, cell.timing, s.wear, seed)
 
 
-def alone(cell: Any, robot: Any, seed: int | np.random.SeedSequence,
-          downtime: Any) -> WearLog | None:
-    """``wear:`` without failures: the robot's orders wrapped (:func:`attach`); else None."""
+def alone(cell: Any, seed: int | np.random.SeedSequence, downtime: Any) -> WearStops | None:
+    """``wear:`` without failures: the robot's motors' wear (:class:`WearStops`); else None."""
     if not cell.scenario.wear.enabled or downtime is not None:
         return None
-    return attach(cell.table, cell.timing, cell.scenario.wear, robot, seed)
+    return wear_stops(cell.table, cell.timing, cell.scenario.wear, seed)
 
 
 def measures(wear: WearLog | None, downtime: Any, end_s: float) -> WearResult | None:

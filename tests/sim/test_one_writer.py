@@ -17,8 +17,8 @@ CELL = Path(__file__).resolve().parents[2] / "cell"
 #: and ``feed_delay_s`` are the feeder's, given as it makes the part (:data:`MAKERS`).
 OWNERS = {
     "at_bot_s": {"sim/conveyors.py"}, "plan": {"sim/controller.py"},
-    # the robot's process: one event an order, or (with failures) its legs one by one
-    "pick_s": {"sim/robot.py", "sim/failures.py"},
+    # the robot's process, whether or not anything can stop it (its one cycle)
+    "pick_s": {"sim/robot.py"},
     "touchdown_s": {"sim/conveyors.py"}, "spacing_in": {"sim/conveyors.py"},
     "delivery_interval_s": {"sim/conveyors.py"},
 }

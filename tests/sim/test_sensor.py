@@ -126,10 +126,10 @@ def test_sensor_down_reports_nothing_even_ideal(thesis_cell: Scenario) -> None:
     """h21's failure process sets View.sensor_up False: next_part is None, ideal included
     (the view of a run whose sensor can fail)."""
     from cell.sim.assembly import assemble
-    from cell.sim.controller import FallibleView
+    from cell.sim.controller import View
 
     cell_ = assemble(thesis_cell)
-    view = FallibleView.__new__(FallibleView)
+    view = View.__new__(View)
     view.sensor_up, view.now, view.part, view.n, view.fed_s = False, 0.0, 0, 3, [1.0, 2.0, 3.0]
     assert view.next_part(1.0, 3.0) is None
     assert cell_.k.lookahead_margin_s == 0.0

@@ -80,9 +80,9 @@ def adaptive_plan(k: CellConstants, v: float, nxt: tuple[float, float] | None,
     b: its pseudo-distance then; a part not yet on the belt: a until the feeder drops it, b the
     belt's length), None: none is coming; ``gap_in``: the output belt's travel since the last
     touch-down (None: none yet); ``lag``: B → LO at v, if known; ``idle_s``: seconds since that
-    touch-down (None: both spacing causes marked, :class:`Adaptive` names the one).  For speed,
-    inline with their rare cases called: 3.1 (3.2: :func:`aim_early`; 108.45k to 107.19k
-    instructions a part, cachegrind), 5.0 (:func:`output_speed`) and the contract (122.5k to 118.4k)."""
+    touch-down (None: both spacing causes marked, :class:`Adaptive` names the one).  Steps 3.1,
+    5.0 and the spacing contract are inline, their rare cases called (3.2: :func:`aim_early`,
+    5.0's limits: :func:`output_speed`)."""
     t, flags = k.timing, 0
     r1a = t.r1_pre.time(v) if lag is None else lag
     r1b = t.r1_post.time(v)

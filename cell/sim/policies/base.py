@@ -72,11 +72,7 @@ class CellConstants:
     """The spacing contract's threshold: the most the last part set down may have travelled
     when the next part reaches B for 45 in to be kept with the output belt at its floor until
     G (R I + R II at their nominal sum) and at nominal from G to TD.  Set once, at
-    construction: read once a part by :func:`cell.sim.policies.adaptive.adaptive_plan`, as a
-    property it cost about 2 % of ``parts_per_s_adaptive_5k``; as a ``functools.cached_property``
-    it gave the constants an instance ``__dict__`` CPython 3.11 cannot specialise attribute
-    reads on (every ``k.x`` a generic lookup): as a field, the adaptive run 115.6k to 110.2k
-    instructions per part, cachegrind."""
+    construction (a constant of the cell, like the others)."""
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "floor_gap_in", self.spacing - self.u_nom * self.r3_pre_nom

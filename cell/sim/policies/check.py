@@ -2,8 +2,8 @@
 
 A policy (built in or a plug-in) answers :meth:`~cell.sim.policies.base.Policy.plan` with the
 regime times and belt speeds of one cycle.  The controller checks each plan the moment it
-gets it (:class:`cell.sim.controller.Controller`, with :func:`plan_bounds`), so that each plan
-must obey the same physics the built-in policies do before the cell acts on it:
+gets it (:func:`check`, the one check, whatever the policy), so that each plan must obey the
+same physics the built-in policies do before the cell acts on it:
 
 * every regime time finite and no shorter than what a cycle may take
   (:meth:`~cell.sim.robot.RobotTiming.shortest_parts`, the one statement of it, which the
@@ -23,8 +23,8 @@ must obey the same physics the built-in policies do before the cell acts on it:
 
 A number is an int or a float (a boolean in a numeric field is read as its 0 or 1, as the
 controller's comparisons read it; an integer beyond the floats' range is an infinity).
-tests/robust/test_plan_check_agrees.py checks that the controller's check and :func:`problem`
-agree on any plan.
+tests/robust/test_plan_check_agrees.py checks that :func:`check`'s comparisons and
+:func:`problem`'s wording agree on any plan.
 
 The plan is read by attribute name only (``plan.r1_pre``, ``plan.cycle``...), so any
 record with those fields passes.  A bad plan stops the run with one line naming the
@@ -32,13 +32,6 @@ policy and the first bad value (:class:`PolicyError`, exit 2); so does a policy 
 ``plan`` raises.  A policy that returns the very plan it returned last time (the
 non-adaptive robot's one cycle) is not checked again.
 
-For speed, the check is one expression in the controller's loop over the plan's fields read
-by name, the slack baked into :func:`plan_bounds` (NaN fails every comparison; with every
-regime time at or above its floor, a finite cycle below :data:`MAX_S` makes each of them
-finite); only a plan it does not pass comes here, to :func:`refuse`, for the message.
-``make bench``'s ``parts_per_s_adaptive_5k`` (2 shared cores, CPU time, best of 15,
-interleaved): the check wrapped around the policy's ``plan``, its fields gathered with
-``operator.attrgetter``, cost 6-7 % of the adaptive run; in the loop, about 2 %.
 """
 
 from __future__ import annotations
@@ -204,6 +197,36 @@ def plan_bounds(k: Any) -> tuple[float, ...]:
     return tuple(out)
 
 
+def check(plan: Any, bounds: tuple[float, ...], name: str, k: Any) -> None:
+    """The check every plan passes before the cell acts on it (the controller's, for any
+    policy): returns if ``plan`` obeys the physics above, else raises :class:`PolicyError`
+    naming its first bad value (:func:`problem`).  ``bounds``: :func:`plan_bounds` of ``k``.
+
+    The fields are read by name and compared once each, the slack baked into ``bounds`` (NaN
+    fails every comparison; with every regime time at or above its floor, a finite cycle below
+    :data:`MAX_S` makes each of them finite); only a plan that fails goes to :func:`problem`
+    for the message."""
+    a1, a2, a3, a4, a5, a6, c1, d1, c2, d2, c3, d3, c4, d4 = bounds
+    try:
+        r1a, r1b, r2, r3a, r3b, r4 = \
+            plan.r1_pre, plan.r1_post, plan.r2, plan.r3_pre, plan.r3_post, plan.r4
+        v, w, w_next, u = plan.input_speed, plan.input_after_lo, plan.input_next, plan.output_to_g
+        to_g, cycle, limits, steers = plan.to_g, plan.cycle, plan.limits, plan.steers_belts
+        off_g, off_b = to_g - (r1a + r1b + r2), cycle - (to_g + r3a + r3b + r4)
+        floor_at = plan.output_floor_at if steers else math.inf  # at or after TD
+        if (a1 <= r1a and a2 <= r1b and a3 <= r2 and a4 <= r3a and a5 <= r3b and a6 <= r4
+                and c1 <= v <= d1 and c2 <= w <= d2 and c3 <= w_next <= d3 and c4 <= u <= d4
+                and -SUM_S <= off_g <= SUM_S and -SUM_S <= off_b <= SUM_S and cycle < MAX_S
+                and limits.__class__ is int and not limits & ~ALL_LIMITS
+                and steers.__class__ is bool and floor_at >= to_g + r3a - SUM_S
+                and (f := tracking_floors(k)(v))[0] - ABS - REL * f[0] <= r1a  # R I at the pace of
+                and f[1] - ABS - REL * f[1] <= r1b):  # the belt it picks from (v checked above)
+            return
+    except Exception:  # noqa: BLE001, S110 - a field missing or not a number: said below
+        pass
+    refuse(plan, name, k)
+
+
 def plan_failed(name: str, exc: Exception) -> PolicyError:
     """The error of a policy whose ``plan`` raised."""
     return PolicyError(f"policy {name!r}: its plan failed: {type(exc).__name__}: "
@@ -211,8 +234,8 @@ def plan_failed(name: str, exc: Exception) -> PolicyError:
 
 
 def refuse(plan: Any, name: str, k: Any) -> None:
-    """Raise :class:`PolicyError` naming the first bad value of a plan the controller's check
-    did not pass (and return if :func:`problem` finds nothing after all)."""
+    """Raise :class:`PolicyError` naming the first bad value of a plan :func:`check`'s
+    comparisons did not pass (and return if :func:`problem` finds nothing after all)."""
     why = problem(plan, k)
     if why is not None:
         raise PolicyError(f"policy {name!r} planned {why}")
