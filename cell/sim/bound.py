@@ -40,20 +40,11 @@ def fastest_possible_cycle(k: CellConstants) -> float:
 def greedy_picks(come_s: Sequence[float] | Array, length_in: float, v_min: float, v_max: float,
                  part_size_in: float, cycle_min_s: float) -> int:
     """The most parts, coming at ``come_s`` (in order), that fit their windows at B with
-    picks ``cycle_min_s`` apart (see the module's text).
-
-    The arrivals are first read whole: where each part comes at least a fastest cycle after the
-    one before, every part is picked at its earliest, and a hold at the feeder only moves its
-    window's end later, so the count is all of them (as the pass below counts, to the part:
-    tests/sim/test_bound.py); other arrivals take the pass."""
+    picks ``cycle_min_s`` apart: the greedy pass of the module's text, a part at a time."""
     early, late, clear = length_in / v_max, length_in / v_min, part_size_in / v_min
-    a = np.asarray(come_s, dtype=float)
-    first = a + early  # each part's earliest pick (a + early <= a + late where early <= late)
-    if a.size and early <= late and (first[1:] >= first[:-1] + cycle_min_s).all():
-        return int(a.size)
-    next_drop = next_pick = -float("inf")  # the latest drop and the last pick, plus clear, c_min
+    next_drop = next_pick = -float("inf")  # the latest drop plus clear; the last pick plus c_min
     count = 0
-    for come in a.tolist():
+    for come in np.asarray(come_s, dtype=float).tolist():
         latest_drop = come if come > next_drop else next_drop
         next_drop = latest_drop + clear
         pick = come + early

@@ -26,42 +26,6 @@ def test_the_greedy_pass_worked_by_hand() -> None:
     assert greedy_picks([], 12.0, 1.0, 4.0, 1.0, 10.0) == 0
 
 
-def pass_step_by_step(come_s: list[float], length_in: float, v_min: float, v_max: float,
-                      part_size_in: float, cycle_min_s: float) -> int:
-    """The greedy pass of the module's text, one part at a time (the reference)."""
-    early, late, clear = length_in / v_max, length_in / v_min, part_size_in / v_min
-    next_drop = next_pick = -float("inf")
-    count = 0
-    for a in come_s:
-        latest_drop = max(a, next_drop)
-        next_drop = latest_drop + clear
-        pick = max(a + early, next_pick)
-        if pick <= latest_drop + late:
-            count += 1
-            next_pick = pick + cycle_min_s
-    return count
-
-
-#: Gaps between arrivals: bursts (the feeder holds parts), gaps near a fastest cycle (the
-#: picks wait) and long ones; exact ties included.
-_GAPS = st.lists(st.one_of(st.sampled_from([0.0, 0.5, 1.0, 10.0, 25.0]),
-                           st.floats(0.0, 40.0, allow_nan=False)), max_size=80)
-
-
-@settings(max_examples=300, deadline=None)
-@given(gaps=_GAPS, start=st.floats(-100.0, 1e6), length=st.floats(0.5, 200.0),
-       v_min=st.floats(0.01, 5.0), spread=st.floats(0.5, 20.0), size=st.floats(0.0, 5.0),
-       cycle=st.sampled_from([0.0, 1.0, 10.0, 18.0841]) | st.floats(0.0, 60.0))
-def test_the_count_is_what_the_step_by_step_pass_counts(
-        gaps: list[float], start: float, length: float, v_min: float, spread: float,
-        size: float, cycle: float) -> None:
-    come = [start]
-    for g in gaps:
-        come.append(come[-1] + g)
-    args = (length, v_min, v_min * spread, size, cycle)
-    assert greedy_picks(come, *args) == pass_step_by_step(come, *args)
-
-
 def test_the_fastest_cycle_is_below_every_cycle_the_robot_runs(thesis_cell: Scenario) -> None:
     k = assemble(thesis_cell).k
     c = fastest_possible_cycle(k)
