@@ -16,7 +16,7 @@ import pandas as pd
 from cell.experiments.sweep import Sweep
 from cell.experiments.sweep.columns import NAME_SUFFIX
 from cell.reporting.experiment_compact import comparison_name, load_column
-from cell.reporting.experiment_reading import _scatter, show, where
+from cell.reporting.experiment_reading import scatter, show, where
 from cell.reporting.formatting import Headline, decimals, half_width, number, plus_minus, too_few
 
 #: The counts of :data:`cell.sim.records.LIMIT_COUNTS` as the Reading names them.
@@ -263,7 +263,7 @@ def reading(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
         text = ["; ".join(said) + "." if said else ""]
         text += [s[:1].upper() + s[1:] + "." for s in unmoved(h, summary, policies)]
         text += [] if said else trend(h, summary, cols)
-        text += _scatter(h, summary, cols, h.column in whole)
+        text += scatter(h, summary, cols, h.column in whole)
         text = [t for t in text if t]
         if text:
             out.append(f"- **{h.title}.** " + " ".join(text))

@@ -44,7 +44,7 @@ def against(a: str, b: str, at: bool = True) -> str:
     return b
 
 
-def _scatter(h: Headline, summary: pd.DataFrame, cols: Sequence[str],
+def scatter(h: Headline, summary: pd.DataFrame, cols: Sequence[str],
              whole: bool = False) -> list[str]:
     """Points whose interval is wider than their mean: runs far apart, or a mean made
     by a few extreme runs (it lies outside the range of 95 % of them).  A count (``whole``)

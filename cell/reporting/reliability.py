@@ -45,10 +45,10 @@ FIXED, ADAPTIVE = "non-adaptive", "adaptive"
 
 def wear_summary(scenario: Any, seed: np.random.SeedSequence) -> Mapping[str, Any]:
     """One replication: the run's summary row and its wear measures (cell.sim.wear)."""
-    from cell.experiments.sweep.runner import _assembled
+    from cell.experiments.sweep.runner import assembled
     from cell.sim.simulation import simulate
 
-    result = simulate(_assembled(scenario), seed=seed, keep_parts=False, keep_belts=False)
+    result = simulate(assembled(scenario), seed=seed, keep_parts=False, keep_belts=False)
     return {**result.summary.as_dict(), **(result.wear.measures if result.wear else {})}
 
 
