@@ -9,34 +9,15 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 from cell.cli.fit_check import scenario_refuses
+from cell.experiments.fit_data import Data
 from cell.plumbing.errors import ScenarioError
 
 if TYPE_CHECKING:
     from cell.experiments.fit import Fit
     from cell.experiments.fit_pattern import Pattern
-    from cell.scenario.sections import RateProfile
 
 #: Where a time to failure or repair goes.
 EQUIPMENT = "robot, input_belt, output_belt or sensor"
-
-
-class Data(NamedTuple):
-    """What is fitted: the values, which are censored (None: none), what the block's comment
-    calls them, and the notes on what was left out or subsampled."""
-
-    values: Any
-    censored: Any
-    what: str
-    notes: list[str]
-    flag: str = ""
-    """The warning on gaps far out of the body of the data ("" for none)."""
-    ordered: Any = None
-    """The log's gaps in its order, none left out (None: times to failure or repair, or
-    sorted gaps: no order to test)."""
-    kept: Any = None
-    """Which of ``ordered`` are fitted (None: all)."""
-    first_h: float = 0.0
-    """Where on its clock the log begins, h (:func:`~cell.experiments.fit_input.first_clock_h`)."""
 
 
 class Result(NamedTuple):
@@ -100,17 +81,6 @@ def _table(fits: list[Fit], data: Data, chosen: Fit, refused: dict[int, str], wh
     if any(refused.values()):
         table += "\nA fit with a note other than 'written' is not written: a scenario would refuse it."
     return "\n".join([table, *data.notes, *([why] if why else [])])
-
-
-def in_operational_time(data: Data, profile: RateProfile) -> Data:
-    """The data as the gaps a profile's base distribution draws: the log's gaps in operational
-    time (:func:`~cell.experiments.fit_pattern.operational_gaps`), those left out left out."""
-    from cell.experiments.fit_pattern import operational_gaps
-
-    gaps = operational_gaps(data.ordered, profile)
-    values = gaps if data.kept is None else gaps[data.kept]
-    what = f"{data.what}, in operational time (the rate profile's)"
-    return data._replace(values=values, what=what)
 
 
 def _pattern_said(pattern: Pattern | None, iid: bool) -> tuple[list[str], str]:

@@ -238,3 +238,22 @@ def _precision(replications: pd.DataFrame, summary: pd.DataFrame, sweep: Sweep,
 
 
 __all__ = ["display_columns", "markdown", "reading", "sentence"]
+
+
+def first_tables(markdown: str, tables: int = 3) -> str:
+    """The first ``tables`` tables of a report, each under its heading, for the terminal
+    (``cell sweep`` prints them)."""
+    out: list[str] = []
+    heading, shown = "", 0
+    lines = markdown.splitlines()
+    for i, line in enumerate(lines):
+        if line.startswith("## "):
+            heading = line[3:]
+        elif line.startswith("|") and (i == 0 or not lines[i - 1].startswith("|")):
+            if shown == tables:
+                break
+            out += ["", heading] if heading else [""]
+            shown += 1
+        if line.startswith("|"):
+            out.append(line)
+    return "\n".join(out).strip("\n")

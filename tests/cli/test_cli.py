@@ -95,7 +95,7 @@ def test_set_overrides_from_the_command_line(tmp_path):
 
 
 def test_every_subcommand_has_its_module():
-    from cell.cli.main import COMMANDS
+    from cell.cli.parser import COMMANDS
 
     assert set(COMMANDS) == set(SUBCOMMANDS)
     for name in SUBCOMMANDS:

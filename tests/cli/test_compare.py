@@ -95,8 +95,8 @@ def test_compare_out_makes_each_table_once(tmp_path, capsys, monkeypatch):
 
 
 def test_verdict_says_which_is_better_on_each_measure():
-    from cell.cli.compare_command import judgement, verdict
     from cell.experiments.sweep.spec import comparison
+    from cell.reporting.compare_judgement import judgement, verdict
     from cell.scenario.schema import load_scenario
 
     a = load_scenario("baseline")

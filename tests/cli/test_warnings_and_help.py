@@ -61,7 +61,7 @@ def test_four_library_deprecations_and_one_warning_of_ours_say_one_line(monkeypa
 
 
 def _workers_default(command: str) -> str:
-    from cell.cli.main import SUBPARSERS, build_parser
+    from cell.cli.parser import SUBPARSERS, build_parser
 
     build_parser()
     action = next(a for a in SUBPARSERS[command]._actions if "--workers" in a.option_strings)

@@ -132,3 +132,11 @@ def test_no_module_imports_a_private_name() -> None:
         tree = ast.parse(p.read_text(encoding="utf-8"))
         private += [f"{p.relative_to(ROOT)}:{line} {name}" for line, name in private_imports(tree)]
     assert private == []
+
+
+def test_command_line_modules_parse_and_print() -> None:
+    """cli/ parses and prints: its modules stay short, what they print made below them."""
+    long = [f"{p.relative_to(ROOT)}: {p.read_text(encoding='utf-8').count(chr(10))} lines"
+            for p in sorted((PACKAGE / "cli").glob("*.py"))
+            if p.read_text(encoding="utf-8").count("\n") > 200]
+    assert long == []

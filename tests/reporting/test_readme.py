@@ -16,7 +16,7 @@ from typing import Any
 import pandas as pd
 import pytest
 
-from cell.cli.main import COMMANDS
+from cell.cli.parser import COMMANDS
 from cell.reporting import published as thesis
 from cell.sim.records import BELT_COLUMNS, PART_COLUMNS, SUMMARY_COLUMNS
 from tests.reporting.test_reports_readme import agrees, phrase, prose

@@ -366,3 +366,9 @@ def comparison(a: Scenario, b: Scenario, labels: tuple[str, str], replications: 
                  (pa, pb), replications, seed, min(batch, replications),
                  baseline=Baseline(b.controller.policy, (("scenario", lb),),
                                    text=lb))  # the report names the scenarios, not policies
+
+
+def comparison_sides(sweep: Sweep) -> tuple[tuple[str, Point], tuple[str, Point]]:
+    """(label, point) of A and of B, of a :func:`comparison`."""
+    (la, a), (lb, b) = ((dict(p.values)["scenario"], p) for p in sweep.points)
+    return (la, a), (lb, b)
