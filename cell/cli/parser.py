@@ -9,7 +9,7 @@ from typing import Any, NoReturn
 
 from cell import __version__
 
-#: Subcommands in the order ``cell --help`` lists them; each is cell.cli.<name>_command.
+#: Subcommands in the order ``cell --help`` lists them; each is cell.cli.<name>.
 COMMANDS = ("run", "sweep", "compare", "optimize", "sensitivity", "fit", "figures", "animate",
             "path", "mintime", "hindsight", "scenarios", "schema", "docs", "bench")
 
@@ -29,7 +29,7 @@ class UsageError(Exception):
 
 def command_module(name: str) -> Any:
     """The module of subcommand ``name``."""
-    return importlib.import_module(f"cell.cli.{name}_command")
+    return importlib.import_module(f"cell.cli.{name}")
 
 
 def build_parser() -> argparse.ArgumentParser:

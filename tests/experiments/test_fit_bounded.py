@@ -16,8 +16,8 @@ import pytest
 import yaml
 from scipy import stats
 
-from cell.cli.fit_command import add_arguments
-from cell.cli.fit_command import main as cmd_fit
+from cell.cli.fit import add_arguments
+from cell.cli.fit import main as cmd_fit
 from cell.experiments import fit_input
 from cell.experiments.fit import fit_trace
 from cell.experiments.fit_budget import MAX_FIT_VALUES, OutOfTime, subsample, time_limit

@@ -13,9 +13,9 @@ import pytest
 import yaml
 from scipy import stats
 
+from cell.cli.fit import add_arguments
+from cell.cli.fit import main as cmd_fit
 from cell.cli.fit_check import _scenario_text, scenario_refuses
-from cell.cli.fit_command import add_arguments
-from cell.cli.fit_command import main as cmd_fit
 from cell.experiments.fit_censored import censored_loglik, fit_lifetimes, km_distance
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.schema import is_section

@@ -12,8 +12,8 @@ import pytest
 import yaml
 from scipy import stats
 
-from cell.cli.fit_command import add_arguments
-from cell.cli.fit_command import main as cmd_fit
+from cell.cli.fit import add_arguments
+from cell.cli.fit import main as cmd_fit
 from cell.experiments.fit import Fit, fit_trace
 from cell.experiments.fit_choice import CAUTION_OFF, P_FLOOR, caution, choose
 from cell.scenario.schema import load_scenario

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 import yaml
 
-from cell.cli.fit_command import DESCRIPTION, add_arguments
-from cell.cli.fit_command import main as cmd_fit
+from cell.cli.fit import DESCRIPTION, add_arguments
+from cell.cli.fit import main as cmd_fit
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.arrivals import MAX_INTERARRIVAL_S, read_trace
 

@@ -13,8 +13,8 @@ import pytest
 import yaml
 from scipy import stats
 
-from cell.cli.fit_command import add_arguments
-from cell.cli.fit_command import main as cmd_fit
+from cell.cli.fit import add_arguments
+from cell.cli.fit import main as cmd_fit
 from cell.cli.main import main
 from cell.experiments.fit_pattern import LEVEL, MAX_TESTED, WORK, find_pattern, holm, orders
 from cell.experiments.sweep.runner import simulate_summary

@@ -17,8 +17,8 @@ import pytest
 import yaml
 from scipy import special, stats
 
-from cell.cli.fit_command import add_arguments
-from cell.cli.fit_command import main as cmd_fit
+from cell.cli.fit import add_arguments
+from cell.cli.fit import main as cmd_fit
 from cell.experiments.fit import Fit
 from cell.experiments.fit_choice import caution
 from cell.experiments.fit_figure import figure

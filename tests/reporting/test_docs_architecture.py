@@ -60,10 +60,14 @@ def test_the_top_level_holds_only_the_folders() -> None:
 
 
 def test_no_two_modules_share_a_name() -> None:
+    """Apart from a command's own module in cli/, named after the command (cli/fit.py runs
+    ``cell fit``, whose work is experiments/fit/)."""
+    from cell.cli.parser import COMMANDS
+
     seen: dict[str, str] = {}
     twice = []
     for m in modules():
-        if m.name == "__main__.py":
+        if m.name == "__main__.py" or (m.parts[0] == "cli" and m.stem in COMMANDS):
             continue
         if m.name in seen:
             twice.append((seen[m.name], m.as_posix()))
@@ -140,3 +144,11 @@ def test_command_line_modules_parse_and_print() -> None:
             for p in sorted((PACKAGE / "cli").glob("*.py"))
             if p.read_text(encoding="utf-8").count("\n") > 200]
     assert long == []
+
+
+def test_command_modules_are_named_after_their_command() -> None:
+    from cell.cli.parser import COMMANDS
+
+    cli = {p.stem for p in (PACKAGE / "cli").glob("*.py")}
+    assert set(COMMANDS) <= cli
+    assert sorted(n for n in cli if n.endswith("_command")) == []

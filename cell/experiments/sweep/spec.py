@@ -354,7 +354,7 @@ def _check_point(scenario: Scenario, file: object) -> dict[str, float]:
 def comparison(a: Scenario, b: Scenario, labels: tuple[str, str], replications: int, seed: int,
                batch: int = 20) -> Sweep:
     """Two scenarios as a sweep of two points, varying the pseudo-key ``scenario`` (their
-    labels, which must differ: :func:`cell.cli.compare_command.labels`): ``a`` against ``b``
+    labels, which must differ: :func:`cell.cli.compare.labels`): ``a`` against ``b``
     (the baseline), with common random numbers."""
     la, lb = labels
     if la == lb:
