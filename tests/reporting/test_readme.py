@@ -102,7 +102,7 @@ def stress() -> list[int]:
 
 
 def wear() -> list[float]:
-    from cell.reporting.reliability import flip_exponent, verdicts
+    from cell.reporting.maps.reliability import flip_exponent, verdicts
 
     v = verdicts(pd.read_csv(REPORTS / "reliability" / "reliability.csv"))
     r = v.iloc[-1]
