@@ -46,7 +46,7 @@ from cell.plumbing.output.atomic import OutputDir
 from cell.reporting.experiment_data import difference_table, measures, summary_table
 from cell.reporting.experiment_plots import figures
 from cell.reporting.experiment_text import markdown
-from cell.reporting.table_7_1 import is_table_7_1, table_7_1_files
+from cell.reporting.table_7_1.table import is_table_7_1, table_7_1_files
 
 REPORT_FILES = ("report.md", "summary.csv", "differences.csv", "fig_*.png")
 TABLE_7_1_FILES = ("table_7_1.csv", "table_7_1.md")

@@ -37,7 +37,7 @@ from cell.reporting import published
 from cell.reporting.experiment_data import runs_of
 from cell.reporting.formatting import half_width, table_head, table_row
 from cell.reporting.run_summary import is_thesis_cell
-from cell.reporting.table_7_1_reading import (
+from cell.reporting.table_7_1.sentences import (
     ACCOUNTINGS,
     LABELS,
     MEASURES,
