@@ -121,7 +121,7 @@ def main(args: argparse.Namespace) -> int:
     target = None
     if args.out:
         from cell.plumbing.output.atomic import OutputDir
-        from cell.reporting.experiment import REPORT_FILES, Target
+        from cell.reporting.experiment.report import REPORT_FILES, Target
 
         names = (*REPORT_FILES, "replications.csv")
         OutputDir.check(args.out, names)  # before anything runs
@@ -132,12 +132,12 @@ def main(args: argparse.Namespace) -> int:
                             warn_windows=False)  # said above, in compare's words
         replications = outcome.replications
     from cell.reporting.compare_judgement import verdict
-    from cell.reporting.experiment import difference_table, summary_table
+    from cell.reporting.experiment.report import difference_table, summary_table
 
     tables = summary_table(replications, sweep), difference_table(replications, sweep)
     print(verdict(*tables, sweep, replications, args.practical))
     if target is not None:
-        from cell.reporting.experiment import write_report
+        from cell.reporting.experiment.report import write_report
 
         write_report(replications, sweep, target, command_line(args, seed), warning, tables)
         print(f"wrote {args.out}/: report.md, summary.csv, differences.csv, figures, "

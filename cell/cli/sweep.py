@@ -97,7 +97,7 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
     from cell.experiments.sweep.checks import size_note
     from cell.experiments.sweep.outdir import check_out, check_owner, lock
     from cell.plumbing.output.paths import check_umask
-    from cell.reporting.experiment_text import first_tables
+    from cell.reporting.experiment.text import first_tables
     from cell.scenario.overrides import parse_sets
 
     check_umask(args.out)  # its folders could not be written in
@@ -109,7 +109,7 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
     check_owner(sweep, out, args.resume)  # no results of another sweep, nor this one's, lost
     target = None
     if args.report:
-        from cell.reporting.experiment import plan_report
+        from cell.reporting.experiment.report import plan_report
 
         target = plan_report(sweep, args.report, results=args.out)  # before anything runs
     from cell.reporting.run_summary import nominal_warning
@@ -138,7 +138,7 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
           f"{reps} replications ({outcome.tasks_run} tasks run, "
           f"{outcome.tasks_reused} reused)")
     if target is not None:
-        from cell.reporting.experiment import write_report
+        from cell.reporting.experiment.report import write_report
         from cell.scenario import catalog
 
         command = f"cell sweep {shlex.quote(catalog.shown(sweep.source))} --report ..."

@@ -8,7 +8,7 @@ import pytest
 
 from cell.experiments.sweep.spec import comparison
 from cell.reporting.compare_judgement import verdict
-from cell.reporting.experiment_text import sentence
+from cell.reporting.experiment.text import sentence
 from cell.reporting.formatting import HEADLINES
 from cell.scenario.run_length import RunLength
 from cell.scenario.schema import load_scenario

@@ -181,7 +181,7 @@ def test_reading_follows_the_direction_of_the_numbers():
 def test_the_report_writes_both_table_7_1_files(sweeps, tmp_path, unrendered):
     """A Table 7.1 sweep's report holds table_7_1.csv (the long form, read back whole) and
     table_7_1.md, as :func:`table_7_1_files` makes them."""
-    from cell.reporting.experiment import plan_report, write_report
+    from cell.reporting.experiment.report import plan_report, write_report
 
     sweep = load_sweep(sweeps.write(tmp_path, set={"run.parts": 500}))  # laid out like Table 7.1
     frame = run_sweep(sweep, tmp_path / "o", workers=1, replicate=sweeps.bookkeeping,

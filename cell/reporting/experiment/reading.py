@@ -1,6 +1,6 @@
 """The sentences of an experiment's report: who is ahead where and by how much, trends,
 and where single runs scatter so widely that the mean says little; with the small helpers
-that show a grid point's values (:mod:`cell.reporting.experiment_text` lays them out)."""
+that show a grid point's values (:mod:`cell.reporting.experiment.text` lays them out)."""
 
 from __future__ import annotations
 
