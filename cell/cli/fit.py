@@ -1,20 +1,20 @@
 """``cell fit TRACE.csv [--column interarrival_s] [--times] [--out SCENARIO.yaml]``: input modelling.
 
 Fits candidate scipy.stats distributions to observed inter-arrival times by maximum
-likelihood (:mod:`cell.experiments.fit`), each within a time budget, prints them ranked with
+likelihood (:mod:`cell.experiments.fit.mle`), each within a time budget, prints them ranked with
 their means and sds beside the data's, and writes the ``arrivals:`` block of the best one a
 scenario accepts (each candidate is validated as a scenario holding it:
-:mod:`cell.cli.fit_check`; of those, when the best misses the data's mean or sd, the one
-nearest them: :func:`~cell.experiments.fit_choice.choose`), with a histogram of the data and the
+:mod:`cell.experiments.fit.scenario_check`; of those, when the best misses the data's mean or sd, the one
+nearest them: :func:`~cell.experiments.fit.choice.choose`), with a histogram of the data and the
 fitted densities.  A fit that does not stand for the data
-(:func:`~cell.experiments.fit_choice.caution`) is said in a warning and in the block, which then
+(:func:`~cell.experiments.fit.choice.caution`) is said in a warning and in the block, which then
 points to replaying the data as a trace.  ``--times`` reads the column as arrival times and
 fits the gaps between them; gaps far out of the body of the data are flagged, and
 ``--max-gap S`` or ``--drop-outliers`` leaves them out.  ``--as time_to_failure`` (or
 ``time_to_repair``) fits times to failure or repair instead, right-censored where
-``--censored COLUMN`` says so (:mod:`cell.experiments.fit_censored`), and writes that block of
+``--censored COLUMN`` says so (:mod:`cell.experiments.fit.censored`), and writes that block of
 the ``failures:`` section.  A log of arrivals is first tested for a trend, a rate that changes
-with the time of day and correlated gaps (:mod:`cell.experiments.fit_pattern`); when the rate
+with the time of day and correlated gaps (:mod:`cell.experiments.fit.pattern`); when the rate
 changes, the block written is the rate profile the counts estimate with the base distribution
 fitted to the gaps in operational time (``--iid``: one iid fit, the tests' result beside it).
 """
@@ -27,10 +27,10 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from cell.cli.fit_check import BLOCKS
 from cell.cli.fit_options import families_option, pattern_options
 from cell.cli.fit_write import fitted_block, write
-from cell.experiments.fit_data import in_operational_time, read_data
+from cell.experiments.fit.fitted_data import in_operational_time, read_data
+from cell.experiments.fit.scenario_check import BLOCKS
 from cell.plumbing.errors import ScenarioError
 
 HELP = "fit a distribution to observed inter-arrival times (or times to failure or repair); write its block"
@@ -150,7 +150,7 @@ def main(args: argparse.Namespace) -> int:
     replay = "" if lifetimes else _replay(trace, out, args.column, args.times)
     pattern = None
     if data.ordered is not None:
-        from cell.experiments.fit_pattern import find_pattern
+        from cell.experiments.fit.pattern import find_pattern
 
         pattern = find_pattern(data.ordered, data.first_h, args.period_h, start_h, data.kept)
         profile = pattern.profile()

@@ -18,8 +18,8 @@ def seconds_option(value: float | None, option: str) -> None:
 def families_option(args: argparse.Namespace, lifetimes: bool) -> list[str]:
     """The families to try (--families, or the defaults for the block), each checked; and the
     options that go with --as, or not."""
-    from cell.experiments.fit import DEFAULT_FAMILIES, family_of
-    from cell.experiments.fit_censored import LIFETIME_FAMILIES
+    from cell.experiments.fit.censored import LIFETIME_FAMILIES
+    from cell.experiments.fit.mle import DEFAULT_FAMILIES, family_of
 
     seconds_option(args.max_gap, "--max-gap")
     seconds_option(args.budget, "--budget")

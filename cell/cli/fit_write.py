@@ -1,5 +1,5 @@
 """``cell fit``'s second half: fit what was read, pick the block to write (each candidate
-validated as a scenario: :mod:`cell.cli.fit_check`), and write it with the figure."""
+validated as a scenario: :mod:`cell.experiments.fit.scenario_check`), and write it with the figure."""
 
 from __future__ import annotations
 
@@ -8,13 +8,13 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
-from cell.cli.fit_check import scenario_refuses
-from cell.experiments.fit_data import Data
+from cell.experiments.fit.fitted_data import Data
+from cell.experiments.fit.scenario_check import scenario_refuses
 from cell.plumbing.errors import ScenarioError
 
 if TYPE_CHECKING:
-    from cell.experiments.fit import Fit
-    from cell.experiments.fit_pattern import Pattern
+    from cell.experiments.fit.mle import Fit
+    from cell.experiments.fit.pattern import Pattern
 
 #: Where a time to failure or repair goes.
 EQUIPMENT = "robot, input_belt, output_belt or sensor"
@@ -31,9 +31,9 @@ class Result(NamedTuple):
 
 
 def _fits(args: argparse.Namespace, trace: Path, data: Data, families: list[str]) -> list[Fit]:
-    from cell.experiments.fit import fit_trace
-    from cell.experiments.fit_budget import DEFAULT_BUDGET_S
-    from cell.experiments.fit_censored import fit_lifetimes
+    from cell.experiments.fit.budget import DEFAULT_BUDGET_S
+    from cell.experiments.fit.censored import fit_lifetimes
+    from cell.experiments.fit.mle import fit_trace
 
     budget = args.budget if args.budget is not None else DEFAULT_BUDGET_S
     try:
@@ -46,10 +46,10 @@ def _fits(args: argparse.Namespace, trace: Path, data: Data, families: list[str]
 
 def refusals(fits: list[Fit], key: str, file: object, extra: str = "") -> dict[int, str]:
     """Why a scenario would refuse each fit's block (by ``id``; "" where it accepts it): the
-    quick checks first (:func:`~cell.experiments.fit_choice.unusable`), then the scenario's own
+    quick checks first (:func:`~cell.experiments.fit.choice.unusable`), then the scenario's own
     validation of the block as it would be written (with ``extra``, its profile line)."""
-    from cell.experiments.fit_choice import unusable
-    from cell.experiments.fit_output import block_yaml
+    from cell.experiments.fit.choice import unusable
+    from cell.experiments.fit.output import block_yaml
     from cell.scenario.arrivals import MAX_INTERARRIVAL_S
 
     most = MAX_INTERARRIVAL_S if key == "arrivals" else math.inf
@@ -69,7 +69,7 @@ def _method(fit: Fit, data: Data) -> str:
 def _table(fits: list[Fit], data: Data, chosen: Fit, refused: dict[int, str], why: str) -> str:
     import numpy as np
 
-    from cell.experiments.fit_output import DataMoments, format_table
+    from cell.experiments.fit.output import DataMoments, format_table
 
     x = np.asarray(data.values, dtype=float)
     if data.censored is None:
@@ -108,9 +108,9 @@ def fitted_block(args: argparse.Namespace, trace: Path, out: Path | None, data: 
     ``pattern``: what the tests of the log found, and with a rate that changes over the
     period (and no ``--iid``) the profile written with the fit of the gaps in operational
     time (``data`` then holds those gaps)."""
-    from cell.experiments.fit_choice import caution, choose, first_accepted
-    from cell.experiments.fit_output import block_yaml
-    from cell.experiments.fit_pattern import profile_yaml
+    from cell.experiments.fit.choice import caution, choose, first_accepted
+    from cell.experiments.fit.output import block_yaml
+    from cell.experiments.fit.pattern import profile_yaml
 
     iid = bool(getattr(args, "iid", False))
     profile = pattern.profile() if pattern is not None and pattern.by_time and not iid else None
@@ -159,7 +159,7 @@ def write(args: argparse.Namespace, data: Data, result: Result, out: Path | None
 
 
 def _draw(args: argparse.Namespace, data: Data, result: Result, path: Any) -> None:
-    from cell.experiments.fit_figure import draw, draw_censored
+    from cell.experiments.fit.figure import draw, draw_censored
 
     what = {"time_to_failure": "time to failure", "time_to_repair": "time to repair"}.get(args.block)
     if data.censored is not None:

@@ -18,9 +18,9 @@ from scipy import stats
 
 from cell.cli.fit import add_arguments
 from cell.cli.fit import main as cmd_fit
-from cell.experiments import fit_input
-from cell.experiments.fit import fit_trace
-from cell.experiments.fit_budget import MAX_FIT_VALUES, OutOfTime, subsample, time_limit
+from cell.experiments.fit import column as fit_input
+from cell.experiments.fit.budget import MAX_FIT_VALUES, OutOfTime, subsample, time_limit
+from cell.experiments.fit.mle import fit_trace
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.schema import load_scenario
 from cell.scenario.trace_file import cells_of, find_column, records

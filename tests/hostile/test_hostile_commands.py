@@ -35,7 +35,7 @@ COMMANDS: dict[str, tuple[list[str], str, str]] = {
     "animate": (["animate", "baseline", "--parts", "1"], "cell.scenario.schema.load_scenario", "file.gif"),
     "bench": (["bench"], "cell.bench.throughput.benchmarks", "file"),
     "schema": (["schema"], "cell.scenario.schema.json_schema", "file"),
-    "fit": (["fit", "{trace}"], "cell.experiments.fit_input.read_column", "file.yaml"),
+    "fit": (["fit", "{trace}"], "cell.experiments.fit.column.read_column", "file.yaml"),
 }
 
 

@@ -31,16 +31,16 @@ class Data(NamedTuple):
     kept: Any = None
     """Which of ``ordered`` are fitted (None: all)."""
     first_h: float = 0.0
-    """Where on its clock the log begins, h (:func:`~cell.experiments.fit_input.first_clock_h`)."""
+    """Where on its clock the log begins, h (:func:`~cell.experiments.fit.column.first_clock_h`)."""
 
 
 def read_data(trace: Path, column: str, *, lifetimes: bool, times: bool, gaps: bool,
               censored_by: str | None, max_gap: float | None, drop_outliers: bool) -> Data:
     """The values to fit, from the trace's ``column`` (``cell fit``'s options by their names),
     and the notes and warnings on them."""
-    from cell.experiments.fit import MIN_VALUES
-    from cell.experiments.fit_gaps import far_out, fence, flag, flagged, leave_out
-    from cell.experiments.fit_input import first_clock_h, read_column, read_lifetimes
+    from cell.experiments.fit.column import first_clock_h, read_column, read_lifetimes
+    from cell.experiments.fit.gaps import far_out, fence, flag, flagged, leave_out
+    from cell.experiments.fit.mle import MIN_VALUES
     from cell.scenario.arrivals import MAX_INTERARRIVAL_S
 
     if lifetimes and not times:
@@ -77,7 +77,7 @@ def read_data(trace: Path, column: str, *, lifetimes: bool, times: bool, gaps: b
 
 def subsampled(n: int, noun: str) -> list[str]:
     """The note on a fit to a random subsample of ``n`` values (none if all are fitted)."""
-    from cell.experiments.fit_budget import MAX_FIT_VALUES
+    from cell.experiments.fit.budget import MAX_FIT_VALUES
 
     if n <= MAX_FIT_VALUES:
         return []
@@ -88,8 +88,8 @@ def subsampled(n: int, noun: str) -> list[str]:
 
 def in_operational_time(data: Data, profile: RateProfile) -> Data:
     """The data as the gaps a profile's base distribution draws: the log's gaps in operational
-    time (:func:`~cell.experiments.fit_pattern.operational_gaps`), those left out left out."""
-    from cell.experiments.fit_pattern import operational_gaps
+    time (:func:`~cell.experiments.fit.pattern.operational_gaps`), those left out left out."""
+    from cell.experiments.fit.pattern import operational_gaps
 
     gaps = operational_gaps(data.ordered, profile)
     values = gaps if data.kept is None else gaps[data.kept]
