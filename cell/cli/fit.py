@@ -28,7 +28,8 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from cell.cli.fit_options import families_option, pattern_options
-from cell.cli.fit_write import fitted_block, write
+from cell.cli.fit_write import write
+from cell.experiments.fit.block import FitOptions, fitted_block
 from cell.experiments.fit.fitted_data import in_operational_time, read_data
 from cell.experiments.fit.scenario_check import BLOCKS
 from cell.plumbing.errors import ScenarioError
@@ -156,7 +157,8 @@ def main(args: argparse.Namespace) -> int:
         profile = pattern.profile()
         if pattern.by_time and not args.iid and profile is not None:
             data = in_operational_time(data, profile)
-    result = fitted_block(args, trace, out, data, families, replay, pattern)
+    options = FitOptions(args.block, args.column, args.rank_by, args.budget, bool(args.iid))
+    result = fitted_block(options, trace, out, data, families, replay, pattern)
     write(args, data, result, out, figure)
     if data.flag:
         print(f"cell: warning: {data.flag}", file=sys.stderr)
