@@ -49,17 +49,17 @@ whatif: $(STAMP)
 stress: $(STAMP)
 	rm -rf build/stress
 	$(PY) -m cell sweep scenarios/stress.yaml --out build/stress --workers $(WORKERS)
-	MPLBACKEND=Agg $(PY) -m cell.reporting.stress build/stress/replications.csv reports/stress
+	MPLBACKEND=Agg $(PY) -m cell.reporting.maps.stress build/stress/replications.csv reports/stress
 
 sensor: $(STAMP)
 	rm -rf build/sensor
 	$(PY) -m cell sweep scenarios/sensor.yaml --out build/sensor --workers $(WORKERS)
-	MPLBACKEND=Agg $(PY) -m cell.reporting.sensor_map build/sensor/replications.csv reports/sensor
+	MPLBACKEND=Agg $(PY) -m cell.reporting.maps.sensor_map build/sensor/replications.csv reports/sensor
 
 # The reliability study (issue 21): both policies with motor wear, a year of two shifts a run.
 reliability: $(STAMP)
 	rm -rf build/reliability
-	MPLBACKEND=Agg $(PY) -m cell.reporting.reliability scenarios/reliability.yaml build/reliability reports/reliability
+	MPLBACKEND=Agg $(PY) -m cell.reporting.maps.reliability scenarios/reliability.yaml build/reliability reports/reliability
 
 figures: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m cell figures --out reports/figures

@@ -221,7 +221,7 @@ def sweep_overhead_ms_per_point(points: int = 200, parts: int = 20) -> float:
     import yaml
 
     from cell.experiments.sweep import load_sweep, run_sweep
-    from cell.reporting.experiment import difference_table, summary_table
+    from cell.reporting.experiment.report import difference_table, summary_table
 
     spans = []
     with tempfile.TemporaryDirectory() as tmp:

@@ -1,7 +1,8 @@
 """What the ``cell`` command's subcommands share: the scenario, ``--set`` and ``--workers``
 arguments, and reading the scenario they name.
 
-The subcommands are the modules ``cell/cli/*_command.py``, one each.  Each holds ``HELP``
+The subcommands are the modules ``cell/cli/<command>.py``, each named after its command
+(:data:`cell.cli.parser.COMMANDS`).  Each holds ``HELP``
 and ``DESCRIPTION``, ``add_arguments(parser)`` and
 ``main(args)``; it imports the package inside ``main`` only, so building the
 parser (and ``cell --help``) loads nothing heavy, and a command loads only what

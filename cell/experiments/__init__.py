@@ -1,2 +1,2 @@
 """Analysis of experiments: statistics over replications (:mod:`cell.experiments.stats`)
-and input modelling, fitting inter-arrival distributions to traces (:mod:`cell.experiments.fit`)."""
+and input modelling, fitting inter-arrival distributions to traces (:mod:`cell.experiments.fit.mle`)."""

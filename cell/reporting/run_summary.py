@@ -102,6 +102,23 @@ def nominal_warning(sweep: Sweep) -> str | None:
                        f"{where or worst.policy})", f" (set: {{{key}: null}} in the sweep file)")
 
 
+def comparison_nominal_warning(sweep: Sweep) -> str | None:
+    """``cell compare``'s :func:`nominal_warning`: one line if A's or B's controller aims at a
+    nominal cycle it states that is off its arrivals' mean (as ``cell run`` warns of a run),
+    else None."""
+    from cell.experiments.sweep.spec import comparison_sides
+
+    said: dict[str, list[str]] = {}
+    for label, p in comparison_sides(sweep):
+        if abs(p.nominal_gap) > NOMINAL_MISMATCH:  # NaN: it follows the arrivals
+            cycle = float(p.scenario.controller.nominal_cycle_s or math.nan)
+            said.setdefault(nominal_mismatch(cycle, cycle / (1 + p.nominal_gap)), []).append(label)
+    if not said:
+        return None
+    return nominal_off("; ".join(f"{' and '.join(who)}: {text}" for text, who in said.items()),
+                       " (--set controller.nominal_cycle_s=null)")
+
+
 def nominal_mismatch(cycle_s: float, mean_s: float) -> str:
     """``controller.nominal_cycle_s (X s) is +N% off the arrivals' mean (Y s)``."""
     return (f"controller.nominal_cycle_s ({cycle_s:.4f} s) is {cycle_s / mean_s - 1:+.1%} off "

@@ -11,8 +11,8 @@ from pathlib import Path
 import pytest
 from PIL import Image, ImageSequence
 
-from cell.cli.animate_command import add_arguments
-from cell.cli.animate_command import main as cmd_animate
+from cell.cli.animate import add_arguments
+from cell.cli.animate import main as cmd_animate
 from cell.plumbing.errors import CellError
 from cell.reporting.animation.movie import animate
 from cell.reporting.animation.scene import TAIL_S

@@ -95,7 +95,7 @@ def test_a_nominal_cycle_in_ms_is_warned_of_as_cell_run_warns(
     assert cli(["run", "baseline", *common, "--out", str(tmp_path / "run")]) == 0
     run = said(capsys)
     assert len(run) == 1 and "ms" in run[0] and "%" not in run[0], run
-    from cell.cli.animate_command import notes
+    from cell.cli.animate import notes
     from cell.scenario.schema import load_scenario
 
     scenario = load_scenario("baseline", {"controller.nominal_cycle_s": 22587, "run.parts": 2})

@@ -95,11 +95,11 @@ def test_set_overrides_from_the_command_line(tmp_path):
 
 
 def test_every_subcommand_has_its_module():
-    from cell.cli.main import COMMANDS
+    from cell.cli.parser import COMMANDS
 
     assert set(COMMANDS) == set(SUBCOMMANDS)
     for name in SUBCOMMANDS:
-        module = importlib.import_module(f"cell.cli.{name}_command")
+        module = importlib.import_module(f"cell.cli.{name}")
         assert callable(module.main) and callable(module.add_arguments), name
 
 
@@ -262,7 +262,7 @@ def test_an_hours_long_run_shows_its_progress_towards_the_parts_expected(
         tmp_path, monkeypatch, capsys):
     """``run.hours`` gives no part count: the progress counts towards the parts expected
     (hours over the mean inter-arrival time) and ends at the parts that came."""
-    from cell.cli import run_command
+    from cell.cli import run as run_command
 
     monkeypatch.setattr(run_command, "PROGRESS_FROM_PARTS", 50)
     assert main(["run", "baseline", "--set", "run.hours=2", "--out", str(tmp_path / "o")]) == 0
@@ -279,7 +279,7 @@ def test_a_warning_is_one_line_but_not_an_unclosed_file_freed_meanwhile(monkeypa
     object of anybody's, freed while the command ran, as Python's own filters hide it)."""
     import warnings
 
-    import cell.cli.scenarios_command as command
+    import cell.cli.scenarios as command
 
     real, said = command.main, "a sample warning"
 

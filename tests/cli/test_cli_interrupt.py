@@ -54,21 +54,21 @@ def test_main_reports_it_in_one_line_and_130(monkeypatch, capsys, where, error):
             raise KeyboardInterrupt
         raise _raised_while_interrupted("context")
 
-    target = "cell.cli.scenarios_command.main" if where == "command" else "cell.cli.main.build_parser"
+    target = "cell.cli.scenarios.main" if where == "command" else "cell.cli.main.build_parser"
     monkeypatch.setattr(target, stop)
     assert main(["scenarios"]) == INTERRUPTED
     assert capsys.readouterr().err == "cell: interrupted\n"
 
 
 def test_an_import_error_of_its_own_keeps_its_traceback(monkeypatch):
-    monkeypatch.setattr("cell.cli.scenarios_command.main", lambda args: __import__("no_such_module_x"))
+    monkeypatch.setattr("cell.cli.scenarios.main", lambda args: __import__("no_such_module_x"))
     with pytest.raises(ImportError):
         main(["scenarios"])
 
 
 _CHILD = """
 import sys
-import cell.cli.scenarios_command as command
+import cell.cli.scenarios as command
 def stopped(args):
     try:
         exec("raise KeyboardInterrupt")  # Ctrl-C inside code being exec'd, as in an import
@@ -91,7 +91,7 @@ def test_a_real_process_exits_130_with_one_line():
 def test_the_process_ends_now_only_when_it_is_the_commands(monkeypatch):
     ended = []
     monkeypatch.setattr(cell.cli.main, "exit_now", ended.append)
-    monkeypatch.setattr("cell.cli.scenarios_command.main", lambda args: exec("raise KeyboardInterrupt"))
+    monkeypatch.setattr("cell.cli.scenarios.main", lambda args: exec("raise KeyboardInterrupt"))
     assert main(["scenarios"]) == INTERRUPTED and ended == []
     monkeypatch.setattr(sys, "argv", ["cell", "scenarios"])
     assert main() == INTERRUPTED and ended == [INTERRUPTED]

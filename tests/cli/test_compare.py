@@ -11,7 +11,7 @@ import yaml
 
 from cell.cli.main import main
 from cell.experiments.sweep import load_sweep, run_sweep
-from cell.reporting.experiment import difference_table
+from cell.reporting.experiment.report import difference_table
 from tests.prose import in_order
 
 # Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
@@ -80,7 +80,7 @@ def test_compare_paired_interval_is_scipys(tmp_path, capsys):
 
 def test_compare_out_makes_each_table_once(tmp_path, capsys, monkeypatch):
     """The verdict and ``--out``'s files come from one summary and one difference table."""
-    import cell.reporting.experiment as experiment
+    import cell.reporting.experiment.report as experiment
 
     made: list[str] = []
     for name in ("summary_table", "difference_table"):
@@ -95,8 +95,8 @@ def test_compare_out_makes_each_table_once(tmp_path, capsys, monkeypatch):
 
 
 def test_verdict_says_which_is_better_on_each_measure():
-    from cell.cli.compare_command import judgement, verdict
     from cell.experiments.sweep.spec import comparison
+    from cell.reporting.compare_judgement import judgement, verdict
     from cell.scenario.schema import load_scenario
 
     a = load_scenario("baseline")

@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from cell.cli.compare_command import labels
+from cell.cli.compare import labels
 from cell.cli.main import main
 from cell.scenario.schema import load_scenario
 

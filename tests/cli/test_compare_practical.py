@@ -14,10 +14,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cell.cli.compare_command import judgement, verdict
-from cell.cli.compare_rates import rate_error_s, rates_differ
 from cell.cli.main import main
 from cell.experiments.sweep.spec import comparison
+from cell.reporting.compare_judgement import judgement, verdict
+from cell.reporting.compare_rates import rate_error_s, rates_differ
 from cell.reporting.compare_verdict import Judged, decide
 from cell.scenario.schema import load_scenario
 

@@ -6,9 +6,9 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
-from cell.cli.compare_command import verdict
 from cell.experiments.sweep.spec import comparison
-from cell.reporting.experiment_text import sentence
+from cell.reporting.compare_judgement import verdict
+from cell.reporting.experiment.text import sentence
 from cell.reporting.formatting import HEADLINES
 from cell.scenario.run_length import RunLength
 from cell.scenario.schema import load_scenario

@@ -12,10 +12,10 @@ from pathlib import Path
 import pytest
 
 import cell
-import cell.cli.optimize_command
-import cell.cli.scenarios_command
-import cell.cli.sensitivity_command
-import cell.cli.sweep_command
+import cell.cli.optimize
+import cell.cli.scenarios
+import cell.cli.sensitivity
+import cell.cli.sweep
 from cell.cli.main import main
 
 #: A library's source file, as a warning from compiling it names it.
@@ -43,7 +43,7 @@ def emitting(*raised: tuple[type[Warning], str, str]):
 ])
 def test_a_warning_is_said_as_pythons_default_filters_would(monkeypatch, capsys, category,
                                                             filename, said):
-    monkeypatch.setattr(cell.cli.scenarios_command, "main",
+    monkeypatch.setattr(cell.cli.scenarios, "main",
                         emitting((category, "invalid escape sequence '\\s'", filename)))
     assert main(["scenarios"]) == 0
     err = capsys.readouterr().err
@@ -53,7 +53,7 @@ def test_a_warning_is_said_as_pythons_default_filters_would(monkeypatch, capsys,
 
 def test_four_library_deprecations_and_one_warning_of_ours_say_one_line(monkeypatch, capsys):
     raised = [(DeprecationWarning, f"invalid escape sequence '\\{c}'", LIBRARY) for c in "sdpw"]
-    monkeypatch.setattr(cell.cli.scenarios_command, "main",
+    monkeypatch.setattr(cell.cli.scenarios, "main",
                         emitting(*raised, (UserWarning, "a fit left out", OWN)))
     assert main(["scenarios"]) == 0
     lines = [x for x in capsys.readouterr().err.splitlines() if x.startswith("cell: warning")]
@@ -61,7 +61,7 @@ def test_four_library_deprecations_and_one_warning_of_ours_say_one_line(monkeypa
 
 
 def _workers_default(command: str) -> str:
-    from cell.cli.main import SUBPARSERS, build_parser
+    from cell.cli.parser import SUBPARSERS, build_parser
 
     build_parser()
     action = next(a for a in SUBPARSERS[command]._actions if "--workers" in a.option_strings)
@@ -71,8 +71,8 @@ def _workers_default(command: str) -> str:
 
 
 @pytest.mark.parametrize(("command", "module", "uses"), [
-    ("optimize", cell.cli.optimize_command, "args.workers or 1"),
-    ("sensitivity", cell.cli.sensitivity_command, "args.workers or 1"),
+    ("optimize", cell.cli.optimize, "args.workers or 1"),
+    ("sensitivity", cell.cli.sensitivity, "args.workers or 1"),
 ])
 def test_workers_default_in_help_is_what_the_command_uses(command, module, uses):
     """optimize and sensitivity run one worker when --workers is left out (their code says

@@ -8,7 +8,7 @@ import re
 import pytest
 
 from cell.experiments.sweep import load_sweep, run_sweep
-from cell.reporting.experiment import plan_report, write_report
+from cell.reporting.experiment.report import plan_report, write_report
 
 # Figures laid out, not rasterised: these tests read the tables and markdown.
 pytestmark = pytest.mark.usefixtures("unrendered")

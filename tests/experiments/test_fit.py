@@ -12,11 +12,11 @@ import pytest
 import yaml
 from scipy import stats
 
-from cell.cli.fit_command import add_arguments
-from cell.cli.fit_command import main as cmd_fit
-from cell.experiments.fit import Fit, fit_trace
-from cell.experiments.fit_budget import subsample
-from cell.experiments.fit_output import arrivals_yaml, format_table
+from cell.cli.fit import add_arguments
+from cell.cli.fit import main as cmd_fit
+from cell.experiments.fit.budget import subsample
+from cell.experiments.fit.mle import Fit, fit_trace
+from cell.experiments.fit.output import arrivals_yaml, format_table
 from cell.plumbing.errors import ScenarioError
 
 # Thesis eq. 6.9: T = 17.6019 + 5.4342 (-ln(1 - u))^0.2038.

@@ -16,11 +16,11 @@ import pytest
 import yaml
 from scipy import stats
 
-from cell.cli.fit_command import add_arguments
-from cell.cli.fit_command import main as cmd_fit
-from cell.experiments import fit_input
-from cell.experiments.fit import fit_trace
-from cell.experiments.fit_budget import MAX_FIT_VALUES, OutOfTime, subsample, time_limit
+from cell.cli.fit import add_arguments
+from cell.cli.fit import main as cmd_fit
+from cell.experiments.fit import column as fit_input
+from cell.experiments.fit.budget import MAX_FIT_VALUES, OutOfTime, subsample, time_limit
+from cell.experiments.fit.mle import fit_trace
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.schema import load_scenario
 from cell.scenario.trace_file import cells_of, find_column, records
@@ -170,12 +170,12 @@ def test_truncpareto_on_a_small_sample_is_refused_by_the_scenario_check(small: P
 
 def test_every_candidate_is_validated_as_a_scenario_before_one_is_written(small: Path, monkeypatch, capsys):
     """The fit a scenario refuses is passed over for the next, whatever the quick checks said."""
-    from cell.cli import fit_write
+    from cell.experiments.fit import block
 
     def refuses(block: str, key: str, file: object) -> str:
         return "arrivals.params refused: say" if "gamma" in block else ""
 
-    monkeypatch.setattr(fit_write, "scenario_refuses", refuses)
+    monkeypatch.setattr(block, "scenario_refuses", refuses)
     assert cmd_fit(parse(str(small), "--families", "gamma,lognorm")) == 0
     printed = capsys.readouterr().out
     assert yaml.safe_load(printed)["arrivals"]["distribution"] == "lognorm"

@@ -13,10 +13,10 @@ import pytest
 import yaml
 from scipy import stats
 
-from cell.cli.fit_check import _scenario_text, scenario_refuses
-from cell.cli.fit_command import add_arguments
-from cell.cli.fit_command import main as cmd_fit
-from cell.experiments.fit_censored import censored_loglik, fit_lifetimes, km_distance
+from cell.cli.fit import add_arguments
+from cell.cli.fit import main as cmd_fit
+from cell.experiments.fit.censored import censored_loglik, fit_lifetimes, km_distance
+from cell.experiments.fit.scenario_check import _scenario_text, scenario_refuses
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.schema import is_section
 from tests.prose import in_order
@@ -138,8 +138,8 @@ def test_a_failures_block_is_validated_under_the_failures_section():
 def test_a_fitted_time_is_written_by_its_mean_in_hours_and_read_back_as_the_fit(family, params):
     """The block by ``mean_h`` and ``shape`` (seven digits each) is the fitted distribution to
     within the rounding: scipy's mean, sd and each parameter within 1e-6."""
-    from cell.experiments.fit import Fit
-    from cell.experiments.fit_output import block_yaml
+    from cell.experiments.fit.mle import Fit
+    from cell.experiments.fit.output import block_yaml
     from cell.scenario.failure_sections import TimeDistribution
     from cell.scenario.failure_spec import frozen
 
@@ -155,8 +155,8 @@ def test_a_fitted_time_is_written_by_its_mean_in_hours_and_read_back_as_the_fit(
 
 
 def test_a_fit_with_a_location_keeps_scipy_form():
-    from cell.experiments.fit import Fit
-    from cell.experiments.fit_output import block_yaml
+    from cell.experiments.fit.mle import Fit
+    from cell.experiments.fit.output import block_yaml
 
     fit = Fit("weibull_min", {"c": 1.5, "loc": 30.0, "scale": 900.0}, 0.05, 0.5, -100.0, 204.0)
     block = yaml.safe_load(block_yaml(fit, "time_to_repair", "log.csv"))["time_to_repair"]

@@ -12,10 +12,10 @@ import pytest
 import yaml
 from scipy import stats
 
-from cell.cli.fit_command import add_arguments
-from cell.cli.fit_command import main as cmd_fit
-from cell.experiments.fit import Fit, fit_trace
-from cell.experiments.fit_choice import CAUTION_OFF, P_FLOOR, caution, choose
+from cell.cli.fit import add_arguments
+from cell.cli.fit import main as cmd_fit
+from cell.experiments.fit.choice import CAUTION_OFF, P_FLOOR, caution, choose
+from cell.experiments.fit.mle import Fit, fit_trace
 from cell.scenario.schema import load_scenario
 from tests.prose import in_order
 

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 import yaml
 
-from cell.cli.fit_command import DESCRIPTION, add_arguments
-from cell.cli.fit_command import main as cmd_fit
+from cell.cli.fit import DESCRIPTION, add_arguments
+from cell.cli.fit import main as cmd_fit
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.arrivals import MAX_INTERARRIVAL_S, read_trace
 
@@ -153,7 +153,7 @@ def test_a_header_name_with_spaces_around_it_is_the_column(tmp_path):
     """As a run's trace reader takes it: ' interarrival_s' (a space after the comma) is the
     column; two columns of that name are refused rather than one chosen, by both readers (pandas
     would have read a second 'interarrival_s' as 'interarrival_s.1' and fitted the first)."""
-    from cell.experiments.fit_input import read_column
+    from cell.experiments.fit.column import read_column
 
     gaps = [20.0 + 0.5 * (i * 7 % 11) for i in range(30)]  # not sorted: gaps, not times
     path = tmp_path / "log.csv"
@@ -206,7 +206,7 @@ def test_both_readers_name_the_same_file_line(tmp_path: Path):
     with pytest.raises(ScenarioError, match="line 13 has inter-arrival time '-2.5'"):
         read_trace(path)
     write(path, path.read_text().replace("-2.5", "21.5"))
-    from cell.experiments.fit_input import read_column
+    from cell.experiments.fit.column import read_column
 
     assert read_column(path).tolist() == read_trace(path).tolist()
 

@@ -1,4 +1,4 @@
-"""``cell fit`` notices a log that is not iid (cell.experiments.fit_pattern): its false-alarm
+"""``cell fit`` notices a log that is not iid (cell.experiments.fit.pattern): its false-alarm
 rate on iid logs is its stated level; it finds a rate 20 % higher in the first two hours of each
 8-hour shift, and the rate profile it writes reproduces the log's own losses where one iid fit
 loses none."""
@@ -13,10 +13,10 @@ import pytest
 import yaml
 from scipy import stats
 
-from cell.cli.fit_command import add_arguments
-from cell.cli.fit_command import main as cmd_fit
+from cell.cli.fit import add_arguments
+from cell.cli.fit import main as cmd_fit
 from cell.cli.main import main
-from cell.experiments.fit_pattern import LEVEL, MAX_TESTED, WORK, find_pattern, holm, orders
+from cell.experiments.fit.pattern import LEVEL, MAX_TESTED, WORK, find_pattern, holm, orders
 from cell.experiments.sweep.runner import simulate_summary
 from cell.scenario.schema import load_scenario
 from cell.sim.simulation import simulate

@@ -17,12 +17,12 @@ import pytest
 import yaml
 from scipy import special, stats
 
-from cell.cli.fit_command import add_arguments
-from cell.cli.fit_command import main as cmd_fit
-from cell.experiments.fit import Fit
-from cell.experiments.fit_choice import caution
-from cell.experiments.fit_figure import figure
-from cell.experiments.fit_gaps import far_out, fence, flagged, leave_out
+from cell.cli.fit import add_arguments
+from cell.cli.fit import main as cmd_fit
+from cell.experiments.fit.choice import caution
+from cell.experiments.fit.figure import figure
+from cell.experiments.fit.gaps import far_out, fence, flagged, leave_out
+from cell.experiments.fit.mle import Fit
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.schema import load_scenario
 from tests.prose import in_order

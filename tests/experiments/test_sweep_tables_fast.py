@@ -1,4 +1,4 @@
-"""summary.csv and differences.csv made at once for all points (cell.reporting.experiment_data,
+"""summary.csv and differences.csv made at once for all points (cell.reporting.experiment.data,
 cell.experiments.stats.summarise_many) hold the figures the point-by-point way gives, bit for bit:
 each point's runs sliced from the frame, summarised and paired one by one."""
 
@@ -13,12 +13,12 @@ from hypothesis import strategies as st
 
 from cell.experiments.stats import paired_difference, paired_many, summarise, summarise_many
 from cell.experiments.sweep import grid_columns, load_sweep, run_sweep
-from cell.reporting.experiment_data import (
+from cell.experiments.sweep.results import runs_of
+from cell.reporting.experiment.data import (
     all_pairs,
     difference_table,
     grid_values,
     measures,
-    runs_of,
     summary_table,
 )
 

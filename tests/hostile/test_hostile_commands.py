@@ -35,7 +35,7 @@ COMMANDS: dict[str, tuple[list[str], str, str]] = {
     "animate": (["animate", "baseline", "--parts", "1"], "cell.scenario.schema.load_scenario", "file.gif"),
     "bench": (["bench"], "cell.bench.throughput.benchmarks", "file"),
     "schema": (["schema"], "cell.scenario.schema.json_schema", "file"),
-    "fit": (["fit", "{trace}"], "cell.experiments.fit_input.read_column", "file.yaml"),
+    "fit": (["fit", "{trace}"], "cell.experiments.fit.column.read_column", "file.yaml"),
 }
 
 
@@ -253,9 +253,9 @@ def _raising(exc: BaseException) -> Any:
 ], ids=lambda v: type(v).__name__ if isinstance(v, BaseException) else None)
 def test_the_top_turns_anticipated_failures_into_one_line(monkeypatch: pytest.MonkeyPatch, exc: BaseException,
                                                            words: tuple[str, ...]) -> None:
-    import cell.cli.run_command
+    import cell.cli.run
 
-    monkeypatch.setattr(cell.cli.run_command, "main", _raising(exc))
+    monkeypatch.setattr(cell.cli.run, "main", _raising(exc))
     refused(cli("run", "baseline", "--out", "OUT"), *words)
 
 
@@ -273,9 +273,9 @@ def test_a_real_memory_error_is_one_line(tmp_path: Path, monkeypatch: pytest.Mon
 @pytest.mark.parametrize("exc", [ZeroDivisionError("a bug"), OSError(errno.EBADF, "a bug")])
 def test_an_unexpected_exception_keeps_its_traceback(monkeypatch: pytest.MonkeyPatch,
                                                      exc: BaseException) -> None:
-    import cell.cli.run_command
+    import cell.cli.run
 
-    monkeypatch.setattr(cell.cli.run_command, "main", _raising(exc))
+    monkeypatch.setattr(cell.cli.run, "main", _raising(exc))
     with pytest.raises(type(exc)):
         cli("run", "baseline", "--out", "OUT")
 

@@ -60,10 +60,14 @@ def test_the_top_level_holds_only_the_folders() -> None:
 
 
 def test_no_two_modules_share_a_name() -> None:
+    """Apart from a command's own module in cli/, named after the command (cli/fit.py runs
+    ``cell fit``, whose work is experiments/fit/)."""
+    from cell.cli.parser import COMMANDS
+
     seen: dict[str, str] = {}
     twice = []
     for m in modules():
-        if m.name == "__main__.py":
+        if m.name == "__main__.py" or (m.parts[0] == "cli" and m.stem in COMMANDS):
             continue
         if m.name in seen:
             twice.append((seen[m.name], m.as_posix()))
@@ -103,3 +107,48 @@ def test_the_import_contract_is_written_by_folder() -> None:
     layers = config["tool"]["importlinter"]["contracts"][0]["layers"]
     named = [name.strip() for layer in layers for name in layer.split("|")]
     assert sorted(named) == sorted(f"cell.{f}" for f in FOLDERS)
+
+
+def private_imports(tree: ast.AST) -> list[tuple[int, str]]:
+    """``from cell... import _name`` in a module's tree (a dunder such as ``__version__``
+    is public), as (line, name)."""
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module and (
+                node.module == "cell" or node.module.startswith("cell.")):
+            found += [(node.lineno, a.name) for a in node.names
+                      if a.name.startswith("_") and not a.name.startswith("__")]
+        if isinstance(node, ast.ImportFrom) and node.level > 0:
+            found += [(node.lineno, a.name) for a in node.names
+                      if a.name.startswith("_") and not a.name.startswith("__")]
+    return found
+
+
+def test_the_private_import_check_sees_one() -> None:
+    tree = ast.parse("from cell.x import a, _b, __version__\nfrom .y import _c\n"
+                     "def f():\n    from cell.z import _d\n")
+    assert sorted(private_imports(tree)) == [(1, "_b"), (2, "_c"), (4, "_d")]
+
+
+def test_no_module_imports_a_private_name() -> None:
+    private = []
+    for p in sorted(PACKAGE.rglob("*.py")):
+        tree = ast.parse(p.read_text(encoding="utf-8"))
+        private += [f"{p.relative_to(ROOT)}:{line} {name}" for line, name in private_imports(tree)]
+    assert private == []
+
+
+def test_command_line_modules_parse_and_print() -> None:
+    """cli/ parses and prints: its modules stay short, what they print made below them."""
+    long = [f"{p.relative_to(ROOT)}: {p.read_text(encoding='utf-8').count(chr(10))} lines"
+            for p in sorted((PACKAGE / "cli").glob("*.py"))
+            if p.read_text(encoding="utf-8").count("\n") > 200]
+    assert long == []
+
+
+def test_command_modules_are_named_after_their_command() -> None:
+    from cell.cli.parser import COMMANDS
+
+    cli = {p.stem for p in (PACKAGE / "cli").glob("*.py")}
+    assert set(COMMANDS) <= cli
+    assert sorted(n for n in cli if n.endswith("_command")) == []

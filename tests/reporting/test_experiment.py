@@ -20,7 +20,7 @@ import yaml
 
 from cell.cli.main import main
 from cell.experiments.sweep import load_sweep, run_sweep
-from cell.reporting.experiment import (
+from cell.reporting.experiment.report import (
     difference_table,
     plan_report,
     summary_table,

@@ -1,4 +1,4 @@
-"""The report's figures (cell.reporting.experiment_plots): which keys give panels and
+"""The report's figures (cell.reporting.experiment.plots): which keys give panels and
 which give a policy's own lines, one legend naming every line, titles that fit, and
 intervals of counts that stop at 0."""
 
@@ -8,8 +8,7 @@ import matplotlib as mpl
 import pytest
 
 from cell.experiments.sweep import load_sweep, run_sweep
-from cell.reporting.experiment import summary_table
-from cell.reporting.experiment_plots import (
+from cell.reporting.experiment.plots import (
     RC,
     TITLE_WIDTH,
     draw,
@@ -17,7 +16,8 @@ from cell.reporting.experiment_plots import (
     layout,
     title,
 )
-from cell.reporting.experiment_reading import show
+from cell.reporting.experiment.reading import show
+from cell.reporting.experiment.report import summary_table
 from cell.reporting.formatting import HEADLINES
 
 PANEL_KEY = "belts.spacing_tol_in"

@@ -8,7 +8,7 @@ import pandas as pd
 
 from cell.experiments.stats import PAIRED_KEYS, summarise
 from cell.experiments.sweep import load_sweep
-from cell.reporting.experiment_explain import reading
+from cell.reporting.experiment.explain import reading
 from cell.reporting.formatting import HEADLINES
 from tests.prose import in_order
 

@@ -7,8 +7,8 @@ import pandas as pd
 import pytest
 
 from cell.experiments.stats import PAIRED_KEYS, summarise
-from cell.reporting.experiment_explain import reading
-from cell.reporting.experiment_text import cell
+from cell.reporting.experiment.explain import reading
+from cell.reporting.experiment.text import cell
 from cell.reporting.formatting import HEADLINES
 from tests.prose import in_order
 

@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 
 from cell.cli.main import main
-from cell.reporting.experiment_text import cell
+from cell.reporting.experiment.text import cell
 from cell.reporting.formatting import estimate, plus_minus
 from cell.reporting.run_summary import format_summary, oee_line
 from cell.sim.records import RunSummary

@@ -16,7 +16,7 @@ from typing import Any
 import pandas as pd
 import pytest
 
-from cell.cli.main import COMMANDS
+from cell.cli.parser import COMMANDS
 from cell.reporting import published as thesis
 from cell.sim.records import BELT_COLUMNS, PART_COLUMNS, SUMMARY_COLUMNS
 from tests.reporting.test_reports_readme import agrees, phrase, prose
@@ -102,7 +102,7 @@ def stress() -> list[int]:
 
 
 def wear() -> list[float]:
-    from cell.reporting.reliability import flip_exponent, verdicts
+    from cell.reporting.maps.reliability import flip_exponent, verdicts
 
     v = verdicts(pd.read_csv(REPORTS / "reliability" / "reliability.csv"))
     r = v.iloc[-1]

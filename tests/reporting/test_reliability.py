@@ -1,4 +1,4 @@
-"""The reliability study's report (cell.reporting.reliability; reports/reliability/)."""
+"""The reliability study's report (cell.reporting.maps.reliability; reports/reliability/)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cell.reporting import reliability as rel
+from cell.reporting.maps import reliability as rel
 from tests.prose import in_order
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from cell.experiments.sweep import load_sweep, run_sweep
 from cell.plumbing.errors import CellError
-from cell.reporting.table_7_1 import (
+from cell.reporting.table_7_1.table import (
     COLUMNS,
     markdown,
     reading,
@@ -181,7 +181,7 @@ def test_reading_follows_the_direction_of_the_numbers():
 def test_the_report_writes_both_table_7_1_files(sweeps, tmp_path, unrendered):
     """A Table 7.1 sweep's report holds table_7_1.csv (the long form, read back whole) and
     table_7_1.md, as :func:`table_7_1_files` makes them."""
-    from cell.reporting.experiment import plan_report, write_report
+    from cell.reporting.experiment.report import plan_report, write_report
 
     sweep = load_sweep(sweeps.write(tmp_path, set={"run.parts": 500}))  # laid out like Table 7.1
     frame = run_sweep(sweep, tmp_path / "o", workers=1, replicate=sweeps.bookkeeping,
@@ -202,7 +202,7 @@ def test_memoryless_reading_follows_the_numbers():
     import numpy as np
     import pandas as pd
 
-    from cell.reporting.table_7_1 import memoryless as _memoryless
+    from cell.reporting.table_7_1.table import memoryless as _memoryless
 
     rng = np.random.default_rng(0)
     near = pd.DataFrame({"policy": "adaptive", "ip_thesis_memoryless": 1.0214 + rng.normal(0, 1e-3, 200),
@@ -218,8 +218,8 @@ def test_memoryless_reading_follows_the_numbers():
 def test_published_figures_are_data_that_route_the_layout(monkeypatch):
     """What the thesis published per policy decides the tables and the reading."""
     from cell.reporting import published as thesis
-    from cell.reporting.table_7_1 import LAYOUTS
-    from cell.reporting.table_7_1_reading import reading_by_cycle, reading_one_run
+    from cell.reporting.table_7_1.sentences import reading_by_cycle, reading_one_run
+    from cell.reporting.table_7_1.table import LAYOUTS
 
     assert set(LAYOUTS) == set(thesis.PUBLISHED) == {"non-adaptive", "adaptive"}
     for policy, layout in LAYOUTS.items():

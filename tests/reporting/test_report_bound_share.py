@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from cell.experiments.sweep import load_sweep, run_sweep
-from cell.reporting.experiment import difference_table, summary_table
-from cell.reporting.experiment_data import BOUND_SHARE, with_bound_share
-from cell.reporting.experiment_text import markdown
+from cell.reporting.experiment.data import BOUND_SHARE, with_bound_share
+from cell.reporting.experiment.report import difference_table, summary_table
+from cell.reporting.experiment.text import markdown
 from tests.prose import in_order
 
 
@@ -84,7 +84,7 @@ def test_the_summary_has_parts_lost_as_a_share_of_arrivals_as_optimize_reports_i
     """Issue 35 item 5: a sweep's summary has ``parts_missed_pct``, the measure cell optimize
     and the studies report, run by run from the same runs (the bound's share stays last)."""
     from cell.experiments.study import measures_of
-    from cell.reporting.experiment_data import MISSED_SHARE
+    from cell.reporting.experiment.data import MISSED_SHARE
 
     sweep, frame, summary, differences, _ = report
     assert MISSED_SHARE == "parts_missed_pct" and MISSED_SHARE not in frame

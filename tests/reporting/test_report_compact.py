@@ -4,8 +4,8 @@ two screens and holds both comparisons; the Reading says where the parts go."""
 from __future__ import annotations
 
 from cell.experiments.sweep import load_sweep, run_sweep
-from cell.reporting.experiment import difference_table, summary_table
-from cell.reporting.experiment_text import markdown
+from cell.reporting.experiment.report import difference_table, summary_table
+from cell.reporting.experiment.text import markdown
 from cell.reporting.formatting import HEADLINES
 from tests.prose import in_order
 

@@ -64,7 +64,7 @@ def test_a_report_folder_of_its_own_holds_table_7_1_beside_the_rest(sweeps, tmp_
 ])
 def test_table_7_1_only_beside_the_thesis_s_own_cell(sweeps, tmp_path, other):
     """Laid out like Table 7.1 but on another cell: the general report, no thesis beside it."""
-    from cell.reporting.table_7_1 import is_table_7_1
+    from cell.reporting.table_7_1.table import is_table_7_1
 
     sweep = load_sweep(sweeps.write(tmp_path, replications=2, batch=2, set=other))
     assert not is_table_7_1(sweep)
@@ -75,7 +75,7 @@ def test_table_7_1_only_beside_the_thesis_s_own_cell(sweeps, tmp_path, other):
 
 def test_table_7_1_reads_the_thesis_s_cell_once_for_all_points(sweeps, tmp_path, monkeypatch):
     """Three points, each checked against the built-in baseline: read once, not per point."""
-    from cell.reporting.table_7_1 import is_table_7_1
+    from cell.reporting.table_7_1.table import is_table_7_1
     from cell.scenario import yamlio
 
     sweep = load_sweep(sweeps.write(tmp_path, replications=2, batch=2, set={"run.parts": 500}))

@@ -6,8 +6,8 @@ from __future__ import annotations
 import pandas as pd
 
 from cell.experiments.sweep import load_sweep, run_sweep
-from cell.reporting.experiment import difference_table, summary_table
-from cell.reporting.experiment_text import markdown
+from cell.reporting.experiment.report import difference_table, summary_table
+from cell.reporting.experiment.text import markdown
 from cell.reporting.formatting import half_width, plus_minus
 
 

@@ -1,4 +1,4 @@
-"""The stress map (cell.reporting.stress): its figures against scipy, its verdicts against
+"""The stress map (cell.reporting.maps.stress): its figures against scipy, its verdicts against
 their intervals, and the committed reports/stress against the claim it reads."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ import pytest
 import scipy.stats
 
 from cell.experiments.sweep import load_sweep
-from cell.reporting.stress import reading, table, verdict, write
+from cell.reporting.maps.stress import reading, table, verdict, write
 from cell.scenario import catalog
 from tests.prose import in_order
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from cell.reporting.stress import reading, table
+from cell.reporting.maps.stress import reading, table
 from tests.prose import in_order
 
 

@@ -121,7 +121,7 @@ def _swallowed_then(number: int, error: BaseException):
 def test_a_stop_that_became_another_error_is_still_the_stop(monkeypatch, capsys, number, error):
     from cell.cli.main import main
 
-    monkeypatch.setattr("cell.cli.scenarios_command.main", _swallowed_then(number, error))
+    monkeypatch.setattr("cell.cli.scenarios.main", _swallowed_then(number, error))
     assert main(["scenarios"]) == LINES[number][0]
     assert capsys.readouterr().err == LINES[number][1] + "\n"
 
@@ -130,7 +130,7 @@ def test_a_refusal_that_came_of_a_stop_is_the_stop(monkeypatch, capsys):
     from cell.cli.main import main
     from cell.plumbing.errors import CellError
 
-    monkeypatch.setattr("cell.cli.scenarios_command.main",
+    monkeypatch.setattr("cell.cli.scenarios.main",
                         _swallowed_then(signal.SIGINT, CellError("a.mp4: ffmpeg stopped")))
     assert main(["scenarios"]) == 130
     assert capsys.readouterr().err == "cell: interrupted\n"
@@ -165,7 +165,7 @@ def test_a_stop_raised_in_a_destructor_still_stops_the_command_and_says_only_its
         went_on.append(True)
         return 0
 
-    monkeypatch.setattr("cell.cli.scenarios_command.main", command)
+    monkeypatch.setattr("cell.cli.scenarios.main", command)
     assert main(["scenarios"]) == LINES[number][0]
     assert capsys.readouterr().err == LINES[number][1] + "\n"
     assert went_on == []

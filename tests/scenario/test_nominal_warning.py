@@ -84,7 +84,7 @@ def test_compare_warns_once_for_both_sides(capsys):
 
 
 def test_compare_names_only_the_side_that_is_off():
-    from cell.cli.compare_command import nominal_warning as compare_warning
+    from cell.reporting.run_summary import comparison_nominal_warning as compare_warning
 
     a = load_scenario("baseline")
     b = a.with_overrides({"arrivals": {**GAMMA, "mean_s": 25}})

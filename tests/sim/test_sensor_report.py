@@ -1,4 +1,4 @@
-"""The sensor-quality map (cell.reporting.sensor_map): its reading from the numbers, the
+"""The sensor-quality map (cell.reporting.maps.sensor_map): its reading from the numbers, the
 committed reports/sensor against its own CSV, and the README's quote of its headline."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 
 from cell.experiments.sweep import load_sweep
-from cell.reporting.sensor_map import headline, reading, table, write
+from cell.reporting.maps.sensor_map import headline, reading, table, write
 from cell.scenario import catalog
 from tests.prose import in_order
 

@@ -177,3 +177,10 @@ def assemble_results(sweep: Sweep, task_dir: Path, tasks: Iterable[Task], target
         if name != target.name:
             (target.parent / name).unlink(missing_ok=True)
     return target
+
+
+def runs_of(replications: pd.DataFrame, sweep: Sweep, i: int) -> pd.DataFrame:
+    """Point ``i``'s replications, in replication order."""
+    p = sweep.points[i]
+    rows = replications[(replications["policy"] == p.policy) & (replications["point"] == p.index)]
+    return rows.sort_values("replication")

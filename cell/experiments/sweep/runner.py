@@ -75,7 +75,7 @@ CLUSTER_WINDOW = 1024
 
 
 @memo(key=Identity, maxsize=1)
-def _assembled(scenario: Scenario) -> AssembledCell:
+def assembled(scenario: Scenario) -> AssembledCell:
     """The scenario's cell, assembled once for the replications of one scenario object
     that follow each other (a task's; in one process, a point's)."""
     from cell.sim.assembly import assemble
@@ -87,7 +87,7 @@ def simulate_summary(scenario: Scenario, seed: np.random.SeedSequence) -> Mappin
     """The default replication: one run of the cell, its summary row."""
     from cell.sim.simulation import simulate
 
-    return simulate(_assembled(scenario), seed=seed, keep_parts=False,
+    return simulate(assembled(scenario), seed=seed, keep_parts=False,
                     keep_belts=False).summary.as_dict()
 
 

@@ -354,7 +354,7 @@ def _check_point(scenario: Scenario, file: object) -> dict[str, float]:
 def comparison(a: Scenario, b: Scenario, labels: tuple[str, str], replications: int, seed: int,
                batch: int = 20) -> Sweep:
     """Two scenarios as a sweep of two points, varying the pseudo-key ``scenario`` (their
-    labels, which must differ: :func:`cell.cli.compare_command.labels`): ``a`` against ``b``
+    labels, which must differ: :func:`cell.cli.compare.labels`): ``a`` against ``b``
     (the baseline), with common random numbers."""
     la, lb = labels
     if la == lb:
@@ -366,3 +366,9 @@ def comparison(a: Scenario, b: Scenario, labels: tuple[str, str], replications: 
                  (pa, pb), replications, seed, min(batch, replications),
                  baseline=Baseline(b.controller.policy, (("scenario", lb),),
                                    text=lb))  # the report names the scenarios, not policies
+
+
+def comparison_sides(sweep: Sweep) -> tuple[tuple[str, Point], tuple[str, Point]]:
+    """(label, point) of A and of B, of a :func:`comparison`."""
+    (la, a), (lb, b) = ((dict(p.values)["scenario"], p) for p in sweep.points)
+    return (la, a), (lb, b)

@@ -6,7 +6,7 @@ Measured (CPU time, a task of one 20-part replication): writing its file took 5.
 reading it back for ``replications.csv`` 2.4 ms through pandas, 0.4 and 0.2 ms here; the
 whole overhead of a sweep point beyond its simulation (``cell bench``,
 ``sweep_overhead_ms_per_point``, CPU time) went from 17.7 ms to 2.7 ms with the devices of
-:mod:`cell.experiments.sweep.results` and :mod:`cell.reporting.experiment_data`.
+:mod:`cell.experiments.sweep.results` and :mod:`cell.reporting.experiment.data`.
 
 The typing follows pandas, column by column and file by file: a column of Python ints is
 written as integers, of floats (or floats and ints, or floats and None) as floats

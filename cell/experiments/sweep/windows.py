@@ -126,3 +126,34 @@ def window_warning(sweep: Sweep) -> str | None:
             f"over different windows ({what}{auto}): their {WINDOW_MEASURES_TEXT} are not "
             "comparable and are left out of differences.csv; compare the rates, or give the "
             "points the same window")
+
+
+def suggest_window(va: object, vb: object) -> str:
+    """A value valid for both (``--set`` sets it for both): the larger number, the fixed
+    warm-up when the other is ``auto``, or ``N`` (said to be a fixed number) when both are
+    ``auto``: no number is known before the runs, MSER-5 choosing one per run."""
+    numbers = [v for v in (va, vb) if isinstance(v, int)]
+    return str(max(numbers)) if numbers else "N"
+
+
+def comparison_window_warning(sweep: Sweep) -> str | None:
+    """``cell compare``'s :func:`window_warning`: one line if A's and B's counts and extremes
+    are over different windows, else None."""
+    from cell.experiments.sweep.spec import comparison_sides
+
+    (la, a), (lb, b) = comparison_sides(sweep)
+    differ = windows_apart(a.scenario, b.scenario)
+    if not differ:
+        return None
+    said = {"parts": "runs {} parts", "length": "runs {}", "warmup_parts": "has run.warmup_parts {}"}
+    what = "; ".join(f"{la} {said[k].format(va)}, {lb} {vb}" for k, va, vb in differ)
+    if any(AUTO in (va, vb) for _, va, vb in differ):
+        what += f" (auto: {AUTO_WHY}, so {la}'s and {lb}'s windows differ in length)"
+    sets = " ".join("--set run.hours=H" if k == "length" else  # H hours for both
+                    f"--set run.{k}={suggest_window(va, vb)}" for k, va, vb in differ)
+    if any(va == vb == AUTO for _, va, vb in differ):
+        sets += ", N a fixed number of parts"
+    if any(k == "length" for k, _, _ in differ):
+        sets += ", H the hours of both"
+    return (f"{what}: {WINDOW_MEASURES_TEXT} are not comparable; compare the rates, or give "
+            f"both the same window ({sets})")

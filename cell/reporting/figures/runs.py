@@ -25,7 +25,7 @@ from cell.reporting.figures.style import (
     save,
 )
 from cell.reporting.published import TABLE_7_1_CYCLES
-from cell.reporting.table_7_1 import fixed_cycle
+from cell.reporting.table_7_1.table import fixed_cycle
 from cell.scenario.schema import Scenario
 from cell.sim.policy_setup import nominal_cycle
 

@@ -20,7 +20,7 @@ CHECKED_UNDER = "robot"
 def _scenario_text(block: str, key: str) -> str | None:
     """A scenario's text holding ``block`` (a ``key:`` block), or None when this build has no
     section to hold it (a ``failures:`` section: then :func:`scenario_refuses` has nothing
-    to add to :func:`cell.experiments.fit_choice.unusable`)."""
+    to add to :func:`cell.experiments.fit.choice.unusable`)."""
     if key == "arrivals":
         return block
     from cell.scenario.schema import is_section

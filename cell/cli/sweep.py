@@ -97,19 +97,19 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
     from cell.experiments.sweep.checks import size_note
     from cell.experiments.sweep.outdir import check_out, check_owner, lock
     from cell.plumbing.output.paths import check_umask
+    from cell.reporting.experiment.text import first_tables
+    from cell.scenario.overrides import parse_sets
 
     check_umask(args.out)  # its folders could not be written in
     out = check_out(args.out)  # before the sweep file's points are built and checked
     _check_select(args)
     check_workers(args.workers, args.scheduler)
-    from cell.scenario.overrides import parse_sets
-
     sweep = load_sweep(args.sweep, parse_sets(args.sets))
     _check_select(args, sweep)  # what the sweep file decides: before anything runs or is written
     check_owner(sweep, out, args.resume)  # no results of another sweep, nor this one's, lost
     target = None
     if args.report:
-        from cell.reporting.experiment import plan_report
+        from cell.reporting.experiment.report import plan_report
 
         target = plan_report(sweep, args.report, results=args.out)  # before anything runs
     from cell.reporting.run_summary import nominal_warning
@@ -138,7 +138,7 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
           f"{reps} replications ({outcome.tasks_run} tasks run, "
           f"{outcome.tasks_reused} reused)")
     if target is not None:
-        from cell.reporting.experiment import write_report
+        from cell.reporting.experiment.report import write_report
         from cell.scenario import catalog
 
         command = f"cell sweep {shlex.quote(catalog.shown(sweep.source))} --report ..."
@@ -148,7 +148,7 @@ def _sweep(args: argparse.Namespace, stop: _Stop) -> int:
         shown = next((Path(p) for p in written if Path(p).name == "table_7_1.md"), None) or \
             next((Path(p) for p in written if Path(p).name == "report.md"), None)
         if shown is not None:
-            print(f"\n{headline(shown.read_text(encoding='utf-8'))}\n(all of it: {shown})")
+            print(f"\n{first_tables(shown.read_text(encoding='utf-8'))}\n(all of it: {shown})")
     if args.select_best:
         _select_best(args, sweep, outcome, out)
     return 0
@@ -193,21 +193,3 @@ def _select_best(args: argparse.Namespace, sweep: Any, outcome: Any, out: Path) 
     print("\n" + sentence(sel, labels, args.select_best) + "\n")
     print("\n".join(table(sel, labels, args.select_best)))
     print(f"wrote {out / 'selection.csv'}")
-
-
-def headline(markdown: str, tables: int = 3) -> str:
-    """The first ``tables`` tables of a report, each under its heading, for the terminal."""
-    out: list[str] = []
-    heading, shown = "", 0
-    lines = markdown.splitlines()
-    for i, line in enumerate(lines):
-        if line.startswith("## "):
-            heading = line[3:]
-        elif line.startswith("|") and (i == 0 or not lines[i - 1].startswith("|")):
-            if shown == tables:
-                break
-            out += ["", heading] if heading else [""]
-            shown += 1
-        if line.startswith("|"):
-            out.append(line)
-    return "\n".join(out).strip("\n")

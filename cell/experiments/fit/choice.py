@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import stats
 
-from cell.experiments.fit import Fit
+from cell.experiments.fit.mle import Fit
 from cell.scenario.arrivals import MAX_INTERARRIVAL_S
 
 #: A KS p-value below this rejects a fit (the p-value is optimistic, so this is lenient).

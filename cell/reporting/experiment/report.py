@@ -16,8 +16,8 @@ at all):
   ``ci_high``, ``p_value`` (:func:`cell.experiments.stats.paired_difference`);
 - ``report.md``: a table, a figure and the paired differences per headline
   measure (:mod:`cell.reporting.formatting`), and a reading drawn from the numbers
-  (:mod:`cell.reporting.experiment_text`);
-- ``fig_<measure>.png`` per headline measure (:mod:`cell.reporting.experiment_plots`);
+  (:mod:`cell.reporting.experiment.text`);
+- ``fig_<measure>.png`` per headline measure (:mod:`cell.reporting.experiment.plots`);
 - for a sweep laid out like Table 7.1, ``table_7_1.csv`` and ``table_7_1.md``
   (:mod:`cell.reporting.table_7_1`), linked from ``report.md``.
 
@@ -43,10 +43,10 @@ from cell.experiments.sweep import Sweep
 from cell.experiments.sweep.windows import window_warning
 from cell.plumbing.errors import CellError
 from cell.plumbing.output.atomic import OutputDir
-from cell.reporting.experiment_data import difference_table, measures, summary_table
-from cell.reporting.experiment_plots import figures
-from cell.reporting.experiment_text import markdown
-from cell.reporting.table_7_1 import is_table_7_1, table_7_1_files
+from cell.reporting.experiment.data import difference_table, measures, summary_table
+from cell.reporting.experiment.plots import figures
+from cell.reporting.experiment.text import markdown
+from cell.reporting.table_7_1.table import is_table_7_1, table_7_1_files
 
 REPORT_FILES = ("report.md", "summary.csv", "differences.csv", "fig_*.png")
 TABLE_7_1_FILES = ("table_7_1.csv", "table_7_1.md")

@@ -1,7 +1,7 @@
 """The column ``cell fit`` reads: a CSV's inter-arrival gaps, or arrival times made gaps.
 
 Every problem is one :class:`~cell.plumbing.errors.ScenarioError` line naming the file, the
-column (and the file's line) and the value as written; :mod:`cell.experiments.fit` fits what is read.
+column (and the file's line) and the value as written; :mod:`cell.experiments.fit.mle` fits what is read.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from cell.experiments.fit import MIN_VALUES
+from cell.experiments.fit.mle import MIN_VALUES
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.arrivals import MAX_INTERARRIVAL_S
 from cell.scenario.trace_file import cells_of, find_column, records

@@ -4,11 +4,11 @@ comparison (the policies against each other, and each against the named ``baseli
 each a difference with its interval; a difference whose interval holds 0 is in italics.
 Parts delivered has, beside each policy's column, that policy's ``of bound %`` (said in a
 line above the table): its runs'
-deliveries as a share of their bound (:data:`cell.reporting.experiment_data.BOUND_SHARE`),
+deliveries as a share of their bound (:data:`cell.reporting.experiment.data.BOUND_SHARE`),
 mean ± half-width over the replications.
 
 Every figure is one of ``summary.csv``'s or ``differences.csv``'s rows
-(:mod:`cell.reporting.experiment_data`); single runs' ranges stay in ``summary.csv``.
+(:mod:`cell.reporting.experiment.data`); single runs' ranges stay in ``summary.csv``.
 """
 
 from __future__ import annotations
@@ -20,8 +20,8 @@ from typing import Any
 import pandas as pd
 
 from cell.experiments.sweep.columns import NAME_SUFFIX
-from cell.reporting.experiment_data import BOUND_SHARE
-from cell.reporting.experiment_reading import against, show
+from cell.reporting.experiment.data import BOUND_SHARE
+from cell.reporting.experiment.reading import against, show
 from cell.reporting.formatting import Headline, half_width, number, plus_minus, table_head, table_row
 
 #: The summary column that says how loaded a point's robot is (its fastest cycle over the

@@ -1,5 +1,5 @@
 """The numbers of an experiment's report: ``summary.csv`` and ``differences.csv``
-(:mod:`cell.reporting.experiment`), from a sweep's ``replications.csv``.
+(:mod:`cell.reporting.experiment.report`), from a sweep's ``replications.csv``.
 
 Every interval comes from :mod:`cell.experiments.stats` (Student t, scipy.stats):
 :func:`~cell.experiments.stats.summarise` per point, and
@@ -70,13 +70,6 @@ def with_bound_share(replications: pd.DataFrame) -> pd.DataFrame:
         share = np.where(bound > 0, 100.0 * replications["parts_delivered"].to_numpy(float)
                          / bound, np.nan)
     return replications.assign(**{BOUND_SHARE: share})
-
-
-def runs_of(replications: pd.DataFrame, sweep: Sweep, i: int) -> pd.DataFrame:
-    """Point ``i``'s replications, in replication order."""
-    p = sweep.points[i]
-    rows = replications[(replications["policy"] == p.policy) & (replications["point"] == p.index)]
-    return rows.sort_values("replication")
 
 
 def grid_values(runs: pd.DataFrame, columns: Sequence[Column]) -> dict[str, object]:

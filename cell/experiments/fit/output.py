@@ -9,7 +9,7 @@ import textwrap
 from collections.abc import Callable, Sequence
 from typing import NamedTuple
 
-from cell.experiments.fit import Fit
+from cell.experiments.fit.mle import Fit
 
 
 class DataMoments(NamedTuple):

@@ -1,6 +1,6 @@
 """``report.md`` of an experiment: tables, paired differences and a reading
-(:mod:`cell.reporting.experiment_reading`), all drawn from ``summary.csv`` and
-``differences.csv`` (:mod:`cell.reporting.experiment`).
+(:mod:`cell.reporting.experiment.reading`), all drawn from ``summary.csv`` and
+``differences.csv`` (:mod:`cell.reporting.experiment.report`).
 
 Every interval printed is one of those tables' (Student t, scipy.stats via
 :mod:`cell.experiments.stats`); a measure that does not vary between replications
@@ -19,11 +19,12 @@ import pandas as pd
 from cell.experiments.stats import precision_reached, relative_half_width
 from cell.experiments.sweep import Sweep, grid_columns
 from cell.experiments.sweep.columns import NAME_SUFFIX
+from cell.experiments.sweep.results import runs_of
 from cell.experiments.sweep.windows import AUTO
-from cell.reporting.experiment_compact import baseline_words, compact_table
-from cell.reporting.experiment_data import run_counts, runs_of
-from cell.reporting.experiment_explain import reading
-from cell.reporting.experiment_reading import against, show, single_runs
+from cell.reporting.experiment.compact import baseline_words, compact_table
+from cell.reporting.experiment.data import run_counts
+from cell.reporting.experiment.explain import reading
+from cell.reporting.experiment.reading import against, show, single_runs
 from cell.reporting.formatting import (
     HEADLINES,
     Headline,
@@ -238,3 +239,22 @@ def _precision(replications: pd.DataFrame, summary: pd.DataFrame, sweep: Sweep,
 
 
 __all__ = ["display_columns", "markdown", "reading", "sentence"]
+
+
+def first_tables(markdown: str, tables: int = 3) -> str:
+    """The first ``tables`` tables of a report, each under its heading, for the terminal
+    (``cell sweep`` prints them)."""
+    out: list[str] = []
+    heading, shown = "", 0
+    lines = markdown.splitlines()
+    for i, line in enumerate(lines):
+        if line.startswith("## "):
+            heading = line[3:]
+        elif line.startswith("|") and (i == 0 or not lines[i - 1].startswith("|")):
+            if shown == tables:
+                break
+            out += ["", heading] if heading else [""]
+            shown += 1
+        if line.startswith("|"):
+            out.append(line)
+    return "\n".join(out).strip("\n")

@@ -15,8 +15,8 @@ import pandas as pd
 
 from cell.experiments.sweep import Sweep
 from cell.experiments.sweep.columns import NAME_SUFFIX
-from cell.reporting.experiment_compact import comparison_name, load_column
-from cell.reporting.experiment_reading import _scatter, show, where
+from cell.reporting.experiment.compact import comparison_name, load_column
+from cell.reporting.experiment.reading import scatter, show, where
 from cell.reporting.formatting import Headline, decimals, half_width, number, plus_minus, too_few
 
 #: The counts of :data:`cell.sim.records.LIMIT_COUNTS` as the Reading names them.
@@ -247,7 +247,7 @@ def causes(summary: pd.DataFrame, cols: Sequence[str], policies: Sequence[str]) 
 def reading(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
             cols: Sequence[str], present: Sequence[Headline],
             whole: Collection[str] = ()) -> list[str]:
-    """What the tables do not say (:mod:`cell.reporting.experiment_explain`): per headline
+    """What the tables do not say (:mod:`cell.reporting.experiment.explain`): per headline
     measure its largest effects (with no comparison of it, each policy's trend along the
     key), where they depend on the point, where a policy does not
     move and why, and where single runs scatter so widely that the mean says little; then
@@ -263,7 +263,7 @@ def reading(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
         text = ["; ".join(said) + "." if said else ""]
         text += [s[:1].upper() + s[1:] + "." for s in unmoved(h, summary, policies)]
         text += [] if said else trend(h, summary, cols)
-        text += _scatter(h, summary, cols, h.column in whole)
+        text += scatter(h, summary, cols, h.column in whole)
         text = [t for t in text if t]
         if text:
             out.append(f"- **{h.title}.** " + " ".join(text))

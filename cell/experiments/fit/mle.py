@@ -2,14 +2,14 @@
 
 ``cell fit TRACE.csv [--column interarrival_s] [--times] [--out SCENARIO.yaml] [--figure F.png]``
 fits candidate ``scipy.stats`` families by maximum likelihood (:func:`fit_trace`: each under a
-time budget, a long trace on a subsample, :mod:`cell.experiments.fit_budget`), ranks them (by AIC,
+time budget, a long trace on a subsample, :mod:`cell.experiments.fit.budget`), ranks them (by AIC,
 or by the Kolmogorov-Smirnov distance), prints the table, and writes the best fit a scenario
-accepts (:func:`cell.experiments.fit_choice.choose`) as the ``arrivals:`` block of a scenario file
-(:mod:`cell.experiments.fit_output`), with a caution when the fit does not stand for the data, and
-a histogram of the data under the fitted densities (:mod:`cell.experiments.fit_figure`).  With
+accepts (:func:`cell.experiments.fit.choice.choose`) as the ``arrivals:`` block of a scenario file
+(:mod:`cell.experiments.fit.output`), with a caution when the fit does not stand for the data, and
+a histogram of the data under the fitted densities (:mod:`cell.experiments.fit.figure`).  With
 ``--times`` the column holds arrival times, and the gaps between them are fitted; gaps far out
-of the body of the data are flagged (:mod:`cell.experiments.fit_gaps`); times to failure or to
-repair, right-censored or not, are fitted by :mod:`cell.experiments.fit_censored`.
+of the body of the data are flagged (:mod:`cell.experiments.fit.gaps`); times to failure or to
+repair, right-censored or not, are fitted by :mod:`cell.experiments.fit.censored`.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, stats
 
-from cell.experiments.fit_budget import DEFAULT_BUDGET_S, OutOfTime, subsample, time_limit
+from cell.experiments.fit.budget import DEFAULT_BUDGET_S, OutOfTime, subsample, time_limit
 from cell.scenario.arrivals import param_names
 
 DEFAULT_FAMILIES: tuple[str, ...] = ("weibull_min", "gamma", "lognorm", "expon", "norm")
@@ -198,8 +198,8 @@ def fit_trace(values: ArrayLike, families: Sequence[str] = DEFAULT_FAMILIES,
     """Fit each family to ``values`` by maximum likelihood and rank them, best first.
 
     Each family's fit has ``budget_s`` seconds (:func:`fit_each`).  More than
-    :data:`~cell.experiments.fit_budget.MAX_FIT_VALUES` values are fitted on a seeded subsample
-    of them (:func:`~cell.experiments.fit_budget.subsample`): the fits, their likelihoods and KS
+    :data:`~cell.experiments.fit.budget.MAX_FIT_VALUES` values are fitted on a seeded subsample
+    of them (:func:`~cell.experiments.fit.budget.subsample`): the fits, their likelihoods and KS
     statistics are the subsample's.
 
     Weibull, gamma and lognormal get a free threshold (:func:`_fit_threshold`);
@@ -237,7 +237,7 @@ def rank(fits: Sequence[Fit], rank_by: str = "aic") -> list[Fit]:
 def fit_each(families: Sequence[str], fit_one: Callable[[str], Fit],
              budget_s: float | None = DEFAULT_BUDGET_S) -> list[Fit]:
     """``fit_one(family)`` for each family, each within ``budget_s`` seconds
-    (:func:`~cell.experiments.fit_budget.time_limit`); a family whose fit fails or overruns is
+    (:func:`~cell.experiments.fit.budget.time_limit`); a family whose fit fails or overruns is
     left out with a warning that says which and why.  ValueError for an unknown family, or
     when no family could be fitted."""
     for family in families:

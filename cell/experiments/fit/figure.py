@@ -11,8 +11,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cell.experiments.fit import Fit
-from cell.experiments.fit_gaps import fence
+from cell.experiments.fit.gaps import fence
+from cell.experiments.fit.mle import Fit
 
 
 def _canvas() -> tuple[Any, Any]:
@@ -26,7 +26,7 @@ def _canvas() -> tuple[Any, Any]:
 
 def body_range(x: NDArray[np.float64]) -> tuple[float, float]:
     """The axis's span: from the least value to the largest within Q3 + 3 IQR
-    (:func:`~cell.experiments.fit_gaps.fence`), 5 % of that span more on each side."""
+    (:func:`~cell.experiments.fit.gaps.fence`), 5 % of that span more on each side."""
     lo = float(x.min())
     hi = float(x[x <= fence(x)].max())
     pad = 0.05 * (hi - lo) if hi > lo else 0.05 * max(abs(lo), 1.0)

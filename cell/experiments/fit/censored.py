@@ -23,8 +23,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import stats
 
-from cell.experiments.fit import Fit, family_of, fit_each, moments_of, rank
-from cell.experiments.fit_budget import DEFAULT_BUDGET_S, subsample
+from cell.experiments.fit.budget import DEFAULT_BUDGET_S, subsample
+from cell.experiments.fit.mle import Fit, family_of, fit_each, moments_of, rank
 from cell.scenario.arrivals import param_names
 
 #: The families tried for times to failure or repair (each with loc held at 0).
@@ -74,7 +74,7 @@ def fit_lifetimes(values: ArrayLike, censored: ArrayLike | None = None,
     lower bound: the item was still working) by maximum likelihood with loc = 0, and rank
     them, best first (AIC counts the free parameters only; ``"ks"`` ranks by D).  Each
     within ``budget_s`` seconds; more than
-    :data:`~cell.experiments.fit_budget.MAX_FIT_VALUES` times on a seeded subsample."""
+    :data:`~cell.experiments.fit.budget.MAX_FIT_VALUES` times on a seeded subsample."""
     if rank_by not in ("aic", "ks"):
         raise ValueError(f"rank_by must be 'aic' or 'ks', got {rank_by!r}")
     x = np.asarray(values, dtype=float).ravel()

@@ -1,20 +1,20 @@
 """``cell fit TRACE.csv [--column interarrival_s] [--times] [--out SCENARIO.yaml]``: input modelling.
 
 Fits candidate scipy.stats distributions to observed inter-arrival times by maximum
-likelihood (:mod:`cell.experiments.fit`), each within a time budget, prints them ranked with
+likelihood (:mod:`cell.experiments.fit.mle`), each within a time budget, prints them ranked with
 their means and sds beside the data's, and writes the ``arrivals:`` block of the best one a
 scenario accepts (each candidate is validated as a scenario holding it:
-:mod:`cell.cli.fit_check`; of those, when the best misses the data's mean or sd, the one
-nearest them: :func:`~cell.experiments.fit_choice.choose`), with a histogram of the data and the
+:mod:`cell.experiments.fit.scenario_check`; of those, when the best misses the data's mean or sd, the one
+nearest them: :func:`~cell.experiments.fit.choice.choose`), with a histogram of the data and the
 fitted densities.  A fit that does not stand for the data
-(:func:`~cell.experiments.fit_choice.caution`) is said in a warning and in the block, which then
+(:func:`~cell.experiments.fit.choice.caution`) is said in a warning and in the block, which then
 points to replaying the data as a trace.  ``--times`` reads the column as arrival times and
 fits the gaps between them; gaps far out of the body of the data are flagged, and
 ``--max-gap S`` or ``--drop-outliers`` leaves them out.  ``--as time_to_failure`` (or
 ``time_to_repair``) fits times to failure or repair instead, right-censored where
-``--censored COLUMN`` says so (:mod:`cell.experiments.fit_censored`), and writes that block of
+``--censored COLUMN`` says so (:mod:`cell.experiments.fit.censored`), and writes that block of
 the ``failures:`` section.  A log of arrivals is first tested for a trend, a rate that changes
-with the time of day and correlated gaps (:mod:`cell.experiments.fit_pattern`); when the rate
+with the time of day and correlated gaps (:mod:`cell.experiments.fit.pattern`); when the rate
 changes, the block written is the rate profile the counts estimate with the base distribution
 fitted to the gaps in operational time (``--iid``: one iid fit, the tests' result beside it).
 """
@@ -22,14 +22,16 @@ fitted to the gaps in operational time (``--iid``: one iid fit, the tests' resul
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from cell.cli.fit_check import BLOCKS
-from cell.cli.fit_write import Data, fitted_block, in_operational_time, write
+from cell.cli.fit_options import families_option, pattern_options
+from cell.cli.fit_write import write
+from cell.experiments.fit.block import FitOptions, fitted_block
+from cell.experiments.fit.fitted_data import in_operational_time, read_data
+from cell.experiments.fit.scenario_check import BLOCKS
 from cell.plumbing.errors import ScenarioError
 
 HELP = "fit a distribution to observed inter-arrival times (or times to failure or repair); write its block"
@@ -127,115 +129,6 @@ def _outputs(args: argparse.Namespace, trace: Path) -> tuple[Path | None, Path |
     return out, figure
 
 
-def _seconds_option(value: float | None, option: str) -> None:
-    if value is not None and not (math.isfinite(value) and value > 0.0):
-        raise ScenarioError(option, option, value, "must be a number of seconds > 0")
-
-
-def _families(args: argparse.Namespace, lifetimes: bool) -> list[str]:
-    """The families to try (--families, or the defaults for the block), each checked; and the
-    options that go with --as, or not."""
-    from cell.experiments.fit import DEFAULT_FAMILIES, family_of
-    from cell.experiments.fit_censored import LIFETIME_FAMILIES
-
-    _seconds_option(args.max_gap, "--max-gap")
-    _seconds_option(args.budget, "--budget")
-    if args.censored is not None and not lifetimes:
-        raise ScenarioError("--censored", "--censored", args.censored,
-                            "censored times are times to failure or repair: give --as time_to_failure "
-                            "or --as time_to_repair")
-    if lifetimes and (args.max_gap is not None or args.drop_outliers):
-        option = "--max-gap" if args.max_gap is not None else "--drop-outliers"
-        raise ScenarioError(option, option, args.max_gap if args.max_gap is not None else True,
-                            "leaves out gaps between arrivals, not times to failure or repair")
-    if args.censored is not None and args.times:
-        raise ScenarioError("--censored", "--censored", args.censored,
-                            "with --times the times are differences of a log: none is censored")
-    default = LIFETIME_FAMILIES if lifetimes else DEFAULT_FAMILIES
-    chosen = args.families if args.families is not None else ",".join(default)
-    families = [f.strip() for f in str(chosen).split(",") if f.strip()]
-    for family in families or [""]:
-        try:
-            family_of(family)
-        except ValueError:
-            raise ScenarioError("--families", "--families", family,
-                                "not a continuous distribution in scipy.stats") from None
-    return families
-
-
-def _pattern_options(args: argparse.Namespace, lifetimes: bool) -> float | None:
-    """--period-h, --period-start (as hours) and --iid checked: a period of hours within a
-    scenario's bounds, a start HH:MM within the day, none with --as or --gaps (no log order)."""
-    from cell.scenario.sections import MAX_HOURS
-
-    given = [(o, v) for o, v in (("--period-h", args.period_h), ("--period-start", args.period_start),
-                                 ("--iid", args.iid or None)) if v is not None]
-    if given and (lifetimes or args.gaps):
-        option, value = given[0]
-        raise ScenarioError(option, option, value, "tests a log of arrivals in its order: not with "
-                            + ("--as" if lifetimes else "--gaps (sorted gaps have no order)"))
-    if args.period_h is not None and not (math.isfinite(args.period_h) and 0 < args.period_h <= MAX_HOURS):
-        raise ScenarioError("--period-h", "--period-h", args.period_h,
-                            f"must be a number of hours > 0, at most {MAX_HOURS:g}")
-    if args.period_start is None:
-        return None
-    text = str(args.period_start)
-    hh, sep, mm = text.partition(":")
-    if not (sep and hh.isdigit() and mm.isdigit() and len(mm) == 2 and int(hh) < 24 and int(mm) < 60):
-        raise ScenarioError("--period-start", "--period-start", text, "must be a clock time HH:MM, "
-                            "00:00 to 23:59")
-    return int(hh) + int(mm) / 60.0
-
-
-def _read(args: argparse.Namespace, trace: Path, lifetimes: bool) -> Data:
-    """The values to fit, from the trace, and the notes and warnings on them."""
-    from cell.experiments.fit import MIN_VALUES
-    from cell.experiments.fit_gaps import far_out, fence, flag, flagged, leave_out
-    from cell.experiments.fit_input import first_clock_h, read_column, read_lifetimes
-    from cell.scenario.arrivals import MAX_INTERARRIVAL_S
-
-    if lifetimes and not args.times:
-        values, censored = read_lifetimes(trace, args.column, args.censored)
-        cut = f", {int(censored.sum())} of them right-censored by {args.censored}" if args.censored else ""
-        count = f"{values.size} times{cut}"
-        return Data(values, censored if censored.any() else None, count, _subsampled(values.size, "times"))
-    values = read_column(trace, args.column, times=args.times, sorted_ok=args.gaps or lifetimes,
-                         most=math.inf if lifetimes else MAX_INTERARRIVAL_S)
-    ordered = None if lifetimes or args.gaps else values
-    first_h = first_clock_h(trace, args.column, args.times) if ordered is not None else 0.0
-    noun = "gaps" if args.times else "values"
-    count = f"{values.size} gaps between {values.size + 1} arrival times" if args.times else \
-        f"{values.size} values"
-    notes: list[str] = []
-    asked = args.max_gap is not None or args.drop_outliers
-    kept = None
-    if asked:
-        limit = args.max_gap if args.max_gap is not None else fence(values)
-        kept = values <= limit
-        how = f"--max-gap {args.max_gap:g}" if args.max_gap is not None else \
-            "--drop-outliers: beyond Q3 + 3 IQR"
-        values, left = leave_out(values, limit, how)
-        notes.append(left)
-        if values.size < MIN_VALUES:
-            option = "--max-gap" if args.max_gap is not None else "--drop-outliers"
-            raise ScenarioError(trace, option, limit,
-                                f"leaves {values.size} {noun}: at least {MIN_VALUES} are needed to fit")
-    tail = far_out(values)
-    said = flag(tail, noun) if flagged(tail) and not (lifetimes or asked) else ""
-    return Data(values, None, count, [n for n in notes if n] + _subsampled(values.size, noun), said,
-                ordered, kept, first_h)
-
-
-def _subsampled(n: int, noun: str) -> list[str]:
-    from cell.experiments.fit_budget import MAX_FIT_VALUES
-
-    if n <= MAX_FIT_VALUES:
-        return []
-    return [f"fitted to {MAX_FIT_VALUES:,} of the {n:,} {noun}, drawn at random with a fixed seed (the "
-            "same each time): the likelihoods, AIC and KS statistics are theirs; the data's mean and sd "
-            f"are all {n:,}'s"]
-
-
 def _replay(trace: Path, out: Path | None, column: str, times: bool) -> str:
     """How to replay the data themselves: the trace as it is, named from --out's directory,
     when its column is a run's (``interarrival_s``, gaps)."""
@@ -250,19 +143,22 @@ def main(args: argparse.Namespace) -> int:
     trace = Path(args.trace)
     out, figure = _outputs(args, trace)
     lifetimes = args.block != "arrivals"
-    families = _families(args, lifetimes)
-    start_h = _pattern_options(args, lifetimes)
-    data = _read(args, trace, lifetimes)
+    families = families_option(args, lifetimes)
+    start_h = pattern_options(args, lifetimes)
+    data = read_data(trace, args.column, lifetimes=lifetimes, times=args.times, gaps=args.gaps,
+                     censored_by=args.censored, max_gap=args.max_gap,
+                     drop_outliers=args.drop_outliers)
     replay = "" if lifetimes else _replay(trace, out, args.column, args.times)
     pattern = None
     if data.ordered is not None:
-        from cell.experiments.fit_pattern import find_pattern
+        from cell.experiments.fit.pattern import find_pattern
 
         pattern = find_pattern(data.ordered, data.first_h, args.period_h, start_h, data.kept)
         profile = pattern.profile()
         if pattern.by_time and not args.iid and profile is not None:
             data = in_operational_time(data, profile)
-    result = fitted_block(args, trace, out, data, families, replay, pattern)
+    options = FitOptions(args.block, args.column, args.rank_by, args.budget, bool(args.iid))
+    result = fitted_block(options, trace, out, data, families, replay, pattern)
     write(args, data, result, out, figure)
     if data.flag:
         print(f"cell: warning: {data.flag}", file=sys.stderr)

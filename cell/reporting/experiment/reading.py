@@ -1,6 +1,6 @@
 """The sentences of an experiment's report: who is ahead where and by how much, trends,
 and where single runs scatter so widely that the mean says little; with the small helpers
-that show a grid point's values (:mod:`cell.reporting.experiment_text` lays them out)."""
+that show a grid point's values (:mod:`cell.reporting.experiment.text` lays them out)."""
 
 from __future__ import annotations
 
@@ -44,7 +44,7 @@ def against(a: str, b: str, at: bool = True) -> str:
     return b
 
 
-def _scatter(h: Headline, summary: pd.DataFrame, cols: Sequence[str],
+def scatter(h: Headline, summary: pd.DataFrame, cols: Sequence[str],
              whole: bool = False) -> list[str]:
     """Points whose interval is wider than their mean: runs far apart, or a mean made
     by a few extreme runs (it lies outside the range of 95 % of them).  A count (``whole``)

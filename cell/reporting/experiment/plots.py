@@ -30,8 +30,8 @@ from matplotlib.figure import Figure
 
 from cell.experiments.sweep import Sweep, grid_columns
 from cell.experiments.sweep.columns import NAME_SUFFIX
-from cell.reporting.experiment_reading import show
-from cell.reporting.experiment_text import display_columns
+from cell.reporting.experiment.reading import show
+from cell.reporting.experiment.text import display_columns
 from cell.reporting.formatting import HEADLINES, Headline
 
 DPI = 110

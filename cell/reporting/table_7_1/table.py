@@ -1,7 +1,7 @@
 """Table 7.1 beside the thesis (thesis §7.2; docs/accounting.md): part of a sweep's report.
 
 For a sweep laid out like Table 7.1 (see :func:`is_table_7_1`), the report
-(:mod:`cell.reporting.experiment`, ``cell sweep ... --report DIR``) holds, beside its
+(:mod:`cell.reporting.experiment.report`, ``cell sweep ... --report DIR``) holds, beside its
 general files, the two that :func:`table_7_1_files` makes:
 
 - ``table_7_1.csv``: long form, one row per (policy, ideal cycle, accounting,
@@ -32,12 +32,12 @@ import numpy as np
 import pandas as pd
 
 from cell.experiments.stats import summarise
+from cell.experiments.sweep.results import runs_of
 from cell.plumbing.errors import CellError
 from cell.reporting import published
-from cell.reporting.experiment_data import runs_of
 from cell.reporting.formatting import half_width, table_head, table_row
 from cell.reporting.run_summary import is_thesis_cell
-from cell.reporting.table_7_1_reading import (
+from cell.reporting.table_7_1.sentences import (
     ACCOUNTINGS,
     LABELS,
     MEASURES,
