@@ -116,3 +116,16 @@ def test_the_bound_is_read_as_a_share():
     for policy in ("adaptive", "non-adaptive"):
         runs = reps[reps.policy == policy]
         assert share[policy] == pytest.approx(runs["parts_delivered"].sum() / 500.0 / len(runs))
+
+
+@pytest.mark.parametrize("given", [[], ["only-one.csv"], ["a.csv", "b", "c"]])
+def test_the_map_modules_refuse_a_wrong_count_of_arguments(given, monkeypatch, capsys):
+    """``python -m cell.reporting.maps.stress`` wants the replications file and the folder:
+    another count is one line and exit 2, never a traceback."""
+    from cell.reporting.maps import map_report
+
+    monkeypatch.setattr("sys.argv", ["stress", *given])
+    with pytest.raises(SystemExit) as stop:
+        map_report.command_line("cell.reporting.maps.stress", write, 2)
+    err = capsys.readouterr().err.splitlines()
+    assert stop.value.code == 2 and len(err) == 1 and f"given {len(given)}" in err[0]

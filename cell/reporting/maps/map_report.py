@@ -47,6 +47,10 @@ def command_line(module: str, make: Callable[..., Path], count: int) -> None:
     """``python -m MODULE ARG...``: make the report from the first ``count`` arguments."""
     from cell.plumbing.errors import CellError
 
+    if len(sys.argv) - 1 != count:  # e.g. the replications file and the report's folder
+        print(f"usage: python -m {module} {' '.join(f'ARG{i + 1}' for i in range(count))} "
+              f"(given {len(sys.argv) - 1})", file=sys.stderr)
+        sys.exit(2)
     try:
         print(f"wrote {make(*sys.argv[1:1 + count])}")
     except (CellError, OSError) as exc:  # bad input, or a replications file not there
