@@ -124,7 +124,8 @@ class SegmentWear:
     exposure is A_i u^(1−p) + B_i, A_i and B_i kept here for every i.
     """
 
-    __slots__ = ("timing", "_ub", "_a", "_b", "_q", "_seen", "_tbreak", "_tfix", "_lfree")
+    __slots__ = ("timing", "_ub", "_a", "_b", "_q", "_seen", "_tbreak", "_tfix", "_lfree",
+                 "_seen_interval")
 
     def __init__(self, timing: Segment, lengths_in: ArrayLike, min_times_s: ArrayLike,
                  steps: ArrayLike, rated_steps_s: ArrayLike, model: WearModel):
@@ -136,6 +137,7 @@ class SegmentWear:
         self.timing = timing
         self._q = 1.0 - p
         self._seen: tuple[float, list[float]] = (math.nan, [])
+        self._seen_interval = (math.nan, 0)
         # c_jk t^(1-p): zero for a joint that does not move, whatever p
         c = np.zeros_like(counts)
         moving = counts > 0
@@ -167,6 +169,16 @@ class SegmentWear:
             return list(self._b[i])
         x = u ** self._q
         return [a * x + b for a, b in zip(self._a[i], self._b[i])]
+
+    def interval(self, time_s: float) -> int:
+        """Which of the stretch's intervals of u ``time_s`` falls in (i: its first i moves
+        free, the rest at their floor), found as :meth:`at_time` finds it."""
+        seen = self._seen_interval
+        if seen[0] == time_s:
+            return seen[1]
+        j = bisect_left(self._tbreak, time_s)
+        self._seen_interval = (time_s, j)
+        return j
 
     def at_time(self, time_s: float) -> list[float]:
         """Exposure per joint of the stretch taking ``time_s`` (its motor floor at least): the
@@ -212,6 +224,11 @@ class CycleWear:
                         table.steps[rows[name]], rated[rows[name]], model)
             for name in STRETCHES)
         self._last: tuple[tuple[float, ...], list[float]] | None = None
+        # speed: docs/performance.md#wear-by-interval
+        self._by_interval: dict[tuple[int, ...], list[float]] | None = \
+            {} if model.exponent == 1.0 else None
+        """With p = 1 (life in steps) a stretch's A u^0 + B is A + B whatever its time within
+        an interval: a cycle's exposure, looked up by its stretches' intervals."""
 
     def of_times(self, times_s: Sequence[float]) -> list[float]:
         """Exposure per joint (5 floats) of one cycle whose stretches take ``times_s``
@@ -220,7 +237,18 @@ class CycleWear:
         last = self._last
         if last is not None and last[0] == key:
             return last[1]
-        e = [w.at_time(t) for w, t in zip(self.stretches, key, strict=True)]
-        out = [a + b + c + d + f + g for a, b, c, d, f, g in zip(*e)]
+        known = self._by_interval
+        if known is None:
+            out = self._computed(key)
+        else:
+            intervals = tuple(w.interval(t) for w, t in zip(self.stretches, key, strict=True))
+            hit = known.get(intervals)
+            if hit is None:
+                hit = known[intervals] = self._computed(key)
+            out = hit
         self._last = (key, out)
         return out
+
+    def _computed(self, times_s: tuple[float, ...]) -> list[float]:
+        e = [w.at_time(t) for w, t in zip(self.stretches, times_s, strict=True)]
+        return [a + b + c + d + f + g for a, b, c, d, f, g in zip(*e)]

@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 from scipy import stats
 
 from cell.arm.motors import max_rates
@@ -90,6 +92,26 @@ def test_r4_exposure_against_its_time_per_exponent(cell) -> None:
         assert ratio == pytest.approx((peak / nominal) ** (1 - p), rel=2e-3)
         if p != 1.0:
             assert (ratio < 1) == (p < 1)
+
+
+@settings(max_examples=60, deadline=None)
+@given(scales=st.lists(st.floats(1.0, 3.0), min_size=6, max_size=6),
+       nudge=st.floats(-1e-6, 1e-6))
+def test_life_in_steps_a_cycle_wears_its_steps_whatever_its_times(cell, scales, nudge) -> None:
+    """p = 1: a move's exposure is its steps over the rated steps, whatever its time, so every
+    cycle wears each motor the same (to rounding); and a cycle's exposure looked up by its
+    stretches' intervals (another cycle's in the same intervals) is, to the bit, the sum over
+    its stretches that it would compute."""
+    wear = CycleWear(cell.table, cell.timing, WearModel(exponent=1.0))
+    floor = [getattr(cell.timing, name).floor_s for name in STRETCHES]
+    times = [f * k for f, k in zip(floor, scales)]
+    other = [t * (1.0 + nudge) for t in times]
+    assume(all(w.interval(a) == w.interval(b)
+               for w, a, b in zip(wear.stretches, times, other)))
+    assert np.allclose(wear.of_times(times), wear.of_times(floor), rtol=1e-9, atol=0)
+    looked_up = wear.of_times(other)
+    summed = [sum(col) for col in zip(*(w.at_time(t) for w, t in zip(wear.stretches, other)))]
+    assert looked_up == summed
 
 
 def test_weibull_in_exposure_at_constant_stress_is_scipy_weibull_min() -> None:
