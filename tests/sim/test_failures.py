@@ -23,6 +23,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import stats
 
+from cell.bench.throughput import events_per_part
 from cell.scenario.schema import load_scenario
 from cell.sim.simulation import simulate
 
@@ -149,34 +150,15 @@ def test_failures_that_never_come_leave_every_part_as_without_failures(name):
     assert fast.summary.parts_delivered == legs.summary.parts_delivered
 
 
-def _events_per_part(s) -> float:
-    import simpy
-
-    count = 0
-    step = simpy.Environment.step
-
-    def counted(env: simpy.Environment) -> None:
-        nonlocal count
-        count += 1
-        step(env)
-
-    simpy.Environment.step = counted  # type: ignore[method-assign,assignment]
-    try:
-        r = simulate(s, keep_parts=False, keep_belts=False).summary
-    finally:
-        simpy.Environment.step = step  # type: ignore[method-assign]
-    return count / r.parts_arrived
-
-
 def test_a_stop_costs_nothing_while_nothing_stops():
     """Failure clocks (motor wear counted on the robot's) add no event to a cycle in which
     nothing fails: the SimPy events a part are those of the run without failures, within a
     few hundredths (the clocks' own and the few failures' events)."""
     wear = {"run.hours": 20.0, "wear.enabled": True}
-    plain = _events_per_part(load_scenario("baseline", wear))
+    plain = events_per_part(load_scenario("baseline", wear))
     f = {**NEVER, "robot": {"time_to_failure": expon(1e12),
                             "time_to_repair": expon(3600.0)}}
-    failing = _events_per_part(load_scenario("baseline", {**wear, "failures": f}))
+    failing = events_per_part(load_scenario("baseline", {**wear, "failures": f}))
     assert failing <= plain + 0.05, (failing, plain)
 
 
