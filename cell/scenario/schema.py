@@ -20,6 +20,7 @@ from typing import Any
 from pydantic import BaseModel, PrivateAttr, ValidationError
 
 from cell.plumbing.errors import ScenarioError
+from cell.scenario.energy_sections import EnergySettings  # noqa: F401 - the schema, re-exported
 from cell.scenario.failure_sections import (  # noqa: F401 - the schema, re-exported
     FailureSettings,
     WearSettings,
@@ -77,6 +78,9 @@ class Scenario(Section):
     sensor: SensorSettings = SensorSettings()
     quality: QualitySettings = QualitySettings()
     """Which parts OEE counts as good; absent: every part set down."""
+    energy: EnergySettings | None = None
+    """Power per state and the arm's motion energy (docs/usage.md, "Energy and cost"); absent:
+    no energy measured."""
 
     _source: str = PrivateAttr(default="<defaults>")
 
@@ -98,12 +102,13 @@ class Scenario(Section):
 
     def to_dict(self) -> dict[str, Any]:
         """Plain YAML-able data (tuples as lists); ``failures``, ``run.hours``,
-        ``arrivals.profile`` and a ``quality`` rule other than the default only when given (so a
+        ``arrivals.profile``, ``energy`` and a ``quality`` rule other than the default only when given (so a
         scenario without them reads as it did before they existed), and with ``run.hours`` no
         ``run.parts`` (the run's length is given one way)."""
         d = _plain(self.model_dump())
-        if d.get("failures") is None:
-            d.pop("failures", None)
+        for optional in ("failures", "energy"):
+            if d.get(optional) is None:
+                d.pop(optional, None)
         d["run"].pop("hours" if d["run"].get("hours") is None else "parts", None)
         if d["arrivals"].get("profile") is None:
             d["arrivals"].pop("profile", None)
@@ -262,6 +267,9 @@ def _cross_checks(s: Scenario, file: object) -> None:
         if lo > nom:
             raise ScenarioError(file, f"belts.{belt}_min_in_s", lo,
                                 f"must be at most belts.{belt}_nominal_in_s ({nom:g})")
+    if s.energy is not None and s.energy.arm == "dynamics" and not s.mintime.dynamics_file:
+        raise ScenarioError(file, "energy.arm", "dynamics", "needs the arm's dynamic model, "
+                            "and mintime.dynamics_file names none")
     from cell.scenario.arrivals import check_arrivals
 
     check_arrivals(s.arrivals, s.base_dir, file)
