@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from typing import Literal
 
+from cell.plumbing.errors import ScenarioError
 from cell.scenario.fields import Section
 from cell.scenario.sections import finite
 
@@ -86,3 +87,10 @@ class EnergySettings(Section):
         """The power (W) of ``equipment`` in ``state``."""
         value: float = getattr(getattr(self.power_w, equipment), state)
         return value
+
+
+def check_energy(energy: EnergySettings | None, dynamics_file: str | None, file: object) -> None:
+    """``arm: dynamics`` needs a dynamic model (``mintime.dynamics_file``)."""
+    if energy is not None and energy.arm == "dynamics" and not dynamics_file:
+        raise ScenarioError(file, "energy.arm", "dynamics", "needs the arm's dynamic model, "
+                            "and mintime.dynamics_file names none")

@@ -20,7 +20,7 @@ from typing import Any
 from pydantic import BaseModel, PrivateAttr, ValidationError
 
 from cell.plumbing.errors import ScenarioError
-from cell.scenario.energy_sections import EnergySettings  # noqa: F401 - the schema, re-exported
+from cell.scenario.energy_sections import EnergySettings, check_energy  # noqa: F401 - re-exported
 from cell.scenario.failure_sections import (  # noqa: F401 - the schema, re-exported
     FailureSettings,
     WearSettings,
@@ -176,6 +176,7 @@ def validate(raw: Any, file: object = "<dict>", source: str | None = None) -> Sc
         raise error_from_validation(exc, raw, file, Scenario) from None
     scenario._source = str(source if source is not None else file)
     _cross_checks(scenario, file)
+    check_energy(scenario.energy, scenario.mintime.dynamics_file, file)
     return scenario
 
 
@@ -267,9 +268,6 @@ def _cross_checks(s: Scenario, file: object) -> None:
         if lo > nom:
             raise ScenarioError(file, f"belts.{belt}_min_in_s", lo,
                                 f"must be at most belts.{belt}_nominal_in_s ({nom:g})")
-    if s.energy is not None and s.energy.arm == "dynamics" and not s.mintime.dynamics_file:
-        raise ScenarioError(file, "energy.arm", "dynamics", "needs the arm's dynamic model, "
-                            "and mintime.dynamics_file names none")
     from cell.scenario.arrivals import check_arrivals
 
     check_arrivals(s.arrivals, s.base_dir, file)

@@ -1,25 +1,20 @@
 """One record type per row of each output file, and the part in flight.
 
-* :class:`PartRecord`: a row of ``parts.csv``, one per arriving part, made once when
-  the part is done, from its :class:`Part`;
-* :class:`RunSummary`: the one row of ``summary.csv`` (and of a sweep's
-  ``replications.csv``, after the grid columns);
+* :class:`PartRecord`: a row of ``parts.csv``, one per arriving part, made once when the part is done;
+* :class:`RunSummary`: the one row of ``summary.csv`` (and of a sweep's ``replications.csv``);
 * :class:`BeltChange`: a row of ``belts.csv``, one per speed change of a belt.
 
-The fields, in order, *are* the columns; each field's docstring is its
-meaning (docs/usage.md's column tables are checked against them).
-
-One writer for each field.  A part travels through the processes as a :class:`Part`, whose
-slots are each written once, by the process that owns the event (the feeder its drop, the
-input conveyor its arrival at B, the controller its plan, the robot its lift-off, the output
-conveyor its set-down); its limits (:data:`LIMITS`) are bits the run's log collects.  The row
-(:class:`PartRecord`, immutable) is made from these once, by the run's log, when the part
-is done: whatever a column derives from (a regime time from the plan, ``picked`` and
-``missed`` from the limit bits, the thesis's columns from the accounting) is derived then,
-in one place.  A write-once record per part rather than an immutable record per event (as
-Ciw's): one object a part instead of four, and no row is made at all when nobody keeps or
-streams the rows (``make bench``'s case).  ``tests/sim/test_one_writer.py`` checks that
-each slot has its one writer.
+The fields, in order, *are* the columns; each field's docstring is its meaning (docs/usage.md's column
+tables are checked against them). One writer for each field. A part travels through the processes as a
+:class:`Part`, whose slots are each written once, by the process that owns the event (the feeder its
+drop, the input conveyor its arrival at B, the controller its plan, the robot its lift-off, the output
+conveyor its set-down); its limits (:data:`LIMITS`) are bits the run's log collects. The row
+(:class:`PartRecord`, immutable) is made from these once, by the run's log, when the part is done:
+whatever a column derives from (a regime time from the plan, ``picked`` and ``missed`` from the limit
+bits, the thesis's columns from the accounting) is derived then, in one place. A write-once record per
+part rather than an immutable record per event (as Ciw's): one object a part instead of four, and no row
+is made at all when nobody keeps or streams the rows (``make bench``'s case).
+``tests/sim/test_one_writer.py`` checks that each slot has its one writer.
 """
 
 from __future__ import annotations
@@ -335,11 +330,17 @@ class RunSummary:
     """The most parts any controller could deliver from the same arrivals with the same robot
     and belts (a bound: each part's window at B, picks a fastest cycle apart; cell.sim.bound)."""
 
+    energy_kwh: float | None = None
+    """The run's energy, kWh (only with an ``energy:`` section; docs/usage.md)."""
+    energy_per_good_part_wh: float | None = None
+    """``energy_kwh`` per good part (``quality.rule``; the whole run's), Wh."""
+
     def __getitem__(self, name: str) -> Any:
         return getattr(self, name)
 
     def as_dict(self) -> dict[str, Any]:
-        return {name: getattr(self, name) for name in SUMMARY_COLUMNS}
+        return {name: getattr(self, name) for name in SUMMARY_COLUMNS + [
+            c for c in OPTIONAL_COLUMNS if getattr(self, c) is not None]}
 
 
 @dataclass(slots=True, frozen=True)
@@ -392,7 +393,8 @@ def columns(record_type: type) -> list[str]:
 
 
 PART_COLUMNS = columns(PartRecord)
-SUMMARY_COLUMNS = columns(RunSummary)
+OPTIONAL_COLUMNS = ("energy_kwh", "energy_per_good_part_wh")  # only with their section given
+SUMMARY_COLUMNS = [c for c in columns(RunSummary) if c not in OPTIONAL_COLUMNS]
 BELT_COLUMNS = columns(BeltChange)
 STATE_COLUMNS = columns(StateSpan)
 STOP_COLUMNS = columns(Stop)

@@ -32,7 +32,7 @@ import numpy as np
 import simpy
 
 from cell.scenario.schema import Scenario
-from cell.sim import accounting, oee, wear_clock
+from cell.sim import accounting, oee, state_energy, wear_clock
 from cell.sim.assembly import AssembledCell, assemble
 from cell.sim.bound import parts_bound
 from cell.sim.failures import Downtime
@@ -281,6 +281,7 @@ def simulate(scenario: Scenario | AssembledCell,
     stops = downtime.all_stops(env.now) if downtime is not None else \
         wear_clock.stop_rows(wear, env.now)  # failures.csv's rows
     lines = oee.measure(summary, log.column, downtime, k.cycle_nom, env.now, stops, s.quality.rule)
+    lines = state_energy.measure(summary, s, lines, log.column, downtime, env.now, stops)
     summary.seed = _seed_value(seed)
     summary.input_speed_max_in_s = station.input.belt.max_speed_in_s
     summary.input_speed_min_in_s = station.input.belt.min_speed_in_s

@@ -8,6 +8,7 @@ import contextlib
 import io
 from pathlib import Path
 
+import pandas as pd
 import pytest
 import yaml
 
@@ -55,3 +56,70 @@ def test_a_scenario_without_energy_reads_and_dumps_as_before():
     from cell.scenario.schema import default_scenario
 
     assert "energy" not in default_scenario().to_dict()
+
+
+# --------------------------------------------------------------------------- state-based energy
+POWER = {"robot": {"busy": 130.0, "waiting": 41.0, "idle": 37.0, "down": 6.0,
+                   "maintenance": 9.0, "off_shift": 2.0},
+         "input_belt": {"running": 55.0, "down": 1.0, "off_shift": 0.0},
+         "output_belt": {"running": 65.0, "down": 2.0, "off_shift": 0.0},
+         "sensor": {"up": 3.5, "down": 0.5, "off_shift": 0.0}}
+FAILS = {"time_to_failure": {"distribution": "expon", "mean_h": 0.5},
+         "time_to_repair": {"distribution": "expon", "mean_s": 300}}
+SENSOR_FAILS = {**FAILS, "time_to_failure": {"distribution": "expon", "mean_h": 0.2},
+                "clock": "calendar"}
+
+
+@pytest.fixture(scope="module")
+def failing_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A two-hour run with the robot, both belts and the sensor failing, and maintenance."""
+    where = tmp_path_factory.mktemp("energy")
+    scenario = {"run": {"hours": 2.0}, "sensor": {"lookahead": "sensor"},
+                "energy": {"power_w": POWER},
+                "failures": {"robot": {**FAILS, "clock": "calendar"}, "input_belt": FAILS,
+                             "output_belt": FAILS, "sensor": SENSOR_FAILS,
+                             "maintenance": {"every_h": 0.75, "duration_min": 10}}}
+    path = where / "failing.yaml"
+    path.write_text(yaml.safe_dump(scenario))
+    code, err = run("run", str(path), "--out", str(where / "out"))
+    assert code == 0, err
+    return where / "out"
+
+
+def test_state_based_energy_is_the_sum_over_states_csv_of_power_times_duration(failing_run):
+    states = pd.read_csv(failing_run / "states.csv")
+    summary = pd.read_csv(failing_run / "summary.csv").iloc[0]
+    # the run visits the states whose power it is meant to count
+    seen = set(zip(states.equipment, states.state))
+    assert {("robot", "down"), ("robot", "maintenance"), ("robot", "busy"),
+            ("input_belt", "down"), ("output_belt", "down"), ("sensor", "down")} <= seen
+    joules = sum(POWER[e][s] * (b - a)
+                 for e, s, a, b in zip(states.equipment, states.state, states.from_s, states.to_s))
+    assert summary.energy_kwh * 3.6e6 == pytest.approx(joules, rel=1e-9)
+    parts = pd.read_csv(failing_run / "parts.csv")
+    good = int(parts.touchdown_s.notna().sum())  # quality.rule set_down: every part set down
+    assert summary.energy_per_good_part_wh == pytest.approx(joules / 3600 / good, rel=1e-9)
+
+
+def test_each_equipments_states_tile_the_run(failing_run):
+    states = pd.read_csv(failing_run / "states.csv")
+    end = pd.read_csv(failing_run / "summary.csv").sim_end_s.iloc[0]
+    assert set(states.equipment) == set(POWER)
+    for _, rows in states.groupby("equipment"):
+        assert rows.from_s.iloc[0] == 0.0 and rows.to_s.iloc[-1] == pytest.approx(end)
+        assert (rows.from_s.to_numpy()[1:] == rows.to_s.to_numpy()[:-1]).all()
+
+
+def test_without_energy_the_summary_has_its_columns_and_no_states_csv(tmp_path: Path):
+    from cell.sim.records import SUMMARY_COLUMNS
+
+    base = ("run", "baseline", "--set", "run.parts=40")
+    assert run(*base, "--out", str(tmp_path / "b"))[0] == 0
+    assert run(*base, "--set", "energy={arm: none}", "--out", str(tmp_path / "e"))[0] == 0
+    assert not (tmp_path / "b" / "states.csv").exists() and (tmp_path / "e" / "states.csv").exists()
+    plain = pd.read_csv(tmp_path / "b" / "summary.csv")
+    energy = pd.read_csv(tmp_path / "e" / "summary.csv")
+    assert list(plain.columns) == SUMMARY_COLUMNS
+    assert list(energy.columns) == [*SUMMARY_COLUMNS, "energy_kwh", "energy_per_good_part_wh"]
+    # the energy section measures; it does not change the run
+    pd.testing.assert_frame_equal(plain, energy[SUMMARY_COLUMNS])
