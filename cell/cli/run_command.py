@@ -72,7 +72,8 @@ def main(args: argparse.Namespace) -> int:
     with OutputDir(args.out, names) as out, \
             Progress(n, "cell run", "parts", enabled=n >= PROGRESS_FROM_PARTS) as progress:
         with out.open("parts.csv", newline="") as pf, out.open("belts.csv", newline="") as bf:
-            parts, belts = RowWriter(pf, PART_COLUMNS), RowWriter(bf, BELT_COLUMNS)
+            arm = scenario.energy is not None and scenario.energy.arm == "dynamics"  # energy_j
+            parts, belts = RowWriter(pf, PART_COLUMNS + ["energy_j"] * arm), RowWriter(bf, BELT_COLUMNS)
             result = simulate(cell, keep_parts=False, on_part=_on_part(parts, progress, n),
                               on_belt=belts.record, keep_belts=False)
             done = result.summary.parts_arrived if scenario.run.hours is not None else n

@@ -4,17 +4,16 @@
 * :class:`RunSummary`: the one row of ``summary.csv`` (and of a sweep's ``replications.csv``);
 * :class:`BeltChange`: a row of ``belts.csv``, one per speed change of a belt.
 
-The fields, in order, *are* the columns; each field's docstring is its meaning (docs/usage.md's column
-tables are checked against them). One writer for each field. A part travels through the processes as a
-:class:`Part`, whose slots are each written once, by the process that owns the event (the feeder its
-drop, the input conveyor its arrival at B, the controller its plan, the robot its lift-off, the output
-conveyor its set-down); its limits (:data:`LIMITS`) are bits the run's log collects. The row
-(:class:`PartRecord`, immutable) is made from these once, by the run's log, when the part is done:
-whatever a column derives from (a regime time from the plan, ``picked`` and ``missed`` from the limit
-bits, the thesis's columns from the accounting) is derived then, in one place. A write-once record per
-part rather than an immutable record per event (as Ciw's): one object a part instead of four, and no row
-is made at all when nobody keeps or streams the rows (``make bench``'s case).
-``tests/sim/test_one_writer.py`` checks that each slot has its one writer.
+The fields, in order, *are* the columns; each field's docstring is its meaning (docs/usage.md's column tables
+are checked against them). One writer for each field. A part travels through the processes as a
+:class:`Part`, whose slots are each written once, by the process that owns the event (the feeder its drop,
+the input conveyor its arrival at B, the controller its plan, the robot its lift-off, the output conveyor its
+set-down); its limits (:data:`LIMITS`) are bits the run's log collects. The row (:class:`PartRecord`,
+immutable) is made from these once, by the run's log, when the part is done: whatever a column derives from
+(a regime time from the plan, ``picked`` and ``missed`` from the limit bits, the thesis's columns from the
+accounting) is derived then, in one place. A write-once record per part rather than an immutable record per
+event (as Ciw's): one object a part instead of four, and no row is made at all when nobody keeps or streams
+the rows (``make bench``'s case). ``tests/sim/test_one_writer.py`` checks that each slot has its one writer.
 """
 
 from __future__ import annotations
@@ -70,8 +69,7 @@ LIMIT_COUNTS: dict[str, LimitCount] = {
     "input_floor": LimitCount("limit_input_floor",
                               "picks with the input belt at its floor (the part after each let go)"),
     "input_ceiling": LimitCount("limit_input_ceiling", "input belt at its ceiling (robot waited)"),
-    "input_tracking": LimitCount("limit_input_tracking",
-                                 "input belt held to the robot's tracking limit"),
+    "input_tracking": LimitCount("limit_input_tracking", "input belt held to the robot's tracking limit"),
     "output_floor": LimitCount("limit_output_floor", "output belt at its floor"),
     "output_ceiling": LimitCount("limit_output_ceiling", "output belt at its ceiling"),
     "held_at_feeder": LimitCount("parts_held", "held at the feeder (belt not clear)"),
@@ -155,6 +153,8 @@ class PartRecord(NamedTuple):
     """How long the feeder held the part back, the belt not having cleared a part's size."""
     limits: str = ""
     """The limits this part's cycle hit (names from :data:`LIMITS`, space-separated)."""
+    energy_j: float | None = None
+    """The arm's motion energy of this transfer, J, electrical (only with ``energy.arm: dynamics``)."""
 
 
 class Part:
@@ -392,7 +392,7 @@ def columns(record_type: type) -> list[str]:
     return list(named) if named is not None else [f.name for f in fields(record_type)]
 
 
-PART_COLUMNS = columns(PartRecord)
+PART_COLUMNS = columns(PartRecord)[:-1]  # energy_j: only with energy.arm: dynamics
 OPTIONAL_COLUMNS = ("energy_kwh", "energy_per_good_part_wh")  # only with their section given
 SUMMARY_COLUMNS = [c for c in columns(RunSummary) if c not in OPTIONAL_COLUMNS]
 BELT_COLUMNS = columns(BeltChange)

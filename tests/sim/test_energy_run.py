@@ -123,3 +123,44 @@ def test_without_energy_the_summary_has_its_columns_and_no_states_csv(tmp_path: 
     assert list(energy.columns) == [*SUMMARY_COLUMNS, "energy_kwh", "energy_per_good_part_wh"]
     # the energy section measures; it does not change the run
     pd.testing.assert_frame_equal(plain, energy[SUMMARY_COLUMNS])
+
+
+# --------------------------------------------------------------------------- the arm's own energy
+@pytest.fixture(scope="module")
+def arm_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A run with the arm's motion energy from its dynamic model, the robot failing."""
+    where = tmp_path_factory.mktemp("arm")
+    code, err = run("run", "baseline", "--set", "run.parts=120", "--set",
+                    f"energy={yaml.safe_dump({'power_w': POWER, 'arm': 'dynamics'}, width=1e9)}",
+                    "--set", f"failures={yaml.safe_dump({'robot': FAILS}, width=1e9)}",
+                    "--out", str(where))
+    assert code == 0, err
+    return where
+
+
+def test_with_arm_dynamics_the_arms_energy_replaces_the_busy_power(arm_run):
+    """The run's energy: every state's power × duration but the robot's busy rows, plus each
+    picked part's transfer energy (energy_j), all read from the run's own files."""
+    from cell.sim.records import PART_COLUMNS
+
+    states = pd.read_csv(arm_run / "states.csv")
+    parts = pd.read_csv(arm_run / "parts.csv")
+    summary = pd.read_csv(arm_run / "summary.csv").iloc[0]
+    assert list(parts.columns) == [*PART_COLUMNS, "energy_j"]
+    assert parts.energy_j[parts.picked].notna().all() and parts.energy_j[~parts.picked].isna().all()
+    flat = sum(POWER[e][s] * (b - a) for e, s, a, b in
+               zip(states.equipment, states.state, states.from_s, states.to_s)
+               if (e, s) != ("robot", "busy"))
+    assert summary.energy_kwh * 3.6e6 == pytest.approx(flat + parts.energy_j.sum(), rel=1e-9)
+
+
+def test_a_transfer_costs_at_least_the_drives_standing_draw_over_its_time(arm_run):
+    from cell.scenario.catalog import BUILT_IN
+    from cell.scenario.dynamics_file import load_dynamics
+
+    standing_w = load_dynamics(BUILT_IN / "microbot_dynamics.yaml").electrical.standing_w().sum()
+    parts = pd.read_csv(arm_run / "parts.csv")
+    picked = parts[parts.picked]
+    motion_s = picked[["r1_s", "r2_s", "r3_s", "r4_s"]].sum(axis=1)
+    extra = picked.energy_j - standing_w * motion_s  # the motion's own work, over the drives'
+    assert (extra > 0).all() and (extra < 0.05 * picked.energy_j).all()
