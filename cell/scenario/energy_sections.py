@@ -94,3 +94,39 @@ def check_energy(energy: EnergySettings | None, dynamics_file: str | None, file:
     if energy is not None and energy.arm == "dynamics" and not dynamics_file:
         raise ScenarioError(file, "energy.arm", "dynamics", "needs the arm's dynamic model, "
                             "and mintime.dynamics_file names none")
+
+
+# --------------------------------------------------------------------------- costs
+def money(default: float = 0.0) -> float:
+    """An amount of money (any currency, the same throughout): finite, not negative."""
+    result: float = finite(default, ge=0.0, le=1e12)
+    return result
+
+
+class OptionCosts(Section):
+    """The amortised cost per hour of the cell's options, each counted as the scenario has it."""
+
+    sensor: float = money()
+    """The look-ahead sensor (counted with ``sensor.lookahead: sensor``)."""
+    buffer_place: float = money()
+    """A buffer place (per place; the cell has none today)."""
+    robot: float = money()
+    """A robot (per robot; the cell has one)."""
+    adaptive_controller: float = money()
+    """The adaptive controller (counted with ``controller.policy: adaptive``)."""
+
+
+class CostSettings(Section):
+    """What the run costs (docs/usage.md, "Energy and cost"); absent: no cost measured."""
+
+    part_value: float = money()
+    """The value of a part lost (ridden off, or scrapped from the hand)."""
+    energy_per_kwh: float = money()
+    """The price of a kWh (the ``energy:`` section's energy; without one, none)."""
+    downtime_per_h: float = money()
+    """The cost of an hour the robot is down (failed or worn, a crew's wait included)."""
+    repair: float = money()
+    """The cost of a repair (each failure of any piece of equipment, a worn motor's included)."""
+    maintenance: float = money()
+    """The cost of a planned maintenance stop."""
+    options_per_h: OptionCosts = OptionCosts()

@@ -20,7 +20,11 @@ from typing import Any
 from pydantic import BaseModel, PrivateAttr, ValidationError
 
 from cell.plumbing.errors import ScenarioError
-from cell.scenario.energy_sections import EnergySettings, check_energy  # noqa: F401 - re-exported
+from cell.scenario.energy_sections import (  # noqa: F401 - the schema, re-exported
+    CostSettings,
+    EnergySettings,
+    check_energy,
+)
 from cell.scenario.failure_sections import (  # noqa: F401 - the schema, re-exported
     FailureSettings,
     WearSettings,
@@ -81,6 +85,9 @@ class Scenario(Section):
     energy: EnergySettings | None = None
     """Power per state and the arm's motion energy (docs/usage.md, "Energy and cost"); absent:
     no energy measured."""
+    costs: CostSettings | None = None
+    """Money: lost parts, energy, downtime, repairs, maintenance, options (docs/usage.md, "Energy
+    and cost"); absent: no cost measured."""
 
     _source: str = PrivateAttr(default="<defaults>")
 
@@ -102,11 +109,11 @@ class Scenario(Section):
 
     def to_dict(self) -> dict[str, Any]:
         """Plain YAML-able data (tuples as lists); ``failures``, ``run.hours``,
-        ``arrivals.profile``, ``energy`` and a ``quality`` rule other than the default only when given (so a
-        scenario without them reads as it did before they existed), and with ``run.hours`` no
-        ``run.parts`` (the run's length is given one way)."""
+        ``arrivals.profile``, ``energy``, ``costs`` and a ``quality`` rule other than the
+        default only when given (so a scenario without them reads as it did before they
+        existed), and with ``run.hours`` no ``run.parts`` (the run's length is given one way)."""
         d = _plain(self.model_dump())
-        for optional in ("failures", "energy"):
+        for optional in ("failures", "energy", "costs"):
             if d.get(optional) is None:
                 d.pop(optional, None)
         d["run"].pop("hours" if d["run"].get("hours") is None else "parts", None)

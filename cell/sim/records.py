@@ -94,8 +94,7 @@ LIMIT_NAMES: dict[int, str] = {}
 
 
 class PartRecord(NamedTuple):
-    """What happened to one part, from the feeder to the output belt (or the floor): a row
-    of parts.csv, made once, when the part is done (:class:`Part` holds it till then)."""
+    """What happened to one part, from the feeder to the output belt (or the floor): parts.csv's row."""
 
     part: int
     """1 … N, in order of arrival (the part's :attr:`Part.index` + 1)."""
@@ -160,12 +159,11 @@ class PartRecord(NamedTuple):
 class Part:
     """A part in flight, from the feeder to the output belt (or the floor).
 
-    Each slot is written once, by its owner (see the module's text): ``index`` (0 … N − 1,
-    the one numbering of parts inside the model; parts.csv's ``part`` is ``index + 1``),
-    ``arrival_s`` and ``feed_delay_s`` by the feeder, ``at_bot_s`` by the input conveyor,
-    ``plan`` (the policy's :class:`~cell.sim.policies.base.Plan`, or None: not picked) by the
-    controller, ``pick_s`` by the robot, ``touchdown_s``, ``spacing_in`` and
-    ``delivery_interval_s`` by the output conveyor.
+    Each slot is written once, by its owner (see the module's text): ``index`` (0 … N − 1, the one
+    numbering of parts inside the model; parts.csv's ``part`` is ``index + 1``), ``arrival_s`` and
+    ``feed_delay_s`` by the feeder, ``at_bot_s`` by the input conveyor, ``plan`` (the policy's
+    :class:`~cell.sim.policies.base.Plan`, or None: not picked) by the controller, ``pick_s`` by the
+    robot, ``touchdown_s``, ``spacing_in`` and ``delivery_interval_s`` by the output conveyor.
     """
 
     __slots__ = ("index", "arrival_s", "feed_delay_s", "at_bot_s", "plan", "pick_s",
@@ -173,8 +171,7 @@ class Part:
 
     def __init__(self, index: int, arrival_s: float, feed_delay_s: float = 0.0):
         self.index, self.arrival_s, self.feed_delay_s = index, arrival_s, feed_delay_s
-        self.at_bot_s = self.pick_s = self.touchdown_s = self.spacing_in = \
-            self.delivery_interval_s = NAN
+        self.at_bot_s = self.pick_s = self.touchdown_s = self.spacing_in = self.delivery_interval_s = NAN
         self.plan: Any = None
 
 
@@ -334,6 +331,10 @@ class RunSummary:
     """The run's energy, kWh (only with an ``energy:`` section; docs/usage.md)."""
     energy_per_good_part_wh: float | None = None
     """``energy_kwh`` per good part (``quality.rule``; the whole run's), Wh."""
+    cost_per_good_part: float | None = None
+    """The run's cost per good part (only with a ``costs:`` section; docs/usage.md)."""
+    cost_per_h: float | None = None
+    """The run's cost per hour of the run (only with a ``costs:`` section)."""
 
     def __getitem__(self, name: str) -> Any:
         return getattr(self, name)
@@ -362,8 +363,7 @@ class StateSpan:
     equipment: str
     """``robot``, ``input_belt``, ``output_belt`` or ``sensor``."""
     state: str
-    """robot: busy / waiting / idle / down / maintenance; belts: running / stopped / down;
-    sensor: up / down."""
+    """robot: busy / waiting / idle / down / maintenance; belts: running / down; sensor: up / down."""
     from_s: float
     """When the state began."""
     to_s: float
@@ -393,8 +393,8 @@ def columns(record_type: type) -> list[str]:
 
 
 PART_COLUMNS = columns(PartRecord)[:-1]  # energy_j: only with energy.arm: dynamics
-OPTIONAL_COLUMNS = ("energy_kwh", "energy_per_good_part_wh")  # only with their section given
-SUMMARY_COLUMNS = [c for c in columns(RunSummary) if c not in OPTIONAL_COLUMNS]
+OPTIONAL_COLUMNS = ("energy_kwh", "energy_per_good_part_wh", "cost_per_good_part", "cost_per_h")
+SUMMARY_COLUMNS = [c for c in columns(RunSummary) if c not in OPTIONAL_COLUMNS]  # those: with sections
 BELT_COLUMNS = columns(BeltChange)
 STATE_COLUMNS = columns(StateSpan)
 STOP_COLUMNS = columns(Stop)

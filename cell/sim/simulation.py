@@ -32,7 +32,7 @@ import numpy as np
 import simpy
 
 from cell.scenario.schema import Scenario
-from cell.sim import accounting, oee, state_energy, wear_clock
+from cell.sim import accounting, oee, run_cost, state_energy, wear_clock
 from cell.sim.assembly import AssembledCell, assemble
 from cell.sim.bound import parts_bound
 from cell.sim.failures import Downtime
@@ -287,6 +287,7 @@ def simulate(scenario: Scenario | AssembledCell,
         wear_clock.stop_rows(wear, env.now)  # failures.csv's rows
     lines = oee.measure(summary, log.column, downtime, k.cycle_nom, env.now, stops, s.quality.rule)
     lines = state_energy.measure(summary, s, lines, log, downtime, env.now, stops)
+    run_cost.measure(summary, s, stops, log.column)
     summary.seed = _seed_value(seed)
     summary.input_speed_max_in_s = station.input.belt.max_speed_in_s
     summary.input_speed_min_in_s = station.input.belt.min_speed_in_s

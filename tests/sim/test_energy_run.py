@@ -164,3 +164,68 @@ def test_a_transfer_costs_at_least_the_drives_standing_draw_over_its_time(arm_ru
     motion_s = picked[["r1_s", "r2_s", "r3_s", "r4_s"]].sum(axis=1)
     extra = picked.energy_j - standing_w * motion_s  # the motion's own work, over the drives'
     assert (extra > 0).all() and (extra < 0.05 * picked.energy_j).all()
+
+
+# --------------------------------------------------------------------------- costs
+COSTS = {"part_value": 12.0, "energy_per_kwh": 0.2, "downtime_per_h": 300.0, "repair": 150.0,
+         "maintenance": 80.0, "options_per_h": {"sensor": 0.4, "buffer_place": 0.1, "robot": 6.0,
+                                                "adaptive_controller": 0.5}}
+
+
+@pytest.fixture(scope="module")
+def costed_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The failing run of :func:`failing_run`, with costs and the spacing quality rule."""
+    where = tmp_path_factory.mktemp("costs")
+    scenario = {"run": {"hours": 2.0}, "sensor": {"lookahead": "sensor"},
+                "quality": {"rule": "spacing"}, "energy": {"power_w": POWER}, "costs": COSTS,
+                "failures": {"robot": {**FAILS, "clock": "calendar", "part_in_hand": "scrap"},
+                             "input_belt": FAILS, "output_belt": FAILS, "sensor": SENSOR_FAILS,
+                             "maintenance": {"every_h": 0.75, "duration_min": 10}}}
+    path = where / "costed.yaml"
+    path.write_text(yaml.safe_dump(scenario))
+    code, err = run("run", str(path), "--out", str(where / "out"))
+    assert code == 0, err
+    return where / "out"
+
+
+def test_the_cost_is_the_hand_computation_from_the_runs_files(costed_run):
+    parts = pd.read_csv(costed_run / "parts.csv", keep_default_na=False, na_values=[""])
+    states = pd.read_csv(costed_run / "states.csv")
+    stops = pd.read_csv(costed_run / "failures.csv")
+    summary = pd.read_csv(costed_run / "summary.csv").iloc[0]
+    hours = summary.sim_end_s / 3600
+    limits = parts.limits.fillna("").str.split()
+    scrapped = limits.map(lambda names: "scrapped" in names)
+    lost = int(parts.missed.sum()) + int(scrapped.sum())
+    assert scrapped.any() and parts.missed.any()
+    down = states[(states.equipment == "robot") & (states.state == "down")]
+    down_h = float((down.to_s - down.from_s).sum()) / 3600
+    maintenance = int((stops.cause == "maintenance").sum())
+    repairs = len(stops) - maintenance
+    assert maintenance > 0 and repairs > 0
+    options = 6.0 + 0.4 + 0.5  # one robot, the sensor (lookahead: sensor), the adaptive controller
+    cost = (lost * 12.0 + summary.energy_kwh * 0.2 + down_h * 300.0 + repairs * 150.0
+            + maintenance * 80.0 + options * hours)
+    off_spacing = limits.map(lambda names: "spacing_off" in names)
+    good = int((parts.touchdown_s.notna() & ~off_spacing).sum())  # quality.rule: spacing
+    assert summary.cost_per_h == pytest.approx(cost / hours, rel=1e-9)
+    assert summary.cost_per_good_part == pytest.approx(cost / good, rel=1e-9)
+
+
+@pytest.mark.parametrize(("key", "value"), [
+    ("costs.part_value", -1), ("costs.energy_per_kwh", -0.2),
+    ("costs.options_per_h.sensor", -0.4), ("costs.options_per_h.conveyor", 1.0)])
+def test_bad_costs_name_file_key_and_value(tmp_path: Path, key, value):
+    section: dict = {}
+    where = section
+    *path, last = key.split(".")[1:]
+    for name in path:
+        where = where.setdefault(name, {})
+    where[last] = value
+    scenario_file = tmp_path / "bad.yaml"
+    scenario_file.write_text(yaml.safe_dump({"costs": section, "run": {"parts": 20}}))
+    code, err = run("run", str(scenario_file), "--out", str(tmp_path / "out"))
+    line = err.strip()
+    assert code == 2 and "\n" not in line
+    assert str(scenario_file) in line and key in line and str(value) in line
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
