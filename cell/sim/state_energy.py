@@ -17,7 +17,6 @@ from typing import Any
 
 import numpy as np
 
-from cell.arm.steptable import SEGMENTS
 from cell.scenario.energy_sections import EnergySettings
 from cell.sim import oee
 from cell.sim.records import RunSummary
@@ -41,15 +40,15 @@ class ArmTransfers:
     stretch times), summed as the run goes.  A call costs 0.2-0.5 ms; a fixed-cycle robot
     repeats its times, so each set of six is computed once."""
 
-    def __init__(self, arm: Any):
-        self.arm, self.total_j = arm, 0.0
+    def __init__(self, arm: Any, segments: Sequence[str]):
+        self.arm, self.segments, self.total_j = arm, tuple(segments), 0.0
         self.known: dict[tuple[float, ...], float] = {}
 
     def __call__(self, plan: Any) -> float:
         times = (plan.r1_pre, plan.r1_post, plan.r2, plan.r3_pre, plan.r3_post, plan.r4)
         joules = self.known.get(times)
         if joules is None:
-            joules = self.known[times] = self.arm.transfer(dict(zip(SEGMENTS, times))).electrical_j
+            joules = self.known[times] = self.arm.transfer(dict(zip(self.segments, times))).electrical_j
         self.total_j += joules
         return joules
 
@@ -60,6 +59,7 @@ def arm_energy_of(cell: Any) -> ArmTransfers | None:
     if s.energy is None or s.energy.arm != "dynamics":
         return None
     from cell.arm.energy import ArmEnergy, planned_legs
+    from cell.arm.steptable import SEGMENTS
     from cell.scenario.dynamics_file import load_dynamics
     from cell.sim.scenario_values import dynamics_path, geometry_of, motors_of, planner_bounds
 
@@ -72,7 +72,7 @@ def arm_energy_of(cell: Any) -> ArmTransfers | None:
 
         results = plan_regimes(geometry, motors_of(s), planner_bounds(s))
         planned = planned_legs(table, model, geometry, results)
-    return ArmTransfers(ArmEnergy.build(table, model, geometry, planned))
+    return ArmTransfers(ArmEnergy.build(table, model, geometry, planned), SEGMENTS)
 
 
 def timelines(scenario: Any, lines: Timelines, column: Callable[[str], np.ndarray],
