@@ -53,7 +53,7 @@ def main(args: argparse.Namespace) -> int:
     from cell.scenario.run_length import expected_parts
     from cell.scenario.schema import inert_settings
     from cell.sim.assembly import assemble
-    from cell.sim.records import BELT_COLUMNS, PART_COLUMNS, SUMMARY_COLUMNS
+    from cell.sim.records import BELT_COLUMNS, PART_COLUMNS
     from cell.sim.simulation import simulate
 
     names = RUN_FILES + FAILURE_FILES + PARQUET_FILES
@@ -72,16 +72,17 @@ def main(args: argparse.Namespace) -> int:
     with OutputDir(args.out, names) as out, \
             Progress(n, "cell run", "parts", enabled=n >= PROGRESS_FROM_PARTS) as progress:
         with out.open("parts.csv", newline="") as pf, out.open("belts.csv", newline="") as bf:
-            parts, belts = RowWriter(pf, PART_COLUMNS), RowWriter(bf, BELT_COLUMNS)
+            arm = scenario.energy is not None and scenario.energy.arm == "dynamics"  # energy_j
+            parts, belts = RowWriter(pf, PART_COLUMNS + ["energy_j"] * arm), RowWriter(bf, BELT_COLUMNS)
             result = simulate(cell, keep_parts=False, on_part=_on_part(parts, progress, n),
                               on_belt=belts.record, keep_belts=False)
             done = result.summary.parts_arrived if scenario.run.hours is not None else n
             progress.grow(done - progress.total)
             progress.update(done - progress.n)
         with out.open("summary.csv", newline="") as sf:
-            RowWriter(sf, SUMMARY_COLUMNS).record(result.summary)
-        if _stops_anything(scenario):
-            _write_failures(out, result)
+            RowWriter(sf, list(result.summary.as_dict())).record(result.summary)
+        if _stops_anything(scenario) or scenario.energy is not None:  # states.csv with energy
+            _write_failures(out, result, _stops_anything(scenario))
         if args.format == "parquet":
             _as_parquet(out)
     _report(args, scenario, result, out.target)
@@ -121,7 +122,8 @@ def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) ->
           f"load (fastest cycle / mean inter-arrival) {r.offered_load:.3f}")
     written = RUN_FILES if args.format == "csv" else PARQUET_FILES
     if not _stops_anything(scenario):
-        print(f"wrote {shown}/{written[0]}, {written[1]} and {written[2]}")
+        also = ", states.csv" if scenario.energy is not None else ""  # energy: its states
+        print(f"wrote {shown}/{written[0]}, {written[1]}{also} and {written[2]}")
         return
     print(stops_line(r, scenario.failures))
     print(f"wrote {shown}/{written[0]}, {written[1]}, {written[2]}, states.csv and failures.csv")
@@ -132,8 +134,8 @@ def _stops_anything(scenario: Any) -> bool:
     return scenario.failures is not None or scenario.wear.enabled
 
 
-def _write_failures(out: Any, result: Any) -> None:
-    """states.csv and failures.csv of a run with failures or wear."""
+def _write_failures(out: Any, result: Any, stops: bool = True) -> None:
+    """states.csv, and failures.csv of a run with failures or wear (``stops``)."""
     from cell.plumbing.csvfile import RowWriter
     from cell.sim.records import STATE_COLUMNS, STOP_COLUMNS
 
@@ -141,6 +143,8 @@ def _write_failures(out: Any, result: Any) -> None:
         write = RowWriter(f, STATE_COLUMNS).record
         for span in result.state_spans():
             write(span)
+    if not stops:
+        return
     with out.open("failures.csv", newline="") as f:
         write = RowWriter(f, STOP_COLUMNS).record
         for stop in result.stops():

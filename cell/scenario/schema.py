@@ -20,6 +20,11 @@ from typing import Any
 from pydantic import BaseModel, PrivateAttr, ValidationError
 
 from cell.plumbing.errors import ScenarioError
+from cell.scenario.energy_sections import (  # noqa: F401 - the schema, re-exported
+    CostSettings,
+    EnergySettings,
+    check_energy,
+)
 from cell.scenario.failure_sections import (  # noqa: F401 - the schema, re-exported
     FailureSettings,
     WearSettings,
@@ -77,6 +82,12 @@ class Scenario(Section):
     sensor: SensorSettings = SensorSettings()
     quality: QualitySettings = QualitySettings()
     """Which parts OEE counts as good; absent: every part set down."""
+    energy: EnergySettings | None = None
+    """Power per state and the arm's motion energy (docs/usage.md, "Energy and cost"); absent:
+    no energy measured."""
+    costs: CostSettings | None = None
+    """Money: lost parts, energy, downtime, repairs, maintenance, options (docs/usage.md, "Energy
+    and cost"); absent: no cost measured."""
 
     _source: str = PrivateAttr(default="<defaults>")
 
@@ -98,12 +109,13 @@ class Scenario(Section):
 
     def to_dict(self) -> dict[str, Any]:
         """Plain YAML-able data (tuples as lists); ``failures``, ``run.hours``,
-        ``arrivals.profile`` and a ``quality`` rule other than the default only when given (so a
-        scenario without them reads as it did before they existed), and with ``run.hours`` no
-        ``run.parts`` (the run's length is given one way)."""
+        ``arrivals.profile``, ``energy``, ``costs`` and a ``quality`` rule other than the
+        default only when given (so a scenario without them reads as it did before they
+        existed), and with ``run.hours`` no ``run.parts`` (the run's length is given one way)."""
         d = _plain(self.model_dump())
-        if d.get("failures") is None:
-            d.pop("failures", None)
+        for optional in ("failures", "energy", "costs"):
+            if d.get(optional) is None:
+                d.pop(optional, None)
         d["run"].pop("hours" if d["run"].get("hours") is None else "parts", None)
         if d["arrivals"].get("profile") is None:
             d["arrivals"].pop("profile", None)
@@ -171,6 +183,7 @@ def validate(raw: Any, file: object = "<dict>", source: str | None = None) -> Sc
         raise error_from_validation(exc, raw, file, Scenario) from None
     scenario._source = str(source if source is not None else file)
     _cross_checks(scenario, file)
+    check_energy(scenario.energy, scenario.mintime.dynamics_file, file)
     return scenario
 
 

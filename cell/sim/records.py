@@ -1,25 +1,19 @@
 """One record type per row of each output file, and the part in flight.
 
-* :class:`PartRecord`: a row of ``parts.csv``, one per arriving part, made once when
-  the part is done, from its :class:`Part`;
-* :class:`RunSummary`: the one row of ``summary.csv`` (and of a sweep's
-  ``replications.csv``, after the grid columns);
+* :class:`PartRecord`: a row of ``parts.csv``, one per arriving part, made once when the part is done;
+* :class:`RunSummary`: the one row of ``summary.csv`` (and of a sweep's ``replications.csv``);
 * :class:`BeltChange`: a row of ``belts.csv``, one per speed change of a belt.
 
-The fields, in order, *are* the columns; each field's docstring is its
-meaning (docs/usage.md's column tables are checked against them).
-
-One writer for each field.  A part travels through the processes as a :class:`Part`, whose
-slots are each written once, by the process that owns the event (the feeder its drop, the
-input conveyor its arrival at B, the controller its plan, the robot its lift-off, the output
-conveyor its set-down); its limits (:data:`LIMITS`) are bits the run's log collects.  The row
-(:class:`PartRecord`, immutable) is made from these once, by the run's log, when the part
-is done: whatever a column derives from (a regime time from the plan, ``picked`` and
-``missed`` from the limit bits, the thesis's columns from the accounting) is derived then,
-in one place.  A write-once record per part rather than an immutable record per event (as
-Ciw's): one object a part instead of four, and no row is made at all when nobody keeps or
-streams the rows (``make bench``'s case).  ``tests/sim/test_one_writer.py`` checks that
-each slot has its one writer.
+The fields, in order, *are* the columns; each field's docstring is its meaning (docs/usage.md's column tables
+are checked against them). One writer for each field. A part travels through the processes as a
+:class:`Part`, whose slots are each written once, by the process that owns the event (the feeder its drop,
+the input conveyor its arrival at B, the controller its plan, the robot its lift-off, the output conveyor its
+set-down); its limits (:data:`LIMITS`) are bits the run's log collects. The row (:class:`PartRecord`,
+immutable) is made from these once, by the run's log, when the part is done: whatever a column derives from
+(a regime time from the plan, ``picked`` and ``missed`` from the limit bits, the thesis's columns from the
+accounting) is derived then, in one place. A write-once record per part rather than an immutable record per
+event (as Ciw's): one object a part instead of four, and no row is made at all when nobody keeps or streams
+the rows (``make bench``'s case). ``tests/sim/test_one_writer.py`` checks that each slot has its one writer.
 """
 
 from __future__ import annotations
@@ -75,8 +69,7 @@ LIMIT_COUNTS: dict[str, LimitCount] = {
     "input_floor": LimitCount("limit_input_floor",
                               "picks with the input belt at its floor (the part after each let go)"),
     "input_ceiling": LimitCount("limit_input_ceiling", "input belt at its ceiling (robot waited)"),
-    "input_tracking": LimitCount("limit_input_tracking",
-                                 "input belt held to the robot's tracking limit"),
+    "input_tracking": LimitCount("limit_input_tracking", "input belt held to the robot's tracking limit"),
     "output_floor": LimitCount("limit_output_floor", "output belt at its floor"),
     "output_ceiling": LimitCount("limit_output_ceiling", "output belt at its ceiling"),
     "held_at_feeder": LimitCount("parts_held", "held at the feeder (belt not clear)"),
@@ -101,8 +94,7 @@ LIMIT_NAMES: dict[int, str] = {}
 
 
 class PartRecord(NamedTuple):
-    """What happened to one part, from the feeder to the output belt (or the floor): a row
-    of parts.csv, made once, when the part is done (:class:`Part` holds it till then)."""
+    """What happened to one part, from the feeder to the output belt (or the floor): parts.csv's row."""
 
     part: int
     """1 … N, in order of arrival (the part's :attr:`Part.index` + 1)."""
@@ -160,17 +152,18 @@ class PartRecord(NamedTuple):
     """How long the feeder held the part back, the belt not having cleared a part's size."""
     limits: str = ""
     """The limits this part's cycle hit (names from :data:`LIMITS`, space-separated)."""
+    energy_j: float | None = None
+    """The arm's motion energy of this transfer, J, electrical (only with ``energy.arm: dynamics``)."""
 
 
 class Part:
     """A part in flight, from the feeder to the output belt (or the floor).
 
-    Each slot is written once, by its owner (see the module's text): ``index`` (0 … N − 1,
-    the one numbering of parts inside the model; parts.csv's ``part`` is ``index + 1``),
-    ``arrival_s`` and ``feed_delay_s`` by the feeder, ``at_bot_s`` by the input conveyor,
-    ``plan`` (the policy's :class:`~cell.sim.policies.base.Plan`, or None: not picked) by the
-    controller, ``pick_s`` by the robot, ``touchdown_s``, ``spacing_in`` and
-    ``delivery_interval_s`` by the output conveyor.
+    Each slot is written once, by its owner (see the module's text): ``index`` (0 … N − 1, the one
+    numbering of parts inside the model; parts.csv's ``part`` is ``index + 1``), ``arrival_s`` and
+    ``feed_delay_s`` by the feeder, ``at_bot_s`` by the input conveyor, ``plan`` (the policy's
+    :class:`~cell.sim.policies.base.Plan`, or None: not picked) by the controller, ``pick_s`` by the
+    robot, ``touchdown_s``, ``spacing_in`` and ``delivery_interval_s`` by the output conveyor.
     """
 
     __slots__ = ("index", "arrival_s", "feed_delay_s", "at_bot_s", "plan", "pick_s",
@@ -178,8 +171,7 @@ class Part:
 
     def __init__(self, index: int, arrival_s: float, feed_delay_s: float = 0.0):
         self.index, self.arrival_s, self.feed_delay_s = index, arrival_s, feed_delay_s
-        self.at_bot_s = self.pick_s = self.touchdown_s = self.spacing_in = \
-            self.delivery_interval_s = NAN
+        self.at_bot_s = self.pick_s = self.touchdown_s = self.spacing_in = self.delivery_interval_s = NAN
         self.plan: Any = None
 
 
@@ -335,11 +327,21 @@ class RunSummary:
     """The most parts any controller could deliver from the same arrivals with the same robot
     and belts (a bound: each part's window at B, picks a fastest cycle apart; cell.sim.bound)."""
 
+    energy_kwh: float | None = None
+    """The run's energy, kWh (only with an ``energy:`` section; docs/usage.md)."""
+    energy_per_good_part_wh: float | None = None
+    """``energy_kwh`` per good part (``quality.rule``; the whole run's), Wh."""
+    cost_per_good_part: float | None = None
+    """The run's cost per good part (only with a ``costs:`` section; docs/usage.md)."""
+    cost_per_h: float | None = None
+    """The run's cost per hour of the run (only with a ``costs:`` section)."""
+
     def __getitem__(self, name: str) -> Any:
         return getattr(self, name)
 
     def as_dict(self) -> dict[str, Any]:
-        return {name: getattr(self, name) for name in SUMMARY_COLUMNS}
+        return {name: getattr(self, name) for name in SUMMARY_COLUMNS + [
+            c for c in OPTIONAL_COLUMNS if getattr(self, c) is not None]}
 
 
 @dataclass(slots=True, frozen=True)
@@ -361,8 +363,7 @@ class StateSpan:
     equipment: str
     """``robot``, ``input_belt``, ``output_belt`` or ``sensor``."""
     state: str
-    """robot: busy / waiting / idle / down / maintenance; belts: running / stopped / down;
-    sensor: up / down."""
+    """robot: busy / waiting / idle / down / maintenance; belts: running / down; sensor: up / down."""
     from_s: float
     """When the state began."""
     to_s: float
@@ -391,8 +392,9 @@ def columns(record_type: type) -> list[str]:
     return list(named) if named is not None else [f.name for f in fields(record_type)]
 
 
-PART_COLUMNS = columns(PartRecord)
-SUMMARY_COLUMNS = columns(RunSummary)
+PART_COLUMNS = columns(PartRecord)[:-1]  # energy_j: only with energy.arm: dynamics
+OPTIONAL_COLUMNS = ("energy_kwh", "energy_per_good_part_wh", "cost_per_good_part", "cost_per_h")
+SUMMARY_COLUMNS = [c for c in columns(RunSummary) if c not in OPTIONAL_COLUMNS]  # those: with sections
 BELT_COLUMNS = columns(BeltChange)
 STATE_COLUMNS = columns(StateSpan)
 STOP_COLUMNS = columns(Stop)

@@ -78,9 +78,10 @@ class SimResult:
 
         if "records" in self.__dict__ and self.records is not None:
             rows: Any = [part_row(r) for r in self.records]
-        else:
-            rows = self._rows or []
-        return pd.DataFrame(rows, columns=PART_COLUMNS)
+            return pd.DataFrame(rows, columns=PART_COLUMNS)
+        rows = self._rows or []
+        frame = pd.DataFrame(rows, columns=[*PART_COLUMNS, "energy_j"])
+        return frame if rows and rows[0][-1] is not None else frame[PART_COLUMNS]
 
     def belt_histories(self) -> dict[str, np.ndarray]:
         """Each belt's speed changes as (m, 2) rows (from_s, speed_in_s), in time order: the

@@ -32,7 +32,7 @@ import numpy as np
 import simpy
 
 from cell.scenario.schema import Scenario
-from cell.sim import accounting, oee, wear_clock
+from cell.sim import accounting, oee, run_cost, state_energy, wear_clock
 from cell.sim.assembly import AssembledCell, assemble
 from cell.sim.bound import parts_bound
 from cell.sim.failures import Downtime
@@ -83,8 +83,11 @@ class RunLog:
     def __init__(self, t: list[float], acct: Accounting, sink: PartSink | None,
                  spacing_in: float, tol_in: float, rows: list[tuple[Any, ...]] | None = None,
                  lengths: tuple[float, float, float, float] = (NAN, NAN, NAN, NAN),
-                 finished: simpy.Event | None = None, n_parts: int = 0):
+                 finished: simpy.Event | None = None, n_parts: int = 0,
+                 energy_of: Callable[[Any], float] | None = None):
         self.t = t
+        self.energy_of = energy_of
+        """A picked part's plan -> the arm's motion energy of its transfer (J), or None."""
         """T_1 … T_{n+1}: the last is only part n's "next arrival"."""
         self.acct, self.sink = acct, sink
         """Told of every completed record, in part order (None: nobody asks)."""
@@ -116,7 +119,8 @@ class RunLog:
         t, acct_part, flags_of = self.t, self.acct.part, self.flags.pop
         spacing_in, tol = self.spacing_in, self.tol_in + 1e-9
         note, pack = self.per_part.extend, _PACK_PER_PART
-        row_of = self._row if self.rows is not None or self.sink is not None else None
+        row_of = self._row if self.rows is not None or self.sink is not None or \
+            self.energy_of is not None else None  # the arm's energy: summed row by row
         names_of = LIMIT_NAMES.get  # limit_names' cache, read first
         waiting, finished, last = self.waiting, self.finished, self.n_parts
         following = 0  # the index of the part to hand on next
@@ -174,7 +178,8 @@ class RunLog:
             v1, v2, v3, v4 = l1 / r1, l2 / r2, l3 / r3, l4 / r4
         row = (i + 1, p.arrival_s, t[i], p.at_bot_s, picked, not picked, lost_thesis, p.pick_s,
                p.touchdown_s, d, cycle, thesis_d, t_next / d, ip_thesis, speed_in, speed_out,
-               p.spacing_in, v1, v2, v3, v4, r1, r2, r3, r4, p.feed_delay_s, limits)
+               p.spacing_in, v1, v2, v3, v4, r1, r2, r3, r4, p.feed_delay_s, limits,
+               None if self.energy_of is None else self.energy_of(plan) if picked and plan else NAN)
         if self.rows is not None:
             self.rows.append(row)
         if self.sink is not None:
@@ -262,7 +267,7 @@ def simulate(scenario: Scenario | AssembledCell,
     finished = env.event() if s.failures is not None and horizon is None else None
     log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows,
                  (tm.r1_length_in, tm.r2.length_in, tm.r3_length_in, tm.r4.length_in),
-                 finished, n)
+                 finished, n, state_energy.arm_energy_of(cell))
     downtime = None if s.failures is None else Downtime(env, s.failures, seed)
     wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
     station = Station(env, cell, seed, log.delivered_part, belts.told, downtime)
@@ -281,6 +286,8 @@ def simulate(scenario: Scenario | AssembledCell,
     stops = downtime.all_stops(env.now) if downtime is not None else \
         wear_clock.stop_rows(wear, env.now)  # failures.csv's rows
     lines = oee.measure(summary, log.column, downtime, k.cycle_nom, env.now, stops, s.quality.rule)
+    lines = state_energy.measure(summary, s, lines, log, downtime, env.now, stops)
+    run_cost.measure(summary, s, stops, log.column)
     summary.seed = _seed_value(seed)
     summary.input_speed_max_in_s = station.input.belt.max_speed_in_s
     summary.input_speed_min_in_s = station.input.belt.min_speed_in_s

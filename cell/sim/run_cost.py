@@ -1,0 +1,56 @@
+"""What a run costs (docs/usage.md, "Energy and cost"): with a ``costs:`` section, summary.csv's
+``cost_per_good_part`` and ``cost_per_h``; without one nothing here runs.
+
+cost = lost parts × part_value + energy (kWh) × energy_per_kwh + the robot's downtime (h) ×
+downtime_per_h + repairs × repair + maintenance stops × maintenance + Σ options_per_h × the
+run's hours, each option counted as the scenario has it (the sensor with ``sensor.lookahead:
+sensor``, the adaptive controller under the ``adaptive`` policy, a robot per robot: one; no
+buffer places).  Lost parts: those ridden off and those scrapped from the hand (the summary's
+``parts_missed`` and ``parts_scrapped``); repairs: every failure in failures.csv, of any piece
+of equipment (a worn motor's included); good parts: by ``quality.rule``, as OEE counts them.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from cell.sim import oee
+from cell.sim.records import RunSummary
+
+#: Robots in the cell (the options' ``robot`` is per robot).
+ROBOTS = 1
+
+
+def options_per_h(scenario: Any) -> float:
+    """The hourly cost of the options the scenario has."""
+    o = scenario.costs.options_per_h
+    return (o.robot * ROBOTS + (o.sensor if scenario.sensor.lookahead == "sensor" else 0.0)
+            + (o.adaptive_controller if scenario.controller.policy == "adaptive" else 0.0))
+
+
+def run_cost(r: RunSummary, scenario: Any, stops: Sequence[tuple[str, str, float, float, Any]]
+             ) -> float:
+    """The run's cost (see the module's text) from its summary and failures.csv's rows."""
+    c = scenario.costs
+    hours = r.sim_end_s / 3600.0
+    maintenance = sum(1 for _, cause, *_ in stops if cause == "maintenance")
+    energy_kwh = r.energy_kwh if r.energy_kwh is not None else 0.0
+    return ((r.parts_missed + r.parts_scrapped) * c.part_value + energy_kwh * c.energy_per_kwh
+            + r.robot_down_fraction * hours * c.downtime_per_h
+            + (len(stops) - maintenance) * c.repair + maintenance * c.maintenance
+            + options_per_h(scenario) * hours)
+
+
+def measure(r: RunSummary, scenario: Any, stops: Sequence[tuple[str, str, float, float, Any]],
+            column: Callable[[str], np.ndarray]) -> None:
+    """With a ``costs:`` section, fill the summary's cost columns."""
+    if scenario.costs is None:
+        return
+    cost = run_cost(r, scenario, stops)
+    _, good = oee.produced_and_good(column, scenario.quality.rule)
+    r.cost_per_good_part = cost / good if good else math.nan
+    r.cost_per_h = cost / (r.sim_end_s / 3600.0) if r.sim_end_s > 0 else math.nan
