@@ -49,7 +49,7 @@ def judgement(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
         rates_differ,
         still_sides,
     )
-    from cell.reporting.compare_verdict import OEE, OEE_LOSSES, SCALES, Judged, decide, losses_line
+    from cell.reporting.compare_verdict import MONEY, OEE, OEE_LOSSES, SCALES, Judged, decide, losses_line
     from cell.reporting.formatting import HEADLINES
     from cell.scenario.run_length import RunLength
 
@@ -67,7 +67,8 @@ def judgement(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
     apart = ", ".join(f"{setting(k)} {va} against {vb}" for k, va, vb in differ)
     judged: list[Judged] = []
     measures = (*HEADLINES, OEE)
-    width = max(len(t) for t in [*(h.title for h in measures), *(r[0] for r in RATE_FREE)])
+    width = max(len(t) for t in [*(h.title for h in (*measures, *MONEY)),
+                                  *(r[0] for r in RATE_FREE)])
     scales = {m: _both(summary, m, la, lb) for m in SCALES}
     if not scales["parts_arrived"] > 0 and length is not None and length.unit == "part":
         scales["parts_arrived"] = float(length.number)  # a summary without the column
@@ -79,6 +80,11 @@ def judgement(summary: pd.DataFrame, differences: pd.DataFrame, sweep: Sweep,
     losses = losses_line(_pairs(summary, OEE_LOSSES, la, lb), la, lb, width)
     if losses is not None:
         lines.append(losses)
+    for h in MONEY:  # said where both sides have costs: or energy:, not weighed (compare_verdict)
+        line = _headline_verdict(h, summary, differences, la, lb, length, width,
+                                 apart if differ else None, bool(demand), [], scales)
+        if line is not None:
+            lines.append(line)
     if replications is not None:
         for title, side, size, line in rate_free(replications, sweep, la, lb, width):
             lines.append(line)

@@ -38,6 +38,17 @@ PRACTICAL_PER_1000 = 1.0
 #: a share of the planned busy time, higher is better.
 OEE = Headline("oee", "OEE (ISO 22400-2, A × P × Q)",
                "{a} reaches an OEE {x} {dir} than {b}", ("higher", "lower"), "higher")
+#: Money and energy, where the scenarios give ``costs:`` and ``energy:`` (summary.csv's optional
+#: columns): each paired difference said with its interval, lower is better; not weighed in the
+#: overall line, whose unit is parts per 1,000 (a cost is the user's own rule of value).
+MONEY = (
+    Headline("cost_per_good_part", "Cost per good part", "{a} costs {x} {dir} a good part than {b}",
+             ("more", "less"), "lower"),
+    Headline("cost_per_h", "Cost per hour", "{a} costs {x} {dir} an hour than {b}",
+             ("more", "less"), "lower"),
+    Headline("energy_per_good_part_wh", "Energy per good part (Wh)",
+             "{a} uses {x} Wh {dir} a good part than {b}", ("more", "less"), "lower"),
+)
 #: Where each side's planned busy time went, shown under OEE (summary.csv's names), not judged.
 OEE_LOSSES = ("loss_downtime", "loss_starved", "loss_blocked", "loss_speed", "loss_quality")
 

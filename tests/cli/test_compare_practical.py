@@ -186,3 +186,27 @@ def test_compare_of_a_fit_and_its_trace_judges_parts_delivered(tmp_path, capsys)
                  "--workers", "1", "--policy", "non-adaptive"]) == 0
     out = capsys.readouterr().out
     assert "not judged" not in out and "rate-free" not in out
+
+
+def test_a_compare_with_costs_and_energy_says_them_and_weighs_only_parts(tmp_path, capsys):
+    """With ``costs:`` and ``energy:`` on both sides the verdict says each money and energy
+    measure's paired difference (lower is better), signed as differences.csv has it; the
+    overall line still weighs the parts measures only (its count of measures is unchanged)."""
+    money = ("--set", 'energy={power_w: {robot: {busy: 120, waiting: 40, idle: 40}}}',
+             "--set", "costs={part_value: 12.0, energy_per_kwh: 0.2}")
+    common = ["--set", "run.parts=30", "--replications", "3", "--workers", "1"]
+    assert main(["compare", "baseline", "non_adaptive", *common]) == 0
+    plain = capsys.readouterr().out.splitlines()
+    assert main(["compare", "baseline", "non_adaptive", *common, *money,
+                 "--out", str(tmp_path / "c")]) == 0
+    said = capsys.readouterr().out.splitlines()
+    diffs = pd.read_csv(tmp_path / "c" / "differences.csv").set_index("measure")["mean"]
+    for title, column in (("Cost per good part", "cost_per_good_part"),
+                          ("Cost per hour", "cost_per_h"),
+                          ("Energy per good part (Wh)", "energy_per_good_part_wh")):
+        line = next(x for x in said if x.strip().startswith(title))
+        a_lower = diffs[column] < 0
+        assert ("baseline better" in line) == a_lower and ("non_adaptive better" in line) != a_lower
+    assert not any(x.strip().startswith("Cost") for x in plain)  # only where costs are given
+    overall = [next(x for x in out if x.startswith("Overall")) for out in (said, plain)]
+    assert overall[0].split("(")[-1] == overall[1].split("(")[-1]  # the same measures weighed
