@@ -56,8 +56,11 @@ def summary_measures() -> list[str]:
     """Every measure a run reports: the summary's numeric columns, then :data:`DERIVED`."""
     from dataclasses import fields
 
+    from cell.sim.records import OPTIONAL_COLUMNS
+
     return [f.name for f in fields(RunSummary)
-            if isinstance(f.default, (int, float)) and f.name != "seed"] + list(DERIVED)
+            if isinstance(f.default, (int, float)) and f.name != "seed"] + list(DERIVED) \
+        + list(OPTIONAL_COLUMNS)
 
 
 def measures_of(row: Mapping[str, Any]) -> dict[str, float]:
@@ -273,8 +276,22 @@ def _constraint(path: Path, i: int, text: Any, measures: Sequence[str]) -> Const
 
 
 def _refuse_unset(study: Study, where: str, measure: str) -> None:
-    if why := unset_why(measure, study.policies_run()):
+    if why := unset_why(measure, study.policies_run()) or section_why(measure, study.base):
         raise ScenarioError(study.source, where, measure, why)
+
+
+#: The summary's measures that only a scenario with their section reports (``energy:``,
+#: ``costs:``; :data:`cell.sim.records.OPTIONAL_COLUMNS`).
+SECTION_MEASURES = {"energy_kwh": "energy", "energy_per_good_part_wh": "energy",
+                    "cost_per_good_part": "costs", "cost_per_h": "costs"}
+
+
+def section_why(measure: str, base: Scenario) -> str | None:
+    """Why no run of ``base`` reports ``measure`` (its section is absent), or None."""
+    section = SECTION_MEASURES.get(measure)
+    if section is not None and getattr(base, section, None) is None:
+        return f"no run reports it: the base scenario has no {section}: section"
+    return None
 
 
 def unset_why(measure: str, policies: Sequence[str]) -> str | None:

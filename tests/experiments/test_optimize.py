@@ -230,3 +230,26 @@ def test_an_unreachable_scheduler_is_one_line_before_anything_is_written(tmp_pat
     err = [x for x in capsys.readouterr().err.strip().splitlines() if not x.startswith("connecting")]
     assert len(err) == 1 and f"--scheduler {address}" in err[0], err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("measure", ["cost_per_good_part", "energy_per_good_part_wh"])
+def test_money_and_energy_are_objectives_where_the_base_gives_their_section(tmp_path, measure):
+    """A study may minimise the cost or energy per good part (summary.csv's optional columns)
+    when its base scenario has the ``costs:`` / ``energy:`` section that reports it; without
+    it the objective is refused naming the key and the measure, before any work."""
+    from cell.plumbing.errors import ScenarioError
+
+    (tmp_path / "money.yaml").write_text(
+        "run: {parts: 20}\nenergy: {power_w: {robot: {busy: 120}}}\n"
+        "costs: {part_value: 12.0, energy_per_kwh: 0.2}\n")
+    (tmp_path / "plain.yaml").write_text("run: {parts: 20}\n")
+    for base in ("money", "plain"):
+        (tmp_path / f"{base}_study.yaml").write_text(
+            f"base: {base}.yaml\nvary:\n  belts.input_nominal_in_s: {{low: 2.0, high: 3.0}}\n"
+            f"objectives:\n  - {{measure: {measure}, goal: minimize}}\ntrials: 2\nreplications: 2\n")
+    study = load_study(tmp_path / "money_study.yaml")
+    assert study.settings.objectives[0].measure == measure
+    with pytest.raises(ScenarioError) as refused:
+        load_study(tmp_path / "plain_study.yaml")
+    assert (refused.value.key, refused.value.value) == ("objectives[0].measure", measure)
+    assert ("costs" if measure.startswith("cost") else "energy") in refused.value.why
