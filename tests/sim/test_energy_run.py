@@ -73,13 +73,17 @@ SENSOR_FAILS = {**FAILS, "time_to_failure": {"distribution": "expon", "mean_h": 
 @pytest.fixture(scope="module")
 def failing_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A two-hour run with the robot, both belts and the sensor failing, and maintenance."""
-    where = tmp_path_factory.mktemp("energy")
-    scenario = {"run": {"hours": 2.0}, "sensor": {"lookahead": "sensor"},
-                "energy": {"power_w": POWER},
-                "failures": {"robot": {**FAILS, "clock": "calendar"}, "input_belt": FAILS,
-                             "output_belt": FAILS, "sensor": SENSOR_FAILS,
+    return _failing(tmp_path_factory.mktemp("energy"), {"energy": {"power_w": POWER}}, {})
+
+
+def _failing(where: Path, more: dict, robot: dict) -> Path:
+    """``cell run`` of two hours with the robot (``robot``: more of its keys), both belts and
+    the sensor failing, and maintenance, plus the sections ``more``; its output folder."""
+    scenario = {"run": {"hours": 2.0}, "sensor": {"lookahead": "sensor"}, **more,
+                "failures": {"robot": {**FAILS, "clock": "calendar", **robot},
+                             "input_belt": FAILS, "output_belt": FAILS, "sensor": SENSOR_FAILS,
                              "maintenance": {"every_h": 0.75, "duration_min": 10}}}
-    path = where / "failing.yaml"
+    path = where / "scenario.yaml"
     path.write_text(yaml.safe_dump(scenario))
     code, err = run("run", str(path), "--out", str(where / "out"))
     assert code == 0, err
@@ -175,17 +179,9 @@ COSTS = {"part_value": 12.0, "energy_per_kwh": 0.2, "downtime_per_h": 300.0, "re
 @pytest.fixture(scope="module")
 def costed_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The failing run of :func:`failing_run`, with costs and the spacing quality rule."""
-    where = tmp_path_factory.mktemp("costs")
-    scenario = {"run": {"hours": 2.0}, "sensor": {"lookahead": "sensor"},
-                "quality": {"rule": "spacing"}, "energy": {"power_w": POWER}, "costs": COSTS,
-                "failures": {"robot": {**FAILS, "clock": "calendar", "part_in_hand": "scrap"},
-                             "input_belt": FAILS, "output_belt": FAILS, "sensor": SENSOR_FAILS,
-                             "maintenance": {"every_h": 0.75, "duration_min": 10}}}
-    path = where / "costed.yaml"
-    path.write_text(yaml.safe_dump(scenario))
-    code, err = run("run", str(path), "--out", str(where / "out"))
-    assert code == 0, err
-    return where / "out"
+    return _failing(tmp_path_factory.mktemp("costs"),
+                    {"quality": {"rule": "spacing"}, "energy": {"power_w": POWER}, "costs": COSTS},
+                    {"part_in_hand": "scrap"})
 
 
 def test_the_cost_is_the_hand_computation_from_the_runs_files(costed_run):
