@@ -189,7 +189,8 @@ def shown_figure(value: float, fmt: str = "{:.4f}") -> str:
 
 
 def _share(value: float) -> str:
-    return f"{value:.1%}" if math.isfinite(value) else "n/a"
+    """A share to 0.1 %; one that rounds to zero prints 0.0 %, not -0.0 %."""
+    return f"{round(value, 3) + 0.0:.1%}" if math.isfinite(value) else "n/a"
 
 
 def _no_quality(r: RunSummary) -> str:

@@ -85,3 +85,13 @@ def test_an_optimisation_with_one_replication_reports_no_nan(tmp_path, unrendere
     assert np.isnan(best["parts_missed_ci95"]).all()  # one replication: no interval
     assert "nan" not in report.lower().replace("no interval", "")
     assert "fewer than two replications" in report
+
+
+@pytest.mark.parametrize("tiny", [-0.0, -1e-6, -4e-4])
+def test_a_loss_that_rounds_to_zero_has_no_minus_sign(tiny):
+    from cell.reporting.run_summary import waterfall_line
+
+    r = RunSummary(policy="adaptive", availability=1.0, performance=1.0, quality=1.0, oee=1.0,
+                   planned_time_s=100.0, loss_downtime=0.0, loss_starved=0.0, loss_blocked=0.0,
+                   loss_speed=tiny, loss_quality=0.0)
+    assert "-0.0" not in waterfall_line(r)
