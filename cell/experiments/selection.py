@@ -25,7 +25,8 @@ GOALS = {"parts_missed": "minimize", "parts_missed_pct": "minimize", "parts_miss
          "spacing_outside_tol": "minimize", "spacing_outside_pct": "minimize",
          "parts_per_hr_wallclock": "maximize", "parts_per_hr_thesis": "maximize",
          "parts_delivered": "maximize", "actual_cycle_wallclock_s": "minimize",
-         "actual_cycle_thesis_s": "minimize"}
+         "actual_cycle_thesis_s": "minimize", "oee": "maximize", "cost_per_good_part": "minimize",
+         "cost_per_h": "minimize", "energy_kwh": "minimize", "energy_per_good_part_wh": "minimize"}
 
 
 def select_scenarios(scenarios: Sequence[Scenario], measure: str, maximize: bool, delta: float,

@@ -110,6 +110,9 @@ class SelectSettings(Section):
     """At most this many replications of each candidate."""
     measure: str | None = None
     """The measure to select on (default: the first objective that is a measure)."""
+    goal: Literal["minimize", "maximize"] | None = None
+    """Whether more or less of ``measure`` is better, where no objective on it says so and it
+    is not one of the headline measures whose sense is known (selection.GOALS)."""
 
 
 class MorrisSettings(Section):
@@ -257,7 +260,27 @@ def load_study(path: str | Path, corners: bool = True) -> Study:
             raise ScenarioError(path, "select.measure", settings.select.measure,
                                 "no run reports it: name a measure of the run summary")
         _refuse_unset(study, "select.measure", settings.select.measure)
+        if _selection_goal(settings.objectives, settings.select) is None:
+            raise ScenarioError(path, "select.measure", settings.select.measure,
+                                "say whether more or less is better (select.goal: maximize or "
+                                "minimize)")
     return study
+
+
+def _selection_goal(objectives: Any, select: SelectSettings) -> str | None:
+    """The sense of ``select.measure``: ``select.goal``, an objective's goal on the same
+    measure, or the headline measure's usual sense; None if none of them says."""
+    from cell.experiments.selection import GOALS
+
+    return select.goal or next((o.goal for o in objectives if o.measure == select.measure),
+                               GOALS.get(select.measure or ""))
+
+
+def selection_goal(study: Study) -> str | None:
+    """The sense of the study's ``select.measure`` (None: no selection measure named)."""
+    sel = study.settings.select
+    return None if sel is None or not sel.measure else _selection_goal(study.settings.objectives,
+                                                                        sel)
 
 
 def _constraint(path: Path, i: int, text: Any, measures: Sequence[str]) -> Constraint:

@@ -85,11 +85,9 @@ def selection_measure(study: Study) -> tuple[str, bool]:
     sel = study.settings.select
     keys = {p.key for p in study.params}
     if sel is not None and sel.measure:
-        from cell.experiments.selection import GOALS
+        from cell.experiments.study import selection_goal
 
-        goal = next((o.goal for o in study.settings.objectives if o.measure == sel.measure),
-                    GOALS.get(sel.measure, "maximize"))
-        return sel.measure, goal == "maximize"
+        return sel.measure, selection_goal(study) == "maximize"
     o = next((o for o in study.settings.objectives if o.measure not in keys), None)
     if o is None:
         raise ValueError("no objective is a measure; name select.measure")

@@ -90,6 +90,8 @@ replications: 2
 @pytest.mark.parametrize("select, where, value", [
     ("{measure: thesis_slack_s, delta: 1.0}", "select.measure", "thesis_slack_s"),
     ("{delta: .inf}", "select.delta", "inf"),
+    # a measure of no known sense, on which no objective is: more or less better is not guessed
+    ("{measure: robot_failures, delta: 1.0}", "select.measure", "robot_failures"),
 ])
 def test_a_study_select_is_refused_before_any_trial(tmp_path: Path, capsys, select: str,
                                                     where: str, value: str) -> None:
@@ -100,3 +102,14 @@ def test_a_study_select_is_refused_before_any_trial(tmp_path: Path, capsys, sele
     line = _line(capsys)
     assert str(path) in line and where in line and value in line, line
     assert not out.exists()
+
+
+def test_a_selection_measure_of_no_known_sense_takes_select_goal(tmp_path: Path) -> None:
+    from cell.experiments.study import load_study, selection_goal
+
+    path = tmp_path / "study.yaml"
+    for goal in ("minimize", "maximize"):
+        path.write_text(STUDY + f"select: {{measure: robot_failures, delta: 1.0, goal: {goal}}}\n")
+        assert selection_goal(load_study(path)) == goal
+    path.write_text(STUDY + "select: {measure: parts_missed, delta: 1.0}\n")
+    assert selection_goal(load_study(path)) == "minimize"  # the objective's own goal
