@@ -146,7 +146,8 @@ def opt() -> dict[str, Any]:
                      ran[(belt - 1.00).abs() < 1e-9]["parts_missed"].min(),
                      ran[(belt - 1.00).abs() < 1e-9]["parts_missed"].max()],
             "ends": [e[m].mean() for m in ("vavg_r4_in_s", "arm_energy_per_transfer_j",
-                                           "energy_per_good_part_wh", "parts_missed") for e in ends]}
+                                           "energy_per_good_part_wh", "parts_missed") for e in ends],
+            "quarters": [high - (high - low) / 4, high, low, low + (high - low) / 4]}
 
 
 DYN, KIN, CONST = "minimum-time (dynamic)", "minimum-time (kinematic)", "constant-rate"
@@ -198,6 +199,8 @@ NUMBERS: list[tuple[str, str, str]] = [
      "good part, is {} % of a part's cost", "opt()['parts'], opt()['best']['energy_per_good_part_wh'], "
      "opt()['energy_pct']"),
     ("README.md", "(at 1.10 in/s {} parts a run at the least, at 1.00 in/s {} to {})", "*opt()['slow']"),
+    ("README.md", "over the trials with a nominal cycle of {}–{} s against those at {}–{} s",
+     "*opt()['quarters']"),
     ("README.md", "the mean R IV speed is {} against {} in/s, each transfer draws {} against {} J from "
      "the arm's drives … the energy per good part is {} against {} Wh, and {} parts are lost a run "
      "against {}", "*opt()['ends']"),
