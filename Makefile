@@ -54,7 +54,7 @@ stress: $(STAMP)
 sensor: $(STAMP)
 	rm -rf build/sensor
 	$(PY) -m cell sweep scenarios/sensor.yaml --out build/sensor --workers $(WORKERS)
-	MPLBACKEND=Agg $(PY) -m cell.reporting.maps.sensor_map build/sensor/replications.csv reports/sensor
+	MPLBACKEND=Agg $(PY) -m cell.reporting.maps.sensor_map build/sensor/replications.csv reports/sensor scenarios/sensor.yaml
 
 # The reliability study (issue 21): both policies with motor wear, a year of two shifts a run.
 reliability: $(STAMP)

@@ -192,15 +192,15 @@ def suggest(trial: Any, p: Param) -> Any:
 
 
 def measured(study: Study) -> list[str]:
-    """The measures a trial records: the objectives', the constraints', the selection's and
-    the headline ones."""
+    """The measures a trial records: the objectives', the constraints', the selection's, the
+    headline ones and the study's ``measures:``."""
     keys = {p.key for p in study.params}
     names = [o.measure for o in study.settings.objectives if o.measure not in keys]
     names += [c.measure for c in study.constraints]
     if study.settings.select is not None and study.settings.select.measure:
         names.append(study.settings.select.measure)
     names += ["parts_missed", "spacing_outside_pct", "parts_per_hr_wallclock"]
-    return list(dict.fromkeys(names))
+    return list(dict.fromkeys(names + list(study.settings.measures)))
 
 
 def evaluate(study: Study, trial: Any) -> tuple[float, ...]:

@@ -142,7 +142,8 @@ class StudySettings(Section):
     seed: int = _count(1984, 0)
     select: SelectSettings | None = None
     measures: list[str] = Field(default_factory=list)
-    """cell sensitivity: the measures whose indices are reported."""
+    """cell sensitivity: the measures whose indices are reported; cell optimize: further
+    measures each trial records (trials.csv and the report's tables)."""
     policies: list[str] = Field(default_factory=list)
     """cell sensitivity: each policy gets its own indices, on the same points."""
     morris: MorrisSettings = MorrisSettings()
@@ -306,7 +307,8 @@ def _refuse_unset(study: Study, where: str, measure: str) -> None:
 #: The summary's measures that only a scenario with their section reports (``energy:``,
 #: ``costs:``; :data:`cell.sim.records.OPTIONAL_COLUMNS`).
 SECTION_MEASURES = {"energy_kwh": "energy", "energy_per_good_part_wh": "energy",
-                    "cost_per_good_part": "costs", "cost_per_h": "costs"}
+                    "cost_per_good_part": "costs", "cost_per_h": "costs",
+                    "arm_energy_per_transfer_j": "energy"}
 
 
 def section_why(measure: str, base: Scenario) -> str | None:
@@ -314,6 +316,8 @@ def section_why(measure: str, base: Scenario) -> str | None:
     section = SECTION_MEASURES.get(measure)
     if section is not None and getattr(base, section, None) is None:
         return f"no run reports it: the base scenario has no {section}: section"
+    if measure == "arm_energy_per_transfer_j" and base.energy is not None and base.energy.arm != "dynamics":
+        return "no run reports it: the base scenario's energy.arm is not dynamics"
     return None
 
 

@@ -186,6 +186,59 @@ def answer(study: Study, front: Any) -> str:
     return f"The best feasible point ({cons} kept on the means): {points}."
 
 
+#: The share of a key's range at each end that :func:`key_effects` compares.
+END_SHARE = 0.25
+
+
+def key_effects(study: Study, frame: Any) -> list[str]:
+    """Each measure's mean over the trials with a numeric key in the lowest quarter of its
+    range against those in the highest (every trial that ran, feasible or not), as a table;
+    nothing when no numeric key has trials at both ends."""
+    ran = frame[frame["refused"] == ""] if len(frame) else frame
+    ms = measured(study)
+    ends = []
+    for p in study.params:
+        if p.is_choice or not len(ran):
+            continue
+        cut = END_SHARE * (p.high - p.low)
+        groups = [(lo, hi, ran[(ran[p.key] >= lo) & (ran[p.key] <= hi)])
+                  for lo, hi in ((p.low, p.low + cut), (p.high - cut, p.high))]
+        if all(len(g) for _, _, g in groups):
+            ends += [(p.key, lo, hi, g) for lo, hi, g in groups]
+    if not ends:
+        return []
+    lines = ["## What each key does", "",
+             f"Each measure's mean over the trials with a key in the lowest quarter of its range "
+             f"and over those in the highest ({len(ran)} trials that ran, feasible or not; the "
+             "other keys as the search set them, so an end's trials differ in those too).", "",
+             "| measure | " + " | ".join(f"{k} {lo:g}–{hi:g} ({len(g)} trials)"
+                                       for k, lo, hi, g in ends) + " |",
+             "|---" * (1 + len(ends)) + "|"]
+    for m in ms:
+        lines.append(f"| {m} | " + " | ".join(f"{float(g[m].mean()):.4g}" for *_, g in ends) + " |")
+    return [*lines, ""]
+
+
+def flatness(study: Study, frame: Any) -> list[str]:
+    """With one objective that is a measure and a selection's δ: how many feasible trials are
+    within δ of the best on it (the objective is flat over them), as a paragraph."""
+    s = study.settings
+    keys = {p.key for p in study.params}
+    if len(s.objectives) != 1 or s.objectives[0].measure in keys or s.select is None \
+            or not len(frame):
+        return []
+    m, up = s.objectives[0].measure, s.objectives[0].goal == "maximize"
+    feasible = frame[frame["feasible"].astype(bool)]
+    if not len(feasible):
+        return []
+    best = float(feasible[m].max() if up else feasible[m].min())
+    near = feasible[(feasible[m] - best).abs() <= s.select.delta]
+    return ["", f"{len(near)} of the {len(feasible)} feasible trials are within δ = "
+            f"{s.select.delta:g} of the best on {m} ({float(near[m].min()):.4g} to "
+            f"{float(near[m].max()):.4g}): over them the objective is flat, and what tells "
+            "them apart is the other measures (trials.csv, and \"What each key does\")."]
+
+
 def importance_measure(study: Study) -> tuple[str, bool]:
     """The measure the keys' importance is for: the selection's, else the first objective."""
     try:
@@ -222,7 +275,7 @@ def markdown(study: Study, frame: Any, picked: list[int], sel: Selection | None,
         lines.append(f"| {p.key} | {rng} |")
     front = frame[frame["on_front"]] if len(frame) else frame
     title = "Pareto front" if len(s.objectives) > 1 else "Best feasible trial"
-    lines += ["", "## Answer", "", answer(study, front), "", f"## {title}", ""]
+    lines += ["", "## Answer", "", answer(study, front), *flatness(study, frame), "", f"## {title}", ""]
     if not len(front):
         lines.append("No trial met the constraints.")
     else:
@@ -233,7 +286,9 @@ def markdown(study: Study, frame: Any, picked: list[int], sel: Selection | None,
         for _, r in shown.sort_values([study.settings.objectives[0].measure, "trial"]).iterrows():
             cells = [_show(r[k]) for k in keys] + [estimate(r[m], r[m + '_ci95']) for m in ms]
             lines.append(f"| {int(r['trial'])} | " + " | ".join(cells) + " |")
-    lines += ["", "![history](history.png) ![front](front.png)", "", "## Importance", ""]
+    lines += ["", "![history](history.png) ![front](front.png)", ""]
+    lines += key_effects(study, frame)
+    lines += ["## Importance", ""]
     lines += [f"- {k}: {v:.2f}" for k, v in imp.items()] or ["- (too few trials)"]
     lines += ["", "![importance](importance.png)", ""]
     if sel is not None:

@@ -1,8 +1,6 @@
-"""One record type per row of each output file, and the part in flight.
-
-* :class:`PartRecord`: a row of ``parts.csv``, one per arriving part, made once when the part is done;
-* :class:`RunSummary`: the one row of ``summary.csv`` (and of a sweep's ``replications.csv``);
-* :class:`BeltChange`: a row of ``belts.csv``, one per speed change of a belt.
+"""One record type per row of each output file, and the part in flight: :class:`PartRecord`, a row of
+``parts.csv``, one per arriving part, made once when the part is done; :class:`RunSummary`, the one row
+of ``summary.csv`` (and of a sweep's ``replications.csv``); :class:`BeltChange`, a row of ``belts.csv``.
 
 The fields, in order, *are* the columns; each field's docstring is its meaning (docs/usage.md's column tables
 are checked against them). One writer for each field. A part travels through the processes as a
@@ -335,6 +333,8 @@ class RunSummary:
     """The run's cost per good part (only with a ``costs:`` section; docs/usage.md)."""
     cost_per_h: float | None = None
     """The run's cost per hour of the run (only with a ``costs:`` section)."""
+    arm_energy_per_transfer_j: float | None = None
+    """The mean of parts.csv's ``energy_j``, J (only with ``energy.arm: dynamics``)."""
 
     def __getitem__(self, name: str) -> Any:
         return getattr(self, name)
@@ -393,7 +393,7 @@ def columns(record_type: type) -> list[str]:
 
 
 PART_COLUMNS = columns(PartRecord)[:-1]  # energy_j: only with energy.arm: dynamics
-OPTIONAL_COLUMNS = ("energy_kwh", "energy_per_good_part_wh", "cost_per_good_part", "cost_per_h")
+OPTIONAL_COLUMNS = tuple(columns(RunSummary)[columns(RunSummary).index("energy_kwh"):])  # the sections' own
 SUMMARY_COLUMNS = [c for c in columns(RunSummary) if c not in OPTIONAL_COLUMNS]  # those: with sections
 BELT_COLUMNS = columns(BeltChange)
 STATE_COLUMNS = columns(StateSpan)

@@ -32,17 +32,23 @@ def options_per_h(scenario: Any) -> float:
             + (o.adaptive_controller if scenario.controller.policy == "adaptive" else 0.0))
 
 
+def cost(c: Any, lost: Any, energy_kwh: Any, down_h: Any, repairs: Any, maintenance: Any,
+         options_per_h: Any, hours: Any) -> Any:
+    """The cost (the module's sum) under the ``costs:`` section ``c``: numbers, or arrays of
+    them (a study's options, cell.reporting.money_reading)."""
+    return (lost * c.part_value + energy_kwh * c.energy_per_kwh + down_h * c.downtime_per_h
+            + repairs * c.repair + maintenance * c.maintenance + options_per_h * hours)
+
+
 def run_cost(r: RunSummary, scenario: Any, stops: Sequence[tuple[str, str, float, float, Any]]
              ) -> float:
     """The run's cost (see the module's text) from its summary and failures.csv's rows."""
-    c = scenario.costs
     hours = r.sim_end_s / 3600.0
     maintenance = sum(1 for _, cause, *_ in stops if cause == "maintenance")
     energy_kwh = r.energy_kwh if r.energy_kwh is not None else 0.0
-    return ((r.parts_missed + r.parts_scrapped) * c.part_value + energy_kwh * c.energy_per_kwh
-            + r.robot_down_fraction * hours * c.downtime_per_h
-            + (len(stops) - maintenance) * c.repair + maintenance * c.maintenance
-            + options_per_h(scenario) * hours)
+    return float(cost(scenario.costs, r.parts_missed + r.parts_scrapped, energy_kwh,
+                      r.robot_down_fraction * hours, len(stops) - maintenance, maintenance,
+                      options_per_h(scenario), hours))
 
 
 def measure(r: RunSummary, scenario: Any, stops: Sequence[tuple[str, str, float, float, Any]],
@@ -50,7 +56,7 @@ def measure(r: RunSummary, scenario: Any, stops: Sequence[tuple[str, str, float,
     """With a ``costs:`` section, fill the summary's cost columns."""
     if scenario.costs is None:
         return
-    cost = run_cost(r, scenario, stops)
+    total = run_cost(r, scenario, stops)
     _, good = oee.produced_and_good(column, scenario.quality.rule)
-    r.cost_per_good_part = cost / good if good else math.nan
-    r.cost_per_h = cost / (r.sim_end_s / 3600.0) if r.sim_end_s > 0 else math.nan
+    r.cost_per_good_part = total / good if good else math.nan
+    r.cost_per_h = total / (r.sim_end_s / 3600.0) if r.sim_end_s > 0 else math.nan

@@ -41,7 +41,7 @@ class ArmTransfers:
     repeats its times, so each set of six is computed once."""
 
     def __init__(self, arm: Any, segments: Sequence[str]):
-        self.arm, self.segments, self.total_j = arm, tuple(segments), 0.0
+        self.arm, self.segments, self.total_j, self.transfers = arm, tuple(segments), 0.0, 0
         self.known: dict[tuple[float, ...], float] = {}
 
     def __call__(self, plan: Any) -> float:
@@ -50,6 +50,7 @@ class ArmTransfers:
         if joules is None:
             joules = self.known[times] = self.arm.transfer(dict(zip(self.segments, times))).electrical_j
         self.total_j += joules
+        self.transfers += 1
         return joules
 
 
@@ -100,6 +101,7 @@ def measure(r: RunSummary, scenario: Any, lines: Timelines, log: Any, downtime: 
     joules = state_energy_j(lines, energy, busy=arm is None)
     if arm is not None:
         joules += arm.total_j
+        r.arm_energy_per_transfer_j = arm.total_j / arm.transfers if arm.transfers else float("nan")
     _, good = oee.produced_and_good(column, scenario.quality.rule)
     r.energy_kwh = joules / J_PER_KWH
     r.energy_per_good_part_wh = joules / J_PER_WH / good if good else float("nan")

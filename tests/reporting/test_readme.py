@@ -116,15 +116,38 @@ def mt(model: str, *keys: str) -> list[float]:
     return [float(doc[model][k]) for k in keys or ("R2_s", "R4_s", "cycle_thesis_logic_s")]
 
 
-def opt() -> dict[str, pd.Series]:
-    """reports/optimize: the front's one point, the best at 1.10 in/s, the chosen trial and the
-    front's point as KN's selection saw them."""
-    front, trials = (pd.read_csv(REPORTS / "optimize" / f) for f in ("front.csv", "trials.csv"))
-    sel = pd.read_csv(REPORTS / "optimize" / "selection.csv").set_index("verdict", drop=False)
-    chosen = sel.loc["chosen"]
-    return {"front": front.iloc[0], "chosen": chosen, "at_front": sel.set_index("trial").loc[
-        front.iloc[0]["trial"]], "picked": trials.set_index("trial").loc[chosen["trial"]],
-        "at_110": trials[trials["belts.input_nominal_in_s"] == 1.10]["parts_missed"].min()}
+def opt() -> dict[str, Any]:
+    """reports/optimize: the best trial, the feasible trials within the selection's δ of it,
+    KN's candidates, the loss at the slowest belts, and the trials at either end of the
+    nominal cycle's range (its lowest and highest quarter, every trial that ran)."""
+    import yaml
+
+    trials = pd.read_csv(REPORTS / "optimize" / "trials.csv")
+    best = pd.read_csv(REPORTS / "optimize" / "best.csv").iloc[0]
+    study = yaml.safe_load((ROOT / "scenarios" / "optimize.yaml").read_text())
+    prices = yaml.safe_load((ROOT / "scenarios" / "costed.yaml").read_text())["costs"]
+    feasible = trials[trials["feasible"]]
+    near = feasible[(feasible["cost_per_good_part"] - best["cost_per_good_part"]).abs()
+                    <= study["select"]["delta"]]
+    ran = trials[trials["refused"].isna()]
+    low, high = study["vary"]["controller.nominal_cycle_s"]["low"], study["vary"][
+        "controller.nominal_cycle_s"]["high"]
+    cycle = ran["controller.nominal_cycle_s"]
+    ends = [ran[(cycle >= a) & (cycle <= b)] for a, b in
+            ((high - (high - low) / 4, high), (low, low + (high - low) / 4))]
+    belt = ran["belts.input_nominal_in_s"]
+    return {"best": best, "near": [len(near), len(feasible), near["cost_per_good_part"].min(),
+                                   near["cost_per_good_part"].max()],
+            "candidates": len(pd.read_csv(REPORTS / "optimize" / "selection.csv")),
+            "parts": prices["part_value"] / best["cost_per_good_part"],
+            "energy_pct": 100 * best["energy_per_good_part_wh"] / 1000 * prices["energy_per_kwh"]
+            / best["cost_per_good_part"],
+            "slow": [ran[(belt - 1.10).abs() < 1e-9]["parts_missed"].min(),
+                     ran[(belt - 1.00).abs() < 1e-9]["parts_missed"].min(),
+                     ran[(belt - 1.00).abs() < 1e-9]["parts_missed"].max()],
+            "ends": [e[m].mean() for m in ("vavg_r4_in_s", "arm_energy_per_transfer_j",
+                                           "energy_per_good_part_wh", "parts_missed") for e in ends],
+            "quarters": [high - (high - low) / 4, high, low, low + (high - low) / 4]}
 
 
 DYN, KIN, CONST = "minimum-time (dynamic)", "minimum-time (kinematic)", "constant-rate"
@@ -166,14 +189,21 @@ NUMBERS: list[tuple[str, str, str]] = [
      "*wi('adaptive', 'parts_missed', 'both')[['run_p2_5', 'run_p97_5']], "
      "wi('adaptive', 'parts_per_hr_wallclock', 'both')['mean']"),
     # the worked optimisation
-    ("README.md", "as slowly as **{} in/s** with a nominal cycle as long as **{} s** at once (losses {} "
-     "parts of 500 on average, {} % of spacings off)", "*opt()['front'][['belts.input_nominal_in_s', "
-     "'controller.nominal_cycle_s', 'parts_missed', 'spacing_outside_pct']]"),
-    ("README.md", "(at 1.10 in/s already {} on average)", "opt()['at_110']"),
-    ("README.md", "**trial {}** ({} in/s, {} s, {} parts/hr), and finds that the longest cycle costs "
-     "about {} parts/hr ({})", "opt()['chosen']['trial'], *opt()['picked'][['belts.input_nominal_in_s', "
-     "'controller.nominal_cycle_s']], opt()['chosen']['mean'], "
-     "opt()['chosen']['mean'] - opt()['at_front']['mean'], opt()['at_front']['mean']"),
+    ("README.md", "an input belt at **{} in/s** with a nominal cycle of **{} s**, **{}** a good part "
+     "({} parts lost)", "*opt()['best'][['belts.input_nominal_in_s', 'controller.nominal_cycle_s', "
+     "'cost_per_good_part', 'parts_missed']]"),
+    ("README.md", "all {} of the {} feasible trials cost within 0.001 of it ({} to {} a good part)",
+     "*opt()['near']"),
+    ("README.md", "re-running the {} best", "opt()['candidates']"),
+    ("README.md", "as much as {} good parts' share of the cell's hourly costs, while the energy, {} Wh a "
+     "good part, is {} % of a part's cost", "opt()['parts'], opt()['best']['energy_per_good_part_wh'], "
+     "opt()['energy_pct']"),
+    ("README.md", "(at 1.10 in/s {} parts a run at the least, at 1.00 in/s {} to {})", "*opt()['slow']"),
+    ("README.md", "over the trials with a nominal cycle of {}–{} s against those at {}–{} s",
+     "*opt()['quarters']"),
+    ("README.md", "the mean R IV speed is {} against {} in/s, each transfer draws {} against {} J from "
+     "the arm's drives … the energy per good part is {} against {} Wh, and {} parts are lost a run "
+     "against {}", "*opt()['ends']"),
     # docs/model.md: the departures' table (adaptive Table 7.1 runs) and the planner's cycles
     ("docs/model.md", "on the thesis's arrivals (adaptive, {} runs of {} parts)",
      "ad('parts_arrived')['n'], ad('parts_arrived')['mean']"),

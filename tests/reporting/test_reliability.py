@@ -77,3 +77,34 @@ def test_the_committed_robot_mtbf_is_the_renewal_figure_of_its_motor_lives() -> 
     assert np.allclose(t["robot_mtbf_h"], renewal, rtol=1e-3)
     down = wear.repair_h / (t["robot_mtbf_h"] + wear.repair_h) * rel.YEAR_H
     assert np.allclose(t["expected_down_h_per_year"], down, rtol=1e-3)
+
+
+def test_the_committed_money_follows_from_its_own_csv() -> None:
+    """reliability.csv's money is its own year's counts at scenarios/reliability.yaml's prices:
+    lost parts, the robot's downtime as run, its wear stops, and the hours at the options each
+    robot has (the adaptive controller only for the adaptive one); lost and good parts agree
+    with the table's own per-year figures; the README names the cheapest option per target."""
+    import yaml
+
+    prices = yaml.safe_load((ROOT / "scenarios" / "reliability.yaml").read_text())["set"]
+    t = pd.read_csv(REPORT / "reliability.csv")
+    assert (t["hours"] == rel.YEAR_H).all()
+    hand = (t["lost"] * prices["costs.part_value"] + t["down_h"] * prices["costs.downtime_per_h"]
+            + t["repairs"] * prices["costs.repair"]
+            + (prices["costs.options_per_h.robot"] + (t["policy"] == rel.ADAPTIVE)
+               * prices["costs.options_per_h.adaptive_controller"]) * rel.YEAR_H)
+    assert np.allclose(hand, t["cost"], rtol=1e-9)
+    assert np.allclose(t["cost"] / t["good"], t["cost_per_good_part"], rtol=1e-9)
+    # the same year as the table's: its downtime as run, its wear stops, its parts (the table
+    # averages each run's rate, the money the runs' totals: equal to the runs' spread in hours)
+    assert np.allclose(t["down_h"], t["down_h_per_year"], rtol=1e-3)
+    assert np.allclose(t["repairs"], t["stops_per_year"], rtol=1e-3)
+    assert np.allclose(t["good"], t["parts_per_h"] * rel.YEAR_H, rtol=1e-3)
+    assert (t["lost"] >= t["parts_missed_per_year"] * 0.99).all()
+    text = (REPORT / "README.md").read_text(encoding="utf-8")
+    for _, options in t.groupby("wear_exponent"):
+        for target in rel.LOSS_TARGETS:
+            meets = options[options["lost"] <= target]
+            if len(meets):
+                best = meets.loc[meets["cost_per_good_part"].idxmin()]
+                assert f"cheapest with {rel.option_name(best)}, {best['cost_per_good_part']:.4f}" in text

@@ -156,6 +156,8 @@ def test_with_arm_dynamics_the_arms_energy_replaces_the_busy_power(arm_run):
                zip(states.equipment, states.state, states.from_s, states.to_s)
                if (e, s) != ("robot", "busy"))
     assert summary.energy_kwh * 3.6e6 == pytest.approx(flat + parts.energy_j.sum(), rel=1e-9)
+    # the summary's energy per transfer is parts.csv's, averaged over the transfers costed
+    assert summary.arm_energy_per_transfer_j == pytest.approx(parts.energy_j.mean(), rel=1e-9)
 
 
 def test_a_transfer_costs_at_least_the_drives_standing_draw_over_its_time(arm_run):

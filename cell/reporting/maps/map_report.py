@@ -43,16 +43,19 @@ def write_set(out_dir: str | Path, name: str, table: pd.DataFrame, png: bytes, t
     return Path(out_dir)
 
 
-def command_line(module: str, make: Callable[..., Path], count: int) -> None:
-    """``python -m MODULE ARG...``: make the report from the first ``count`` arguments."""
+def command_line(module: str, make: Callable[..., Path], count: int, optional: int = 0) -> None:
+    """``python -m MODULE ARG...``: make the report from ``count`` arguments and up to
+    ``optional`` more."""
     from cell.plumbing.errors import CellError
 
-    if len(sys.argv) - 1 != count:  # e.g. the replications file and the report's folder
-        print(f"usage: python -m {module} {' '.join(f'ARG{i + 1}' for i in range(count))} "
-              f"(given {len(sys.argv) - 1})", file=sys.stderr)
+    given = len(sys.argv) - 1
+    if not count <= given <= count + optional:  # e.g. the replications file and the report's folder
+        more = "".join(f" [ARG{i + 1}]" for i in range(count, count + optional))
+        print(f"usage: python -m {module} {' '.join(f'ARG{i + 1}' for i in range(count))}{more} "
+              f"(given {given})", file=sys.stderr)
         sys.exit(2)
     try:
-        print(f"wrote {make(*sys.argv[1:1 + count])}")
+        print(f"wrote {make(*sys.argv[1:1 + given])}")
     except (CellError, OSError) as exc:  # bad input, or a replications file not there
         print(f"{module}: error: {exc}", file=sys.stderr)
         sys.exit(2)

@@ -22,6 +22,11 @@ place is a renewal process and the robot's mean time between wear stops is MTBF 
 process).  The reading uses the expected figures, which do not depend on how the few stops
 fell.
 
+With a ``costs:`` section in the sweep's scenarios, the table gains each option's money per
+year (:mod:`cell.reporting.money_reading`: parts lost, good parts, downtime, repairs, options
+per hour and cost) and the README a money reading: the cheapest way to each of
+:data:`LOSS_TARGETS`.  Without one, nothing changes.
+
 ``python -m cell.reporting.maps.reliability SWEEP.yaml BUILD_DIR REPORT_DIR``.
 """
 
@@ -35,12 +40,15 @@ import numpy as np
 import pandas as pd
 
 from cell.plumbing.output.atomic import OutputDir
+from cell.reporting import money_reading
 from cell.reporting.maps import map_report
 
 FILES = map_report.files("reliability")
 #: Hours of a year of two shifts (250 days × 16 h), what downtime is quoted per.
 YEAR_H = 4000.0
 FIXED, ADAPTIVE = "non-adaptive", "adaptive"
+#: The money reading's loss targets, parts lost a year (``math.inf``: none).
+LOSS_TARGETS = (1_000.0, 15_000.0, 100_000.0, float("inf"))
 
 
 def wear_summary(scenario: Any, seed: np.random.SeedSequence) -> Mapping[str, Any]:
@@ -263,11 +271,67 @@ def overview(t: pd.DataFrame) -> list[str]:
     return [*lines, ""]
 
 
-def write(replications: str | Path, out_dir: str | Path) -> Path:
+def money(t: pd.DataFrame, reps: pd.DataFrame, sweep: Any) -> pd.DataFrame:
+    """``t`` with each option's money a year (:func:`cell.reporting.money_reading.priced`):
+    its runs' means (:func:`~cell.reporting.money_reading.run_inputs`) scaled from the runs'
+    hours to a :data:`YEAR_H` year."""
+    scenarios = {(p.policy, p.index): p.scenario for p in sweep.points}
+    rows = []
+    for _, runs in reps.groupby(["wear_exponent", "policy", "point"], sort=False):
+        first = runs.iloc[0]
+        p, policy, point = first["wear_exponent"], str(first["policy"]), int(first["point"])
+        got = money_reading.run_inputs(runs, scenarios[(policy, point)])
+        scale = YEAR_H / got["hours"]
+        cycle = np.nan if policy == ADAPTIVE else float(runs["ideal_cycle_s"].iloc[0])
+        rows.append({"wear_exponent": p, "policy": policy, "cycle_s": cycle,
+                     **{k: (v if k == "options_per_h" else v * scale) for k, v in got.items()}})
+    priced = money_reading.priced(pd.DataFrame(rows), sweep.points[0].scenario.costs)
+    return t.merge(priced, on=["wear_exponent", "policy", "cycle_s"], how="left",
+                   validate="one_to_one")
+
+
+def option_name(row: pd.Series) -> str:
+    """An option as the money reading names it."""
+    return "the adaptive robot" if row["policy"] == ADAPTIVE else \
+        f"the fixed robot at {row['cycle_s']:.4f} s"
+
+
+def money_lines(t: pd.DataFrame, costs: Any) -> list[str]:
+    """The money reading: per wear exponent, the cheapest way to each loss target a year."""
+    lines = ["## Money", "",
+             f"With the study's `costs:` (a part lost {costs.part_value:g}, an hour of the "
+             f"robot down {costs.downtime_per_h:g}, a repair {costs.repair:g}, the robot "
+             f"{costs.options_per_h.robot:g} an hour, the adaptive controller "
+             f"{costs.options_per_h.adaptive_controller:g}; docs/usage.md, \"Energy and "
+             f"cost\"), each option's cost a {YEAR_H:.0f} h year is its parts lost × their value "
+             "+ its downtime (as run) × the hour's cost + its wear stops × a repair + its hours × "
+             "the options it has; `reliability.csv` has each term (the `lost`, `good`, `down_h`, "
+             "`repairs` columns are a year's).", ""]
+    named = t.assign(option=[option_name(r) for _, r in t.iterrows()])
+    for p in sorted(named["wear_exponent"].unique()):
+        options = named[named["wear_exponent"] == p].reset_index(drop=True)
+        ad = options[options["policy"] == ADAPTIVE].iloc[0]
+        share = money_reading.shares(ad, costs)
+        lines += [f"**p = {p:g}.** " + " ".join(money_reading.sentences(
+            options, LOSS_TARGETS, "option", "a year")) + " The adaptive robot's cost is "
+            f"{100 * share['options']:.0f} % its hours, {100 * share['lost parts']:.0f} % lost "
+            f"parts, {100 * share['downtime']:.0f} % downtime and "
+            f"{100 * share['repairs and maintenance']:.0f} % repairs.", ""]
+    return lines
+
+
+def write(replications: str | Path, out_dir: str | Path, sweep: Any = None) -> Path:
+    """The report from the replications; with ``sweep`` (its scenarios with ``costs:``),
+    the money reading too."""
     map_report.check(out_dir, "reliability")
     reps = pd.read_csv(replications)
     t = table(reps)
-    return map_report.write_set(out_dir, "reliability", t, figure(t), markdown(t, reps))
+    text = markdown(t, reps)
+    costs = sweep.points[0].scenario.costs if sweep is not None else None
+    if costs is not None:
+        t = money(t, reps, sweep)
+        text = text + "\n" + "\n".join(money_lines(t, costs)).rstrip() + "\n"
+    return map_report.write_set(out_dir, "reliability", t, figure(t), text)
 
 
 def run(sweep_file: str | Path, build: str | Path, out_dir: str | Path,
@@ -277,8 +341,9 @@ def run(sweep_file: str | Path, build: str | Path, out_dir: str | Path,
     from cell.experiments.sweep.spec import load_sweep
 
     OutputDir.check(out_dir, FILES, option="DIR")
-    outcome = run_sweep(load_sweep(sweep_file), build, workers=workers, replicate=wear_summary)
-    return write(outcome.path, out_dir)
+    sweep = load_sweep(sweep_file)
+    outcome = run_sweep(sweep, build, workers=workers, replicate=wear_summary)
+    return write(outcome.path, out_dir, sweep)
 
 
 if __name__ == "__main__":  # pragma: no cover

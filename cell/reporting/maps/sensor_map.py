@@ -11,7 +11,12 @@ robot once, on the thesis's arrivals and on widely spread ones) this writes, as 
 - ``README.md``: a reading generated from the numbers: how good the sensor must be for
   the adaptive robot to keep its advantage, and how much the ideal look-ahead overstates it.
 
-``python -m cell.reporting.maps.sensor_map REPLICATIONS.csv DIR``.
+With the sweep file as a third argument and a ``costs:`` section in its scenarios, the
+table gains each option's money (:mod:`cell.reporting.money_reading`: per 500-part run, the
+parts lost, good parts, hours, downtime, options per hour and cost) and the README a money
+reading: the cheapest way to each of :data:`LOSS_TARGETS`.  Without it, nothing changes.
+
+``python -m cell.reporting.maps.sensor_map REPLICATIONS.csv DIR [SWEEP.yaml]``.
 """
 
 from __future__ import annotations
@@ -23,6 +28,7 @@ from typing import Any
 import pandas as pd
 
 from cell.experiments.stats import paired_difference, summarise
+from cell.reporting import money_reading
 from cell.reporting.maps import map_report
 
 FILES = map_report.files("sensor")
@@ -33,6 +39,8 @@ AXES = {"range": ("range_in", "range, in before B", "a range of {:.4g} in"),
         "latency": ("latency_s", "latency, s", "a latency of {:g} s"),
         "miss": ("miss_probability", "share of parts missed", "{:.0%} of parts missed")}
 AXIS_COLUMNS = tuple(column for column, _, _ in AXES.values())
+#: The money reading's loss targets, parts lost per 500-part run (``math.inf``: none).
+LOSS_TARGETS = (1.0, 5.0, 25.0, math.inf)
 #: "Keeps its advantage": at least this share of the perfect drop-point sensor's paired
 #: advantage over the fixed-cycle robot.
 KEEP = 0.9
@@ -235,12 +243,68 @@ def drop_point(reps: pd.DataFrame) -> float:
     return float(assemble(load_scenario("baseline")).k.input_length)
 
 
-def write(replications: str | Path, out_dir: str | Path) -> Path:
+def money(t: pd.DataFrame, reps: pd.DataFrame, sweep: Any) -> pd.DataFrame:
+    """``t`` with each option's money (:func:`cell.reporting.money_reading.priced`, per
+    500-part run), from its runs and its point's scenario."""
+    scenarios = {(p.policy, p.index): p.scenario for p in sweep.points}
+    rows = []
+    for _, runs in reps.groupby(["arrivals.name", "policy", "point"], sort=False):
+        policy, point = str(runs["policy"].iloc[0]), int(runs["point"].iloc[0])
+        name = "fixed cycle" if policy == "non-adaptive" else str(runs["sensor.name"].iloc[0])
+        rows.append({"arrivals": runs["arrivals.name"].iloc[0], "sensor": name,
+                     **money_reading.run_inputs(runs, scenarios[(policy, point)])})
+    priced = money_reading.priced(pd.DataFrame(rows), costs_of(sweep))
+    return t.merge(priced, on=["arrivals", "sensor"], how="left", validate="one_to_one")
+
+
+def run_parts(t: pd.DataFrame) -> int:
+    """The parts of a run (delivered and lost, the same for every option)."""
+    return int(round(float((t["good"] + t["lost"]).max())))
+
+
+def costs_of(sweep: Any) -> Any:
+    """The sweep's ``costs:`` (every point's, the same), or None."""
+    return sweep.points[0].scenario.costs
+
+
+def money_lines(t: pd.DataFrame, costs: Any) -> list[str]:
+    """The money reading: per arrivals, the cheapest way to each loss target among the
+    options one can buy (the ideal look-ahead is an idealisation, not one of them)."""
+    parts = run_parts(t)
+    lines = ["## Money", "",
+             f"With the study's `costs:` (a part lost {costs.part_value:g}, the robot "
+             f"{costs.options_per_h.robot:g} an hour, the adaptive controller "
+             f"{costs.options_per_h.adaptive_controller:g}, the sensor "
+             f"{costs.options_per_h.sensor:g}; docs/usage.md, \"Energy and cost\"), each "
+             f"option's cost per {parts}-part run is its parts lost × their value + its hours × the "
+             "options it has (+ its downtime, repairs and energy where it has them); `sensor.csv` has each "
+             "term. Every physical sensor has the same price, so among them the cheapest is the "
+             "one that loses least and keeps the pace best.", ""]
+    for arrivals in t["arrivals"].unique():
+        options = t[(t["arrivals"] == arrivals) & (t["sensor"] != "ideal")].reset_index(drop=True)
+        fixed = options[options["sensor"] == "fixed cycle"].iloc[0]
+        lines += [f"**The {arrivals} arrivals.** " + " ".join(money_reading.sentences(
+            options, LOSS_TARGETS, "sensor", f"per {parts} parts")) + f" The fixed-cycle robot's "
+            f"lost parts are {100 * money_reading.shares(fixed, costs)['lost parts']:.0f} % of "
+            f"its cost, {fixed['cost_per_good_part']:.4f} a good part.", ""]
+    return lines
+
+
+def write(replications: str | Path, out_dir: str | Path, sweep_file: str | Path | None = None
+          ) -> Path:
     map_report.check(out_dir, "sensor")
     reps = pd.read_csv(replications)
     t = table(reps, drop_point(reps))
-    return map_report.write_set(out_dir, "sensor", t, figure(t), markdown(t, str(replications)))
+    text = markdown(t, str(replications))
+    if sweep_file is not None:
+        from cell.experiments.sweep.spec import load_sweep
+
+        sweep = load_sweep(sweep_file)
+        if costs_of(sweep) is not None:
+            t = money(t, reps, sweep)
+            text = text + "\n" + "\n".join(money_lines(t, costs_of(sweep))).rstrip() + "\n"
+    return map_report.write_set(out_dir, "sensor", t, figure(t), text)
 
 
 if __name__ == "__main__":  # pragma: no cover
-    map_report.command_line("cell.reporting.maps.sensor_map", write, 2)
+    map_report.command_line("cell.reporting.maps.sensor_map", write, 2, optional=1)
