@@ -73,8 +73,10 @@ def main(args: argparse.Namespace) -> int:
             Progress(n, "cell run", "parts", enabled=n >= PROGRESS_FROM_PARTS) as progress:
         with out.open("parts.csv", newline="") as pf, out.open("belts.csv", newline="") as bf:
             arm = scenario.energy is not None and scenario.energy.arm == "dynamics"  # energy_j
-            parts, belts = RowWriter(pf, PART_COLUMNS + ["energy_j"] * arm), RowWriter(bf, BELT_COLUMNS)
-            result = simulate(cell, keep_parts=False, on_part=_on_part(parts, progress, n),
+            timed = scenario.calendar is not None  # arrival_time
+            parts = RowWriter(pf, PART_COLUMNS + ["energy_j"] * arm + ["arrival_time"] * timed)
+            belts = RowWriter(bf, BELT_COLUMNS)
+            result = simulate(cell, keep_parts=False, on_part=_on_part(parts, progress, n, scenario),
                               on_belt=belts.record, keep_belts=False)
             done = result.summary.parts_arrived if scenario.run.hours is not None else n
             progress.grow(done - progress.total)
@@ -89,12 +91,16 @@ def main(args: argparse.Namespace) -> int:
     return 0
 
 
-def _on_part(parts: Any, progress: Any, n: int) -> Callable[[Any], None]:
-    """What each part's record goes to: its row in parts.csv and, on a run that shows its
-    progress, the count (in chunks: a call per part would show in the run's time)."""
+def _on_part(parts: Any, progress: Any, n: int, scenario: Any) -> Callable[[Any], None]:
+    """What each part's record goes to: its row in parts.csv (with its timestamp under a
+    calendar) and, on a run that shows its progress, the count (in chunks: a call per part
+    would show in the run's time)."""
+    from cell.sim.calendar import stamped
+
+    write = stamped(scenario, parts.record)
     if not progress.enabled:
-        return parts.record
-    step, write = max(1, n // 200), parts.record
+        return write
+    step = max(1, n // 200)
 
     def counted(record: Any) -> None:
         write(record)
@@ -130,8 +136,8 @@ def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) ->
 
 
 def _stops_anything(scenario: Any) -> bool:
-    """Whether the scenario can stop the cell (``failures:``, or ``wear:`` on)."""
-    return scenario.failures is not None or scenario.wear.enabled
+    """Whether the scenario can stop the cell (``failures:``, ``wear:`` on, or a calendar)."""
+    return scenario.failures is not None or scenario.wear.enabled or scenario.calendar is not None
 
 
 def _write_failures(out: Any, result: Any, stops: bool = True) -> None:
