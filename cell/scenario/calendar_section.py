@@ -30,6 +30,7 @@ DAYS = ("mon", "tue", "wed", "thu", "fri", "sat", "sun")
 DAY_S = 86_400.0
 WEEK_S = 7 * DAY_S
 Day = Literal["mon", "tue", "wed", "thu", "fri", "sat", "sun"]
+WEEKDAYS: tuple[Day, ...] = ("mon", "tue", "wed", "thu", "fri")
 #: ``"HH:MM"`` from 00:00 to 24:00 (24:00 only as an end: the day's midnight).
 Clock = str
 Span = tuple[Clock, Clock]
@@ -41,7 +42,7 @@ class CalendarSettings(Section):
     start: str
     """When the run starts, an ISO date and time (``2027-01-04T06:00``, a Monday): the
     calendar's timestamps count from it."""
-    days: list[Day] = Field(default_factory=lambda: ["mon", "tue", "wed", "thu", "fri"])
+    days: list[Day] = Field(default_factory=lambda: list(WEEKDAYS))
     """The working days of the week (``mon`` … ``sun``)."""
     shifts: list[Span]
     """Each working day's shifts, ``["06:00", "14:00"]``; one ending before it starts crosses

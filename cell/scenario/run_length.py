@@ -104,7 +104,9 @@ def horizon_s(s: Any) -> float | None:
         return None
     from cell.scenario.calendar_section import WEEK_S, days_end_s
 
-    return float(weeks * WEEK_S) if weeks is not None else days_end_s(s.calendar, int(days))
+    if weeks is not None:
+        return float(weeks * WEEK_S)
+    return None if days is None else days_end_s(s.calendar, days)
 
 
 def expected_parts(s: Any) -> float:
