@@ -125,11 +125,11 @@ class WeekPattern:
         k = np.clip(k, 0, self.starts.size - 1)
         return weeks * WEEK_S + self.starts[k] + (rest - cum[k]) - self.phase_s
 
-    def inside(self, t: float) -> bool:
-        """Whether instant ``t`` (s from the start) lies in the pattern."""
-        within = (t + self.phase_s) % WEEK_S
-        k = int(np.searchsorted(self.starts, within, side="right")) - 1
-        return k >= 0 and within < float(self.ends[k])
+    def inside(self, t: Any) -> Any:
+        """Whether each instant ``t`` (s from the start) lies in the pattern."""
+        within = np.mod(np.asarray(t, dtype=float) + self.phase_s, WEEK_S)
+        k = np.searchsorted(self.starts, within, side="right") - 1
+        return (k >= 0) & (within < self.ends[np.maximum(k, 0)])
 
     def spans(self, a: float, b: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The pattern's intervals within [a, b] on the run's clock, in time order."""

@@ -66,7 +66,7 @@ class Shifts:
         env, week, d = self.env, self.week, self.downtime
         while True:
             now = env.now
-            working = week.inside(now)
+            working = bool(week.inside(now))
             change = week.next_change(now)
             if working:
                 d.off_at = change
