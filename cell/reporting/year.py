@@ -60,7 +60,7 @@ def one_year(path: str, policy: str, crew: str, replication: int) -> list[dict[s
     """One run (a year): its rows of ``runs.csv``, shift by shift and the whole year."""
     from cell.scenario.calendar_section import working_week
     from cell.scenario.schema import load_scenario
-    from cell.sim import calendar, oee
+    from cell.sim import oee
     from cell.sim.simulation import simulate
 
     base = load_scenario(path)
@@ -76,13 +76,15 @@ def one_year(path: str, policy: str, crew: str, replication: int) -> list[dict[s
     seed = np.random.SeedSequence(s.run.seed, spawn_key=(replication,))
     result = simulate(s, seed, keep_parts=False, keep_belts=False, on_part=told)
     r, cal = result.summary, s.calendar
+    if cal is None:
+        raise ValueError(f"{path}: the worked year needs a calendar: section")
     end = r.sim_end_s
     t_down, t_lost = np.frombuffer(set_down), np.frombuffer(lost)
     rows = []
     shifts = [(f"{i + 1} ({a}-{b})", [(a, b)]) for i, (a, b) in enumerate(cal.shifts)]
     for name, hours in [*shifts, ("all", None)]:
         week = working_week(cal, s.source, hours, "calendar.shifts")
-        off = week.gaps(0.0, end) if hours is not None else calendar.off_spans(s, end)
+        off = week.gaps(0.0, end)
         seconds = oee.unit_seconds(None, result.downtime, end,  # type: ignore[arg-type]
                                    result.stop_rows, [off])
         made = int(np.count_nonzero(week.inside(t_down)))
