@@ -226,7 +226,8 @@ def measure(r: RunSummary, column: Callable[[str], np.ndarray], downtime: Any,
     r.parts_scrapped = int(np.count_nonzero(limits & LIMIT_BIT["scrapped"]))
     failures = sum(1 for name, cause, *_ in stops if _robot_down(name, cause))
     r.robot_failures = failures
-    robot_up_s = end_s * (1.0 - share["down"] - share["maintenance"])
+    # (with a calendar, MTBF and MTTR in working time: off shift is neither up nor down)
+    robot_up_s = end_s * (1.0 - share["down"] - share["maintenance"] - share.get("off_shift", 0.0))
     r.mtbf_observed_s = robot_up_s / failures if failures else math.nan
     r.mttr_observed_s = share["down"] * end_s / failures if failures else math.nan
     return lines

@@ -159,6 +159,9 @@ def test_availability_on_the_working_clock_is_mtbf_over_mtbf_plus_mttr(working_c
     a = MTBF_H / (MTBF_H + MTTR_H)
     se = math.sqrt(2 * MTBF_H ** 2 * MTTR_H ** 2 / ((MTBF_H + MTTR_H) ** 3 * t_h))
     assert abs((1.0 - r.loss_downtime) - a) < 4 * se
+    n = r.robot_failures  # observed MTBF and MTTR count working time: the drawn means
+    assert abs(r.mtbf_observed_s / 3600.0 - MTBF_H) < 4 * MTBF_H / math.sqrt(n)
+    assert abs(r.mttr_observed_s / 3600.0 - MTTR_H) < 4 * MTTR_H / math.sqrt(n)
 
 
 def test_run_days_and_weeks_end_where_the_calendar_says():
