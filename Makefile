@@ -94,6 +94,6 @@ clean:
 	rm -rf $(VENV) build .pytest_cache .hypothesis
 
 # The worked year on a shift calendar (issue 33): both policies, a repair crew on both shifts
-# against the first shift only, three years each (about 12 minutes on 2 cores).
+# against the first shift only, three years each (about 14 minutes on 2 cores shared with other work).
 year: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m cell.reporting.year scenarios/year.yaml reports/year --workers $(WORKERS)

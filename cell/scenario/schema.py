@@ -287,14 +287,14 @@ def _cross_checks(s: Scenario, file: object) -> None:
 
     check_arrivals(s.arrivals, s.base_dir, file)
     _length_and_failures(s, file)
-    from cell.scenario.calendar_checks import check_calendar
-
-    check_calendar(s, file)
 
 
 def _length_and_failures(s: Scenario, file: object) -> None:
     """``run.hours`` against ``run.parts``; the ``failures:`` section's times and the motors'
-    wear, against the run's length (what bounds the stops it brings)."""
+    wear, against the run's length (what bounds the stops it brings); the calendar."""
+    from cell.scenario.calendar_checks import check_calendar
+
+    check_calendar(s, file)
     timed = s.run.hours is not None or s.run.days is not None or s.run.weeks is not None
     if timed or s.failures is not None or s.wear.enabled:
         from cell.scenario.failure_spec import check_failures, check_wear

@@ -263,9 +263,8 @@ def simulate(scenario: Scenario | AssembledCell,
     acct = policy.accounting()
     env = simpy.Environment()
     tm = k.timing
-    # with failures (or shifts) the clocks never end: the run ends when its last part is done
-    stands = s.failures is not None or s.calendar is not None
-    finished = env.event() if stands and horizon is None else None
+    stands = s.failures is not None or s.calendar is not None  # clocks that never end: the
+    finished = env.event() if stands and horizon is None else None  # run ends with its last part
     log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows,
                  (tm.r1_length_in, tm.r2.length_in, tm.r3_length_in, tm.r4.length_in),
                  finished, n, state_energy.arm_energy_of(cell))
