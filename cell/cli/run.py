@@ -83,7 +83,7 @@ def main(args: argparse.Namespace) -> int:
             progress.update(done - progress.n)
         with out.open("summary.csv", newline="") as sf:
             RowWriter(sf, list(result.summary.as_dict())).record(result.summary)
-        if _stops_anything(scenario) or scenario.energy is not None:  # states.csv with energy
+        if _has_states(scenario):
             _write_failures(out, result, _stops_anything(scenario))
         if args.format == "parquet":
             _as_parquet(out)
@@ -128,7 +128,7 @@ def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) ->
           f"load (fastest cycle / mean inter-arrival) {r.offered_load:.3f}")
     written = RUN_FILES if args.format == "csv" else PARQUET_FILES
     if not _stops_anything(scenario):
-        also = ", states.csv" if scenario.energy is not None else ""  # energy: its states
+        also = ", states.csv" if _has_states(scenario) else ""
         print(f"wrote {shown}/{written[0]}, {written[1]}{also} and {written[2]}")
         return
     print(stops_line(r, scenario.failures))
@@ -136,8 +136,13 @@ def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) ->
 
 
 def _stops_anything(scenario: Any) -> bool:
-    """Whether the scenario can stop the cell (``failures:``, ``wear:`` on, or a calendar)."""
-    return scenario.failures is not None or scenario.wear.enabled or scenario.calendar is not None
+    """Whether the scenario can stop the cell (``failures:``, or ``wear:`` on)."""
+    return scenario.failures is not None or scenario.wear.enabled
+
+
+def _has_states(scenario: Any) -> bool:
+    """Whether states.csv is written: with stops, ``energy:`` (its states) or a calendar."""
+    return _stops_anything(scenario) or scenario.energy is not None or scenario.calendar is not None
 
 
 def _write_failures(out: Any, result: Any, stops: bool = True) -> None:

@@ -279,3 +279,11 @@ def days_end_s(cal: CalendarSettings, n: int) -> float:
                 if counted == n:
                     return max(ends)
         i += 1
+
+
+def describe(cal: CalendarSettings, file: object = "<calendar>") -> str:
+    """One line for a run's heading: the working week, and what it means for the run."""
+    week = working_week(cal, file)
+    return (f"from {cal.start}, {week.per_week_s / 3600.0:g} working hours a week "
+            f"({', '.join(cal.days)}); nothing comes and the cell stands off shift, and an "
+            f"arrivals profile counts working hours")

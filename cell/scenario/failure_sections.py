@@ -110,8 +110,9 @@ class MaintenanceSettings(Section):
     duration_min: float = finite(..., gt=0.0, le=MAX_HOURS * 60)
     """Minutes each stop lasts."""
     off_shift: bool = Field(False, strict=True)
-    """With a calendar: each stop waits, once due, for the cell's next time off shift (a break
-    or the end of a shift) and starts then, out of the planned busy time."""
+    """With a calendar: each stop waits, once due, until the cell stands for a time off shift
+    it fits in (a night, a weekend; the week's longest if none is long enough) and is done
+    then, out of the planned busy time."""
 
     @model_serializer(mode="wrap")
     def _given_only(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:

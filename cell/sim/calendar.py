@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 import simpy
 
-from cell.scenario.calendar_section import WeekPattern, working_week
+from cell.scenario.calendar_section import WEEK_S, WeekPattern, working_week
 from cell.scenario.failure_sections import FailureSettings
 from cell.sim.failure_clock import MOVING_NOT, Distributed
 
@@ -110,6 +110,16 @@ class Shifts:
                 e.clock.follow(MOVING_NOT if d.standing else 0)
             elif isinstance(e.exposure, WorkingTime):
                 e.clock.follow(e.exposure.leg)
+
+    def off_for(self, duration_s: float):  # noqa: ANN201 (SimPy generator)
+        """Until the cell stands for a time off shift at least ``duration_s`` long (or the
+        week's longest, if none is that long)."""
+        gaps_s, gaps_e = self.week.gaps(0.0, 2 * WEEK_S)  # each of the week's gaps whole
+        longest = float(np.max(gaps_e - gaps_s))
+        need = min(duration_s, longest) - 1e-6
+        while not (self.downtime.standing and
+                   self.week.next_change(self.env.now) - self.env.now >= need):
+            yield self.off
 
     def repair_s(self, work_s: float) -> float:
         """How long from now a repair of ``work_s`` seconds of crew time takes."""

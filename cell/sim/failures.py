@@ -216,16 +216,19 @@ class RobotStops:
         while True:
             self.maintenance_at = k * every_s
             yield env.timeout(max(k * every_s - env.now, 0.0))
-            if off_shift and shifts is not None and not self.cell.standing:
-                yield shifts.off  # the cell's next time off shift
+            if off_shift and shifts is not None:  # a time off shift it fits in (the cell stands)
+                yield from shifts.off_for(duration_s)
             self.maintenance_at = math.inf
-            if self.in_cycle or self.stop is not None:
+            if (self.in_cycle and not self.cell.standing) or self.stop is not None:
                 self.maintenance_due = env.event()
                 self.robot.free_at_s = math.inf  # no new part once back at B
                 yield self.maintenance_due
             else:
                 self.stop = "maintenance"
-                self.doing(STOPPED, math.inf)
+                if self.in_cycle:  # held off shift mid-cycle: held for the maintenance too
+                    self.touch()
+                else:
+                    self.doing(STOPPED, math.inf)
             key = self.cell.begin("robot", "maintenance", "")
             yield env.timeout(duration_s)
             self.cell.end(key)

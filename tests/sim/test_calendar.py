@@ -177,7 +177,8 @@ def test_run_days_and_weeks_end_where_the_calendar_says():
 
 
 def test_parts_csv_has_arrival_time_only_with_a_calendar(tmp_path: Path):
-    """parts.csv's ``arrival_time`` is the calendar's start plus ``arrival_s``."""
+    """parts.csv's ``arrival_time`` is the calendar's start plus ``arrival_s``; states.csv is
+    written, failures.csv only with failures."""
     import pandas as pd
 
     path = tmp_path / "s.yaml"
@@ -187,6 +188,8 @@ def test_parts_csv_has_arrival_time_only_with_a_calendar(tmp_path: Path):
     stamps = pd.to_datetime(parts["arrival_time"])
     back = (stamps - pd.Timestamp(START)).dt.total_seconds()
     np.testing.assert_allclose(back, parts["arrival_s"], atol=1e-3)
+    assert (tmp_path / "a" / "states.csv").is_file()  # off_shift shown; nothing failed:
+    assert not (tmp_path / "a" / "failures.csv").exists()  # no failures.csv
     assert main(["run", "baseline", "--set", "run.parts=40", "--out", str(tmp_path / "b")]) == 0
     assert "arrival_time" not in pd.read_csv(tmp_path / "b" / "parts.csv").columns
 
@@ -267,3 +270,22 @@ def test_a_profile_under_a_calendar_follows_the_working_hour_of_the_shift():
     share = np.mean(hour_of_shift < 2.0)
     p = 2.4 / (2.4 + 5.75)
     assert abs(share - p) < 4.5 * math.sqrt(p * (1 - p) / n)
+
+
+def test_maintenance_off_shift_waits_for_a_time_off_it_fits_in():
+    """Planned stops of 60 min every 20 h with ``off_shift``: each starts while the cell stands
+    for a night or a weekend (not a quarter-hour break) and ends before work resumes, so the
+    planned busy time is the whole working time; the adaptive robot, nearly always mid-cycle
+    at a shift's end, is maintained where it stands."""
+    s = default_scenario().with_overrides({
+        "calendar": TWO_SHIFTS, "run.weeks": 2,
+        "failures": {"maintenance": {"every_h": 20, "duration_min": 60, "off_shift": True}}})
+    r = simulate(s, 4, keep_parts=False, keep_belts=False)
+    work = working_spans(TWO_SHIFTS, r.summary.sim_end_s)
+    stops = [(a, b) for name, cause, a, b, _ in r.stop_rows if cause == "maintenance"]
+    assert len(stops) >= 10
+    for a, b in stops:
+        assert not any(s_ < a < e_ - 1e-6 for s_, e_ in work)  # off shift
+        nxt = min([s_ for s_, _ in work if s_ > a] or [np.inf])
+        assert b <= nxt + 1e-6  # done before work resumes: not in a quarter-hour break
+    assert r.summary.planned_time_s == pytest.approx(2 * 5 * 15.5 * 3600.0)
