@@ -289,3 +289,30 @@ def test_maintenance_off_shift_waits_for_a_time_off_it_fits_in():
         nxt = min([s_ for s_, _ in work if s_ > a] or [np.inf])
         assert b <= nxt + 1e-6  # done before work resumes: not in a quarter-hour break
     assert r.summary.planned_time_s == pytest.approx(2 * 5 * 15.5 * 3600.0)
+
+
+def crew_time(spans: list[tuple[float, float]], a: float, b: float) -> float:
+    return sum(max(0.0, min(e, b) - max(s_, a)) for s_, e in spans)
+
+
+def test_a_repair_takes_its_time_in_the_crews_hours():
+    """A crew on the first shift only (06:00-14:00 less its break): every repair ends in the
+    crew's hours, a failure in the second shift waits for the next morning, and the crew's
+    time from a failure to its repair (datetime's calendar) averages the drawn mean repair time,
+    MTTR = 0.5 h (exponential, unlimited crews: no wait for a crew; within 4 standard errors)."""
+    s = default_scenario().with_overrides({
+        "calendar": TWO_SHIFTS, "run.weeks": 12,
+        "arrivals": {"distribution": "expon", "mean_s": 900.0, "cv": 1.0},
+        "failures": {"robot": {"time_to_failure": {"distribution": "expon", "mean_h": 3},
+                               "time_to_repair": {"distribution": "expon", "mean_h": 0.5},
+                               "clock": "working"},
+                     "repair": {"hours": [["06:00", "14:00"]]}}})
+    r = simulate(s, 8, keep_parts=False, keep_belts=False)
+    end = r.summary.sim_end_s
+    crew = working_spans({**TWO_SHIFTS, "shifts": [["06:00", "14:00"]]}, end)
+    done = [(a, b) for name, _, a, b, _ in r.stop_rows if name == "robot" and b < end]
+    assert inside(np.array([b for _, b in done]), crew).all()
+    late = [(a, b) for a, b in done if not inside(np.array([a]), crew)[0]]
+    assert late and all(b - a > 8 * 3600.0 for a, b in late)  # waited overnight at least
+    hours = np.array([crew_time(crew, a, b) for a, b in done]) / 3600.0
+    assert abs(hours.mean() - 0.5) < 4 * 0.5 / math.sqrt(hours.size)
