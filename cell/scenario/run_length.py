@@ -78,11 +78,12 @@ def check_hours(s: Any, file: object) -> None:
         return
     key = timed[0]
     value = getattr(s.run, key)
-    others = [k for k in LENGTH_KEYS if k != key and (k in timed or (
-        k == "parts" and "parts" in s.run.model_fields_set))]
+    others = [k for k in timed if k != key] + \
+        (["parts"] if "parts" in s.run.model_fields_set else [])
     if others:
-        raise ScenarioError(file, f"run.{key}", value, f"give one of run.parts, run.hours, "
-                            f"run.days, run.weeks, not run.{key} and run.{others[0]}")
+        other = others[0]
+        raise ScenarioError(file, f"run.{key}", value, f"give run.{key} or run.{other} "
+                            f"({getattr(s.run, other)}), not both")
     if key in ("days", "weeks") and getattr(s, "calendar", None) is None:
         raise ScenarioError(file, f"run.{key}", value, "counts the working days of a "
                             "calendar: give a calendar: section, or run.hours")

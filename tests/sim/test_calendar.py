@@ -316,3 +316,12 @@ def test_a_repair_takes_its_time_in_the_crews_hours():
     assert late and all(b - a > 8 * 3600.0 for a, b in late)  # waited overnight at least
     hours = np.array([crew_time(crew, a, b) for a, b in done]) / 3600.0
     assert abs(hours.mean() - 0.5) < 4 * 0.5 / math.sqrt(hours.size)
+
+
+def test_two_run_lengths_are_refused(capsys, tmp_path: Path):
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(yaml.safe_dump({"calendar": TWO_SHIFTS, "run": {"days": 2, "weeks": 1}}))
+    assert main(["run", str(scenario), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"cell: error: {scenario}: run.days = 2") and "run.weeks" in err
+    assert not (tmp_path / "out").exists()
