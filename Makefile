@@ -11,7 +11,7 @@ WORKERS ?= 2
 export PYTHONDONTWRITEBYTECODE :=
 export PYTHONPYCACHEPREFIX := $(if $(filter /%,$(VENV)),$(VENV),$(CURDIR)/$(VENV))/pycache
 
-.PHONY: all venv test sweep sweep-mintime whatif stress sensor reliability figures animation bench lint clean optimize sensitivity kn-check
+.PHONY: all venv test year sweep sweep-mintime whatif stress sensor reliability figures animation bench lint clean optimize sensitivity kn-check
 
 all: test
 
@@ -92,3 +92,8 @@ lint: $(STAMP)
 
 clean:
 	rm -rf $(VENV) build .pytest_cache .hypothesis
+
+# The worked year on a shift calendar (issue 33): both policies, a repair crew on both shifts
+# against the first shift only, three years each (about 14 minutes on 2 cores shared with other work).
+year: $(STAMP)
+	MPLBACKEND=Agg $(PY) -m cell.reporting.year scenarios/year.yaml reports/year --workers $(WORKERS)

@@ -73,15 +73,17 @@ def main(args: argparse.Namespace) -> int:
             Progress(n, "cell run", "parts", enabled=n >= PROGRESS_FROM_PARTS) as progress:
         with out.open("parts.csv", newline="") as pf, out.open("belts.csv", newline="") as bf:
             arm = scenario.energy is not None and scenario.energy.arm == "dynamics"  # energy_j
-            parts, belts = RowWriter(pf, PART_COLUMNS + ["energy_j"] * arm), RowWriter(bf, BELT_COLUMNS)
-            result = simulate(cell, keep_parts=False, on_part=_on_part(parts, progress, n),
+            timed = scenario.calendar is not None  # arrival_time
+            parts = RowWriter(pf, PART_COLUMNS + ["energy_j"] * arm + ["arrival_time"] * timed)
+            belts = RowWriter(bf, BELT_COLUMNS)
+            result = simulate(cell, keep_parts=False, on_part=_on_part(parts, progress, n, scenario),
                               on_belt=belts.record, keep_belts=False)
             done = result.summary.parts_arrived if scenario.run.hours is not None else n
             progress.grow(done - progress.total)
             progress.update(done - progress.n)
         with out.open("summary.csv", newline="") as sf:
             RowWriter(sf, list(result.summary.as_dict())).record(result.summary)
-        if _stops_anything(scenario) or scenario.energy is not None:  # states.csv with energy
+        if _has_states(scenario):
             _write_failures(out, result, _stops_anything(scenario))
         if args.format == "parquet":
             _as_parquet(out)
@@ -89,12 +91,16 @@ def main(args: argparse.Namespace) -> int:
     return 0
 
 
-def _on_part(parts: Any, progress: Any, n: int) -> Callable[[Any], None]:
-    """What each part's record goes to: its row in parts.csv and, on a run that shows its
-    progress, the count (in chunks: a call per part would show in the run's time)."""
+def _on_part(parts: Any, progress: Any, n: int, scenario: Any) -> Callable[[Any], None]:
+    """What each part's record goes to: its row in parts.csv (with its timestamp under a
+    calendar) and, on a run that shows its progress, the count (in chunks: a call per part
+    would show in the run's time)."""
+    from cell.sim.calendar import stamped
+
+    write = stamped(scenario, parts.record)
     if not progress.enabled:
-        return parts.record
-    step, write = max(1, n // 200), parts.record
+        return write
+    step = max(1, n // 200)
 
     def counted(record: Any) -> None:
         write(record)
@@ -122,7 +128,7 @@ def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) ->
           f"load (fastest cycle / mean inter-arrival) {r.offered_load:.3f}")
     written = RUN_FILES if args.format == "csv" else PARQUET_FILES
     if not _stops_anything(scenario):
-        also = ", states.csv" if scenario.energy is not None else ""  # energy: its states
+        also = ", states.csv" if _has_states(scenario) else ""
         print(f"wrote {shown}/{written[0]}, {written[1]}{also} and {written[2]}")
         return
     print(stops_line(r, scenario.failures))
@@ -132,6 +138,11 @@ def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) ->
 def _stops_anything(scenario: Any) -> bool:
     """Whether the scenario can stop the cell (``failures:``, or ``wear:`` on)."""
     return scenario.failures is not None or scenario.wear.enabled
+
+
+def _has_states(scenario: Any) -> bool:
+    """Whether states.csv is written: with stops, ``energy:`` (its states) or a calendar."""
+    return _stops_anything(scenario) or scenario.energy is not None or scenario.calendar is not None
 
 
 def _write_failures(out: Any, result: Any, stops: bool = True) -> None:

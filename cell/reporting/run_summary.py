@@ -42,6 +42,10 @@ def run_heading(cell: AssembledCell) -> str:
                f"nominal cycle {k.cycle_nom:.4f} s ({source}); mean inter-arrival "
                f"{k.mean_interarrival_s:.4f} s; the robot's fastest cycle {k.fastest_cycle_s:.4f} "
                f"s: offered load {k.offered_load:.3f}")
+    if s.calendar is not None:
+        from cell.scenario.calendar_section import describe as week
+
+        heading += f"\ncalendar: {week(s.calendar, s.source)}"
     if s.arrivals.profile is not None:
         from cell.scenario.rate_profile import describe
 

@@ -72,9 +72,10 @@ class EquipmentFailures(Section):
     """Time from a repair to the next failure, counted on ``clock``."""
     time_to_repair: TimeDistribution
     """Time a repair takes once a crew is on it."""
-    clock: Literal["operating", "calendar"] = "operating"
+    clock: Literal["operating", "calendar", "working"] = "operating"
     """``operating``: the failure clock runs only while the equipment works (the robot in
-    motion); ``calendar``: whenever it is up."""
+    motion); ``calendar``: whenever it is up; ``working``: whenever it is up in the calendar's
+    working time (needs a ``calendar:`` section)."""
 
 
 class RobotFailures(EquipmentFailures):
@@ -89,6 +90,16 @@ class RepairSettings(Section):
 
     crews: int = Field(1, strict=True, ge=1, le=1000)
     """Crews working at once."""
+    hours: list[tuple[str, str]] | None = None
+    """With a calendar: the crews' hours on the calendar's working days, clock spans as its
+    shifts (``[["06:00", "14:00"]]``: the first shift only), less its breaks; a repair stands
+    outside them.  Absent: the calendar's working time."""
+
+    @model_serializer(mode="wrap")
+    def _given_only(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """``hours`` only where given: a section without it dumps as before it existed."""
+        d: dict[str, Any] = handler(self)
+        return {k: v for k, v in d.items() if k != "hours" or v is not None}
 
 
 class MaintenanceSettings(Section):
@@ -98,6 +109,16 @@ class MaintenanceSettings(Section):
     """Hours between the starts of planned stops (from the start of the run)."""
     duration_min: float = finite(..., gt=0.0, le=MAX_HOURS * 60)
     """Minutes each stop lasts."""
+    off_shift: bool = Field(False, strict=True)
+    """With a calendar: each stop waits, once due, until the cell stands for a time off shift
+    it fits in (a night, a weekend; the week's longest if none is long enough) and is done
+    then, out of the planned busy time."""
+
+    @model_serializer(mode="wrap")
+    def _given_only(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """``off_shift`` only when true: a section without it dumps as before it existed."""
+        d: dict[str, Any] = handler(self)
+        return {k: v for k, v in d.items() if k != "off_shift" or v}
 
 
 class FailureSettings(Section):

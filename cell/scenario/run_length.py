@@ -1,6 +1,7 @@
-"""How long a run may be: ``run.parts`` and ``run.hours`` are exclusive, and the parts an
-hours-long run would bring stay within the bound on parts (checked where a scenario is read;
-:mod:`cell.sim.horizon` draws the run's arrivals and runs it to its end)."""
+"""How long a run may be: ``run.parts``, ``run.hours``, and with a calendar ``run.days`` and
+``run.weeks``, one of them; the parts a run of a time would bring stay within the bound on
+parts (checked where a scenario is read; :mod:`cell.sim.horizon` draws the run's arrivals and
+runs it to its end)."""
 
 from __future__ import annotations
 
@@ -20,12 +21,15 @@ class RunLength:
 
     count: float
     unit: str
-    """``part`` or ``hour``."""
+    """``part``, ``hour``, ``day`` (working days of a calendar) or ``week``."""
 
     @classmethod
     def of(cls, run: Any) -> RunLength:
         """A scenario's ``run`` section's length."""
-        return cls(run.parts, "part") if run.hours is None else cls(run.hours, "hour")
+        for key in LENGTH_KEYS[1:]:
+            if getattr(run, key, None) is not None:
+                return cls(getattr(run, key), key[:-1])
+        return cls(run.parts, "part")
 
     @property
     def number(self) -> str:
@@ -42,8 +46,8 @@ class RunLength:
         return f"{self.number} {self.unit}{'s' if self.count != 1 else ''}"
 
 
-#: The keys of ``run`` that set its length; a scenario gives one or the other.
-LENGTH_KEYS = ("parts", "hours")
+#: The keys of ``run`` that set its length; a scenario gives one of them.
+LENGTH_KEYS = ("parts", "hours", "days", "weeks")
 
 
 def lengths_given(layer: Mapping[str, Any], dotted: bool) -> set[str]:
@@ -58,42 +62,76 @@ def lengths_given(layer: Mapping[str, Any], dotted: bool) -> set[str]:
 
 def keep_one_length(raw: dict[str, Any], given: set[str]) -> None:
     """A layer (a file over the defaults, ``--set`` over a file) that gives the run's length one
-    way sets it: the other key, from the layers below, goes from ``raw``.  A layer that gives
-    both keeps both, for :func:`check_hours` to refuse."""
+    way sets it: the other keys, from the layers below, go from ``raw``.  A layer that gives
+    two keeps both, for :func:`check_hours` to refuse."""
     run = raw.get("run")
     if len(given) == 1 and isinstance(run, Mapping):
-        (other,) = set(LENGTH_KEYS) - given
-        raw["run"] = {k: v for k, v in run.items() if k != other}
+        raw["run"] = {k: v for k, v in run.items() if k in given or k not in LENGTH_KEYS}
 
 
 def check_hours(s: Any, file: object) -> None:
-    """``run.hours`` and ``run.parts`` are exclusive (both *given*, whatever their values); the
-    parts an hours-long run brings stay within the bound on parts."""
-    hours = s.run.hours
-    if hours is None:
+    """``run.parts``, ``run.hours``, ``run.days`` and ``run.weeks`` are exclusive (two *given*,
+    whatever their values); days and weeks need a calendar; the parts a run of a time brings
+    stay within the bound on parts."""
+    timed = [k for k in LENGTH_KEYS[1:] if getattr(s.run, k, None) is not None]
+    if not timed:
         return
-    if "parts" in s.run.model_fields_set:
-        raise ScenarioError(file, "run.hours", hours, f"give run.hours or run.parts "
-                            f"({s.run.parts}), not both")
+    key = timed[0]
+    value = getattr(s.run, key)
+    others = [k for k in timed if k != key] + \
+        (["parts"] if "parts" in s.run.model_fields_set else [])
+    if others:
+        other = others[0]
+        raise ScenarioError(file, f"run.{key}", value, f"give run.{key} or run.{other} "
+                            f"({getattr(s.run, other)}), not both")
+    if key in ("days", "weeks") and getattr(s, "calendar", None) is None:
+        raise ScenarioError(file, f"run.{key}", value, "counts the working days of a "
+                            "calendar: give a calendar: section, or run.hours")
     from cell.scenario.sections import MAX_PARTS
 
     expected = expected_parts(s)
     if expected > MAX_PARTS:
-        raise ScenarioError(file, "run.hours", hours, f"about {expected:.3g} parts would come; "
+        raise ScenarioError(file, f"run.{key}", value, f"about {expected:.3g} parts would come; "
                             f"at most {MAX_PARTS:g} a run")
 
 
+def horizon_s(s: Any) -> float | None:
+    """The run's length in seconds from its start when given as a time (``run.hours``,
+    ``run.days``, ``run.weeks``), else None."""
+    if s.run.hours is not None:
+        return float(s.run.hours * SECONDS_PER_HOUR)
+    days, weeks = getattr(s.run, "days", None), getattr(s.run, "weeks", None)
+    if days is None and weeks is None:
+        return None
+    from cell.scenario.calendar_section import WEEK_S, days_end_s
+
+    if weeks is not None:
+        return float(weeks * WEEK_S)
+    return None if days is None else days_end_s(s.calendar, days)
+
+
 def expected_parts(s: Any) -> float:
-    """The parts a run brings: ``run.parts``, or about ``run.hours`` over the mean
-    inter-arrival time (what an hours-long run's progress counts towards)."""
-    if s.run.hours is None:
+    """The parts a run brings: ``run.parts``, or about its working time over the mean
+    inter-arrival time (what a run of a time's progress counts towards)."""
+    horizon = horizon_s(s)
+    if horizon is None:
         return float(s.run.parts)
-    return float(s.run.hours * SECONDS_PER_HOUR / mean_interarrival(s.arrivals, s.base_dir))
+    return float(working_s(s, horizon) / mean_interarrival(s.arrivals, s.base_dir))
+
+
+def working_s(s: Any, t: float) -> float:
+    """The working time in the run's first ``t`` seconds: all of it without a calendar."""
+    if getattr(s, "calendar", None) is None:
+        return t
+    from cell.scenario.calendar_section import working_week
+
+    return float(working_week(s.calendar, s.source).measure(t))
 
 
 def expected_seconds(s: Any) -> float:
-    """The run's length in simulated time: ``run.hours``, or ``run.parts`` mean inter-arrival
+    """The run's length in simulated time: its horizon, or ``run.parts`` mean inter-arrival
     times (what bounds the stops a run can bring: :mod:`cell.scenario.failure_spec`)."""
-    if s.run.hours is not None:
-        return float(s.run.hours * SECONDS_PER_HOUR)
+    horizon = horizon_s(s)
+    if horizon is not None:
+        return horizon
     return float(s.run.parts * mean_interarrival(s.arrivals, s.base_dir))

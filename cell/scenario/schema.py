@@ -20,6 +20,7 @@ from typing import Any
 from pydantic import BaseModel, PrivateAttr, ValidationError
 
 from cell.plumbing.errors import ScenarioError
+from cell.scenario.calendar_section import CalendarSettings
 from cell.scenario.energy_sections import (  # noqa: F401 - the schema, re-exported
     CostSettings,
     EnergySettings,
@@ -89,6 +90,10 @@ class Scenario(Section):
     """Money: lost parts, energy, downtime, repairs, maintenance, options (docs/usage.md, "Energy
     and cost"); absent: no cost measured."""
 
+    calendar: CalendarSettings | None = None
+    """The plant's working week: shifts, breaks, working days (docs/usage.md, "A shift
+    calendar"); absent: the cell works without a break from the run's start."""
+
     _source: str = PrivateAttr(default="<defaults>")
 
     @property
@@ -113,10 +118,13 @@ class Scenario(Section):
         default only when given (so a scenario without them reads as it did before they
         existed), and with ``run.hours`` no ``run.parts`` (the run's length is given one way)."""
         d = _plain(self.model_dump())
-        for optional in ("failures", "energy", "costs"):
+        for optional in ("failures", "energy", "costs", "calendar"):
             if d.get(optional) is None:
                 d.pop(optional, None)
-        d["run"].pop("hours" if d["run"].get("hours") is None else "parts", None)
+        given = [k for k in ("hours", "days", "weeks") if d["run"].get(k) is not None]
+        for k in ("hours", "days", "weeks", *(["parts"] if given else [])):
+            if k not in given:
+                d["run"].pop(k, None)
         if d["arrivals"].get("profile") is None:
             d["arrivals"].pop("profile", None)
         if d["quality"] == QualitySettings().model_dump():
@@ -283,8 +291,12 @@ def _cross_checks(s: Scenario, file: object) -> None:
 
 def _length_and_failures(s: Scenario, file: object) -> None:
     """``run.hours`` against ``run.parts``; the ``failures:`` section's times and the motors'
-    wear, against the run's length (what bounds the stops it brings)."""
-    if s.run.hours is not None or s.failures is not None or s.wear.enabled:
+    wear, against the run's length (what bounds the stops it brings); the calendar."""
+    from cell.scenario.calendar_checks import check_calendar
+
+    check_calendar(s, file)
+    timed = s.run.hours is not None or s.run.days is not None or s.run.weeks is not None
+    if timed or s.failures is not None or s.wear.enabled:
         from cell.scenario.failure_spec import check_failures, check_wear
         from cell.scenario.run_length import check_hours, expected_seconds
 

@@ -271,8 +271,14 @@ class RunSettings(Section):
     """Root of every random stream (numpy SeedSequence)."""
     hours: float | None = finite(None, gt=0.0, le=MAX_HOURS)
     """The run's length in hours instead of parts: the parts that come in that time, the run
-    stopped at its end (parts still in the cell then are counted as such).  Give run.hours
-    or run.parts, not both."""
+    stopped at its end (parts still in the cell then are counted as such).  Give one of
+    run.parts, run.hours, run.days and run.weeks."""
+    days: int | None = Field(None, strict=True, ge=1, le=36_600)
+    """With a calendar: the run's length in working days (days of the calendar with working
+    time, counted from the start's date), the run stopped at the end of the last one's last
+    shift."""
+    weeks: int | None = Field(None, strict=True, ge=1, le=5_200)
+    """With a calendar: the run's length in whole weeks (7 × 24 h from the start)."""
 
 
 class MinTimeSettings(Section):

@@ -65,7 +65,9 @@ class Equipment:
         request = crews.request() if crews is not None else None
         if request is not None:
             yield request
-        yield env.timeout(self.repair())
+        work = self.repair()
+        shifts = self.cell.shifts  # a calendar: the repair in its crew's hours
+        yield env.timeout(work if shifts is None else shifts.repair_s(work))
         if request is not None:
             crews.release(request)  # type: ignore[union-attr]
         self.down = False
@@ -133,7 +135,7 @@ class RobotStops:
     def held(self, leg: int) -> bool:
         """Whether the robot is held now in ``leg``: stopped, or tracking a stopped belt."""
         belt = self.cell.input_belt if leg == 0 else self.cell.output_belt if leg == 3 else None
-        return self.stop is not None or (belt is not None and belt.stopped)
+        return self.stop is not None or self.cell.standing or (belt is not None and belt.stopped)
 
     def touch(self) -> None:
         """Something that can hold the robot changed: its legs look again."""
@@ -208,20 +210,25 @@ class RobotStops:
         else:
             self.at_rest()
 
-    def maintenance(self, every_s: float, duration_s: float):  # noqa: ANN201 (SimPy generator)
-        env = self.env
+    def maintenance(self, every_s: float, duration_s: float, off_shift: bool = False):  # noqa: ANN201
+        env, shifts = self.env, self.cell.shifts
         k = 1
         while True:
             self.maintenance_at = k * every_s
             yield env.timeout(max(k * every_s - env.now, 0.0))
+            if off_shift and shifts is not None:  # a time off shift it fits in (the cell stands)
+                yield from shifts.off_for(duration_s)
             self.maintenance_at = math.inf
-            if self.in_cycle or self.stop is not None:
+            if (self.in_cycle and not self.cell.standing) or self.stop is not None:
                 self.maintenance_due = env.event()
                 self.robot.free_at_s = math.inf  # no new part once back at B
                 yield self.maintenance_due
             else:
                 self.stop = "maintenance"
-                self.doing(STOPPED, math.inf)
+                if self.in_cycle:  # held off shift mid-cycle: held for the maintenance too
+                    self.touch()
+                else:
+                    self.doing(STOPPED, math.inf)
             key = self.cell.begin("robot", "maintenance", "")
             yield env.timeout(duration_s)
             self.cell.end(key)
@@ -259,6 +266,13 @@ class Downtime:
         self.input_belt: Any = None
         self.output_belt: Any = None
         self.equipment: list[Equipment] = []
+        self.shifts: Any = None
+        """A calendar's shifts (:class:`cell.sim.calendar.Shifts`), None without one."""
+        self.standing = False
+        """True while the cell stands off shift."""
+        self.off_at = math.inf
+        """When the cell next stands off shift (now, while it stands; inf: never)."""
+        self.conveyors: tuple[Any, ...] = ()
         self._belt_clocks: list[Equipment] = []
         self._open: dict[int, tuple[str, str, float, Any]] = {}
         self._next = 0
@@ -269,10 +283,12 @@ class Downtime:
         f, rs = self.spec, self.robot
         self.log, self.output = log, output
         self.input_belt, self.output_belt = conveyor.belt, output.belt
+        self.conveyors = (conveyor, output)
 
         def belt(which: Any, stop: bool) -> Callable[[], Any]:
             def change() -> str:
-                (which.stop if stop else which.restart)(self.env.now)
+                if stop != which.belt.stopped and (stop or not self.standing):  # off shift: stands
+                    (which.stop if stop else which.restart)(self.env.now)
                 rs.touch()
                 return ""
             return change
@@ -309,10 +325,16 @@ class Downtime:
                 self._belt_clocks.append(e)
         m = self.spec.maintenance
         if m is not None:
-            self.env.process(rs.maintenance(m.every_h * SECONDS_PER_HOUR, m.duration_min * 60.0))
+            self.env.process(rs.maintenance(m.every_h * SECONDS_PER_HOUR, m.duration_min * 60.0,
+                                            m.off_shift))
+        if self.shifts is not None:
+            self.shifts.start()
 
     def clear_until(self, t: float, name: str | None = None) -> bool:
-        """Whether the belts (or the one named) run now and cannot fail before ``t``."""
+        """Whether the belts (or the one named) run now and cannot fail (or stand off shift)
+        before ``t``."""
+        if t >= self.off_at:
+            return False
         for e in self._belt_clocks:
             if (name is None or e.name == name) and (e.down or e.clock.due_s <= t):  # type: ignore[union-attr]
                 return False

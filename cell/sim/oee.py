@@ -69,19 +69,22 @@ def _busy(column: Callable[[str], np.ndarray], downtime: Any, end_s: float
 
 
 def timelines(column: Callable[[str], np.ndarray], downtime: Any, end_s: float,
-              stops: Sequence[tuple[str, str, float, float, Any]] = ()
+              stops: Sequence[tuple[str, str, float, float, Any]] = (),
+              off_shift: tuple[np.ndarray, np.ndarray] | None = None
               ) -> dict[str, list[tuple[str, float, float]]]:
     """Each piece of equipment's (state, from, to) over [0, end_s]; ``column`` gives the run
     log's per-part values (every part, warm-up included); ``stops``: the run's (failures.csv's
-    rows, as :meth:`cell.sim.failures.Downtime.all_stops` gives them)."""
+    rows, as :meth:`cell.sim.failures.Downtime.all_stops` gives them); ``off_shift``: a
+    calendar's time off shift, every equipment's state ``off_shift`` then (before any other)."""
+    off = [] if off_shift is None else [("off_shift", *off_shift)]
     out = {"robot": states(end_s, [
-        ("down", *_spans(stops, _robot_down)), ("maintenance", *_spans(stops, _maintenance)),
+        *off, ("down", *_spans(stops, _robot_down)), ("maintenance", *_spans(stops, _maintenance)),
         ("busy", *_busy(column, downtime, end_s)), ("waiting", column("arrival"),
                                                      column("at_bot"))], "idle")}
     for belt in ("input_belt", "output_belt"):
-        out[belt] = states(end_s, [("down", *_spans(stops, _named(belt)))], "running")
+        out[belt] = states(end_s, [*off, ("down", *_spans(stops, _named(belt)))], "running")
     if downtime is not None and downtime.spec.sensor is not None:
-        out["sensor"] = states(end_s, [("down", *_spans(stops, lambda n, c: n == "sensor"))],
+        out["sensor"] = states(end_s, [*off, ("down", *_spans(stops, lambda n, c: n == "sensor"))],
                                "up")
     return out
 
@@ -195,7 +198,8 @@ def oee_figures(seconds: dict[str, float], cycle_s: float, produced: int, good: 
 
 def measure(r: RunSummary, column: Callable[[str], np.ndarray], downtime: Any,
             nominal_cycle_s: float, end_s: float,
-            stops: list[tuple[str, str, float, float, Any]], quality_rule: str = "set_down"
+            stops: list[tuple[str, str, float, float, Any]], quality_rule: str = "set_down",
+            off_shift: tuple[np.ndarray, np.ndarray] | None = None
             ) -> dict[str, list[tuple[str, float, float]]]:
     """Fill the summary's time shares, OEE (ISO 22400-2) and reliability figures from the
     run's ``stops`` (failures.csv's rows: its failures', or wear's alone); the timelines (with
@@ -205,14 +209,15 @@ def measure(r: RunSummary, column: Callable[[str], np.ndarray], downtime: Any,
         lines: dict[str, list[tuple[str, float, float]]] = {}
         share = fast_shares(column, end_s)
     else:
-        lines = timelines(column, downtime, end_s, stops)
+        lines = timelines(column, downtime, end_s, stops, off_shift)
         share = fractions(lines["robot"], end_s, ROBOT_STATES)
     r.robot_busy_fraction, r.robot_waiting_fraction = share["busy"], share["waiting"]
     r.robot_idle_fraction, r.robot_down_fraction = share["idle"], share["down"]
     r.robot_maintenance_fraction = share["maintenance"]
     produced, good = produced_and_good(column, quality_rule)
-    figures = oee_figures(unit_seconds(column, downtime, end_s, stops), nominal_cycle_s,
-                          produced, good)
+    planned_off = () if off_shift is None else (off_shift,)
+    figures = oee_figures(unit_seconds(column, downtime, end_s, stops, planned_off),
+                          nominal_cycle_s, produced, good)
     for name, value in figures.items():
         setattr(r, name, value)
     r.service_level = r.parts_delivered / r.parts_arrived if r.parts_arrived else math.nan
@@ -221,7 +226,8 @@ def measure(r: RunSummary, column: Callable[[str], np.ndarray], downtime: Any,
     r.parts_scrapped = int(np.count_nonzero(limits & LIMIT_BIT["scrapped"]))
     failures = sum(1 for name, cause, *_ in stops if _robot_down(name, cause))
     r.robot_failures = failures
-    robot_up_s = end_s * (1.0 - share["down"] - share["maintenance"])
+    # (with a calendar, MTBF and MTTR in working time: off shift is neither up nor down)
+    robot_up_s = end_s * (1.0 - share["down"] - share["maintenance"] - share.get("off_shift", 0.0))
     r.mtbf_observed_s = robot_up_s / failures if failures else math.nan
     r.mttr_observed_s = share["down"] * end_s / failures if failures else math.nan
     return lines

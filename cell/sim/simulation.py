@@ -32,7 +32,7 @@ import numpy as np
 import simpy
 
 from cell.scenario.schema import Scenario
-from cell.sim import accounting, oee, run_cost, state_energy, wear_clock
+from cell.sim import accounting, calendar, oee, run_cost, state_energy, wear_clock
 from cell.sim.assembly import AssembledCell, assemble
 from cell.sim.bound import parts_bound
 from cell.sim.failures import Downtime
@@ -263,16 +263,17 @@ def simulate(scenario: Scenario | AssembledCell,
     acct = policy.accounting()
     env = simpy.Environment()
     tm = k.timing
-    # with failures the clocks never end: the run ends when its last part is done
-    finished = env.event() if s.failures is not None and horizon is None else None
+    stands = s.failures is not None or s.calendar is not None  # clocks that never end: the
+    finished = env.event() if stands and horizon is None else None  # run ends with its last part
     log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows,
                  (tm.r1_length_in, tm.r2.length_in, tm.r3_length_in, tm.r4.length_in),
                  finished, n, state_energy.arm_energy_of(cell))
-    downtime = None if s.failures is None else Downtime(env, s.failures, seed)
+    downtime = None if not stands else Downtime(env, s.failures or calendar.NO_FAILURES, seed)
     wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
     station = Station(env, cell, seed, log.delivered_part, belts.told, downtime)
     feeder = Feeder(env, t_list, station.input, n, k.part_size, log.flag)
     station.control(feeder.fed_s, n, log)
+    calendar.keep(env, s, downtime)  # a calendar's shifts, started with the failure clocks
     if downtime is None and horizon is None:
         env.run()
     else:
@@ -285,7 +286,8 @@ def simulate(scenario: Scenario | AssembledCell,
     wear = None if station.wear is None else station.wear.log  # wear: without failures
     stops = downtime.all_stops(env.now) if downtime is not None else \
         wear_clock.stop_rows(wear, env.now)  # failures.csv's rows
-    lines = oee.measure(summary, log.column, downtime, k.cycle_nom, env.now, stops, s.quality.rule)
+    lines = oee.measure(summary, log.column, downtime, k.cycle_nom, env.now, stops, s.quality.rule,
+                        calendar.off_spans(s, env.now))
     lines = state_energy.measure(summary, s, lines, log, downtime, env.now, stops)
     run_cost.measure(summary, s, stops, log.column)
     summary.seed = _seed_value(seed)

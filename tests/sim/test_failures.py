@@ -261,7 +261,7 @@ def test_the_shares_summed_without_failures_are_the_timelines(name, monkeypatch)
 
     monkeypatch.setattr(sim.oee, "measure", grab)
     simulate(load_scenario(name, {"run.parts": 400}), keep_parts=False, keep_belts=False)
-    _, column, _, _, end, stops, _ = seen["args"]
+    _, column, _, _, end, stops, *_ = seen["args"]
     assert stops == []  # no failures, no wear: nothing stops the cell
     fast = oee.fast_shares(column, end)
     full = oee.fractions(oee.timelines(column, None, end)["robot"], end, oee.ROBOT_STATES)
