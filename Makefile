@@ -11,6 +11,8 @@ WORKERS ?= 2
 export PYTHONDONTWRITEBYTECODE :=
 export PYTHONPYCACHEPREFIX := $(if $(filter /%,$(VENV)),$(VENV),$(CURDIR)/$(VENV))/pycache
 
+
+.PHONY: learn benchmark
 .PHONY: all venv test sweep sweep-mintime whatif stress sensor reliability figures animation bench lint clean optimize sensitivity kn-check
 
 all: test
@@ -92,3 +94,13 @@ lint: $(STAMP)
 
 clean:
 	rm -rf $(VENV) build .pytest_cache .hypothesis
+
+# The learned controller's network retrained (issue 36 item 3): CMA-ES, the optional extra [rl],
+# seeded, about 6 minutes on one core of this 2-core machine; writes cell/rl/weights/learned.json.
+learn: $(STAMP)
+	$(PY) -m pip install -qq --no-compile -e ".[rl]"
+	$(PY) -m cell.rl.train
+
+# The benchmark (issue 36 item 4): every controller's parts against the hindsight optimum.
+benchmark: $(STAMP)
+	MPLBACKEND=Agg $(PY) -m cell.reporting.benchmark reports/benchmark
