@@ -1,0 +1,75 @@
+"""The learned controller is a plug-in policy like any other: cell run, cell compare, cell sweep
+and the stress map take it by name; with a zero network it is the thesis's adaptive decision,
+and running it needs no training library."""
+
+from __future__ import annotations
+
+import csv
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from cell.cli.main import main
+from cell.rl.learned import Learned, load_weights, size
+from cell.scenario.schema import load_scenario
+from cell.sim.assembly import AssembledCell, assemble
+from cell.sim.simulation import simulate
+
+STRESSED = {"arrivals.distribution": "gamma", "arrivals.cv": 1.0, "arrivals.mean_s": 17.1799,
+            "controller.nominal_cycle_s": None, "sensor.lookahead": "sensor", "run.parts": 80}
+
+
+def test_a_zero_network_is_the_adaptive_decision() -> None:
+    s = load_scenario("baseline", {**STRESSED, "controller.policy": "adaptive"})
+    cell = assemble(s)
+    zero = AssembledCell(s, cell.timing, cell.k, Learned(cell.k, s.controller, None,
+                                                         np.zeros(size())))
+    a, b = simulate(cell, seed=3).records, simulate(zero, seed=3).records
+    assert [repr(r) for r in a] == [repr(r) for r in b]
+
+
+def test_the_committed_weights_change_the_decisions() -> None:
+    assert load_weights().shape == (size(),) and np.abs(load_weights()).max() > 0
+    s = load_scenario("baseline", STRESSED)
+    learned = simulate(s.with_overrides({"controller.policy": "learned"}), seed=3).records
+    adaptive = simulate(s.with_overrides({"controller.policy": "adaptive"}), seed=3).records
+    assert [r.input_speed_in_s for r in learned] != [r.input_speed_in_s for r in adaptive]
+
+
+def test_cell_run_takes_it_without_a_training_library(tmp_path: Path) -> None:
+    code = ("import sys; from cell.cli.main import main; "
+            f"rc = main(['run', 'baseline', '--out', {str(tmp_path / 'r')!r}, '--set', "
+            "'controller.policy=learned', '--set', 'run.parts=30']); "
+            "print(rc, 'cma' in sys.modules, 'torch' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split()[-3:] == ["0", "False", "False"]
+    with open(tmp_path / "r" / "summary.csv", newline="") as f:
+        assert next(csv.DictReader(f))["policy"] == "learned"
+
+
+def test_cell_compare_takes_it(tmp_path: Path) -> None:
+    a, b = tmp_path / "learned.yaml", tmp_path / "adaptive.yaml"
+    for path, policy in ((a, "learned"), (b, "adaptive")):
+        path.write_text(f"name: {policy}\ncontroller:\n  policy: {policy}\nrun:\n  parts: 40\n")
+    assert main(["compare", str(a), str(b), "--replications", "3", "--workers", "1",
+                 "--out", str(tmp_path / "c")]) == 0
+    reps = pd.read_csv(tmp_path / "c" / "replications.csv")
+    assert set(reps["policy"]) == {"learned", "adaptive"}
+
+
+def test_a_sweep_and_the_stress_map_take_it(tmp_path: Path, unrendered: None) -> None:
+    from cell.reporting.maps import stress
+
+    sweep = tmp_path / "sweep.yaml"
+    sweep.write_text(
+        "name: tiny\nbase: baseline\nset:\n  run.parts: 40\n  controller.nominal_cycle_s: null\n"
+        "  sensor.lookahead: sensor\ngrid:\n  arrivals.distribution: [gamma]\n"
+        "  arrivals.cv: [1.0]\n  arrivals.mean_s: [17.1799]\n"
+        "policies: [non-adaptive, adaptive, learned]\nreplications: 3\nseed: 1984\n")
+    assert main(["sweep", str(sweep), "--out", str(tmp_path / "s"), "--workers", "1"]) == 0
+    stress.write(tmp_path / "s" / "replications.csv", tmp_path / "map")
+    table = pd.read_csv(tmp_path / "map" / "stress.csv")
+    assert list(table["policy"]) == ["non-adaptive", "adaptive", "learned"]
