@@ -132,7 +132,7 @@ def figure(t: pd.DataFrame) -> bytes:
     ax.set_xticks(range(len(points)), points, fontsize=8)
     ax.set_ylabel("parts delivered / hindsight optimum")
     ax.set_ylim(0.5, None)
-    ax.legend(fontsize=8, ncol=5, loc="lower center")
+    ax.legend(fontsize=8, ncol=5, loc="upper left")
     ax.set_title(f"Each controller against the hindsight optimum ({bm.PARTS} parts a run, "
                  f"{bm.REPLICATIONS} replications a pattern, 95 % intervals)", fontsize=10)
     return png_bytes(fig)

@@ -146,6 +146,17 @@ def test_vector_env_steps_each_copy_as_alone(stress_point):
     envs.close()
 
 
+def test_async_vector_env_runs_each_copy_in_its_process(stress_point):
+    envs = gymnasium.vector.AsyncVectorEnv([lambda: CellEnv(stress_point)] * 2)
+    obs, _ = envs.reset(seed=21)
+    alone, _ = CellEnv(stress_point).reset(seed=21)
+    assert obs[0].tobytes() == alone.tobytes()
+    for _ in range(10):
+        obs, r, done, trunc, _ = envs.step(envs.action_space.sample())
+    assert envs.observation_space.contains(obs)
+    envs.close()
+
+
 def test_registered_with_gymnasium(stress_point):
     env = gymnasium.make(ENV_ID, scenario=stress_point)
     obs, _ = env.reset(seed=1)

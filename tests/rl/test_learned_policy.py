@@ -73,3 +73,15 @@ def test_a_sweep_and_the_stress_map_take_it(tmp_path: Path, unrendered: None) ->
     stress.write(tmp_path / "s" / "replications.csv", tmp_path / "map")
     table = pd.read_csv(tmp_path / "map" / "stress.csv")
     assert list(table["policy"]) == ["non-adaptive", "adaptive", "learned"]
+
+
+def test_docs_quote_the_committed_training_scores() -> None:
+    import json
+
+    from cell.rl.learned import WEIGHTS
+
+    found = json.loads(WEIGHTS.read_text(encoding="utf-8"))
+    assert found["parts_delivered"] > found["parts_delivered_adaptive"]
+    docs = Path(__file__).resolve().parents[2] / "docs" / "rl.md"
+    text = " ".join(docs.read_text(encoding="utf-8").split())
+    assert f"({found['parts_delivered']} parts against {found['parts_delivered_adaptive']})" in text
