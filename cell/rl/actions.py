@@ -7,7 +7,8 @@ hit).  :func:`to_plan` maps any vector (NaN and infinities included) to a plan t
 :func:`cell.sim.policies.check.check` passes: each value clipped to the check's own bounds
 (R I's at the pace of the input belt the part reached B on), ``to_g`` and ``cycle`` kept where
 they are within the check's tolerance of their regimes' sums and replaced by those sums
-otherwise.  A value the check accepts is left as it is, to the bit: the map is the identity on
+otherwise, the limits kept to :data:`PLAN_LIMITS`.  A value the check accepts (with limits
+among those) is left as it is, to the bit: the map is the identity on
 the feasible set, so a decision passed through the environment is the decision.
 """
 
@@ -21,7 +22,6 @@ import numpy as np
 from cell.sim.policies.base import CellConstants, Plan
 from cell.sim.policies.check import (
     ABS,
-    ALL_LIMITS,
     MAX_S,
     REL,
     SUM_S,
@@ -29,11 +29,28 @@ from cell.sim.policies.check import (
     tracking_floors,
 )
 from cell.sim.policies.fixed import fixed_plan
+from cell.sim.records import (
+    INPUT_CEILING,
+    INPUT_FLOOR,
+    INPUT_TRACKING,
+    OUTPUT_CEILING,
+    OUTPUT_FLOOR,
+    R2_PEAK,
+    R4_PEAK,
+    SPACING_UNFORESEEN,
+    SPACING_WAIT,
+)
 
 #: The action's components, in order: the fields of :class:`~cell.sim.policies.base.Plan`.
 FIELDS = ("r1_pre", "r1_post", "r2", "r3_pre", "r3_post", "r4", "input_after_lo", "input_next",
           "output_to_g", "output_floor_at", "to_g", "cycle", "limits")
 TIMES = FIELDS[:6]
+#: The limits a plan may say it hit: the belts' and motors' (what the adaptive controller
+#: flags).  The others are what happened to the part (let go, set down off spacing, held at the
+#: feeder, lost or scrapped in a failure): the cell's to record, not a plan's to claim (the check
+#: would pass a plan claiming them, and the run would count its part lost).
+PLAN_LIMITS = (INPUT_FLOOR | INPUT_CEILING | INPUT_TRACKING | OUTPUT_FLOOR | OUTPUT_CEILING
+               | R2_PEAK | R4_PEAK | SPACING_WAIT | SPACING_UNFORESEEN)
 SPEEDS = ("input_after_lo", "input_next", "output_to_g")
 
 
@@ -58,7 +75,7 @@ class ActionMap:
         pick (R I's floors at its fastest); infinite where the check sets none."""
         inf = math.inf
         lo = [*self.time_lo, *self.speed_lo, 0.0, 0.0, 0.0, 0.0]
-        hi = [inf] * 6 + [*self.speed_hi, inf, inf, inf, float(ALL_LIMITS)]
+        hi = [inf] * 6 + [*self.speed_hi, inf, inf, inf, float(PLAN_LIMITS)]
         return np.array(lo, dtype=np.float64), np.array(hi, dtype=np.float64)
 
     def to_plan(self, action: Any, v: float) -> Plan:
@@ -100,7 +117,7 @@ class ActionMap:
         if not floor_at >= td - SUM_S:  # NaN too: at the touch-down
             floor_at = td
         x = a[12]
-        limits = int(round(x)) & ALL_LIMITS if math.isfinite(x) and x >= 0 else 0
+        limits = int(round(x)) & PLAN_LIMITS if math.isfinite(x) and x >= 0 else 0
         return Plan(r1_pre=r1a, r1_post=r1b, r2=r2, r3_pre=r3a, r3_post=r3b, r4=r4,
                     input_speed=v, input_after_lo=w, input_next=w_next, output_to_g=u,
                     to_g=to_g, cycle=cycle, limits=limits, steers_belts=True,

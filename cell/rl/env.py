@@ -167,7 +167,7 @@ class CellEnv(gym.Env):
                                        name=f"cell episode {episode}")
         self.thread.start()
         done = self.advance()
-        self.reward_since()  # parts done before the first decision: none can be
+        # nothing is done before the first decision; its time is counted at the first step
         return (observe.empty() if done else self.observation()), {"seed": episode}
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:

@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 
 from cell.plumbing.csvfile import RowWriter
 from cell.rl import ENV_ID, CellEnv
-from cell.rl.actions import FIELDS, ActionMap, action_of
+from cell.rl.actions import FIELDS, PLAN_LIMITS, ActionMap, action_of
 from cell.scenario import catalog
 from cell.scenario.schema import load_scenario
 from cell.sim.policies.adaptive import Adaptive
@@ -78,6 +78,7 @@ def test_map_lands_in_the_checked_set_and_fixes_it(k, values, v):
     m = ActionMap(k)
     plan = m.to_plan(np.array(values), v)
     check(plan, plan_bounds(k), "agent", k)  # raises if refused
+    assert plan.limits & ~PLAN_LIMITS == 0  # no outcome claimed (let go, scrapped...)
     again = m.to_plan(action_of(plan), plan.input_speed)
     assert action_of(again).tobytes() == action_of(plan).tobytes()
 
@@ -171,3 +172,22 @@ def test_reward_terms_refused_by_name(stress_point):
         CellEnv(stress_point, reward={"profit": 1.0})
     with pytest.raises(ScenarioError, match="reward.cost"):
         CellEnv(stress_point, reward={"cost": 1.0})
+
+
+def test_the_cost_reward_sums_to_the_runs_cost(stress_point):
+    """With costs: and no failures or energy, the cost terms summed over an episode are the
+    run's cost (cell.sim.run_cost): lost parts x part_value + the options' hours."""
+    from cell.sim.run_cost import run_cost
+
+    s = stress_point.with_overrides({"costs": {"part_value": 12.0,
+                                               "options_per_h": {"robot": 6.0, "sensor": 0.4}}})
+    env = CellEnv(s, reward={"delivered": 0.0, "cost": 1.0})
+    env.action_space.seed(5)
+    env.reset(seed=9)
+    total, done, info = 0.0, False, {}
+    while not done:
+        _, r, done, _, info = env.step(env.action_space.sample())
+        total += r
+    summary = info["summary"]
+    assert summary.parts_missed > 0
+    assert total == pytest.approx(-run_cost(summary, s, []), rel=1e-9)
