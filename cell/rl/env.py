@@ -34,7 +34,7 @@ from cell.rl.actions import ActionMap, action_of
 from cell.scenario.schema import Scenario, load_scenario
 from cell.sim.assembly import AssembledCell, assemble
 from cell.sim.policies.base import CellConstants, CellView, Plan, Policy
-from cell.sim.records import RODE_OFF, SPACING_OFF
+from cell.sim.records import RODE_OFF, SCRAPPED, SPACING_OFF
 from cell.sim.run_cost import options_per_h
 from cell.sim.simulation import Run, SimResult
 
@@ -145,9 +145,9 @@ class CellEnv(gym.Env):
         self.counted = 0
         self.seeded = False
         self.last_s = 0.0
-        hourly = options_per_h(s) if s.costs is not None else 0.0
         self.part_value = s.costs.part_value if s.costs is not None else 0.0
-        self.hourly = hourly
+        self.hourly = options_per_h(s) if s.costs is not None else 0.0
+        """The cost reward's prices: a part lost, an hour of the options the scenario has."""
 
     # ------------------------------------------------------------------ gymnasium's API
     def reset(self, *, seed: int | None = None,
@@ -185,8 +185,8 @@ class CellEnv(gym.Env):
 
     # ------------------------------------------------------------------ the run
     def advance(self) -> bool:
-        """Step the run's SimPy environment to the next decision (False) or to the run's end
-        (True: the run finished and :attr:`result` made)."""
+        """Let the run go on to its next decision (False) or to its end (True: :attr:`result`
+        made); a run's error is raised here."""
         what, value = self.agent.hear()
         self.view = value if what == "decide" else None
         if what == "error":
@@ -228,7 +228,8 @@ class CellEnv(gym.Env):
         delivered = int(np.count_nonzero(np.isfinite(log.column("touchdown", start))))
         lost = int(np.count_nonzero(limits & RODE_OFF))
         off = int(np.count_nonzero(limits & SPACING_OFF))
-        cost = lost * self.part_value + hours * self.hourly
+        scrapped = int(np.count_nonzero(limits & SCRAPPED))  # in a failure: a cost, not "lost"
+        cost = (lost + scrapped) * self.part_value + hours * self.hourly
         return float(w["delivered"] * delivered - w["lost"] * lost - w["spacing_off"] * off
                      - w["cost"] * cost)
 
