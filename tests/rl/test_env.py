@@ -5,8 +5,6 @@ from __future__ import annotations
 
 import csv
 import math
-import subprocess
-import sys
 
 import gymnasium
 import numpy as np
@@ -15,6 +13,7 @@ from gymnasium.utils.env_checker import check_env
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from cell.cli.main import main
 from cell.plumbing.csvfile import RowWriter
 from cell.rl import ENV_ID, CellEnv
 from cell.rl.actions import FIELDS, PLAN_LIMITS, ActionMap, action_of
@@ -112,10 +111,9 @@ def test_adaptive_decisions_through_the_env_reproduce_cell_run(tmp_path, lookahe
     `cell run` writes for the same seed, byte for byte."""
     s = scenario(120, **{"sensor.lookahead": lookahead, "run.seed": 17})
     out = tmp_path / "run"
-    subprocess.run([sys.executable, "-m", "cell", "run", "baseline", "--out", str(out),
-                    "--set", "run.parts=120", "--set", "controller.policy=adaptive",
-                    "--set", f"sensor.lookahead={lookahead}", "--set", "run.seed=17"],
-                   check=True, capture_output=True)
+    assert main(["run", "baseline", "--out", str(out), "--set", "run.parts=120",
+                 "--set", "controller.policy=adaptive", "--set", f"sensor.lookahead={lookahead}",
+                 "--set", "run.seed=17"]) == 0
     env = CellEnv(s, keep_parts=True)
     rule = Adaptive(env.k, s.controller)
     env.reset(seed=17)
