@@ -11,7 +11,7 @@ WORKERS ?= 2
 export PYTHONDONTWRITEBYTECODE :=
 export PYTHONPYCACHEPREFIX := $(if $(filter /%,$(VENV)),$(VENV),$(CURDIR)/$(VENV))/pycache
 
-.PHONY: all venv test year sweep sweep-mintime whatif stress sensor reliability figures animation bench lint clean optimize sensitivity kn-check
+.PHONY: all venv test year learn benchmark sweep sweep-mintime whatif stress sensor reliability figures animation bench lint clean optimize sensitivity kn-check
 
 all: test
 
@@ -97,3 +97,13 @@ clean:
 # against the first shift only, three years each (about 14 minutes on 2 cores shared with other work).
 year: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m cell.reporting.year scenarios/year.yaml reports/year --workers $(WORKERS)
+
+# The learned controller's network retrained (issue 36 item 3): CMA-ES, the optional extra [rl],
+# seeded, about 6 minutes on one core of this 2-core machine; writes cell/rl/weights/learned.json.
+learn: $(STAMP)
+	$(PY) -m pip install -qq --no-compile -e ".[rl]"
+	$(PY) -m cell.rl.train
+
+# The benchmark (issue 36 item 4): every controller's parts against the hindsight optimum.
+benchmark: $(STAMP)
+	MPLBACKEND=Agg $(PY) -m cell.reporting.benchmark reports/benchmark

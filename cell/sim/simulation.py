@@ -54,7 +54,7 @@ from cell.sim.records import (
 from cell.sim.sim_result import BeltLog, BeltSink, SimResult
 from cell.sim.station import Station
 
-__all__ = ["PER_PART", "BeltLog", "BeltSink", "PartSink", "RunLog", "SimResult", "simulate"]
+__all__ = ["PER_PART", "BeltLog", "BeltSink", "PartSink", "Run", "RunLog", "SimResult", "simulate"]
 
 PartSink = Callable[[PartRecord], Any]
 #: What the run's log keeps of each part for the summary: seven floats, then the limits' bits
@@ -250,54 +250,91 @@ def simulate(scenario: Scenario | AssembledCell,
     in the result (off for long runs, which stream them to ``on_part`` /
     ``on_belt`` instead, as each becomes final: memory then stays flat).
     """
-    cell = scenario if isinstance(scenario, AssembledCell) else assemble(scenario)
-    s, k, policy = cell.scenario, cell.k, cell.policy
-    seed = s.run.seed if seed is None else seed
-    # T_1 .. T_{n+1}: the last is only the last part's "next arrival".
-    t_all, n, horizon = run_arrivals(s, seed)
-    t_list: list[float] = t_all.tolist()
+    run = Run(scenario, seed, keep_parts=keep_parts, on_part=on_part, on_belt=on_belt,
+              keep_belts=keep_belts)
+    run.go()
+    return run.result()
 
-    rows: list[tuple[Any, ...]] | None = [] if keep_parts else None
-    belts = BeltLog(keep_belts, on_belt)
 
-    acct = policy.accounting()
-    env = simpy.Environment()
-    tm = k.timing
-    stands = s.failures is not None or s.calendar is not None  # clocks that never end: the
-    finished = env.event() if stands and horizon is None else None  # run ends with its last part
-    log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows,
-                 (tm.r1_length_in, tm.r2.length_in, tm.r3_length_in, tm.r4.length_in),
-                 finished, n, state_energy.arm_energy_of(cell))
-    downtime = None if not stands else Downtime(env, s.failures or calendar.NO_FAILURES, seed)
-    wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
-    station = Station(env, cell, seed, log.delivered_part, belts.told, downtime)
-    feeder = Feeder(env, t_list, station.input, n, k.part_size, log.flag)
-    station.control(feeder.fed_s, n, log)
-    calendar.keep(env, s, downtime)  # a calendar's shifts, started with the failure clocks
-    if downtime is None and horizon is None:
-        env.run()
-    else:
+class Run:
+    """One run set up, its processes started: :func:`simulate` runs it to its end in one go
+    (:meth:`go`); :class:`cell.rl.CellEnv` steps its SimPy environment from one decision of the
+    controller to the next (:meth:`over` says when there is nothing left to step), then reads
+    the same :meth:`result`."""
+
+    def __init__(self, scenario: Scenario | AssembledCell,
+                 seed: int | np.random.SeedSequence | None = None, *, keep_parts: bool = True,
+                 on_part: PartSink | None = None, on_belt: BeltSink | None = None,
+                 keep_belts: bool = True):
+        cell = scenario if isinstance(scenario, AssembledCell) else assemble(scenario)
+        s, k, policy = cell.scenario, cell.k, cell.policy
+        seed = s.run.seed if seed is None else seed
+        # T_1 .. T_{n+1}: the last is only the last part's "next arrival".
+        t_all, n, horizon = run_arrivals(s, seed)
+        t_list: list[float] = t_all.tolist()
+
+        rows: list[tuple[Any, ...]] | None = [] if keep_parts else None
+        belts = BeltLog(keep_belts, on_belt)
+
+        acct = policy.accounting()
+        env = simpy.Environment()
+        tm = k.timing
+        stands = s.failures is not None or s.calendar is not None  # clocks that never end: the
+        finished = env.event() if stands and horizon is None else None  # run ends with its last part
+        log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows,
+                     (tm.r1_length_in, tm.r2.length_in, tm.r3_length_in, tm.r4.length_in),
+                     finished, n, state_energy.arm_energy_of(cell))
+        downtime = None if not stands else Downtime(env, s.failures or calendar.NO_FAILURES, seed)
+        wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
+        station = Station(env, cell, seed, log.delivered_part, belts.told, downtime)
+        feeder = Feeder(env, t_list, station.input, n, k.part_size, log.flag)
+        station.control(feeder.fed_s, n, log)
+        calendar.keep(env, s, downtime)  # a calendar's shifts, started with the failure clocks
         if downtime is not None:
             downtime.start()
-        run_until_done(env, log, horizon, finished)
-    station.close(env.now)
+        self.cell, self.seed, self.env, self.log, self.acct = cell, seed, env, log, acct
+        self.t_all, self.n, self.horizon, self.finished = t_all, n, horizon, finished
+        self.rows, self.belts, self.keep_belts, self.downtime = rows, belts, keep_belts, downtime
+        self.station, self.feeder = station, feeder
 
-    summary = _summary(cell, log, acct, t_all, n, env.now)
-    wear = None if station.wear is None else station.wear.log  # wear: without failures
-    stops = downtime.all_stops(env.now) if downtime is not None else \
-        wear_clock.stop_rows(wear, env.now)  # failures.csv's rows
-    lines = oee.measure(summary, log.column, downtime, k.cycle_nom, env.now, stops, s.quality.rule,
-                        calendar.off_spans(s, env.now))
-    lines = state_energy.measure(summary, s, lines, log, downtime, env.now, stops)
-    run_cost.measure(summary, s, stops, log.column)
-    summary.seed = _seed_value(seed)
-    summary.input_speed_max_in_s = station.input.belt.max_speed_in_s
-    summary.input_speed_min_in_s = station.input.belt.min_speed_in_s
-    summary.parts_bound = parts_bound(k, feeder.fed_s[summary.warmup_parts:n])
-    result = SimResult(summary, rows, belts if keep_belts else None)
-    result.downtime, result.timelines, result.stop_rows = downtime, lines, stops
-    result.wear = wear_clock.measures(wear, downtime, env.now)
-    return result
+    def go(self) -> None:
+        """Run to the end: every part done, or the horizon (:func:`run_until_done`)."""
+        if self.downtime is None and self.horizon is None:
+            self.env.run()
+        else:
+            run_until_done(self.env, self.log, self.horizon, self.finished)
+
+    def over(self) -> bool:
+        """Whether stepping the environment on would pass the run's end (then :meth:`go`
+        finishes it without a further event of the run's own)."""
+        nxt = self.env.peek()
+        if self.finished is not None:
+            return self.finished.processed or nxt == math.inf
+        return nxt == math.inf or (self.horizon is not None and nxt >= self.horizon)
+
+    def result(self) -> SimResult:
+        """The run's result once it is over: its summary, rows and belts."""
+        cell, log, acct, env, station, downtime = \
+            self.cell, self.log, self.acct, self.env, self.station, self.downtime
+        s, k, n, seed = cell.scenario, cell.k, self.n, self.seed
+        station.close(env.now)
+
+        summary = _summary(cell, log, acct, self.t_all, n, env.now)
+        wear = None if station.wear is None else station.wear.log  # wear: without failures
+        stops = downtime.all_stops(env.now) if downtime is not None else \
+            wear_clock.stop_rows(wear, env.now)  # failures.csv's rows
+        lines = oee.measure(summary, log.column, downtime, k.cycle_nom, env.now, stops,
+                            s.quality.rule, calendar.off_spans(s, env.now))
+        lines = state_energy.measure(summary, s, lines, log, downtime, env.now, stops)
+        run_cost.measure(summary, s, stops, log.column)
+        summary.seed = _seed_value(seed)
+        summary.input_speed_max_in_s = station.input.belt.max_speed_in_s
+        summary.input_speed_min_in_s = station.input.belt.min_speed_in_s
+        summary.parts_bound = parts_bound(k, self.feeder.fed_s[summary.warmup_parts:n])
+        result = SimResult(summary, self.rows, self.belts if self.keep_belts else None)
+        result.downtime, result.timelines, result.stop_rows = downtime, lines, stops
+        result.wear = wear_clock.measures(wear, downtime, env.now)
+        return result
 
 
 def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, n: int,

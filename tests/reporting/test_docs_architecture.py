@@ -15,7 +15,7 @@ tomllib = pytest.importorskip("tomllib")
 
 ROOT = Path(__file__).resolve().parents[2]
 PACKAGE = ROOT / "cell"
-FOLDERS = ("cli", "reporting", "bench", "experiments", "sim", "scenario", "arm", "plumbing")
+FOLDERS = ("cli", "reporting", "bench", "experiments", "rl", "sim", "scenario", "arm", "plumbing")
 
 
 def modules() -> list[Path]:

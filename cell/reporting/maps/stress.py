@@ -57,7 +57,8 @@ def table(reps: pd.DataFrame) -> pd.DataFrame:
         mean = float(mean)  # type: ignore[arg-type]
         by = {p: g.sort_values("replication") for p, g in point.groupby("policy")}
         fixed = by["non-adaptive"]
-        for policy in POLICIES:
+        others = sorted(str(p) for p in by if p not in POLICIES)  # a plug-in's too
+        for policy in [*POLICIES, *others]:
             runs = by[policy]
             delivered = summarise(runs["parts_delivered"].to_numpy(float))
             per_hr = summarise(runs["parts_per_hr_wallclock"].to_numpy(float))
