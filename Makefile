@@ -17,10 +17,11 @@ all: test
 
 # --no-compile: Python compiles the modules a run imports as it first imports them; compiling
 # every installed module up front made a fresh install about 80 s instead of 30 s.
-$(STAMP): pyproject.toml
+# constraints.txt pins every library to the release the committed reports were made with.
+$(STAMP): pyproject.toml constraints.txt
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -qq --upgrade pip
-	$(PY) -m pip install -qq --no-compile -e ".[dev,dist]"
+	$(PY) -m pip install -qq --no-compile -c constraints.txt -e ".[dev,dist]"
 	@touch $(STAMP)
 
 venv: $(STAMP)
@@ -101,7 +102,7 @@ year: $(STAMP)
 # The learned controller's network retrained (issue 36 item 3): CMA-ES, the optional extra [rl],
 # seeded, about 6 minutes on one core of this 2-core machine; writes cell/rl/weights/learned.json.
 learn: $(STAMP)
-	$(PY) -m pip install -qq --no-compile -e ".[rl]"
+	$(PY) -m pip install -qq --no-compile -c constraints.txt -e ".[rl]"
 	$(PY) -m cell.rl.train
 
 # The benchmark (issue 36 item 4): every controller's parts against the hindsight optimum.
