@@ -17,7 +17,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from pydantic import BaseModel, PrivateAttr, ValidationError
+from pydantic import BaseModel, Field, PrivateAttr, ValidationError
 
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.energy_sections import (  # noqa: F401 - the schema, re-exported
@@ -30,6 +30,13 @@ from cell.scenario.failure_sections import (  # noqa: F401 - the schema, re-expo
     WearSettings,
 )
 from cell.scenario.fields import Section, error_from_validation, model_at, unwrap_optional
+from cell.scenario.layout_sections import (  # noqa: F401 - the schema, re-exported
+    MAX_STATIONS,
+    STATION_SECTIONS,
+    BufferSettings,
+    StationSettings,
+    station_raw,
+)
 from cell.scenario.overrides import apply_overrides, merge
 from cell.scenario.run_length import keep_one_length, lengths_given
 from cell.scenario.sections import (  # noqa: F401 - the schema, re-exported
@@ -88,8 +95,25 @@ class Scenario(Section):
     costs: CostSettings | None = None
     """Money: lost parts, energy, downtime, repairs, maintenance, options (docs/usage.md, "Energy
     and cost"); absent: no cost measured."""
+    buffer: BufferSettings | None = None
+    """An accumulating buffer before B (docs/layout.md); absent or ``places: 0``: none."""
+    stations: list[StationSettings] | None = Field(None, max_length=MAX_STATIONS)
+    """More stations, downstream on the input line or in series (docs/layout.md); the
+    scenario's own cell is the first; absent: the thesis's one cell."""
 
     _source: str = PrivateAttr(default="<defaults>")
+    _stations: list[tuple[StationSettings, Scenario]] = PrivateAttr(default_factory=list)
+
+    @property
+    def line(self) -> list[tuple[StationSettings, Scenario]]:
+        """Each station after the first: its settings and its own scenario (the scenario's
+        sections with its overrides), in order; empty without ``stations:``."""
+        return self._stations
+
+    @property
+    def has_layout(self) -> bool:
+        """Whether a ``buffer:`` or ``stations:`` section is given (stations.csv is written)."""
+        return self.buffer is not None or self.stations is not None
 
     @property
     def source(self) -> str:
@@ -102,8 +126,16 @@ class Scenario(Section):
         return Path(self._source).parent if self._source != "<defaults>" else Path.cwd()
 
     def get(self, dotted: str) -> Any:
+        parts = dotted.split(".")
+        if parts[0] == "stations" and len(parts) > 2:  # a station's own value, by its name
+            for station, scenario in self._stations:
+                if station.name == parts[1]:
+                    own = getattr(station, parts[2]) if parts[2] not in STATION_SECTIONS else None
+                    return own if len(parts) == 3 and parts[2] not in STATION_SECTIONS \
+                        else scenario.get(".".join(parts[2:]))
+            raise KeyError(dotted)
         obj: Any = self
-        for part in dotted.split("."):
+        for part in parts:
             obj = obj[part] if isinstance(obj, Mapping) else getattr(obj, part)
         return obj
 
@@ -113,7 +145,7 @@ class Scenario(Section):
         default only when given (so a scenario without them reads as it did before they
         existed), and with ``run.hours`` no ``run.parts`` (the run's length is given one way)."""
         d = _plain(self.model_dump())
-        for optional in ("failures", "energy", "costs"):
+        for optional in ("failures", "energy", "costs", "buffer", "stations"):
             if d.get(optional) is None:
                 d.pop(optional, None)
         d["run"].pop("hours" if d["run"].get("hours") is None else "parts", None)
@@ -180,11 +212,72 @@ def validate(raw: Any, file: object = "<dict>", source: str | None = None) -> Sc
     try:
         scenario = Scenario.model_validate(raw)
     except ValidationError as exc:
-        raise error_from_validation(exc, raw, file, Scenario) from None
+        raise _named_station(error_from_validation(exc, raw, file, Scenario), raw) from None
     scenario._source = str(source if source is not None else file)
     _cross_checks(scenario, file)
     check_energy(scenario.energy, scenario.mintime.dynamics_file, file)
+    _check_layout(scenario, raw, file)
     return scenario
+
+
+def _named_station(exc: ScenarioError, raw: Any) -> ScenarioError:
+    """A station's key by the station's name (``stations.catcher.offset_in``) rather than by
+    its place in the list (``stations[1].offset_in``), when it has one."""
+    key = exc.key
+    if not key.startswith("stations["):
+        return exc
+    index, _, rest = key[len("stations["):].partition("]")
+    try:
+        name = raw["stations"][int(index)]["name"]
+    except (KeyError, IndexError, TypeError, ValueError):
+        return exc
+    if not isinstance(name, str) or not name:
+        return exc
+    return ScenarioError(exc.file, f"stations.{name}{rest}", exc.value, exc.why)
+
+
+def _check_layout(s: Scenario, raw: Mapping[str, Any], file: object) -> None:
+    """The buffer's pitch against the part; each station placed where it can work, and its
+    own scenario (the scenario's sections with its overrides) valid, its keys named in full."""
+    b = s.buffer
+    if b is not None and b.pitch_in is not None and b.pitch_in < s.part.size_in:
+        raise ScenarioError(file, "buffer.pitch_in", b.pitch_in, f"shorter than the part "
+                            f"({s.part.size_in:g} in, part.size_in): waiting parts would overlap")
+    if not s.stations:
+        return
+    seen: set[str] = set()
+    base = {k: v for k, v in raw.items() if k != "stations"}
+    for st in s.stations:
+        key = f"stations.{st.name}"
+        if st.name in seen:
+            raise ScenarioError(file, f"{key}.name", st.name, "two stations have this name")
+        seen.add(st.name)
+        own, other = ("offset_in", "transfer_in") if st.placement == "downstream" else \
+            ("transfer_in", "offset_in")
+        if getattr(st, other) is not None:
+            raise ScenarioError(file, f"{key}.{other}", getattr(st, other),
+                                "not for a " + st.placement + " station")
+        length = getattr(st, own)
+        if length is None:
+            raise ScenarioError(file, f"{key}.{own}", None, f"a {st.placement} station needs it")
+        if st.placement == "downstream":  # no closer than the open hand's span: the hand at
+            clear = s.robot.hand.open_in  # F and the one at B could touch (docs/layout.md)
+            if length < 0:
+                raise ScenarioError(file, f"{key}.offset_in", length, "places the station "
+                                    "before the F of the station it follows: it must lie past it")
+            if length < clear:
+                raise ScenarioError(file, f"{key}.offset_in", length, f"closer than the open "
+                                    f"hand's span ({clear:g} in, robot.hand.open_in): the two "
+                                    "arms could collide")
+        elif not length > 0:
+            raise ScenarioError(file, f"{key}.transfer_in", length, "a transfer must have a "
+                                "length: the station needs a drop point before its B")
+        try:
+            own_s = validate(station_raw(base, st, merge, is_section), file, source=s.source)
+        except ScenarioError as exc:
+            inner = own if exc.key == "belts.input_length_in" else exc.key
+            raise ScenarioError(exc.file, f"{key}.{inner}", exc.value, exc.why) from None
+        s._stations.append((st, own_s))
 
 
 def is_section(path: tuple[str, ...]) -> bool:
@@ -206,6 +299,10 @@ def known_key(dotted: str) -> bool:
             model = annotation
             continue
         rest = parts[i + 1:]
+        if model is Scenario and part == "stations":  # stations.NAME.KEY..., by the station's name
+            return len(rest) >= 2 and bool(rest[0]) and (
+                rest[1] in ("placement", "offset_in", "transfer_in") and len(rest) == 2
+                or rest[1] in STATION_SECTIONS and known_key(".".join(rest[1:])))
         is_mapping = getattr(annotation, "__origin__", None) is dict
         return not rest or (is_mapping and len(rest) == 1 and bool(rest[0]))
     return True

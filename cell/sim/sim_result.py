@@ -19,7 +19,15 @@ import numpy as np
 
 from cell.sim import oee, wear_clock
 from cell.sim.failures import Downtime
-from cell.sim.records import PART_COLUMNS, BeltChange, PartRecord, RunSummary, StateSpan, Stop
+from cell.sim.records import (
+    OPTIONAL_PART_COLUMNS,
+    PART_COLUMNS,
+    BeltChange,
+    PartRecord,
+    RunSummary,
+    StateSpan,
+    Stop,
+)
 
 BeltSink = Callable[[BeltChange], Any]
 #: parts.csv's columns of a record, as a tuple.
@@ -35,6 +43,8 @@ class SimResult:
     first asked for.
     """
     wear: wear_clock.WearResult | None = None  # with wear.enabled: its measures and stops
+    station_rows: list[tuple[Any, ...]] | None = None
+    """stations.csv's rows (with ``stations:`` or ``buffer:``; cell.sim.line.STATION_COLUMNS)."""
 
     def __init__(self, summary: RunSummary, rows: list[tuple[Any, ...]] | None = None,
                  belt_log: BeltLog | None = None):
@@ -80,8 +90,10 @@ class SimResult:
             rows: Any = [part_row(r) for r in self.records]
             return pd.DataFrame(rows, columns=PART_COLUMNS)
         rows = self._rows or []
-        frame = pd.DataFrame(rows, columns=[*PART_COLUMNS, "energy_j"])
-        return frame if rows and rows[0][-1] is not None else frame[PART_COLUMNS]
+        frame = pd.DataFrame(rows, columns=[*PART_COLUMNS, *OPTIONAL_PART_COLUMNS])
+        n = len(PART_COLUMNS)  # an optional column is there when its section is (not None)
+        return frame[PART_COLUMNS + [c for i, c in enumerate(OPTIONAL_PART_COLUMNS)
+                                     if rows and rows[0][n + i] is not None]]
 
     def belt_histories(self) -> dict[str, np.ndarray]:
         """Each belt's speed changes as (m, 2) rows (from_s, speed_in_s), in time order: the

@@ -84,8 +84,12 @@ class RunLog:
                  spacing_in: float, tol_in: float, rows: list[tuple[Any, ...]] | None = None,
                  lengths: tuple[float, float, float, float] = (NAN, NAN, NAN, NAN),
                  finished: simpy.Event | None = None, n_parts: int = 0,
-                 energy_of: Callable[[Any], float] | None = None):
+                 energy_of: Callable[[Any], float] | None = None,
+                 layout: tuple[bool, bool] = (False, False)):
         self.t = t
+        self.layout = layout
+        """Whether parts.csv's ``station`` and ``buffer_wait_s`` columns are made (``stations:``,
+        a ``buffer:`` anywhere)."""
         self.energy_of = energy_of
         """A picked part's plan -> the arm's motion energy of its transfer (J), or None."""
         """T_1 … T_{n+1}: the last is only part n's "next arrival"."""
@@ -179,7 +183,8 @@ class RunLog:
         row = (i + 1, p.arrival_s, t[i], p.at_bot_s, picked, not picked, lost_thesis, p.pick_s,
                p.touchdown_s, d, cycle, thesis_d, t_next / d, ip_thesis, speed_in, speed_out,
                p.spacing_in, v1, v2, v3, v4, r1, r2, r3, r4, p.feed_delay_s, limits,
-               None if self.energy_of is None else self.energy_of(plan) if picked and plan else NAN)
+               None if self.energy_of is None else self.energy_of(plan) if picked and plan else NAN,
+               p.station if self.layout[0] else None, p.buffer_wait_s if self.layout[1] else None)
         if self.rows is not None:
             self.rows.append(row)
         if self.sink is not None:
@@ -265,21 +270,38 @@ def simulate(scenario: Scenario | AssembledCell,
     tm = k.timing
     # with failures the clocks never end: the run ends when its last part is done
     finished = env.event() if s.failures is not None and horizon is None else None
+    line = None
+    if s.has_layout:  # a buffer, more stations (docs/layout.md)
+        from cell.sim.line import Line
+
+        if finished is None and any(own.scenario.failures is not None for _, own in cell.line):
+            finished = env.event() if horizon is None else None
     log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows,
                  (tm.r1_length_in, tm.r2.length_in, tm.r3_length_in, tm.r4.length_in),
-                 finished, n, state_energy.arm_energy_of(cell))
+                 finished, n, state_energy.arm_energy_of(cell),
+                 (s.stations is not None, _has_buffer(cell)))
     downtime = None if s.failures is None else Downtime(env, s.failures, seed)
     wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
-    station = Station(env, cell, seed, log.delivered_part, belts.told, downtime)
-    feeder = Feeder(env, t_list, station.input, n, k.part_size, log.flag)
-    station.control(feeder.fed_s, n, log)
-    if downtime is None and horizon is None:
+    if s.has_layout:
+        line = Line(env, cell, seed, log, belts.told, downtime)
+        station = line.first
+        feeder = Feeder(env, t_list, station.input, n, k.part_size, log.flag)
+        line.control(feeder.fed_s, n)
+        line.logs[0].parts_in = n
+    else:
+        station = Station(env, cell, seed, log.delivered_part, belts.told, downtime)
+        feeder = Feeder(env, t_list, station.input, n, k.part_size, log.flag)
+        station.control(feeder.fed_s, n, log)
+    if downtime is None and finished is None and horizon is None:
         env.run()
     else:
         if downtime is not None:
             downtime.start()
         run_until_done(env, log, horizon, finished)
-    station.close(env.now)
+    if line is not None:
+        line.close(env.now)
+    else:
+        station.close(env.now)
 
     summary = _summary(cell, log, acct, t_all, n, env.now)
     wear = None if station.wear is None else station.wear.log  # wear: without failures
@@ -295,7 +317,15 @@ def simulate(scenario: Scenario | AssembledCell,
     result = SimResult(summary, rows, belts if keep_belts else None)
     result.downtime, result.timelines, result.stop_rows = downtime, lines, stops
     result.wear = wear_clock.measures(wear, downtime, env.now)
+    if line is not None:
+        result.station_rows = line.rows(env.now)
     return result
+
+
+def _has_buffer(cell: AssembledCell) -> bool:
+    """Whether any station of the layout has a ``buffer:`` section (parts.csv's
+    ``buffer_wait_s``)."""
+    return any(c.scenario.buffer is not None for c in (cell, *(own for _, own in cell.line)))
 
 
 def _summary(cell: AssembledCell, log: RunLog, acct: Accounting, t: np.ndarray, n: int,

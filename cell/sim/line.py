@@ -1,0 +1,251 @@
+"""A line of stations (``stations:``, ``buffer:``; docs/layout.md, docs/architecture.md
+"Stations"): each station another :class:`~cell.sim.station.Station`, its own log of what it
+did with the parts (:class:`StationLog`), and one new process, the transfer that carries the
+parts a station lets ride past its F on to the station downstream (:class:`Transfer`).
+
+A station's parts go on from it by its placement: those it lets go (busy, its buffer full, its
+robot down) to a ``downstream`` station after it on the input line, those it sets down to the
+``series`` station its output belt feeds.  A part nobody after it takes is done, for the line:
+the run's log (:class:`~cell.sim.simulation.RunLog`) makes its row.  Each station after the
+first draws its failures and its sensor from random streams of its own (children
+``STATION_STREAM + i`` of the run's root seed), so the first station's are those of the cell
+alone.
+"""
+
+from __future__ import annotations
+
+import math
+from array import array
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import simpy
+
+from cell.scenario.arrivals import root_seed
+from cell.sim import oee, wear_clock
+from cell.sim.failures import Downtime
+from cell.sim.mailbox import Mailbox
+from cell.sim.records import BUFFER_FULL, LOST_DOWNTIME, SCRAPPED, Part
+from cell.sim.station import Station
+
+if TYPE_CHECKING:
+    from cell.sim.assembly import AssembledCell
+
+#: The first of the stations' child streams of the run's root seed (station i: this + i).
+STATION_STREAM = 100
+#: The first station's name in stations.csv and parts.csv (the scenario's own cell).
+FIRST = "first"
+#: stations.csv's columns, in order (docs/usage.md).
+STATION_COLUMNS = ("station", "parts_in", "parts_delivered", "parts_lost", "lost_busy",
+                   "lost_full", "lost_down", "busy_fraction", "starved_fraction",
+                   "blocked_fraction", "buffer_mean", "buffer_max")
+
+
+def station_seed(seed: Any, i: int) -> Any:
+    """Station i's root seed: the run's for the first, a child stream's for the others."""
+    if i == 0:
+        return seed
+    root = root_seed(seed)
+    return np.random.SeedSequence(root.entropy, spawn_key=(*root.spawn_key, STATION_STREAM + i),
+                                  pool_size=root.pool_size)
+
+
+class StationLog:
+    """What one station did with the parts that came to it, and where each goes next.
+
+    It is the station's log for its controller, robot and failures (a part's limits noted, a
+    part lost), and its output conveyor's ``delivered``.  A part done here goes on to the
+    station that takes it (``on_lost``, ``on_delivered``), or, if none does, to the run's log
+    with the limits it hit here."""
+
+    def __init__(self, name: str, line: Any):
+        self.name, self.line = name, line
+        self.flags: dict[int, int] = {}
+        self.on_lost: Callable[[Part], Any] | None = None
+        """The transfer to the station downstream on the input line (None: lost for good)."""
+        self.on_delivered: Callable[[Part], Any] | None = None
+        """The series station this one's output belt feeds (None: delivered by the line)."""
+        self.parts_in = self.delivered = self.lost_busy = self.lost_full = self.lost_down = 0
+        self.came: dict[int, float] = {}
+        """When each part still here came to the station (dropped on its input window)."""
+        self.columns: dict[str, array[float]] = {c: array("d") for c in
+                                                  ("arrival", "at_bot", "cycle", "picked")}
+        """Per part done here: when it came, its B (its cycle's start), its cycle, picked."""
+
+    def arrive(self, part: Part, now: float) -> None:
+        """A part is dropped on this station's input window now."""
+        self.parts_in += 1
+        self.came[part.index] = now
+
+    def flag(self, part: Part, limits: int) -> None:
+        i = part.index
+        self.flags[i] = self.flags.get(i, 0) | limits
+
+    def _note(self, part: Part, picked: bool) -> int:
+        c = self.columns
+        c["arrival"].append(self.came.pop(part.index, part.arrival_s))
+        c["at_bot"].append(part.at_bot_s)
+        c["cycle"].append(part.plan.cycle if picked else math.nan)
+        c["picked"].append(1.0 if picked else 0.0)
+        return self.flags.pop(part.index, 0)
+
+    def missed(self, part: Part) -> None:
+        """The part is lost here: let go (the robot busy), past a full buffer, to downtime
+        (or scrapped from the hand)."""
+        scrapped = self.flags.get(part.index, 0) & SCRAPPED
+        flags = self._note(part, bool(scrapped))
+        if flags & BUFFER_FULL:
+            self.lost_full += 1
+        elif flags & (LOST_DOWNTIME | SCRAPPED):
+            self.lost_down += 1
+        else:
+            self.lost_busy += 1
+        if self.on_lost is not None and not scrapped:
+            self.on_lost(part)
+            return
+        self._done(part, flags, self.line.missed)
+
+    def delivered_part(self, part: Part) -> None:
+        """The part is set down on this station's output belt."""
+        flags = self._note(part, True)
+        self.delivered += 1
+        if self.on_delivered is not None:
+            self.on_delivered(part)
+            return
+        self._done(part, flags, self.line.delivered_part)
+
+    def _done(self, part: Part, flags: int, done: Callable[[Part], Any]) -> None:
+        part.station = self.name
+        if flags:
+            self.line.flag(part, flags)
+        done(part)
+
+    def column(self, name: str) -> np.ndarray:
+        """One of :attr:`columns` in the order the parts began their cycles here."""
+        order = np.argsort(np.frombuffer(self.columns["at_bot"]), kind="stable")
+        return np.frombuffer(self.columns[name])[order]
+
+
+class Transfer:
+    """Carries the parts a station lets ride past its F on to the station ``window_in`` past
+    it on the input line (SimPy process): each dropped on that station's input window the
+    instant the belt has carried it to F, reckoned on the belt's plan when it rides off."""
+
+    def __init__(self, env: simpy.Environment, upstream: Station, downstream: Station,
+                 log: StationLog):
+        self.env, self.upstream, self.downstream, self.log = env, upstream, downstream, log
+        k = upstream.cell.k
+        self.window_in = k.timing.r1_length_in
+        """B → F on the upstream station's belt (in)."""
+        self.v_nom = k.v_nom
+        self.box: Mailbox = Mailbox(env)
+        self.process = env.process(self.run())
+
+    def take(self, part: Part) -> None:
+        """A part rides on past the upstream station's B now."""
+        belt, now = self.upstream.input.belt, self.env.now
+        past = belt.travel(now) - belt.travel(min(part.at_bot_s, now))  # how far past B
+        left = max(self.window_in - past, 0.0)
+        v = belt.speed(now)
+        at_f = now + left / self.v_nom if belt.stopped or not v > 0 else \
+            belt.time_at(belt.travel(now) + left)
+        self.box.put((part, at_f))
+
+    def run(self):  # noqa: ANN201 (SimPy generator)
+        env, get, conveyor, log = self.env, self.box.get, self.downstream.input, self.log
+        while True:
+            part, at_f = yield get()
+            if at_f > env.now:
+                yield env.timeout(at_f - env.now)
+            now = env.now
+            log.arrive(part, now)
+            conveyor.drop(part, conveyor.belt.travel(now))
+
+
+def series_feed(env: simpy.Environment, downstream: Station, log: StationLog
+                ) -> Callable[[Part], None]:
+    """What a station's output belt hands each part set down to, when it feeds a series
+    station: the part begins its visit there, dropped on that station's input window at its
+    touch-down (the window starts at the touch-down point: ``transfer_in`` to B)."""
+    conveyor = downstream.input
+
+    def feed(part: Part) -> None:
+        now = env.now
+        part.begin_visit()
+        log.arrive(part, now)
+        conveyor.drop(part, conveyor.belt.travel(now))
+    return feed
+
+
+class Line:
+    """The stations of a layout, built and wired; the first fed by the feeder."""
+
+    def __init__(self, env: simpy.Environment, cell: AssembledCell, seed: Any, log: Any,
+                 told: Callable[[int], Any], downtime: Downtime | None):
+        self.env = env
+        self.cells: list[tuple[str, str, AssembledCell]] = [(FIRST, "first", cell)] + [
+            (st.name, st.placement, own) for st, own in cell.line]
+        self.logs = [StationLog(name, log) for name, _, _ in self.cells]
+        self.downtimes: list[Downtime | None] = [downtime]
+        self.stations: list[Station] = []
+        none = _no_belts
+        for i, (_, _, own) in enumerate(self.cells):
+            seed_i = station_seed(seed, i)
+            if i:
+                dt = None if own.scenario.failures is None else \
+                    Downtime(env, own.scenario.failures, seed_i)
+                wear_clock.count_on(dt, own, seed_i)
+                self.downtimes.append(dt)
+            self.stations.append(Station(env, own, seed_i, self.logs[i].delivered_part,
+                                         told if i == 0 else none, self.downtimes[i]))
+        self.transfers: list[Transfer] = []
+        head = 0  # the last station before that is not downstream: a series station's feeder
+        for i, (_, placement, _) in enumerate(self.cells[1:], start=1):
+            if placement == "downstream":
+                t = Transfer(env, self.stations[i - 1], self.stations[i], self.logs[i])
+                self.transfers.append(t)
+                self.logs[i - 1].on_lost = t.take
+            else:
+                self.logs[head].on_delivered = series_feed(env, self.stations[i], self.logs[i])
+                head = i
+
+    @property
+    def first(self) -> Station:
+        return self.stations[0]
+
+    def control(self, fed_s: list[float], n_parts: int) -> None:
+        """Start every station's controller (the first's look-ahead reads ``fed_s``) and
+        their failure clocks."""
+        for i, station in enumerate(self.stations):
+            station.control(fed_s if i == 0 else None, n_parts, self.logs[i])
+            if i:
+                dt = self.downtimes[i]
+                if dt is not None:
+                    dt.start()
+
+    def close(self, end_s: float) -> None:
+        for station in self.stations:
+            station.close(end_s)
+
+    def rows(self, end_s: float) -> list[tuple[Any, ...]]:
+        """stations.csv's rows (:data:`STATION_COLUMNS`), over the whole run."""
+        out = []
+        for (name, _, _), log, station, dt in zip(self.cells, self.logs, self.stations,
+                                                  self.downtimes):
+            stops = dt.all_stops(end_s) if dt is not None else []
+            sec = oee.unit_seconds(log.column, dt, end_s, stops)
+            share = (lambda x: x / end_s) if end_s > 0 else (lambda x: math.nan)
+            b = station.buffer
+            out.append((name, log.parts_in, log.delivered,
+                        log.lost_busy + log.lost_full + log.lost_down, log.lost_busy,
+                        log.lost_full, log.lost_down, share(sec["busy"]),
+                        share(sec["starved"]), share(sec["blocked"]),
+                        b.occupancy_mean(end_s) if b is not None else 0.0,
+                        b.most if b is not None else 0))
+        return out
+
+
+def _no_belts(belt: int) -> None:
+    """A station after the first keeps no belt history (belts.csv is the first's)."""
+    return None
