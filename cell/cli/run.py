@@ -56,7 +56,7 @@ def main(args: argparse.Namespace) -> int:
     from cell.sim.records import BELT_COLUMNS, PART_COLUMNS
     from cell.sim.simulation import simulate
 
-    names = RUN_FILES + FAILURE_FILES + PARQUET_FILES
+    names = RUN_FILES + FAILURE_FILES + PARQUET_FILES + ("stations.csv",)
     OutputDir.check(args.out, names)  # before any work
     _refuse_a_run(args)
     scenario = scenario_of(args)
@@ -72,8 +72,8 @@ def main(args: argparse.Namespace) -> int:
     with OutputDir(args.out, names) as out, \
             Progress(n, "cell run", "parts", enabled=n >= PROGRESS_FROM_PARTS) as progress:
         with out.open("parts.csv", newline="") as pf, out.open("belts.csv", newline="") as bf:
-            arm = scenario.energy is not None and scenario.energy.arm == "dynamics"  # energy_j
-            parts, belts = RowWriter(pf, PART_COLUMNS + ["energy_j"] * arm), RowWriter(bf, BELT_COLUMNS)
+            parts, belts = RowWriter(pf, PART_COLUMNS + _optional_columns(cell)), \
+                RowWriter(bf, BELT_COLUMNS)
             result = simulate(cell, keep_parts=False, on_part=_on_part(parts, progress, n),
                               on_belt=belts.record, keep_belts=False)
             done = result.summary.parts_arrived if scenario.run.hours is not None else n
@@ -81,12 +81,29 @@ def main(args: argparse.Namespace) -> int:
             progress.update(done - progress.n)
         with out.open("summary.csv", newline="") as sf:
             RowWriter(sf, list(result.summary.as_dict())).record(result.summary)
+        if result.station_rows is not None:  # buffer: or stations: (docs/layout.md)
+            from cell.sim.line import STATION_COLUMNS
+
+            with out.open("stations.csv", newline="") as f:
+                write = RowWriter(f, STATION_COLUMNS).record
+                for row in result.station_rows:
+                    write(row)
         if _stops_anything(scenario) or scenario.energy is not None:  # states.csv with energy
             _write_failures(out, result, _stops_anything(scenario))
         if args.format == "parquet":
             _as_parquet(out)
     _report(args, scenario, result, out.target)
     return 0
+
+
+def _optional_columns(cell: Any) -> list[str]:
+    """parts.csv's columns that come with their sections: ``energy_j`` (``energy.arm:
+    dynamics``), ``station`` (``stations:``), ``buffer_wait_s`` (a ``buffer:`` anywhere)."""
+    s = cell.scenario
+    arm = s.energy is not None and s.energy.arm == "dynamics"
+    buffered = any(c.scenario.buffer is not None for c in (cell, *(own for _, own in cell.line)))
+    return ["energy_j"] * arm + ["station"] * (s.stations is not None) + \
+        ["buffer_wait_s"] * buffered
 
 
 def _on_part(parts: Any, progress: Any, n: int) -> Callable[[Any], None]:
@@ -123,6 +140,7 @@ def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) ->
     written = RUN_FILES if args.format == "csv" else PARQUET_FILES
     if not _stops_anything(scenario):
         also = ", states.csv" if scenario.energy is not None else ""  # energy: its states
+        also += ", stations.csv" if result.station_rows is not None else ""
         print(f"wrote {shown}/{written[0]}, {written[1]}{also} and {written[2]}")
         return
     print(stops_line(r, scenario.failures))

@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from array import array
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 import simpy
@@ -36,10 +36,40 @@ if TYPE_CHECKING:
 STATION_STREAM = 100
 #: The first station's name in stations.csv and parts.csv (the scenario's own cell).
 FIRST = "first"
-#: stations.csv's columns, in order (docs/usage.md).
-STATION_COLUMNS = ("station", "parts_in", "parts_delivered", "parts_lost", "lost_busy",
-                   "lost_full", "lost_down", "busy_fraction", "starved_fraction",
-                   "blocked_fraction", "buffer_mean", "buffer_max")
+
+
+class StationRow(NamedTuple):
+    """A row of stations.csv: what one station did over the whole run (docs/layout.md)."""
+
+    station: str
+    """``first`` (the scenario's own cell), or the station's name."""
+    parts_in: int
+    """Parts that came to it (dropped on its input window)."""
+    parts_delivered: int
+    """Parts it set down on its output belt."""
+    parts_lost: int
+    """Parts it did not take: ``lost_busy`` + ``lost_full`` + ``lost_down`` (a station
+    downstream may still take them)."""
+    lost_busy: int
+    """Let go: they reached B while the robot was busy."""
+    lost_full: int
+    """Rode on past its full buffer (``when_full: ride_off``)."""
+    lost_down: int
+    """Lost to its downtime (rode off while its robot was stopped, or scrapped from the hand)."""
+    busy_fraction: float
+    """Share of the run its robot was in motion."""
+    starved_fraction: float
+    """Share its robot was up and still with no part to take."""
+    blocked_fraction: float
+    """Share its robot was up and still while its output belt stood."""
+    buffer_mean: float
+    """Mean number of parts waiting in its buffer (0: none)."""
+    buffer_max: int
+    """The most parts that waited in it at once."""
+
+
+#: stations.csv's columns, in order.
+STATION_COLUMNS = StationRow._fields
 
 
 def station_seed(seed: Any, i: int) -> Any:
@@ -228,7 +258,7 @@ class Line:
         for station in self.stations:
             station.close(end_s)
 
-    def rows(self, end_s: float) -> list[tuple[Any, ...]]:
+    def rows(self, end_s: float) -> list[StationRow]:
         """stations.csv's rows (:data:`STATION_COLUMNS`), over the whole run."""
         out = []
         for (name, _, _), log, station, dt in zip(self.cells, self.logs, self.stations,
@@ -237,7 +267,7 @@ class Line:
             sec = oee.unit_seconds(log.column, dt, end_s, stops)
             share = (lambda x: x / end_s) if end_s > 0 else (lambda x: math.nan)
             b = station.buffer
-            out.append((name, log.parts_in, log.delivered,
+            out.append(StationRow(name, log.parts_in, log.delivered,
                         log.lost_busy + log.lost_full + log.lost_down, log.lost_busy,
                         log.lost_full, log.lost_down, share(sec["busy"]),
                         share(sec["starved"]), share(sec["blocked"]),

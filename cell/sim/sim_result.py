@@ -43,7 +43,7 @@ class SimResult:
     first asked for.
     """
     wear: wear_clock.WearResult | None = None  # with wear.enabled: its measures and stops
-    station_rows: list[tuple[Any, ...]] | None = None
+    station_rows: list[Any] | None = None
     """stations.csv's rows (with ``stations:`` or ``buffer:``; cell.sim.line.STATION_COLUMNS)."""
 
     def __init__(self, summary: RunSummary, rows: list[tuple[Any, ...]] | None = None,
