@@ -100,8 +100,10 @@ class StationLog:
         self.came: dict[int, float] = {}
         """When each part still here came to the station (dropped on its input window)."""
         self.columns: dict[str, array[float]] = {c: array("d") for c in
-                                                  ("arrival", "at_bot", "cycle", "picked")}
-        """Per part done here: when it came, its B (its cycle's start), its cycle, picked."""
+                                                  ("arrival", "at_bot", "cycle", "picked",
+                                                   "part", "left")}
+        """Per part done here: when it came, its B (its cycle's start), its cycle, picked, its
+        index, and when it left (set down, or rode on from B)."""
 
     def arrive(self, part: Part, now: float) -> None:
         """A part is dropped on this station's input window now."""
@@ -118,6 +120,8 @@ class StationLog:
         c["at_bot"].append(part.at_bot_s)
         c["cycle"].append(part.plan.cycle if picked else math.nan)
         c["picked"].append(1.0 if picked else 0.0)
+        c["part"].append(part.index)
+        c["left"].append(part.touchdown_s if part.touchdown_s == part.touchdown_s else part.at_bot_s)
         return self.flags.pop(part.index, 0)
 
     def missed(self, part: Part) -> None:

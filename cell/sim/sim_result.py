@@ -43,6 +43,8 @@ class SimResult:
     first asked for.
     """
     wear: wear_clock.WearResult | None = None  # with wear.enabled: its measures and stops
+    line: Any = None
+    """The layout's stations and their logs (cell.sim.line.Line; None without one)."""
     station_rows: list[Any] | None = None
     """stations.csv's rows (with ``stations:`` or ``buffer:``; cell.sim.line.STATION_COLUMNS)."""
 

@@ -318,7 +318,7 @@ def simulate(scenario: Scenario | AssembledCell,
     result.downtime, result.timelines, result.stop_rows = downtime, lines, stops
     result.wear = wear_clock.measures(wear, downtime, env.now)
     if line is not None:
-        result.station_rows = line.rows(env.now)
+        result.station_rows, result.line = line.rows(env.now), line
     return result
 
 
