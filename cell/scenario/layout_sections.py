@@ -15,6 +15,7 @@ from typing import Any, Literal
 
 from pydantic import Field
 
+from cell.plumbing.errors import ScenarioError
 from cell.scenario.fields import Section
 from cell.scenario.sections import MAX_LENGTH_IN, finite
 
@@ -74,16 +75,75 @@ class StationSettings(Section):
     """Overrides of ``mintime:``."""
 
 
-def station_raw(base: Mapping[str, Any], station: StationSettings,
-                merge: Any, is_section: Any) -> dict[str, Any]:
+def station_raw(base: Mapping[str, Any], station: StationSettings, merge: Any) -> dict[str, Any]:
     """The station's scenario as plain data: the scenario's (without ``stations``) with the
     station's sections merged in and its input window's length, the offset or the transfer."""
     raw = {k: v for k, v in base.items() if k != "stations"}
     for name in STATION_SECTIONS:
         given = getattr(station, name)
         if given is not None:
-            raw = merge(raw, {name: given}, (), is_section)
+            raw = merge(raw, {name: given})
     length = station.offset_in if station.placement == "downstream" else station.transfer_in
     raw["belts"] = {**raw.get("belts", {}), "input_length_in": length}
     raw["name"] = f"{raw.get('name', '')}/{station.name}"
     return raw
+
+
+def named_station(exc: ScenarioError, raw: Any) -> ScenarioError:
+    """A station's key by the station's name (``stations.catcher.offset_in``) rather than by
+    its place in the list (``stations[1].offset_in``), when it has one."""
+    key = exc.key
+    if not key.startswith("stations["):
+        return exc
+    index, _, rest = key[len("stations["):].partition("]")
+    try:
+        name = raw["stations"][int(index)]["name"]
+    except (KeyError, IndexError, TypeError, ValueError):
+        return exc
+    if not isinstance(name, str) or not name:
+        return exc
+    return ScenarioError(exc.file, f"stations.{name}{rest}", exc.value, exc.why)
+
+
+def check_layout(s: Any, raw: Mapping[str, Any], file: object, validate: Any, merge: Any) -> None:
+    """The buffer's pitch against the part; each station placed where it can work, and its
+    own scenario (the scenario's sections with its overrides) valid, its keys named in full."""
+    b = s.buffer
+    if b is not None and b.pitch_in is not None and b.pitch_in < s.part.size_in:
+        raise ScenarioError(file, "buffer.pitch_in", b.pitch_in, f"shorter than the part "
+                            f"({s.part.size_in:g} in, part.size_in): waiting parts would overlap")
+    if not s.stations:
+        return
+    seen: set[str] = set()
+    base = {k: v for k, v in raw.items() if k != "stations"}
+    for st in s.stations:
+        key = f"stations.{st.name}"
+        if st.name in seen:
+            raise ScenarioError(file, f"{key}.name", st.name, "two stations have this name")
+        seen.add(st.name)
+        own, other = ("offset_in", "transfer_in") if st.placement == "downstream" else \
+            ("transfer_in", "offset_in")
+        if getattr(st, other) is not None:
+            raise ScenarioError(file, f"{key}.{other}", getattr(st, other),
+                                "not for a " + st.placement + " station")
+        length = getattr(st, own)
+        if length is None:
+            raise ScenarioError(file, f"{key}.{own}", None, f"a {st.placement} station needs it")
+        if st.placement == "downstream":  # no closer than the open hand's span: the hand at
+            clear = s.robot.hand.open_in  # F and the one at B could touch (docs/layout.md)
+            if length < 0:
+                raise ScenarioError(file, f"{key}.offset_in", length, "places the station "
+                                    "before the F of the station it follows: it must lie past it")
+            if length < clear:
+                raise ScenarioError(file, f"{key}.offset_in", length, f"closer than the open "
+                                    f"hand's span ({clear:g} in, robot.hand.open_in): the two "
+                                    "arms could collide")
+        elif not length > 0:
+            raise ScenarioError(file, f"{key}.transfer_in", length, "a transfer must have a "
+                                "length: the station needs a drop point before its B")
+        try:
+            own_s = validate(station_raw(base, st, merge))
+        except ScenarioError as exc:
+            inner = own if exc.key == "belts.input_length_in" else exc.key
+            raise ScenarioError(exc.file, f"{key}.{inner}", exc.value, exc.why) from None
+        s._stations.append((st, own_s))

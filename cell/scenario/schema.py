@@ -35,7 +35,8 @@ from cell.scenario.layout_sections import (  # noqa: F401 - the schema, re-expor
     STATION_SECTIONS,
     BufferSettings,
     StationSettings,
-    station_raw,
+    check_layout,
+    named_station,
 )
 from cell.scenario.overrides import apply_overrides, merge
 from cell.scenario.run_length import keep_one_length, lengths_given
@@ -212,72 +213,13 @@ def validate(raw: Any, file: object = "<dict>", source: str | None = None) -> Sc
     try:
         scenario = Scenario.model_validate(raw)
     except ValidationError as exc:
-        raise _named_station(error_from_validation(exc, raw, file, Scenario), raw) from None
+        raise named_station(error_from_validation(exc, raw, file, Scenario), raw) from None
     scenario._source = str(source if source is not None else file)
     _cross_checks(scenario, file)
     check_energy(scenario.energy, scenario.mintime.dynamics_file, file)
-    _check_layout(scenario, raw, file)
+    check_layout(scenario, raw, file, lambda r: validate(r, file, source=scenario.source),
+                 lambda base, more: merge(base, more, (), is_section))
     return scenario
-
-
-def _named_station(exc: ScenarioError, raw: Any) -> ScenarioError:
-    """A station's key by the station's name (``stations.catcher.offset_in``) rather than by
-    its place in the list (``stations[1].offset_in``), when it has one."""
-    key = exc.key
-    if not key.startswith("stations["):
-        return exc
-    index, _, rest = key[len("stations["):].partition("]")
-    try:
-        name = raw["stations"][int(index)]["name"]
-    except (KeyError, IndexError, TypeError, ValueError):
-        return exc
-    if not isinstance(name, str) or not name:
-        return exc
-    return ScenarioError(exc.file, f"stations.{name}{rest}", exc.value, exc.why)
-
-
-def _check_layout(s: Scenario, raw: Mapping[str, Any], file: object) -> None:
-    """The buffer's pitch against the part; each station placed where it can work, and its
-    own scenario (the scenario's sections with its overrides) valid, its keys named in full."""
-    b = s.buffer
-    if b is not None and b.pitch_in is not None and b.pitch_in < s.part.size_in:
-        raise ScenarioError(file, "buffer.pitch_in", b.pitch_in, f"shorter than the part "
-                            f"({s.part.size_in:g} in, part.size_in): waiting parts would overlap")
-    if not s.stations:
-        return
-    seen: set[str] = set()
-    base = {k: v for k, v in raw.items() if k != "stations"}
-    for st in s.stations:
-        key = f"stations.{st.name}"
-        if st.name in seen:
-            raise ScenarioError(file, f"{key}.name", st.name, "two stations have this name")
-        seen.add(st.name)
-        own, other = ("offset_in", "transfer_in") if st.placement == "downstream" else \
-            ("transfer_in", "offset_in")
-        if getattr(st, other) is not None:
-            raise ScenarioError(file, f"{key}.{other}", getattr(st, other),
-                                "not for a " + st.placement + " station")
-        length = getattr(st, own)
-        if length is None:
-            raise ScenarioError(file, f"{key}.{own}", None, f"a {st.placement} station needs it")
-        if st.placement == "downstream":  # no closer than the open hand's span: the hand at
-            clear = s.robot.hand.open_in  # F and the one at B could touch (docs/layout.md)
-            if length < 0:
-                raise ScenarioError(file, f"{key}.offset_in", length, "places the station "
-                                    "before the F of the station it follows: it must lie past it")
-            if length < clear:
-                raise ScenarioError(file, f"{key}.offset_in", length, f"closer than the open "
-                                    f"hand's span ({clear:g} in, robot.hand.open_in): the two "
-                                    "arms could collide")
-        elif not length > 0:
-            raise ScenarioError(file, f"{key}.transfer_in", length, "a transfer must have a "
-                                "length: the station needs a drop point before its B")
-        try:
-            own_s = validate(station_raw(base, st, merge, is_section), file, source=s.source)
-        except ScenarioError as exc:
-            inner = own if exc.key == "belts.input_length_in" else exc.key
-            raise ScenarioError(exc.file, f"{key}.{inner}", exc.value, exc.why) from None
-        s._stations.append((st, own_s))
 
 
 def is_section(path: tuple[str, ...]) -> bool:

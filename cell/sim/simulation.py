@@ -270,38 +270,22 @@ def simulate(scenario: Scenario | AssembledCell,
     tm = k.timing
     # with failures the clocks never end: the run ends when its last part is done
     finished = env.event() if s.failures is not None and horizon is None else None
-    line = None
-    if s.has_layout:  # a buffer, more stations (docs/layout.md)
-        from cell.sim.line import Line
-
-        if finished is None and any(own.scenario.failures is not None for _, own in cell.line):
-            finished = env.event() if horizon is None else None
+    if finished is None and horizon is None and any(c.scenario.failures for _, c in cell.line):
+        finished = env.event()  # a later station's failure clocks never end either
     log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows,
                  (tm.r1_length_in, tm.r2.length_in, tm.r3_length_in, tm.r4.length_in),
                  finished, n, state_energy.arm_energy_of(cell),
                  (s.stations is not None, _has_buffer(cell)))
     downtime = None if s.failures is None else Downtime(env, s.failures, seed)
     wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
-    if s.has_layout:
-        line = Line(env, cell, seed, log, belts.told, downtime)
-        station = line.first
-        feeder = Feeder(env, t_list, station.input, n, k.part_size, log.flag)
-        line.control(feeder.fed_s, n)
-        line.logs[0].parts_in = n
-    else:
-        station = Station(env, cell, seed, log.delivered_part, belts.told, downtime)
-        feeder = Feeder(env, t_list, station.input, n, k.part_size, log.flag)
-        station.control(feeder.fed_s, n, log)
+    line, station, feeder = _build(env, cell, seed, log, belts, downtime, t_list, n)
     if downtime is None and finished is None and horizon is None:
         env.run()
     else:
         if downtime is not None:
             downtime.start()
         run_until_done(env, log, horizon, finished)
-    if line is not None:
-        line.close(env.now)
-    else:
-        station.close(env.now)
+    (line or station).close(env.now)
 
     summary = _summary(cell, log, acct, t_all, n, env.now)
     wear = None if station.wear is None else station.wear.log  # wear: without failures
@@ -317,9 +301,26 @@ def simulate(scenario: Scenario | AssembledCell,
     result = SimResult(summary, rows, belts if keep_belts else None)
     result.downtime, result.timelines, result.stop_rows = downtime, lines, stops
     result.wear = wear_clock.measures(wear, downtime, env.now)
-    if line is not None:
-        result.station_rows, result.line = line.rows(env.now), line
+    result.station_rows, result.line = (line.rows(env.now), line) if line else (None, None)
     return result
+
+
+def _build(env: simpy.Environment, cell: AssembledCell, seed: Any, log: RunLog, belts: BeltLog,
+           downtime: Downtime | None, t_list: list[float], n: int) -> tuple[Any, Station, Feeder]:
+    """The station fed by the feeder, and with ``buffer:`` or ``stations:`` the line it is the
+    first of (cell.sim.line; None without)."""
+    if not cell.scenario.has_layout:
+        station = Station(env, cell, seed, log.delivered_part, belts.told, downtime)
+        feeder = Feeder(env, t_list, station.input, n, cell.k.part_size, log.flag)
+        station.control(feeder.fed_s, n, log)
+        return None, station, feeder
+    from cell.sim.line import Line
+
+    line = Line(env, cell, seed, log, belts.told, downtime)
+    feeder = Feeder(env, t_list, line.first.input, n, cell.k.part_size, log.flag)
+    line.control(feeder.fed_s, n)
+    line.logs[0].parts_in = n
+    return line, line.first, feeder
 
 
 def _has_buffer(cell: AssembledCell) -> bool:
