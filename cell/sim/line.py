@@ -15,7 +15,7 @@ alone.
 from __future__ import annotations
 
 import math
-from array import array
+import struct
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -72,6 +72,13 @@ class StationRow(NamedTuple):
 STATION_COLUMNS = StationRow._fields
 
 
+#: What a station's log keeps of each part done there: when it came, its B (its cycle's
+#: start), its cycle (NaN: not picked), whether it was picked, its index, and when it left
+#: (set down, or rode on from B).
+COLUMNS = ("arrival", "at_bot", "cycle", "picked", "part", "left")
+_PACK = struct.Struct(f"={len(COLUMNS)}d").pack
+
+
 def station_seed(seed: Any, i: int) -> Any:
     """Station i's root seed: the run's for the first, a child stream's for the others."""
     if i == 0:
@@ -99,11 +106,9 @@ class StationLog:
         self.parts_in = self.delivered = self.lost_busy = self.lost_full = self.lost_down = 0
         self.came: dict[int, float] = {}
         """When each part still here came to the station (dropped on its input window)."""
-        self.columns: dict[str, array[float]] = {c: array("d") for c in
-                                                  ("arrival", "at_bot", "cycle", "picked",
-                                                   "part", "left")}
-        """Per part done here: when it came, its B (its cycle's start), its cycle, picked, its
-        index, and when it left (set down, or rode on from B)."""
+        self.per_part = bytearray()
+        """Per part done here, :data:`COLUMNS` packed as doubles (one call a part, as the run's
+        log keeps its own)."""
 
     def arrive(self, part: Part, now: float) -> None:
         """A part is dropped on this station's input window now."""
@@ -115,14 +120,12 @@ class StationLog:
         self.flags[i] = self.flags.get(i, 0) | limits
 
     def _note(self, part: Part, picked: bool) -> int:
-        c = self.columns
-        c["arrival"].append(self.came.pop(part.index, part.arrival_s))
-        c["at_bot"].append(part.at_bot_s)
-        c["cycle"].append(part.plan.cycle if picked else math.nan)
-        c["picked"].append(1.0 if picked else 0.0)
-        c["part"].append(part.index)
-        c["left"].append(part.touchdown_s if part.touchdown_s == part.touchdown_s else part.at_bot_s)
-        return self.flags.pop(part.index, 0)
+        i, at_bot, td = part.index, part.at_bot_s, part.touchdown_s
+        # speed: docs/performance.md#station-log
+        self.per_part.extend(_PACK(self.came.pop(i, part.arrival_s), at_bot,
+                                   part.plan.cycle if picked else math.nan, picked, i,
+                                   td if td == td else at_bot))
+        return self.flags.pop(i, 0)
 
     def missed(self, part: Part) -> None:
         """The part is lost here: let go (the robot busy), past a full buffer, to downtime
@@ -156,9 +159,10 @@ class StationLog:
         done(part)
 
     def column(self, name: str) -> np.ndarray:
-        """One of :attr:`columns` in the order the parts began their cycles here."""
-        order = np.argsort(np.frombuffer(self.columns["at_bot"]), kind="stable")
-        return np.frombuffer(self.columns[name])[order]
+        """One of :data:`COLUMNS` in the order the parts began their cycles here."""
+        table = np.frombuffer(self.per_part, dtype=np.float64).reshape(-1, len(COLUMNS))
+        order = np.argsort(table[:, 1], kind="stable")
+        return table[order, COLUMNS.index(name)]
 
 
 class Transfer:
