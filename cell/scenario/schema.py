@@ -242,7 +242,7 @@ def known_key(dotted: str) -> bool:
             continue
         rest = parts[i + 1:]
         if model is Scenario and part == "stations":  # stations.NAME.KEY..., by the station's name
-            return len(rest) >= 2 and bool(rest[0]) and (
+            return not rest or len(rest) >= 2 and bool(rest[0]) and (
                 rest[1] in ("placement", "offset_in", "transfer_in") and len(rest) == 2
                 or rest[1] in STATION_SECTIONS and known_key(".".join(rest[1:])))
         is_mapping = getattr(annotation, "__origin__", None) is dict
