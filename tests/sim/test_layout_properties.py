@@ -91,6 +91,10 @@ def test_any_layout_conserves_parts_and_keeps_its_rules(sets):
         places = (sets.get("buffer") or {}).get("places", 0) if i == 0 else \
             (sets["stations"][i - 1].get("buffer") or sets.get("buffer") or {}).get("places", 0)
         assert row.buffer_max <= places
+        rule = (sets.get("buffer") or {}) if i == 0 else \
+            (sets["stations"][i - 1].get("buffer") or sets.get("buffer") or {})
+        if rule.get("when_full") == "hold_feeder":
+            assert row.lost_full == 0  # parts stand behind a full buffer: none is lost to it
         assert 0.0 <= row.busy_fraction <= 1.0 + 1e-9
         picked = line.logs[i].column("picked")
         assert np.unique(line.logs[i].column("part")[picked == 1]).size == \
