@@ -76,3 +76,18 @@ def test_set_addresses_a_station_by_its_name(capsys, tmp_path):
     err = capsys.readouterr().err.strip()
     assert "stations.nobody.controller.ideal_cycle_s = 21" in err and "(--set)" in err
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_animate_refuses_a_layout_it_cannot_draw(capsys, tmp_path):
+    """cell animate draws the thesis's one cell: a layout is refused in one line, exit 2,
+    no file written (docs/layout.md)."""
+    for changes, key in (({}, "stations"), ({"stations": None, "buffer": {"places": 2}},
+                                             "buffer.places")):
+        doc = {k: v for k, v in {**LINE, **changes}.items() if v is not None}
+        path = tmp_path / "line.yaml"
+        path.write_text(yaml.safe_dump(doc), encoding="utf-8")
+        out = tmp_path / "line.gif"
+        assert main(["animate", str(path), "--out", str(out)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and f"{key} = " in err and str(path) in err
+        assert not out.exists()
