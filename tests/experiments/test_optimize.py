@@ -270,7 +270,7 @@ def test_an_optimisation_over_places_and_a_station_s_key(tmp_path: Path) -> None
         "vary: {buffer.places: {low: 0, high: 4, step: 1},"
         " stations.catcher.offset_in: {low: 10.0, high: 60.0, step: 10.0}}\n"
         "objectives: [{measure: parts_missed, goal: minimize}]\n"
-        "trials: 8\nreplications: 2\nseed: 3\n", encoding="utf-8")
+        "trials: 4\nreplications: 2\nseed: 3\n", encoding="utf-8")
     assert main(["optimize", str(study), "--out", str(tmp_path / "out"), "--workers", "1"]) == 0
     trials = pd.read_csv(tmp_path / "out" / "trials.csv")
     assert set(trials["buffer.places"]) <= {0, 1, 2, 3, 4}
