@@ -18,6 +18,7 @@ the other, on the same parts, across arrival means and spreads) this writes, as 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 import pandas as pd
@@ -50,7 +51,8 @@ def table(reps: pd.DataFrame) -> pd.DataFrame:
     reps = reps.assign(layout=reps.apply(_layout, axis=1)).dropna(subset=["layout"])
     reps = reps.assign(spacing_kept=1.0 - reps["spacing_outside_tol"] / reps["parts_delivered"])
     rows = []
-    for (cv, mean, layout), runs in reps.groupby([*KEYS, "layout"], sort=True):
+    for key, runs in reps.groupby([*KEYS, "layout"], sort=True):
+        cv, mean, layout = cast(tuple[float, float, str], key)
         row: dict[str, object] = {"cv": float(cv), "mean_s": float(mean),
                                   "load": round(float(mean) / FASTEST_S, 2), "layout": layout}
         for column, name in (("parts_missed", "lost"), ("spacing_kept", "spacing_kept"),
@@ -69,7 +71,8 @@ def matches(t: pd.DataFrame) -> pd.DataFrame:
     robot loses no more (NaN: none of the study's), and the two robots' loss beside the
     adaptive robot's and the fixed robot's with 5 places."""
     rows = []
-    for (cv, mean), point in t.groupby(["cv", "mean_s"], sort=True):
+    for key, point in t.groupby(["cv", "mean_s"], sort=True):
+        cv, mean = cast(tuple[float, float], key)
         lost = dict(zip(point["layout"].astype(str), point["lost"]))
         adaptive = lost["adaptive, 0 places"]
         enough = [n for n, name in zip(PLACES, FIXED) if lost[name] <= adaptive]
