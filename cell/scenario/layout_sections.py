@@ -22,6 +22,8 @@ from cell.scenario.sections import MAX_LENGTH_IN, finite
 #: The sections a station may override (the scenario's own are the first station's).
 STATION_SECTIONS = ("cell", "path", "robot", "belts", "controller", "sensor", "failures",
                     "buffer", "mintime")
+#: The scenario's own cell's name in stations.csv and parts.csv (the first station).
+FIRST_STATION = "first"
 #: The most stations a line may have (a bound on slips, as the other bounds).
 MAX_STATIONS = 20
 
@@ -118,8 +120,10 @@ def check_layout(s: Any, raw: Mapping[str, Any], file: object, validate: Any, me
     base = {k: v for k, v in raw.items() if k != "stations"}
     for st in s.stations:
         key = f"stations.{st.name}"
-        if st.name in seen:
-            raise ScenarioError(file, f"{key}.name", st.name, "two stations have this name")
+        if st.name in seen or st.name == FIRST_STATION:
+            raise ScenarioError(file, f"{key}.name", st.name, "two stations have this name"
+                                if st.name in seen else "names the scenario's own cell (the "
+                                "first station in stations.csv): choose another")
         seen.add(st.name)
         own, other = ("offset_in", "transfer_in") if st.placement == "downstream" else \
             ("transfer_in", "offset_in")

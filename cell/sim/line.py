@@ -23,6 +23,7 @@ import numpy as np
 import simpy
 
 from cell.scenario.arrivals import root_seed
+from cell.scenario.layout_sections import FIRST_STATION
 from cell.sim import oee, wear_clock
 from cell.sim.failures import Downtime
 from cell.sim.mailbox import Mailbox
@@ -35,7 +36,7 @@ if TYPE_CHECKING:
 #: The first of the stations' child streams of the run's root seed (station i: this + i).
 STATION_STREAM = 100
 #: The first station's name in stations.csv and parts.csv (the scenario's own cell).
-FIRST = "first"
+FIRST = FIRST_STATION
 
 
 class StationRow(NamedTuple):

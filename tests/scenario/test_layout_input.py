@@ -49,6 +49,8 @@ CASES = {  # what is wrong -> (the file's changes, the key named, the value name
                                   "stations.catcher.controller.ideal_cycle_s", "-3.0"),
     "two stations of one name": ({"stations": _station(1, name="catcher")},
                                  "stations.catcher.name", "'catcher'"),
+    "the first station's name": ({"stations": _station(0, name="first")},
+                                 "stations.first.name", "'first'"),
 }
 
 
