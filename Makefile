@@ -11,7 +11,7 @@ WORKERS ?= 2
 export PYTHONDONTWRITEBYTECODE :=
 export PYTHONPYCACHEPREFIX := $(if $(filter /%,$(VENV)),$(VENV),$(CURDIR)/$(VENV))/pycache
 
-.PHONY: all venv test year learn benchmark sweep sweep-mintime whatif stress sensor reliability figures animation bench lint clean optimize sensitivity kn-check
+.PHONY: all venv test year learn benchmark sweep sweep-mintime whatif stress sensor reliability figures animation bench lint clean optimize sensitivity kn-check layout
 
 all: test
 
@@ -51,6 +51,12 @@ stress: $(STAMP)
 	rm -rf build/stress
 	$(PY) -m cell sweep scenarios/stress.yaml --out build/stress --workers $(WORKERS)
 	MPLBACKEND=Agg $(PY) -m cell.reporting.maps.stress build/stress/replications.csv reports/stress
+
+# Buffer against brains (issue 32): a buffer, the adaptive controller and a second robot.
+layout: $(STAMP)
+	rm -rf build/layout
+	$(PY) -m cell sweep scenarios/layout_study.yaml --out build/layout --workers $(WORKERS)
+	MPLBACKEND=Agg $(PY) -m cell.reporting.maps.layout_study build/layout/replications.csv reports/layout
 
 sensor: $(STAMP)
 	rm -rf build/sensor

@@ -16,6 +16,9 @@ merged in by ``cell bench``):
   robot, both belts and the sensor and motor wear on (:data:`YEAR_FAILURES`), parts per
   second, one run, and its ratio to the adaptive 500,000 parts without failures
   (``year_failures_ratio``, both measured in this run);
+* a two-station line (issue 32: the adaptive cell feeding a second adaptive station in series,
+  so each part is handled twice) against the single station: seconds a part, best of three
+  runs of 20,000 parts each, both in this run (``two_station_cost_ratio``);
 * the overhead of a sweep point beyond its simulation (ms; a 200-point sweep of
   20-part runs, loaded, run, assembled and tabled in one process);
 * whole processes: ``cell run baseline`` from a cold start (median of several,
@@ -51,6 +54,18 @@ TARGETS = {"flat": 0.9, "ceiling_ratio": 0.5, "cold_run_s": 0.7, "sweep_table_7_
 TARGETS["sweep_overhead_ms_per_point"] = 5.0
 #: The year with failures and wear against the same robot's 500,000 parts without (issue 31).
 TARGETS["year_failures_ratio"] = 0.66
+#: A two-station line's cost a part against a single station's, at most (issue 32).
+TARGETS["two_station_cost_ratio"] = 2.2
+#: The second station of that line: in series, 60 in from the first's touch-down.
+SERIES_STATION = [{"name": "next", "placement": "series", "transfer_in": 60.0}]
+
+
+def two_station_cost_ratio(scenario: Scenario, parts: int = 20_000) -> float:
+    """Seconds a part of the two-station line over seconds a part of the single station
+    (:data:`SERIES_STATION`; each best of three, the paths solved first)."""
+    one = scenario.with_overrides({"run.parts": parts})
+    two = one.with_overrides({"stations": SERIES_STATION})
+    return (1.0 / parts_per_second(two, repeats=3)) / (1.0 / parts_per_second(one, repeats=3))
 
 
 def _streamed(scenario: Scenario) -> Any:
@@ -263,6 +278,8 @@ def benchmarks(scenario_file: str | Path = "scenarios/baseline.yaml", *,
         base.with_overrides({"controller.policy": "adaptive"}))
     out["year_failures_ratio"] = \
         out["parts_per_s_adaptive_year_failures"] / out["parts_per_s_adaptive_500k"]
+    out["two_station_cost_ratio"] = two_station_cost_ratio(
+        base.with_overrides({"controller.policy": "adaptive"}))
     out["sweep_overhead_ms_per_point"] = sweep_overhead_ms_per_point()
     if processes:
         out["peak_mb_1m_parts"] = peak_mb()
@@ -291,6 +308,10 @@ def verdicts(results: dict[str, Any]) -> list[tuple[str, str, str, bool]]:
         key, least = "year_failures_ratio", TARGETS["year_failures_ratio"]
         rows.append(("adaptive: parts/s a year with failures / 500k without",
                      f"{results[key]:.2f}", f">= {least}", results[key] >= least))
+    if "two_station_cost_ratio" in results:
+        key, most = "two_station_cost_ratio", TARGETS["two_station_cost_ratio"]
+        rows.append(("a two-station line's cost a part / a single station's",
+                     f"{results[key]:.2f}", f"<= {most}", results[key] <= most))
     if "sweep_overhead_ms_per_point" in results:
         key, most = "sweep_overhead_ms_per_point", TARGETS["sweep_overhead_ms_per_point"]
         rows.append((key, f"{results[key]:.2f} ms", f"<= {most:g} ms", results[key] <= most))

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from cell.cli.common import scenario_arguments, scenario_of
 
@@ -106,6 +106,7 @@ def main(args: argparse.Namespace) -> int:
     check_output(args.out)  # before anything is simulated
     check_file(args.out)
     scenario = scenario_of(args)
+    _refuse_a_layout(scenario)
     from cell.scenario.arrivals import mean_interarrival
 
     check_options(args, max(scenario.controller.nominal_cycle_s or 0.0,
@@ -117,3 +118,18 @@ def main(args: argparse.Namespace) -> int:
     print(f"wrote {done.path}: {done.frames} frames, simulated {done.t0_s:.1f}-{done.t1_s:.1f} s, "
           f"{done.size_bytes / 1e6:.2f} MB")
     return 0
+
+
+def _refuse_a_layout(scenario: Any) -> None:
+    """The animation draws the thesis's one cell: a ``buffer:`` with places or ``stations:``
+    are refused in one line, before anything is simulated (docs/layout.md)."""
+    from cell.plumbing.errors import ScenarioError
+
+    given = [(key, value) for key, value in (("stations", scenario.stations),
+                                             ("buffer.places", scenario.buffer and
+                                              scenario.buffer.places)) if value]
+    if given:
+        key, value = given[0]
+        raise ScenarioError(scenario.source, key, [s.name for s in value] if key == "stations"
+                            else value, "cell animate draws one cell without a buffer; a layout "
+                            "is not drawn yet (docs/layout.md)")

@@ -53,10 +53,11 @@ def main(args: argparse.Namespace) -> int:
     from cell.scenario.run_length import expected_parts
     from cell.scenario.schema import inert_settings
     from cell.sim.assembly import assemble
-    from cell.sim.records import BELT_COLUMNS, PART_COLUMNS
+    from cell.sim.records import BELT_COLUMNS
+    from cell.sim.sim_result import part_columns, stops_anything, writes_states
     from cell.sim.simulation import simulate
 
-    names = RUN_FILES + FAILURE_FILES + PARQUET_FILES
+    names = RUN_FILES + FAILURE_FILES + PARQUET_FILES + ("stations.csv",)
     OutputDir.check(args.out, names)  # before any work
     _refuse_a_run(args)
     scenario = scenario_of(args)
@@ -72,9 +73,7 @@ def main(args: argparse.Namespace) -> int:
     with OutputDir(args.out, names) as out, \
             Progress(n, "cell run", "parts", enabled=n >= PROGRESS_FROM_PARTS) as progress:
         with out.open("parts.csv", newline="") as pf, out.open("belts.csv", newline="") as bf:
-            arm = scenario.energy is not None and scenario.energy.arm == "dynamics"  # energy_j
-            timed = scenario.calendar is not None  # arrival_time
-            parts = RowWriter(pf, PART_COLUMNS + ["energy_j"] * arm + ["arrival_time"] * timed)
+            parts = RowWriter(pf, part_columns(cell))
             belts = RowWriter(bf, BELT_COLUMNS)
             result = simulate(cell, keep_parts=False, on_part=_on_part(parts, progress, n, scenario),
                               on_belt=belts.record, keep_belts=False)
@@ -83,8 +82,15 @@ def main(args: argparse.Namespace) -> int:
             progress.update(done - progress.n)
         with out.open("summary.csv", newline="") as sf:
             RowWriter(sf, list(result.summary.as_dict())).record(result.summary)
-        if _has_states(scenario):
-            _write_failures(out, result, _stops_anything(scenario))
+        if result.station_rows is not None:  # buffer: or stations: (docs/layout.md)
+            from cell.sim.line import STATION_COLUMNS
+
+            with out.open("stations.csv", newline="") as f:
+                write = RowWriter(f, STATION_COLUMNS).record
+                for row in result.station_rows:
+                    write(row)
+        if writes_states(scenario):
+            _write_failures(out, result, stops_anything(scenario))
         if args.format == "parquet":
             _as_parquet(out)
     _report(args, scenario, result, out.target)
@@ -120,6 +126,7 @@ def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) ->
         stops_line,
         thesis_figures,
     )
+    from cell.sim.sim_result import stops_anything, writes_states
 
     accounting = shows_thesis(scenario, args.thesis)
     r = result.summary
@@ -127,22 +134,13 @@ def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) ->
     print(f"robot busy (in motion) {r.robot_busy_fraction:.3f} of the run, beside its offered "
           f"load (fastest cycle / mean inter-arrival) {r.offered_load:.3f}")
     written = RUN_FILES if args.format == "csv" else PARQUET_FILES
-    if not _stops_anything(scenario):
-        also = ", states.csv" if _has_states(scenario) else ""
+    if not stops_anything(scenario):
+        also = ", states.csv" if writes_states(scenario) else ""
+        also += ", stations.csv" if result.station_rows is not None else ""
         print(f"wrote {shown}/{written[0]}, {written[1]}{also} and {written[2]}")
         return
     print(stops_line(r, scenario.failures))
     print(f"wrote {shown}/{written[0]}, {written[1]}, {written[2]}, states.csv and failures.csv")
-
-
-def _stops_anything(scenario: Any) -> bool:
-    """Whether the scenario can stop the cell (``failures:``, or ``wear:`` on)."""
-    return scenario.failures is not None or scenario.wear.enabled
-
-
-def _has_states(scenario: Any) -> bool:
-    """Whether states.csv is written: with stops, ``energy:`` (its states) or a calendar."""
-    return _stops_anything(scenario) or scenario.energy is not None or scenario.calendar is not None
 
 
 def _write_failures(out: Any, result: Any, stops: bool = True) -> None:

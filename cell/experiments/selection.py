@@ -15,18 +15,12 @@ from typing import Any
 import numpy as np
 
 from cell.experiments.kn import FlatFirstStage, NotANumber, Selection, kn
+from cell.experiments.study import GOALS
 from cell.plumbing.errors import CellError
 from cell.scenario.schema import Scenario
 
 Stream = Callable[[int], np.random.SeedSequence]
 
-#: The usual sense of the headline measures, for ``--select-best`` without ``--goal``.
-GOALS = {"parts_missed": "minimize", "parts_missed_pct": "minimize", "parts_missed_thesis": "minimize",
-         "spacing_outside_tol": "minimize", "spacing_outside_pct": "minimize",
-         "parts_per_hr_wallclock": "maximize", "parts_per_hr_thesis": "maximize",
-         "parts_delivered": "maximize", "actual_cycle_wallclock_s": "minimize",
-         "actual_cycle_thesis_s": "minimize", "oee": "maximize", "cost_per_good_part": "minimize",
-         "cost_per_h": "minimize", "energy_kwh": "minimize", "energy_per_good_part_wh": "minimize"}
 
 
 def select_scenarios(scenarios: Sequence[Scenario], measure: str, maximize: bool, delta: float,

@@ -52,6 +52,15 @@ MAX_POINTS = 100_000
 _CONSTRAINT = re.compile(r"^\s*(?P<m>[A-Za-z_][A-Za-z0-9_]*)\s*(?P<op><=|>=)\s*(?P<v>[-+0-9.eE]+)\s*$")
 
 
+#: The usual sense of the headline measures: ``--select-best`` without ``--goal``, ``select.measure``.
+GOALS = {"parts_missed": "minimize", "parts_missed_pct": "minimize", "parts_missed_thesis": "minimize",
+         "spacing_outside_tol": "minimize", "spacing_outside_pct": "minimize",
+         "parts_per_hr_wallclock": "maximize", "parts_per_hr_thesis": "maximize",
+         "parts_delivered": "maximize", "actual_cycle_wallclock_s": "minimize",
+         "actual_cycle_thesis_s": "minimize", "oee": "maximize", "cost_per_good_part": "minimize",
+         "cost_per_h": "minimize", "energy_kwh": "minimize", "energy_per_good_part_wh": "minimize"}
+
+
 def summary_measures() -> list[str]:
     """Every measure a run reports: the summary's numeric columns, then :data:`DERIVED`."""
     from dataclasses import fields
@@ -112,7 +121,7 @@ class SelectSettings(Section):
     """The measure to select on (default: the first objective that is a measure)."""
     goal: Literal["minimize", "maximize"] | None = None
     """Whether more or less of ``measure`` is better, where no objective on it says so and it
-    is not one of the headline measures whose sense is known (selection.GOALS)."""
+    is not one of the headline measures whose sense is known (GOALS)."""
 
 
 class MorrisSettings(Section):
@@ -271,8 +280,6 @@ def load_study(path: str | Path, corners: bool = True) -> Study:
 def _selection_goal(objectives: Any, select: SelectSettings) -> str | None:
     """The sense of ``select.measure``: ``select.goal``, an objective's goal on the same
     measure, or the headline measure's usual sense; None if none of them says."""
-    from cell.experiments.selection import GOALS
-
     return select.goal or next((o.goal for o in objectives if o.measure == select.measure),
                                GOALS.get(select.measure or ""))
 

@@ -98,6 +98,14 @@ def _setting(base: Scenario, dotted: str) -> tuple[Any, str | None]:
     not hold (``arrivals.params.loc``) is None."""
     obj: Any = base
     parts = dotted.split(".")
+    if parts[0] == "stations" and len(parts) > 2:  # a station's key, by its name (docs/layout.md)
+        for station, own in base.line:
+            if station.name == parts[1]:
+                if len(parts) == 3 and parts[2] in type(station).model_fields:
+                    return getattr(station, parts[2]), None
+                value, absent = _setting(own, ".".join(parts[2:]))
+                return value, None if absent is None else f"stations.{parts[1]}.{absent}"
+        return None, ".".join(parts[:2])
     for i, part in enumerate(parts):
         if obj is None:
             return None, ".".join(parts[:i])

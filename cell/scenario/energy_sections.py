@@ -109,9 +109,9 @@ class OptionCosts(Section):
     sensor: float = money()
     """The look-ahead sensor (counted with ``sensor.lookahead: sensor``)."""
     buffer_place: float = money()
-    """A buffer place (per place; the cell has none today)."""
+    """A buffer place (per place: ``buffer.places``, each station's)."""
     robot: float = money()
-    """A robot (per robot; the cell has one)."""
+    """A robot (per robot: one, and one per station of ``stations:``)."""
     adaptive_controller: float = money()
     """The adaptive controller (counted with ``controller.policy: adaptive``)."""
 

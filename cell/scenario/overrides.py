@@ -54,8 +54,14 @@ def set_dotted(raw: dict[str, Any], key: str, value: Any, file: object,
     if not all(parts):
         raise ScenarioError(file, key, value, "a dotted key has an empty part")
     node = raw
-    for i, part in enumerate(parts[:-1]):
+    i = -1
+    while i + 1 < len(parts) - 1:
+        i += 1
+        part = parts[i]
         child = node.get(part)
+        if isinstance(child, list) and i + 2 < len(parts):  # a list of named entries
+            node, i = _named_entry(node, part, child, parts[i + 1], key, value, file), i + 1
+            continue
         if child is None:
             child = node[part] = {}
         elif not isinstance(child, dict):
@@ -71,6 +77,20 @@ def set_dotted(raw: dict[str, Any], key: str, value: Any, file: object,
         node[leaf] = merge(old, value, parts, is_section)
     else:
         node[leaf] = copy.deepcopy(value)
+
+
+def _named_entry(node: dict[str, Any], part: str, items: list[Any], name: str, key: str,
+                 value: Any, file: object) -> dict[str, Any]:
+    """The entry of a list of mappings (``stations``) whose ``name`` is ``name``, copied into
+    place so that setting its keys leaves the original as it was."""
+    items = node[part] = list(items)
+    for j, item in enumerate(items):
+        if isinstance(item, Mapping) and item.get("name") == name:
+            entry = items[j] = dict(item)
+            return entry
+    names = [str(item.get("name")) for item in items if isinstance(item, Mapping)]
+    raise ScenarioError(file, key, value, f"no entry of {part} is named {name} (named: "
+                        + ", ".join(names) + ")")
 
 
 def merge(base: Mapping[str, Any], update: Mapping[str, Any], path: tuple[str, ...] = (),

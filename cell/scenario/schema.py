@@ -17,7 +17,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from pydantic import BaseModel, PrivateAttr, ValidationError
+from pydantic import BaseModel, Field, PrivateAttr, ValidationError
 
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.calendar_section import CalendarSettings
@@ -31,6 +31,14 @@ from cell.scenario.failure_sections import (  # noqa: F401 - the schema, re-expo
     WearSettings,
 )
 from cell.scenario.fields import Section, error_from_validation, model_at, unwrap_optional
+from cell.scenario.layout_sections import (  # noqa: F401 - the schema, re-exported
+    MAX_STATIONS,
+    STATION_SECTIONS,
+    BufferSettings,
+    StationSettings,
+    check_layout,
+    named_station,
+)
 from cell.scenario.overrides import apply_overrides, merge
 from cell.scenario.run_length import keep_one_length, lengths_given
 from cell.scenario.sections import (  # noqa: F401 - the schema, re-exported
@@ -89,12 +97,29 @@ class Scenario(Section):
     costs: CostSettings | None = None
     """Money: lost parts, energy, downtime, repairs, maintenance, options (docs/usage.md, "Energy
     and cost"); absent: no cost measured."""
+    buffer: BufferSettings | None = None
+    """An accumulating buffer before B (docs/layout.md); absent or ``places: 0``: none."""
+    stations: list[StationSettings] | None = Field(None, max_length=MAX_STATIONS)
+    """More stations, downstream on the input line or in series (docs/layout.md); the
+    scenario's own cell is the first; absent: the thesis's one cell."""
 
     calendar: CalendarSettings | None = None
     """The plant's working week: shifts, breaks, working days (docs/usage.md, "A shift
     calendar"); absent: the cell works without a break from the run's start."""
 
     _source: str = PrivateAttr(default="<defaults>")
+    _stations: list[tuple[StationSettings, Scenario]] = PrivateAttr(default_factory=list)
+
+    @property
+    def line(self) -> list[tuple[StationSettings, Scenario]]:
+        """Each station after the first: its settings and its own scenario (the scenario's
+        sections with its overrides), in order; empty without ``stations:``."""
+        return self._stations
+
+    @property
+    def has_layout(self) -> bool:
+        """Whether a ``buffer:`` or ``stations:`` section is given (stations.csv is written)."""
+        return self.buffer is not None or self.stations is not None
 
     @property
     def source(self) -> str:
@@ -107,8 +132,16 @@ class Scenario(Section):
         return Path(self._source).parent if self._source != "<defaults>" else Path.cwd()
 
     def get(self, dotted: str) -> Any:
+        parts = dotted.split(".")
+        if parts[0] == "stations" and len(parts) > 2:  # a station's own value, by its name
+            for station, scenario in self._stations:
+                if station.name == parts[1]:
+                    own = getattr(station, parts[2]) if parts[2] not in STATION_SECTIONS else None
+                    return own if len(parts) == 3 and parts[2] not in STATION_SECTIONS \
+                        else scenario.get(".".join(parts[2:]))
+            raise KeyError(dotted)
         obj: Any = self
-        for part in dotted.split("."):
+        for part in parts:
             obj = obj[part] if isinstance(obj, Mapping) else getattr(obj, part)
         return obj
 
@@ -118,7 +151,7 @@ class Scenario(Section):
         default only when given (so a scenario without them reads as it did before they
         existed), and with ``run.hours`` no ``run.parts`` (the run's length is given one way)."""
         d = _plain(self.model_dump())
-        for optional in ("failures", "energy", "costs", "calendar"):
+        for optional in ("failures", "energy", "costs", "calendar", "buffer", "stations"):
             if d.get(optional) is None:
                 d.pop(optional, None)
         given = [k for k in ("hours", "days", "weeks") if d["run"].get(k) is not None]
@@ -188,10 +221,12 @@ def validate(raw: Any, file: object = "<dict>", source: str | None = None) -> Sc
     try:
         scenario = Scenario.model_validate(raw)
     except ValidationError as exc:
-        raise error_from_validation(exc, raw, file, Scenario) from None
+        raise named_station(error_from_validation(exc, raw, file, Scenario), raw) from None
     scenario._source = str(source if source is not None else file)
     _cross_checks(scenario, file)
     check_energy(scenario.energy, scenario.mintime.dynamics_file, file)
+    check_layout(scenario, raw, file, lambda r: validate(r, file, source=scenario.source),
+                 lambda base, more: merge(base, more, (), is_section))
     return scenario
 
 
@@ -214,6 +249,10 @@ def known_key(dotted: str) -> bool:
             model = annotation
             continue
         rest = parts[i + 1:]
+        if model is Scenario and part == "stations":  # stations.NAME.KEY..., by the station's name
+            return not rest or len(rest) >= 2 and bool(rest[0]) and (
+                rest[1] in ("placement", "offset_in", "transfer_in") and len(rest) == 2
+                or rest[1] in STATION_SECTIONS and known_key(".".join(rest[1:])))
         is_mapping = getattr(annotation, "__origin__", None) is dict
         return not rest or (is_mapping and len(rest) == 1 and bool(rest[0]))
     return True

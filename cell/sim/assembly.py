@@ -11,7 +11,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from cell.scenario.schema import Scenario
+from cell.plumbing.errors import ScenarioError
+from cell.scenario.schema import Scenario, StationSettings
 from cell.sim.physics_checks import step_table
 from cell.sim.policies.base import CellConstants, Policy
 from cell.sim.policy_setup import constants, make_policy
@@ -30,11 +31,13 @@ class AssembledCell:
     """A scenario's cell, ready to run: its timing, constants and policy (and its solved
     path, :attr:`table`, solved when first asked for)."""
 
-    __slots__ = ("scenario", "timing", "k", "policy")
+    __slots__ = ("scenario", "timing", "k", "policy", "line")
 
     def __init__(self, scenario: Scenario, timing: RobotTiming, k: CellConstants,
                  policy: Policy):
         self.scenario, self.timing, self.k, self.policy = scenario, timing, k, policy
+        self.line: list[tuple[StationSettings, AssembledCell]] = []
+        """Each station after the first (``stations:``), assembled (docs/layout.md)."""
 
     @property
     def table(self) -> StepTable:
@@ -54,4 +57,11 @@ def assemble(s: Scenario) -> AssembledCell:
     from cell.sim.sensor import sensor_position
 
     sensor_position(s.sensor, k.input_length, s.source)  # a sensor beyond the feeder: refused
-    return AssembledCell(s, timing, k, make_policy(s, k))
+    cell = AssembledCell(s, timing, k, make_policy(s, k))
+    for station, own in s.line:
+        try:
+            cell.line.append((station, assemble(own)))
+        except ScenarioError as exc:  # the station's key, named in full
+            raise ScenarioError(exc.file, f"stations.{station.name}.{exc.key}", exc.value,
+                                exc.why) from None
+    return cell

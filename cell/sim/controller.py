@@ -10,12 +10,13 @@ policy's; nothing here knows which policy runs.
 from __future__ import annotations
 
 import math
-from typing import Protocol
+from typing import Any, Protocol
 
 import simpy
 
 from cell.plumbing.errors import CellError
 from cell.sim.conveyors import EPS_S, InputConveyor, OutputConveyor
+from cell.sim.mailbox import Mailbox
 from cell.sim.policies.base import CellConstants, Policy
 from cell.sim.policies.check import check, plan_bounds, plan_failed
 from cell.sim.records import Part
@@ -52,6 +53,9 @@ class View:
         self.sensor_up = True
         """False while the look-ahead sensor is down (a failure): it then reports nothing,
         the ideal look-ahead included, and ``next_part`` is None."""
+        self.queue: Any = None
+        """The parts waiting at a buffer's gate (None: no buffer): while one waits, it is the
+        next part, at B as soon as the robot is back (docs/layout.md)."""
 
     def input_speed(self) -> float:
         return self._input_speed(self.now + EPS_S)
@@ -105,6 +109,8 @@ class SensorView(View):
         reported distance less the belt's travel since the report); None if none."""
         sensor, now = self.sensor, self.now
         sensor.update(now, self.part)
+        if self.queue:
+            return (lag, 0.0)
         if not self.sensor_up:
             return None
         ahead = self._input_travel(now) + v * lag  # the belt's travel at LO
@@ -120,11 +126,16 @@ class Controller:
 
     def __init__(self, env: simpy.Environment, k: CellConstants, policy: Policy, view: View,
                  conveyor: InputConveyor, output: OutputConveyor, robot: Robot, log: RunLog,
-                 name: str = ""):
+                 name: str = "", source: Mailbox | None = None):
         self.env, self.k, self.policy, self.view = env, k, policy, view
         self.name = name or getattr(policy, "name", "")
         """The policy's name, as the scenario gives it (for a bad plan's message)."""
         self.conveyor, self.output, self.robot, self.log = conveyor, output, robot, log
+        self.source = conveyor.at_bot if source is None else source
+        """Where parts at B come from: the input conveyor, or a buffer's gate."""
+        self.steers_input = source is None
+        """Whether a plan's input belt speeds are set: not with a buffer, whose gate holds a
+        part that comes early (the belt then runs at its nominal speed: docs/layout.md)."""
         self.bounds = plan_bounds(k)
         """The plan check's bounds for this cell (:func:`cell.sim.policies.check.plan_bounds`)."""
         self.process = env.process(self.run())
@@ -147,8 +158,9 @@ class Controller:
         aim = k.lookahead_margin_s  # step 6.3 from when the next part is aimed at B
         floor_after_td = math.nan  # the last planned TD (the spacing contract; nan: none)
         bounds, passed = self.bounds, None  # the last plan that passed the check
+        get, steers_input = self.source.get, self.steers_input
         while True:
-            part: Part = yield conveyor.at_bot.get()
+            part: Part = yield get()
             now = part.at_bot_s
             if not robot.free_at_s <= now + EPS_S:  # the robot is not back: the part rides on
                 self.rides_on(part, now, floor_after_td)
@@ -165,8 +177,9 @@ class Controller:
                 passed = plan
             r1a, to_g, r3a, cycle = plan.r1_pre, plan.to_g, plan.r3_pre, plan.cycle
             if plan.steers_belts:
-                conveyor.replan(now + r1a, plan.input_after_lo, now + cycle + aim,
-                                plan.input_next)
+                if steers_input:
+                    conveyor.replan(now + r1a, plan.input_after_lo, now + cycle + aim,
+                                    plan.input_next)
                 at_g = now + to_g
                 if plan.output_floor_at < INF:  # the spacing contract: the belt's floor after TD
                     output.replan_then(now, plan.output_to_g, at_g, k.u_nom,

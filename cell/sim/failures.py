@@ -103,6 +103,7 @@ class RobotStops:
         self.maintenance_due: simpy.Event | None = None
         self.maintenance_at = math.inf
         """When the next planned stop comes."""
+        self._freed: simpy.Event | None = None
 
     def loss(self, now: float) -> int:
         """A part at B with the robot not back: lost to downtime if a stop kept it away."""
@@ -156,8 +157,18 @@ class RobotStops:
         robot = self.robot
         if not robot.orders.items:  # an order given as this cycle ends keeps its own
             robot.free_at_s = free_at
+        freed, self._freed = self._freed, None
+        if freed is not None:
+            freed.succeed()
         for clock in self.clocks:
             clock.follow(leg)
+
+    def freed(self) -> simpy.Event:
+        """An event that succeeds when it is next told when the robot will be free (what a
+        buffer waits on while the robot is stopped: docs/layout.md)."""
+        if self._freed is None:
+            self._freed = self.env.event()
+        return self._freed
 
     def busy(self, end_s: float) -> tuple[Any, Any]:
         """(from, to) of the robot's motion up to ``end_s``."""

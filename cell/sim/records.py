@@ -20,6 +20,8 @@ import math
 from dataclasses import dataclass, fields
 from typing import Any, NamedTuple
 
+from cell.sim.part import Part  # noqa: F401 - the part in flight, re-exported
+
 NAN = math.nan
 
 #: The limits a part's cycle can hit, as bits of a flag word and as names in parts.csv's
@@ -39,14 +41,15 @@ LIMITS = (
     "scrapped",         # in the hand when the robot failed, scrapped (failures.robot.part_in_hand)
     "spacing_wait",     # spacing off: the robot waited longer than the output floor allows
     "spacing_unforeseen",  # spacing off: a wait the look-ahead did not foresee (belt slowed late)
+    "buffer_full",      # found the buffer full and rode on past it (buffer.when_full: ride_off)
 )
 LIMIT_BIT = {name: 1 << i for i, name in enumerate(LIMITS)}
 (INPUT_FLOOR, INPUT_CEILING, INPUT_TRACKING, OUTPUT_FLOOR, OUTPUT_CEILING, R2_PEAK, R4_PEAK,
- LET_GO, SPACING_OFF, HELD_AT_FEEDER, LOST_DOWNTIME, SCRAPPED, SPACING_WAIT, SPACING_UNFORESEEN) = \
-    (1 << i for i in range(len(LIMITS)))
-#: The one encoding of a part lost at B: it rode off (let go, or lost to downtime).  A part
-#: scrapped in the hand is ``SCRAPPED``; every other part done was set down.
-RODE_OFF = LET_GO | LOST_DOWNTIME
+ LET_GO, SPACING_OFF, HELD_AT_FEEDER, LOST_DOWNTIME, SCRAPPED, SPACING_WAIT, SPACING_UNFORESEEN,
+ BUFFER_FULL) = (1 << i for i in range(len(LIMITS)))
+#: The one encoding of a part lost at B: it rode off (let go, lost to downtime, or past a full
+#: buffer).  A part scrapped in the hand is ``SCRAPPED``; every other part done was set down.
+RODE_OFF = LET_GO | LOST_DOWNTIME | BUFFER_FULL
 
 
 class LimitCount(NamedTuple):
@@ -152,25 +155,12 @@ class PartRecord(NamedTuple):
     """The limits this part's cycle hit (names from :data:`LIMITS`, space-separated)."""
     energy_j: float | None = None
     """The arm's motion energy of this transfer, J, electrical (only with ``energy.arm: dynamics``)."""
-
-
-class Part:
-    """A part in flight, from the feeder to the output belt (or the floor).
-
-    Each slot is written once, by its owner (see the module's text): ``index`` (0 … N − 1, the one
-    numbering of parts inside the model; parts.csv's ``part`` is ``index + 1``), ``arrival_s`` and
-    ``feed_delay_s`` by the feeder, ``at_bot_s`` by the input conveyor, ``plan`` (the policy's
-    :class:`~cell.sim.policies.base.Plan`, or None: not picked) by the controller, ``pick_s`` by the
-    robot, ``touchdown_s``, ``spacing_in`` and ``delivery_interval_s`` by the output conveyor.
-    """
-
-    __slots__ = ("index", "arrival_s", "feed_delay_s", "at_bot_s", "plan", "pick_s",
-                 "touchdown_s", "spacing_in", "delivery_interval_s")
-
-    def __init__(self, index: int, arrival_s: float, feed_delay_s: float = 0.0):
-        self.index, self.arrival_s, self.feed_delay_s = index, arrival_s, feed_delay_s
-        self.at_bot_s = self.pick_s = self.touchdown_s = self.spacing_in = self.delivery_interval_s = NAN
-        self.plan: Any = None
+    station: str | None = None
+    """The station that handled it last: set it down, or let it go for good (only with
+    ``stations:``; docs/layout.md)."""
+    buffer_wait_s: float | None = None
+    """Seconds it stood in buffers, summed over the stations it came to (only with a
+    ``buffer:`` section, the scenario's or a station's; docs/layout.md)."""
 
 
 @dataclass(slots=True)
@@ -392,7 +382,9 @@ def columns(record_type: type) -> list[str]:
     return list(named) if named is not None else [f.name for f in fields(record_type)]
 
 
-PART_COLUMNS = columns(PartRecord)[:-1]  # energy_j: only with energy.arm: dynamics
+PART_COLUMNS = columns(PartRecord)[:-3]  # energy_j, station, buffer_wait_s: with their sections
+#: parts.csv's columns that appear only with their sections, in order.
+OPTIONAL_PART_COLUMNS = ("energy_j", "station", "buffer_wait_s")
 OPTIONAL_COLUMNS = tuple(columns(RunSummary)[columns(RunSummary).index("energy_kwh"):])  # the sections' own
 SUMMARY_COLUMNS = [c for c in columns(RunSummary) if c not in OPTIONAL_COLUMNS]  # those: with sections
 BELT_COLUMNS = columns(BeltChange)

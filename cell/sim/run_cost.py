@@ -4,8 +4,9 @@
 cost = lost parts × part_value + energy (kWh) × energy_per_kwh + the robot's downtime (h) ×
 downtime_per_h + repairs × repair + maintenance stops × maintenance + Σ options_per_h × the
 run's hours, each option counted as the scenario has it (the sensor with ``sensor.lookahead:
-sensor``, the adaptive controller under the ``adaptive`` policy, a robot per robot: one; no
-buffer places).  Lost parts: those ridden off and those scrapped from the hand (the summary's
+sensor``, the adaptive controller under the ``adaptive`` policy, a robot per robot, a buffer
+place per place, for each station of a layout: docs/layout.md).  Lost parts: those ridden off
+and those scrapped from the hand (the summary's
 ``parts_missed`` and ``parts_scrapped``); repairs: every failure in failures.csv, of any piece
 of equipment (a worn motor's included); good parts: by ``quality.rule``, as OEE counts them.
 """
@@ -26,10 +27,14 @@ ROBOTS = 1
 
 
 def options_per_h(scenario: Any) -> float:
-    """The hourly cost of the options the scenario has."""
+    """The hourly cost of the options the scenario has, its stations' summed (``stations:``)."""
     o = scenario.costs.options_per_h
-    return (o.robot * ROBOTS + (o.sensor if scenario.sensor.lookahead == "sensor" else 0.0)
-            + (o.adaptive_controller if scenario.controller.policy == "adaptive" else 0.0))
+    total = 0.0
+    for s in (scenario, *(own for _, own in scenario.line)):
+        total += (o.robot * ROBOTS + (o.sensor if s.sensor.lookahead == "sensor" else 0.0)
+                  + (o.adaptive_controller if s.controller.policy == "adaptive" else 0.0)) + \
+            (o.buffer_place * s.buffer.places if s.buffer is not None else 0.0)
+    return total
 
 
 def cost(c: Any, lost: Any, energy_kwh: Any, down_h: Any, repairs: Any, maintenance: Any,

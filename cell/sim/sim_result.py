@@ -19,9 +19,39 @@ import numpy as np
 
 from cell.sim import oee, wear_clock
 from cell.sim.failures import Downtime
-from cell.sim.records import PART_COLUMNS, BeltChange, PartRecord, RunSummary, StateSpan, Stop
+from cell.sim.records import (
+    OPTIONAL_PART_COLUMNS,
+    PART_COLUMNS,
+    BeltChange,
+    PartRecord,
+    RunSummary,
+    StateSpan,
+    Stop,
+)
 
 BeltSink = Callable[[BeltChange], Any]
+
+
+def part_columns(cell: Any) -> list[str]:
+    """parts.csv's columns for an assembled cell: every run's, then those that come with their
+    sections: ``energy_j`` (``energy.arm: dynamics``), ``station`` (``stations:``),
+    ``buffer_wait_s`` (a ``buffer:`` at any station), ``arrival_time`` (``calendar:``)."""
+    from cell.sim.line import has_buffer
+
+    s = cell.scenario
+    arm = s.energy is not None and s.energy.arm == "dynamics"
+    return PART_COLUMNS + ["energy_j"] * arm + ["station"] * (s.stations is not None) + \
+        ["buffer_wait_s"] * has_buffer(cell) + ["arrival_time"] * (s.calendar is not None)
+
+
+def stops_anything(scenario: Any) -> bool:
+    """Whether the scenario can stop the cell (``failures:``, or ``wear:`` on): failures.csv."""
+    return scenario.failures is not None or scenario.wear.enabled
+
+
+def writes_states(scenario: Any) -> bool:
+    """Whether a run writes states.csv: with stops, ``energy:`` (its states) or a calendar."""
+    return stops_anything(scenario) or scenario.energy is not None or scenario.calendar is not None
 #: parts.csv's columns of a record, as a tuple.
 part_row = attrgetter(*PART_COLUMNS)
 _BELTS = ("input", "output")
@@ -35,6 +65,10 @@ class SimResult:
     first asked for.
     """
     wear: wear_clock.WearResult | None = None  # with wear.enabled: its measures and stops
+    line: Any = None
+    """The layout's stations and their logs (cell.sim.line.Line; None without one)."""
+    station_rows: list[Any] | None = None
+    """stations.csv's rows (with ``stations:`` or ``buffer:``; cell.sim.line.STATION_COLUMNS)."""
 
     def __init__(self, summary: RunSummary, rows: list[tuple[Any, ...]] | None = None,
                  belt_log: BeltLog | None = None):
@@ -80,8 +114,10 @@ class SimResult:
             rows: Any = [part_row(r) for r in self.records]
             return pd.DataFrame(rows, columns=PART_COLUMNS)
         rows = self._rows or []
-        frame = pd.DataFrame(rows, columns=[*PART_COLUMNS, "energy_j"])
-        return frame if rows and rows[0][-1] is not None else frame[PART_COLUMNS]
+        frame = pd.DataFrame(rows, columns=[*PART_COLUMNS, *OPTIONAL_PART_COLUMNS])
+        n = len(PART_COLUMNS)  # an optional column is there when its section is (not None)
+        return frame[PART_COLUMNS + [c for i, c in enumerate(OPTIONAL_PART_COLUMNS)
+                                     if rows and rows[0][n + i] is not None]]
 
     def belt_histories(self) -> dict[str, np.ndarray]:
         """Each belt's speed changes as (m, 2) rows (from_s, speed_in_s), in time order: the

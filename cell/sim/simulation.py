@@ -36,8 +36,8 @@ from cell.sim import accounting, calendar, oee, run_cost, state_energy, wear_clo
 from cell.sim.assembly import AssembledCell, assemble
 from cell.sim.bound import parts_bound
 from cell.sim.failures import Downtime
-from cell.sim.feeder import Feeder
 from cell.sim.horizon import run_arrivals, run_until_done
+from cell.sim.line import build, has_buffer
 from cell.sim.policies.base import Accounting
 from cell.sim.records import (
     LIMIT_BIT,
@@ -52,7 +52,6 @@ from cell.sim.records import (
     limit_names,
 )
 from cell.sim.sim_result import BeltLog, BeltSink, SimResult
-from cell.sim.station import Station
 
 __all__ = ["PER_PART", "BeltLog", "BeltSink", "PartSink", "Run", "RunLog", "SimResult", "simulate"]
 
@@ -84,8 +83,12 @@ class RunLog:
                  spacing_in: float, tol_in: float, rows: list[tuple[Any, ...]] | None = None,
                  lengths: tuple[float, float, float, float] = (NAN, NAN, NAN, NAN),
                  finished: simpy.Event | None = None, n_parts: int = 0,
-                 energy_of: Callable[[Any], float] | None = None):
+                 energy_of: Callable[[Any], float] | None = None,
+                 layout: tuple[bool, bool] = (False, False)):
         self.t = t
+        self.layout = layout
+        """Whether parts.csv's ``station`` and ``buffer_wait_s`` columns are made (``stations:``,
+        a ``buffer:`` anywhere)."""
         self.energy_of = energy_of
         """A picked part's plan -> the arm's motion energy of its transfer (J), or None."""
         """T_1 … T_{n+1}: the last is only part n's "next arrival"."""
@@ -179,7 +182,8 @@ class RunLog:
         row = (i + 1, p.arrival_s, t[i], p.at_bot_s, picked, not picked, lost_thesis, p.pick_s,
                p.touchdown_s, d, cycle, thesis_d, t_next / d, ip_thesis, speed_in, speed_out,
                p.spacing_in, v1, v2, v3, v4, r1, r2, r3, r4, p.feed_delay_s, limits,
-               None if self.energy_of is None else self.energy_of(plan) if picked and plan else NAN)
+               None if self.energy_of is None else self.energy_of(plan) if picked and plan else NAN,
+               p.station if self.layout[0] else None, p.buffer_wait_s if self.layout[1] else None)
         if self.rows is not None:
             self.rows.append(row)
         if self.sink is not None:
@@ -279,27 +283,27 @@ class Run:
         acct = policy.accounting()
         env = simpy.Environment()
         tm = k.timing
-        stands = s.failures is not None or s.calendar is not None  # clocks that never end: the
-        finished = env.event() if stands and horizon is None else None  # run ends with its last part
+        stands = s.failures is not None or s.calendar is not None  # clocks that never end (or a
+        later = any(c.scenario.failures for _, c in cell.line)  # later station's): the run ends
+        finished = env.event() if (stands or later) and horizon is None else None  # with its parts
         log = RunLog(t_list, acct, on_part, k.spacing, k.tol, rows,
                      (tm.r1_length_in, tm.r2.length_in, tm.r3_length_in, tm.r4.length_in),
-                     finished, n, state_energy.arm_energy_of(cell))
+                     finished, n, state_energy.arm_energy_of(cell),
+                     (s.stations is not None, has_buffer(cell)))
         downtime = None if not stands else Downtime(env, s.failures or calendar.NO_FAILURES, seed)
         wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
-        station = Station(env, cell, seed, log.delivered_part, belts.told, downtime)
-        feeder = Feeder(env, t_list, station.input, n, k.part_size, log.flag)
-        station.control(feeder.fed_s, n, log)
+        line, station, feeder = build(env, cell, seed, log, belts.told, downtime, t_list, n)
         calendar.keep(env, s, downtime)  # a calendar's shifts, started with the failure clocks
         if downtime is not None:
             downtime.start()
         self.cell, self.seed, self.env, self.log, self.acct = cell, seed, env, log, acct
         self.t_all, self.n, self.horizon, self.finished = t_all, n, horizon, finished
         self.rows, self.belts, self.keep_belts, self.downtime = rows, belts, keep_belts, downtime
-        self.station, self.feeder = station, feeder
+        self.station, self.feeder, self.line = station, feeder, line
 
     def go(self) -> None:
         """Run to the end: every part done, or the horizon (:func:`run_until_done`)."""
-        if self.downtime is None and self.horizon is None:
+        if self.downtime is None and self.finished is None and self.horizon is None:
             self.env.run()
         else:
             run_until_done(self.env, self.log, self.horizon, self.finished)
@@ -317,7 +321,7 @@ class Run:
         cell, log, acct, env, station, downtime = \
             self.cell, self.log, self.acct, self.env, self.station, self.downtime
         s, k, n, seed = cell.scenario, cell.k, self.n, self.seed
-        station.close(env.now)
+        (self.line or station).close(env.now)
 
         summary = _summary(cell, log, acct, self.t_all, n, env.now)
         wear = None if station.wear is None else station.wear.log  # wear: without failures
@@ -334,6 +338,8 @@ class Run:
         result = SimResult(summary, self.rows, self.belts if self.keep_belts else None)
         result.downtime, result.timelines, result.stop_rows = downtime, lines, stops
         result.wear = wear_clock.measures(wear, downtime, env.now)
+        line = self.line
+        result.station_rows, result.line = (line.rows(env.now), line) if line else (None, None)
         return result
 
 

@@ -18,7 +18,9 @@ from typing import TYPE_CHECKING, Any
 
 import simpy
 
+from cell.scenario.sections import SensorSettings
 from cell.sim import wear_clock
+from cell.sim.buffer import Buffer
 from cell.sim.controller import Controller, RunLog, SensorView, View
 from cell.sim.conveyors import InputConveyor, OutputConveyor
 from cell.sim.failures import BeltStops, Downtime
@@ -55,14 +57,22 @@ class Station:
                            None if downtime is None else downtime.robot, self.wear)
         self.view: View | None = None
         self.controller: Controller | None = None
+        self.buffer: Buffer | None = None
+        """The buffer before B (``buffer:`` with places; None: none, the thesis's cell)."""
 
-    def control(self, fed_s: list[float], n_parts: int, log: RunLog) -> None:
+    def control(self, fed_s: list[float] | None, n_parts: int, log: RunLog) -> None:
         """Start the controller: its view of the cell (the schedule of what comes, ``fed_s``,
-        read by the ideal look-ahead; or a physical sensor's reports)."""
+        read by the ideal look-ahead; or a physical sensor's reports: ``fed_s`` None, a
+        station fed by another, sees with an ideal sensor at its drop point), and the buffer
+        its parts come through if it has one (docs/layout.md)."""
         cell, s = self.cell, self.cell.scenario
         self.view = _view(cell, self.seed, n_parts, fed_s, self.input, self.output)
+        source = None
+        if s.buffer is not None and s.buffer.places > 0:
+            self.buffer = Buffer(self.env, s.buffer, self.robot, self.input.at_bot, log)
+            self.view.queue, source = self.buffer.waiting, self.buffer.gate
         self.controller = Controller(self.env, cell.k, cell.policy, self.view, self.input,
-                                     self.output, self.robot, log, s.controller.policy)
+                                     self.output, self.robot, log, s.controller.policy, source)
         if self.downtime is not None:
             self.downtime.attach(self.input, self.output, self.view, log)
 
@@ -73,12 +83,19 @@ class Station:
         self.output.belt.close(until=end_s)
 
 
-def _view(cell: AssembledCell, seed: Any, n: int, fed_s: list[float], conveyor: InputConveyor,
-          output: OutputConveyor) -> View:
+def _view(cell: AssembledCell, seed: Any, n: int, fed_s: list[float] | None,
+          conveyor: InputConveyor, output: OutputConveyor) -> View:
     """What the controller sees: the feeder's schedule (``sensor.lookahead: ideal``), or only
-    what a physical sensor has reported (``sensor``)."""
+    what a physical sensor has reported (``sensor``; a station fed by another, with no
+    schedule, the ideal look-ahead as a perfect sensor at its drop point)."""
     s, k = cell.scenario, cell.k
-    if s.sensor.lookahead == "ideal":
+    if s.sensor.lookahead == "ideal" and fed_s is not None:
         return View(k, fed_s, n, conveyor, output)
-    position = sensor_position(s.sensor, k.input_length, s.source)
-    return SensorView(k, Sensor(s.sensor, position, conveyor, n, seed), n, conveyor, output)
+    settings = s.sensor if s.sensor.lookahead == "sensor" else PERFECT
+    position = sensor_position(settings, k.input_length, s.source)
+    return SensorView(k, Sensor(settings, position, conveyor, n, seed), n, conveyor, output)
+
+
+#: The ideal look-ahead of a station fed by another: a sensor at its drop point that sees
+#: every part at once, where it is (docs/layout.md).
+PERFECT = SensorSettings(lookahead="sensor")

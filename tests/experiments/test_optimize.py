@@ -253,3 +253,27 @@ def test_money_and_energy_are_objectives_where_the_base_gives_their_section(tmp_
         load_study(tmp_path / "plain_study.yaml")
     assert (refused.value.key, refused.value.value) == ("objectives[0].measure", measure)
     assert ("costs" if measure.startswith("cost") else "energy") in refused.value.why
+
+
+def test_an_optimisation_over_places_and_a_station_s_key(tmp_path: Path) -> None:
+    """A buffer's places and a station's keys (by its name) are varied like any other key
+    (docs/layout.md): each trial's row holds the values it ran, whole places whole, and the
+    best trial has a buffer (Poisson arrivals at about the robot's cycle: without one a
+    single robot loses about half the parts it is offered)."""
+    study = tmp_path / "study.yaml"
+    study.write_text(
+        "name: places\nbase: baseline\n"
+        "set: {run.parts: 80, controller.policy: non-adaptive,"
+        " arrivals: {distribution: expon, params: {loc: 0.0, scale: 22.0}},"
+        " stations: [{name: catcher, placement: downstream, offset_in: 40,"
+        " controller: {policy: non-adaptive}}]}\n"
+        "vary: {buffer.places: {low: 0, high: 4, step: 1},"
+        " stations.catcher.offset_in: {low: 10.0, high: 60.0, step: 10.0}}\n"
+        "objectives: [{measure: parts_missed, goal: minimize}]\n"
+        "trials: 4\nreplications: 2\nseed: 3\n", encoding="utf-8")
+    assert main(["optimize", str(study), "--out", str(tmp_path / "out"), "--workers", "1"]) == 0
+    trials = pd.read_csv(tmp_path / "out" / "trials.csv")
+    assert set(trials["buffer.places"]) <= {0, 1, 2, 3, 4}
+    assert set(trials["stations.catcher.offset_in"]) <= {10.0, 20.0, 30.0, 40.0, 50.0, 60.0}
+    assert (trials["buffer.places"] % 1 == 0).all()
+    assert trials.loc[trials["parts_missed"].idxmin(), "buffer.places"] > 0

@@ -102,6 +102,23 @@ def stress() -> list[int]:
     return [int((a.delivered_vs_fixed_ci_low > 0).sum()), len(a)]
 
 
+def layout_study() -> list[float]:
+    """reports/layout: the fewest and most places with which the fixed robot loses no more parts
+    than the adaptive robot, at how many arrival points, and where two fixed robots lose fewer
+    than the adaptive robot and than the fixed robot with 5 places."""
+    t = pd.read_csv(REPORTS / "layout" / "layout.csv")
+    found, beat_adaptive, beat_buffer, n = [], 0, 0, 0
+    for _, point in t.groupby(["cv", "mean_s"]):
+        lost = dict(zip(point["layout"], point["lost"]))
+        n += 1
+        enough = [k for k in (0, 1, 2, 3, 5) if lost[f"fixed, {k} places"] <= lost["adaptive, 0 places"]]
+        if enough:
+            found.append(min(enough))
+        beat_adaptive += lost["two fixed robots"] < lost["adaptive, 0 places"]
+        beat_buffer += lost["two fixed robots"] < lost["fixed, 5 places"]
+    return [min(found), max(found), len(found), n, beat_adaptive, n, beat_buffer, n]
+
+
 def wear() -> list[float]:
     from cell.reporting.maps.reliability import flip_exponent, verdicts
 
@@ -188,6 +205,10 @@ NUMBERS: list[tuple[str, str, str]] = [
      "t71('adaptive', 'thesis', 'ip'), *[ad(m)['mean'] for m in ('cycle_vs_nominal_pct', "
      "'ip_thesis_memoryless', 'cycle_vs_nominal_memoryless_pct')]"),
     ("README.md", "the same draws at {} of {} points", "*stress()"),
+    ("README.md", "the fixed-cycle robot needs {} to {} places of buffer to lose no more parts than the "
+     "adaptive robot (at {} of {} arrival points); a second fixed-cycle robot loses fewer parts than "
+     "the adaptive robot at {} of {} and than the fixed robot with 5 places at {} of {}",
+     "*layout_study()"),
     ("README.md", "drop point: {} against {} parts per 500 on the thesis arrivals (the ideal look-ahead "
      "overstates it by {}%) and {} against {} parts per 500 on the spread arrivals (the ideal "
      "look-ahead overstates it by {}%)", "*sensor('thesis'), *sensor('spread')"),

@@ -325,3 +325,18 @@ def test_two_run_lengths_are_refused(capsys, tmp_path: Path):
     err = capsys.readouterr().err
     assert err.startswith(f"cell: error: {scenario}: run.days = 2") and "run.weeks" in err
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("layout, key", [
+    ({"buffer": {"places": 2}}, "buffer"),
+    ({"stations": [{"name": "catcher", "placement": "downstream", "offset_in": 40}]}, "stations"),
+])
+def test_a_calendar_with_a_layout_is_refused_until_every_station_keeps_it(capsys, tmp_path: Path,
+                                                                          layout, key):
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(yaml.safe_dump({"calendar": TWO_SHIFTS, **layout}))
+    out = tmp_path / "out"
+    assert main(["run", str(scenario), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and err.startswith(f"cell: error: {scenario}: {key} = ")
+    assert not out.exists()

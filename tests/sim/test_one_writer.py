@@ -16,7 +16,9 @@ CELL = Path(__file__).resolve().parents[2] / "cell"
 #: Each slot's one writer (module, and the process it is part of); ``index``, ``arrival_s``
 #: and ``feed_delay_s`` are the feeder's, given as it makes the part (:data:`MAKERS`).
 OWNERS = {
-    "at_bot_s": {"sim/conveyors.py"}, "plan": {"sim/controller.py"},
+    # a buffer's gate (docs/layout.md) sets the instant tracking begins as it lets a part go
+    "at_bot_s": {"sim/conveyors.py", "sim/buffer.py"}, "plan": {"sim/controller.py"},
+    "buffer_wait_s": {"sim/buffer.py"}, "station": {"sim/line.py"},
     # the robot's process, whether or not anything can stop it (its one cycle)
     "pick_s": {"sim/robot.py"},
     "touchdown_s": {"sim/conveyors.py"}, "spacing_in": {"sim/conveyors.py"},
