@@ -90,7 +90,7 @@ def main(args: argparse.Namespace) -> int:
                 for row in result.station_rows:
                     write(row)
         if writes_states(scenario):
-            _write_failures(out, result, stops_anything(scenario))
+            _write_failures(out, result, stops_anything(scenario), scenario)
         if args.format == "parquet":
             _as_parquet(out)
     _report(args, scenario, result, out.target)
@@ -143,21 +143,22 @@ def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) ->
     print(f"wrote {shown}/{written[0]}, {written[1]}, {written[2]}, states.csv and failures.csv")
 
 
-def _write_failures(out: Any, result: Any, stops: bool = True) -> None:
-    """states.csv, and failures.csv of a run with failures or wear (``stops``)."""
+def _write_failures(out: Any, result: Any, stops: bool, scenario: Any) -> None:
+    """states.csv, and failures.csv of a run with failures or wear (``stops``); under a
+    calendar each row's ends also as timestamps."""
     from cell.plumbing.csvfile import RowWriter
+    from cell.sim.calendar import dated
     from cell.sim.records import STATE_COLUMNS, STOP_COLUMNS
 
-    with out.open("states.csv", newline="") as f:
-        write = RowWriter(f, STATE_COLUMNS).record
-        for span in result.state_spans():
-            write(span)
-    if not stops:
-        return
-    with out.open("failures.csv", newline="") as f:
-        write = RowWriter(f, STOP_COLUMNS).record
-        for stop in result.stops():
-            write(stop)
+    for name, columns, rows in (("states.csv", STATE_COLUMNS, result.state_spans()),
+                                ("failures.csv", STOP_COLUMNS, result.stops() if stops else None)):
+        if rows is None:
+            continue
+        times, rows = dated(scenario, rows)
+        with out.open(name, newline="") as f:
+            write = RowWriter(f, columns + times).record
+            for row in rows:
+                write(row)
 
 
 def _refuse_a_run(args: argparse.Namespace) -> None:

@@ -178,3 +178,31 @@ def stamped(s: Any, sink: Callable[[Any], Any]) -> Callable[[Any], Any]:
         when = start + dt.timedelta(seconds=record.arrival_s)
         return sink(Stamped(record, when.isoformat(timespec="milliseconds")))
     return told
+
+
+class Dated:
+    """A state span's or a stop's row with its ends as calendar timestamps (states.csv's and
+    failures.csv's ``from_time`` and ``to_time``), every other column the record's."""
+
+    __slots__ = ("from_time", "record", "to_time")
+
+    def __init__(self, record: Any, from_time: str, to_time: str):
+        self.record, self.from_time, self.to_time = record, from_time, to_time
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.record, name)
+
+
+def dated(s: Any, rows: Any) -> tuple[list[str], Any]:
+    """The extra columns and the rows of states.csv or failures.csv: under a calendar each
+    row's ``from_s`` and ``to_s`` also as ISO timestamps; without one, no column and the rows."""
+    if s.calendar is None:
+        return [], rows
+    import datetime as dt
+
+    start = s.calendar.start_at
+
+    def at(seconds: float) -> str:
+        return (start + dt.timedelta(seconds=seconds)).isoformat(timespec="milliseconds")
+
+    return ["from_time", "to_time"], (Dated(r, at(r.from_s), at(r.to_s)) for r in rows)

@@ -340,3 +340,27 @@ def test_a_calendar_with_a_layout_is_refused_until_every_station_keeps_it(capsys
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and err.startswith(f"cell: error: {scenario}: {key} = ")
     assert not out.exists()
+
+
+def test_states_and_failures_carry_the_calendars_timestamps(tmp_path: Path):
+    """Under a calendar states.csv and failures.csv give each row's ends as timestamps too:
+    ``from_time`` / ``to_time`` are the start plus ``from_s`` / ``to_s``; without one, neither."""
+    import pandas as pd
+
+    failing = {"robot": {"time_to_failure": {"distribution": "expon", "mean_h": 2},
+                         "time_to_repair": {"distribution": "expon", "mean_h": 0.5}}}
+    path = tmp_path / "s.yaml"
+    path.write_text(yaml.safe_dump({"calendar": TWO_SHIFTS, "run": {"days": 2},
+                                    "failures": failing}))
+    assert main(["run", str(path), "--out", str(tmp_path / "a")]) == 0
+    for name in ("states.csv", "failures.csv"):
+        rows = pd.read_csv(tmp_path / "a" / name)
+        assert len(rows) > 0, name
+        for end in ("from", "to"):
+            back = (pd.to_datetime(rows[f"{end}_time"]) - pd.Timestamp(START)).dt.total_seconds()
+            np.testing.assert_allclose(back, rows[f"{end}_s"], atol=1e-3)
+    plain = tmp_path / "p.yaml"
+    plain.write_text(yaml.safe_dump({"run": {"hours": 20}, "failures": failing}))
+    assert main(["run", str(plain), "--out", str(tmp_path / "b")]) == 0
+    for name in ("states.csv", "failures.csv"):
+        assert "from_time" not in pd.read_csv(tmp_path / "b" / name).columns
