@@ -62,6 +62,19 @@ class Belt:
         """The last settled change (instant, travel, speed), in force when a replan from a later
         instant has settled past the present (a stop starts from it)."""
 
+    @classmethod
+    def of_history(cls, history: Sequence[Sequence[float]]) -> Belt:
+        """The belt that ran ``history``, its (from_s, speed_in_s) changes in time order (as
+        ``belts.csv`` has them), held whole: its travel and :meth:`time_at` at any instant,
+        by the rule the run used (the animation reads the belts so, :mod:`cell.reporting.
+        animation.scene`).  Before the first change the first speed holds back in time."""
+        (t0, v0), *later = history
+        belt = cls(v0)
+        belt._t[0] = t0
+        for t, v in later:
+            belt._run_from(t, v)
+        return belt
+
     @property
     def held(self) -> int:
         """Speed segments held: the one in force and those planned (memory stays flat)."""
