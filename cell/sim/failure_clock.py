@@ -131,6 +131,7 @@ class FailureClock:
         runs out before then, the cycle's use is taken from the budgets at once, the clock
         stands until the cycle's end, and the answer is True; else False, and the caller tells
         the clock each leg as it comes (:meth:`follow`)."""
+        # speed: docs/performance.md#kept-cycles
         if clear and end_s <= self.safe_s:  # no budget can run out: its use taken later
             self.pending.append(legs_s)
             return True

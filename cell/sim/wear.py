@@ -261,6 +261,7 @@ class CycleWear:
         wears joint j by at most d times this)."""
         return [max(r) for r in zip(*(w.peak_rates for w in self.stretches))]
 
+    # speed: docs/performance.md#kept-cycles
     def of_many(self, times_s: Sequence[Sequence[float]]) -> NDArray[np.float64]:
         """(n, 5): :meth:`of_times` of each of n cycles, the same floats.  With p = 1 the
         stretches' intervals are found for all the cycles at once (``searchsorted`` finds what
