@@ -65,13 +65,10 @@ class Belt:
     @classmethod
     def of_history(cls, history: Sequence[Sequence[float]]) -> Belt:
         """The belt that ran ``history``, its (from_s, speed_in_s) changes in time order (as
-        ``belts.csv`` has them), held whole: its travel and :meth:`time_at` at any instant,
-        by the rule the run used (the animation reads the belts so, :mod:`cell.reporting.
-        animation.scene`).  Before the first change the first speed holds back in time."""
-        (t0, v0), *later = history
-        belt = cls(v0)
-        belt._t[0] = t0
-        for t, v in later:
+        ``belts.csv`` has them), held whole (the animation's: one rule of travel)."""
+        belt = cls(history[0][1])
+        belt._t[0] = history[0][0]
+        for t, v in history[1:]:
             belt._run_from(t, v)
         return belt
 
@@ -98,10 +95,9 @@ class Belt:
     def plan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0,
              t3: float | None = None, v3: float = 0.0) -> None:
         """From instant t1 (now or later) run at v1, from t2 > t1 at v2 and from t3 > t2 at v3
-        (the output belt's floor under the spacing contract), dropping later plans: a new plan
-        supersedes what was planned after t1 (the controller replans every cycle), a change
-        within EPS_S of the last one replaces it, and the changes before t1 whose successors
-        have started are settled.  The controller's case first (twice a part)."""
+        (the output belt's floor), dropping later plans: a new plan supersedes what was planned
+        after t1, a change within EPS_S of the last one replaces it, and the changes before t1
+        whose successors have started are settled.  The controller's case first."""
         if not v1 > 0 or (t2 is not None and not v2 > 0) or (t3 is not None and not v3 > 0):
             raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}, {v3!r}")
         if self._halted is not None:  # stopped by a failure: the plan is for the restart
@@ -190,15 +186,11 @@ class Belt:
 
     def _plan_stopped(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0,
                       t3: float | None = None, v3: float = 0.0) -> None:
-        """:meth:`plan` (and :meth:`then`) while stopped: the plan takes effect from the
-        restart on."""
+        """:meth:`plan` while stopped: the plan takes effect from the restart on."""
         assert self._halted is not None
         running, later = self._halted
         later = [(t, v) for t, v in later if t < t1 - EPS_S] + [(t1, v1)]
-        if t2 is not None:
-            later.append((t2, v2))
-        if t3 is not None:
-            later.append((t3, v3))
+        later += [(t, v) for t, v in ((t2, v2), (t3, v3)) if t is not None]
         self._halted = (running, later)
 
     def restart(self, t: float) -> None:
@@ -382,8 +374,7 @@ class OutputConveyor:
 
     def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0,
                t3: float | None = None, v3: float = 0.0) -> None:
-        """New speed plan from the controller (:meth:`Belt.plan`; t3, v3: the spacing
-        contract's floor after the touch-down)."""
+        """New speed plan from the controller (:meth:`Belt.plan`)."""
         self.belt.plan(t1, v1, t2, v2, t3, v3)
 
     def stop(self, now: float) -> None:
