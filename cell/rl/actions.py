@@ -4,7 +4,7 @@ An action is a float64 vector of one plan's fields (:data:`FIELDS`, thesis §5.3
 the six regime times, the input belt after LO and after the cycle, the output belt until G,
 when the output belt drops to its floor, R I + R II, the cycle, and the limits the plan says it
 hit).  :func:`to_plan` maps any vector (NaN and infinities included) to a plan that
-:func:`cell.sim.policies.check.check` passes: each value clipped to the check's own bounds
+:class:`cell.sim.policies.check.PlanCheck` passes: each value clipped to the check's own bounds
 (R I's at the pace of the input belt the part reached B on), ``to_g`` and ``cycle`` kept where
 they are within the check's tolerance of their regimes' sums and replaced by those sums
 otherwise, the limits kept to :data:`PLAN_LIMITS`.  A value the check accepts (with limits

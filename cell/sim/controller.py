@@ -18,7 +18,7 @@ from cell.plumbing.errors import CellError
 from cell.sim.conveyors import EPS_S, InputConveyor, OutputConveyor
 from cell.sim.mailbox import Mailbox
 from cell.sim.policies.base import CellConstants, Policy
-from cell.sim.policies.check import check, plan_bounds, plan_failed
+from cell.sim.policies.check import PlanCheck, plan_failed
 from cell.sim.records import Part
 from cell.sim.robot import Robot
 from cell.sim.sensor import Sensor
@@ -136,8 +136,8 @@ class Controller:
         self.steers_input = source is None
         """Whether a plan's input belt speeds are set: not with a buffer, whose gate holds a
         part that comes early (the belt then runs at its nominal speed: docs/layout.md)."""
-        self.bounds = plan_bounds(k)
-        """The plan check's bounds for this cell (:func:`cell.sim.policies.check.plan_bounds`)."""
+        self.check = PlanCheck(k, self.name)
+        """The plan check (:class:`cell.sim.policies.check.PlanCheck`)."""
         self.process = env.process(self.run())
 
     def rides_on(self, part: Part, now: float, floor_after_td: float) -> None:
@@ -151,13 +151,13 @@ class Controller:
 
     def run(self):  # noqa: ANN201 (SimPy generator)
         """Once per part: the part at B taken the instant it gets there (its ``at_bot_s``),
-        the policy asked for its plan (checked, :func:`cell.sim.policies.check.check`), the
+        the policy asked for its plan (checked, :meth:`.PlanCheck.passes`), the
         belts set and the robot told its order."""
         robot, view, k, log = self.robot, self.view, self.k, self.log
         conveyor, output, plan_for, name = self.conveyor, self.output, self.policy.plan, self.name
         aim = k.lookahead_margin_s  # step 6.3 from when the next part is aimed at B
         floor_after_td = math.nan  # the last planned TD (the spacing contract; nan: none)
-        bounds, passed = self.bounds, None  # the last plan that passed the check
+        passes, passed = self.check.passes, None  # the last plan that passed the check
         get, steers_input = self.source.get, self.steers_input
         while True:
             part: Part = yield get()
@@ -173,7 +173,7 @@ class Controller:
             except Exception as exc:  # noqa: BLE001 - a plug-in's failure, named
                 raise plan_failed(name, exc) from exc
             if plan is not passed:  # checked before the cell acts on it; the fixed
-                check(plan, bounds, name, k)  # robot's one plan, once
+                passes(plan)  # robot's one plan, once
                 passed = plan
             r1a, to_g, r3a, cycle = plan.r1_pre, plan.to_g, plan.r3_pre, plan.cycle
             if plan.steers_belts:
@@ -182,8 +182,8 @@ class Controller:
                                     plan.input_next)
                 at_g = now + to_g
                 if plan.output_floor_at < INF:  # the spacing contract: the belt's floor after TD
-                    output.replan_then(now, plan.output_to_g, at_g, k.u_nom,
-                                       now + plan.output_floor_at, k.output_min)
+                    output.replan(now, plan.output_to_g, at_g, k.u_nom,
+                                  now + plan.output_floor_at, k.output_min)
                     floor_after_td = at_g + r3a
                 else:
                     output.replan(now, plan.output_to_g, at_g, k.u_nom)

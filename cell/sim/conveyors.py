@@ -45,7 +45,8 @@ class Belt:
     entries, not its history.
     """
 
-    __slots__ = ("_t", "_x", "_v", "on_change", "max_speed_in_s", "min_speed_in_s", "_halted", "_anchor")
+    __slots__ = ("_t", "_x", "_v", "on_change", "max_speed_in_s", "min_speed_in_s", "_halted",
+                 "_at_t", "_at_x", "_at_v")
 
     def __init__(self, speed_in_s: float, on_change: Callable[[float, float], Any] | None = None):
         self._t, self._x, self._v = [0.0], [0.0], [speed_in_s]
@@ -57,9 +58,19 @@ class Belt:
         """The fastest and the slowest of the settled speeds (of all of them once closed)."""
         self._halted: tuple[float, list[tuple[float, float]]] | None = None
         """While stopped by a failure: the speed it ran at and the changes planned after."""
-        self._anchor: tuple[float, float, float] = (0.0, 0.0, speed_in_s)
+        self._at_t, self._at_x, self._at_v = 0.0, 0.0, speed_in_s
         """The last settled change (instant, travel, speed), in force when a replan from a later
         instant has settled past the present (a stop starts from it)."""
+
+    @classmethod
+    def of_history(cls, history: Sequence[Sequence[float]]) -> Belt:
+        """The belt that ran ``history``, its (from_s, speed_in_s) changes in time order (as
+        ``belts.csv`` has them), held whole (the animation's: one rule of travel)."""
+        belt = cls(history[0][1])
+        belt._t[0] = history[0][0]
+        for t, v in history[1:]:
+            belt._run_from(t, v)
+        return belt
 
     @property
     def held(self) -> int:
@@ -81,29 +92,35 @@ class Belt:
         k = bisect_right(self._x, x, 1) - 1  # lo=1: k >= 0, as in travel
         return self._t[k] + (x - self._x[k]) / self._v[k]
 
-    def plan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
-        """From instant t1 (now or later) run at v1, and from t2 > t1 at v2, dropping later plans: a
-        new plan supersedes what was planned after t1 (the controller replans every cycle), a change
-        within EPS_S of the last one replaces it, and the changes before t1 whose successors have
-        started are settled.  The controller's case first (twice a part)."""
-        if not v1 > 0 or (t2 is not None and not v2 > 0):
-            raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}")
+    def plan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0,
+             t3: float | None = None, v3: float = 0.0) -> None:
+        """From instant t1 (now or later) run at v1, from t2 > t1 at v2 and from t3 > t2 at v3
+        (the output belt's floor), dropping later plans: a new plan supersedes what was planned
+        after t1, a change within EPS_S of the last one replaces it, and the changes before t1
+        whose successors have started are settled.  The controller's case first."""
+        if not v1 > 0 or (t2 is not None and not v2 > 0) or (t3 is not None and not v3 > 0):
+            raise ValueError(f"belt speeds must be positive, got {v1!r}, {v2!r}, {v3!r}")
         if self._halted is not None:  # stopped by a failure: the plan is for the restart
-            self._plan_stopped(t1, v1, t2, v2)
+            self._plan_stopped(t1, v1, t2, v2, t3, v3)
             return
         ts, xs, vs = self._t, self._x, self._v
         t0 = ts[-1]
         if t0 > t1 + EPS_S and len(ts) > 1 and ts[-2] < t1:  # one change planned after t1
             del ts[-1], xs[-1], vs[-1]  # (the output belt's floor): dropped, as below
             t0 = ts[-1]
-        if t0 < t1 and t2 is not None and t1 < t2:
-            # the controller's every replan: both after the last change, which alone is kept
+        if t0 < t1 and t2 is not None and t1 < t2 and (t3 is None or t2 < t3):
+            # the controller's every replan: all after the last change, which alone is kept
             n = len(ts) - 1
             if n > 0:
                 self._settle(n)
             x0, v0 = xs[-1], vs[-1]
             x1 = x0 + v0 * (t1 - t0)
-            self._t, self._x, self._v = [t0, t1, t2], [x0, x1, x1 + v1 * (t2 - t1)], [v0, v1, v2]
+            x2 = x1 + v1 * (t2 - t1)
+            if t3 is None:
+                self._t, self._x, self._v = [t0, t1, t2], [x0, x1, x2], [v0, v1, v2]
+            else:
+                self._t, self._x, self._v = \
+                    [t0, t1, t2, t3], [x0, x1, x2, x2 + v2 * (t3 - t2)], [v0, v1, v2, v3]
             return
         k = bisect_right(ts, t1 + EPS_S)
         if k == 0:  # would rewrite what is settled (and leave no schedule at all)
@@ -118,15 +135,8 @@ class Belt:
         self._run_from(t1, v1)
         if t2 is not None:
             self._run_from(t2, v2)
-
-    def plan_then(self, t1: float, v1: float, t2: float, v2: float, t3: float, v3: float) -> None:
-        """:meth:`plan` (t1, v1, t2, v2) then :meth:`then` (t3, v3): the output belt's replan under
-        the spacing contract."""
-        if self._halted is not None:
-            self._plan_stopped(t1, v1, t2, v2, t3, v3)
-            return
-        self.plan(t1, v1, t2, v2)
-        self.then(t3, v3)
+        if t3 is not None:
+            self.then(t3, v3)
 
     def then(self, t: float, v: float) -> None:
         """And from instant t, after every change planned, run at v (a third change)."""
@@ -154,7 +164,7 @@ class Belt:
         """The first ``n`` changes are final: note their speeds and tell ``on_change`` (the
         last of them kept as the anchor a stop starts from)."""
         if n:
-            self._anchor = (self._t[n - 1], self._x[n - 1], self._v[n - 1])
+            self._at_t, self._at_x, self._at_v = self._t[n - 1], self._x[n - 1], self._v[n - 1]
         vs = self._v
         hi, lo = self.max_speed_in_s, self.min_speed_in_s
         for v in vs[:n]:
@@ -176,15 +186,11 @@ class Belt:
 
     def _plan_stopped(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0,
                       t3: float | None = None, v3: float = 0.0) -> None:
-        """:meth:`plan` (and :meth:`then`) while stopped: the plan takes effect from the
-        restart on."""
+        """:meth:`plan` while stopped: the plan takes effect from the restart on."""
         assert self._halted is not None
         running, later = self._halted
         later = [(t, v) for t, v in later if t < t1 - EPS_S] + [(t1, v1)]
-        if t2 is not None:
-            later.append((t2, v2))
-        if t3 is not None:
-            later.append((t3, v3))
+        later += [(t, v) for t, v in ((t2, v2), (t3, v3)) if t is not None]
         self._halted = (running, later)
 
     def restart(self, t: float) -> None:
@@ -207,7 +213,7 @@ class Belt:
         planned after t is kept for :meth:`restart` (docs/model.md, "When equipment fails")."""
         ts, vs = self._t, self._v
         if ts[0] > t:  # a replan from a later instant settled the change in force now: stop
-            t0, x0, v0 = self._anchor  # from it, every held change kept for the restart
+            t0, x0, v0 = self._at_t, self._at_x, self._at_v  # from it, every held change kept for the restart
             self._halted = (v0, list(zip(ts, vs)))
             self._t, self._x, self._v = [t], [x0 + v0 * (t - t0)], [0.0]
             return
@@ -366,14 +372,10 @@ class OutputConveyor:
         """Instant of the last touch-down (read once ``last_td_x`` is set)."""
         self.process = env.process(self.run())
 
-    def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0) -> None:
+    def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0,
+               t3: float | None = None, v3: float = 0.0) -> None:
         """New speed plan from the controller (:meth:`Belt.plan`)."""
-        self.belt.plan(t1, v1, t2, v2)
-
-    def replan_then(self, t1: float, v1: float, t2: float, v2: float, t3: float,
-                    v3: float) -> None:
-        """The same with the spacing contract's floor after it (:meth:`Belt.plan_then`)."""
-        self.belt.plan_then(t1, v1, t2, v2, t3, v3)
+        self.belt.plan(t1, v1, t2, v2, t3, v3)
 
     def stop(self, now: float) -> None:
         """A failure stops the belt now (a part the robot sets down stays where it is put)."""

@@ -9,6 +9,11 @@ of each cycle.  The robot's clock is told each cycle's legs as the cycle starts
 and nothing else happens until the cycle ends; otherwise the robot tells the clock each leg
 as it comes (:meth:`FailureClock.follow`).  Either way the clock keeps one event, moved only
 when the instant its budget runs out moves.
+
+While no budget is near its end, a cycle costs the clock one comparison: the exposure bounds
+the use a second (:meth:`Exposure.peak_rates`), so until half the smallest budget's time at
+that rate has passed no cycle can use a budget up, and the cycles' legs are kept and their use
+taken when the clock next looks at its budgets (in the cycles' order: the same floats).
 """
 
 from __future__ import annotations
@@ -17,6 +22,7 @@ import math
 from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
+import numpy as np
 import simpy
 
 from cell.sim.conveyors import EPS_S
@@ -47,6 +53,13 @@ class Exposure(Protocol):
         """A cycle starts whose legs (:data:`LEGS`) take these times: each component's budget
         the whole cycle uses (None: not known ahead, the clock then counts leg by leg)."""
 
+    def cycles(self, legs_s: Sequence[Sequence[float]]) -> np.ndarray:
+        """(n, components): :meth:`cycle` of each of n cycles, in order (the same floats)."""
+
+    def peak_rates(self) -> Sequence[float] | None:
+        """Each component's most budget used a second, whatever the equipment does (None: no
+        bound, or budget used at rest: the clock then takes every cycle's use as it starts)."""
+
 
 class Distributed:
     """A time to failure drawn from a distribution, on the operating or calendar clock."""
@@ -68,6 +81,12 @@ class Distributed:
     def cycle(self, legs_s: Sequence[float]) -> Sequence[float]:
         return (sum(legs_s),)  # 1 a second in every leg, on either clock
 
+    def cycles(self, legs_s: Sequence[Sequence[float]]) -> np.ndarray:
+        return np.array([sum(legs) for legs in legs_s], dtype=float).reshape(-1, 1)
+
+    def peak_rates(self) -> Sequence[float] | None:
+        return None if self.calendar else (1.0,)
+
 
 class FailureClock:
     """An equipment's failure clock: a budget per component (:meth:`Exposure.thresholds`),
@@ -88,6 +107,12 @@ class FailureClock:
         """When the first budget runs out, as planned (inf: never)."""
         self.failing = False
         """True from the failure to the repair (the clock stands meanwhile)."""
+        self.pending: list[Sequence[float]] = []
+        """The legs of the cycles whose use is not yet taken from :attr:`left` (the clock's
+        text: taken, in order, when the clock next looks at its budgets)."""
+        self.safe_s = -math.inf
+        """Till when a cycle (the equipment idle between cycles) cannot use a budget up."""
+        self.peak = exposure.peak_rates()
         self._due: simpy.Event | None = None
         self._first = -1
         self._arm()
@@ -97,6 +122,7 @@ class FailureClock:
         now = self.env.now
         self._use_to(now)
         self.plan = [(now, self.exposure.rates(leg))]
+        self.safe_s = -math.inf
         self._arm()
 
     def cycle(self, legs_s: Sequence[float], end_s: float, clear: bool = True) -> bool:
@@ -105,6 +131,10 @@ class FailureClock:
         runs out before then, the cycle's use is taken from the budgets at once, the clock
         stands until the cycle's end, and the answer is True; else False, and the caller tells
         the clock each leg as it comes (:meth:`follow`)."""
+        # speed: docs/performance.md#kept-cycles
+        if clear and end_s <= self.safe_s:  # no budget can run out: its use taken later
+            self.pending.append(legs_s)
+            return True
         now, exposure = self.env.now, self.exposure
         self._use_to(now)
         use = exposure.cycle(legs_s)
@@ -115,14 +145,35 @@ class FailureClock:
             if b <= u * 1e-9 + 1e-12:  # it may run out in this cycle (a margin for rounding)
                 return False
         self.left, self.since = left, end_s
-        self.plan = [(end_s, exposure.rates(MOVING_NOT))]
-        if self.due_s < math.inf or any(self.plan[0][1]):
+        idle = exposure.rates(MOVING_NOT)
+        self.plan = [(end_s, idle)]
+        if self.due_s < math.inf or any(idle):
             self._arm()
+        elif self.peak is not None:  # idle uses nothing: safe for half the budget at the peak
+            self.safe_s = end_s + 0.5 * min(
+                x / r if r > 0 else math.inf for x, r in zip(left, self.peak))
         return True
+
+    def settle(self) -> None:
+        """Take the kept cycles' use now (the run's end: the exposure's totals complete)."""
+        if self.pending:
+            self._take_pending()
+
+    def _take_pending(self) -> None:
+        """Take the kept cycles' use from the budgets, cycle by cycle (the same floats as one
+        by one: ``subtract.accumulate`` subtracts in order)."""
+        uses = self.exposure.cycles(self.pending)
+        self.pending = []
+        left = np.subtract.accumulate(np.vstack([self.left, uses]), axis=0)
+        if (left[1:] <= uses * 1e-9 + 1e-12).any():  # the bound let a cycle use a budget up
+            raise RuntimeError("a failure clock's kept cycles used a budget up")
+        self.left = left[-1].tolist()
 
     def _use_to(self, t: float) -> None:
         """Take from the budgets what the plan used from :attr:`since` to ``t`` (nothing
         while the equipment is being repaired: the clock stands)."""
+        if self.pending:
+            self._take_pending()
         plan, left, since = self.plan, self.left, self.since
         if t <= since:
             return
@@ -165,7 +216,7 @@ class FailureClock:
     def _fires(self, event: simpy.Event) -> None:
         if event is not self._due:  # moved since: a later (or no) failure is planned
             return
-        self._due, self.due_s = None, math.inf
+        self._due, self.due_s, self.safe_s = None, math.inf, -math.inf
         self._use_to(self.env.now)
         self.failing = True
         self.env.process(self._failed(self._first))

@@ -351,6 +351,12 @@ class Downtime:
                 return False
         return True
 
+    def settle(self) -> None:
+        """Every clock's kept cycles counted (:meth:`FailureClock.settle`), as at the run's end."""
+        for e in self.equipment:
+            if e.clock is not None:
+                e.clock.settle()
+
     def begin(self, name: str, cause: str, part: Any) -> int:
         """A stop begins now; its key (for :meth:`end`)."""
         self._open[self._next] = (name, cause, self.env.now, part)

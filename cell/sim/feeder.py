@@ -60,10 +60,10 @@ class Feeder:
         after = Timer(env).after  # speed: docs/performance.md#mailbox
         size = self.part_size_in
         clear_at = -float("inf")
+        now = env.now
         for i in range(self.n_parts):
             f = fed[i]
-            yield after(max(f - env.now, 0.0))  # after a hold it may be due
-            now = env.now
+            now = yield after(f - now if f > now else 0.0)  # after a hold it may be due
             x = travel(now)
             if x < clear_at - CLEAR_TOL_IN:  # held back till the belt has carried the last clear
                 belt = self.conveyor.belt

@@ -144,10 +144,11 @@ class Mailbox:
 
 
 class Timer:
-    """``yield timer.after(delay)``: a timeout for a process that waits on one at a time.
+    """``now = yield timer.after(delay)``: a timeout for a process that waits on one at a time,
+    whose value is the instant it fires.
 
     One event, re-armed once SimPy has processed it, scheduled exactly as
-    ``env.timeout(delay)`` would be (triggered at once, as a timeout is).
+    ``env.timeout(delay, value=env.now + delay)`` would be (triggered at once, as a timeout is).
     """
 
     __slots__ = ("env", "_event", "_queue", "_eid")
@@ -164,7 +165,8 @@ class Timer:
         else:  # still scheduled (its process was interrupted): a fresh one
             event = self._event = _processed(self.env)
             event.callbacks = []
-        heappush(self._queue, (self.env._now + delay, NORMAL, next(self._eid), event))
+        at = event._value = self.env._now + delay
+        heappush(self._queue, (at, NORMAL, next(self._eid), event))
         return event
 
 
@@ -199,7 +201,10 @@ class TimeoutTimer:
     """:class:`Timer` in SimPy's public API: a new ``env.timeout`` each time."""
 
     def __init__(self, env: simpy.Environment):
-        self.after = env.timeout
+        self.env = env
+
+    def after(self, delay: float) -> Event:
+        return self.env.timeout(delay, self.env.now + delay)
 
 
 def _processed(env: simpy.Environment) -> Event:

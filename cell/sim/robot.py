@@ -15,7 +15,7 @@ hand's length (eq. 6.2) and may take longer than the belt's pace.
 
 What a cycle may take is stated once, here (:meth:`RobotTiming.shortest_parts`,
 docs/model.md "What a cycle may take"), and read by the plan check
-(:mod:`cell.sim.policies.check`, the controller's inline copy included) and by the
+(:class:`cell.sim.policies.check.PlanCheck`, the controller's) and by the
 bound on any controller (:mod:`cell.sim.bound`): R I and R III keep their belt's
 pace over the whole window, B → F and G → K (the thesis's R III, 4.0 s at 2 in/s,
 tracks the output belt to K), at a belt speed no faster than the robot can follow

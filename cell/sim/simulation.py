@@ -138,7 +138,7 @@ class RunLog:
                 flags = flags_of(i, 0)
                 sp = p.spacing_in
                 off = sp - spacing_in  # NaN (none yet): neither test holds
-                if abs(off) > tol:  # NaN (none yet): not off
+                if off > tol or off < -tol:  # NaN (none yet): not off
                     flags |= SPACING_OFF
                 picked = not flags & RODE_OFF
                 plan = p.plan

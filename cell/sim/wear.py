@@ -124,8 +124,8 @@ class SegmentWear:
     exposure is A_i u^(1−p) + B_i, A_i and B_i kept here for every i.
     """
 
-    __slots__ = ("timing", "_ub", "_a", "_b", "_q", "_seen", "_tbreak", "_tfix", "_lfree",
-                 "_seen_interval")
+    __slots__ = ("timing", "peak_rates", "_ub", "_a", "_b", "_q", "_seen", "_tbreak", "_tfix",
+                 "_lfree", "_seen_interval")
 
     def __init__(self, timing: Segment, lengths_in: ArrayLike, min_times_s: ArrayLike,
                  steps: ArrayLike, rated_steps_s: ArrayLike, model: WearModel):
@@ -143,6 +143,12 @@ class SegmentWear:
         moving = counts > 0
         c[moving] = (counts[moving] / (rated[moving] * model.reference_stress)) ** p
         c /= model.rated_life_h * HOUR_S  # t in s, exposure in hours of rated life
+        # a move's exposure a second, c t^(-p), is at its most at its floor t_min (p >= 0)
+        with np.errstate(divide="ignore"):
+            per_s = np.where(c > 0, c * np.broadcast_to(tmin[:, None], c.shape) ** -p, 0.0)
+        self.peak_rates: list[float] = per_s.max(axis=0, initial=0.0).tolist()
+        """Each joint's most exposure a second of the stretch, whatever its time (inf: a
+        move of no floor time wears it)."""
         free = ell > 0
         fixed = _power_sum(c[~free], tmin[~free], self._q)
         ell, tmin, c = ell[free], tmin[free], c[free]
@@ -248,6 +254,37 @@ class CycleWear:
             out = hit
         self._last = (key, out)
         return out
+
+    @property
+    def peak_rates(self) -> list[float]:
+        """Each joint's most exposure a second of any cycle (a bound: a cycle of d seconds
+        wears joint j by at most d times this)."""
+        return [max(r) for r in zip(*(w.peak_rates for w in self.stretches))]
+
+    # speed: docs/performance.md#kept-cycles
+    def of_many(self, times_s: Sequence[Sequence[float]]) -> NDArray[np.float64]:
+        """(n, 5): :meth:`of_times` of each of n cycles, the same floats.  With p = 1 the
+        stretches' intervals are found for all the cycles at once (``searchsorted`` finds what
+        :meth:`SegmentWear.interval`'s bisection finds) and each interval's exposure looked
+        up (computed once, as :meth:`of_times` would)."""
+        known = self._by_interval
+        if known is None or not len(times_s):
+            return np.array([self.of_times(t) for t in times_s], dtype=float).reshape(-1, 5)
+        times = np.array(times_s, dtype=float)
+        cols = [np.searchsorted(w._tbreak, times[:, s], side="left")
+                for s, w in enumerate(self.stretches)]
+        code = cols[0]
+        for col, w in zip(cols[1:], self.stretches[1:]):
+            code = code * (len(w._tbreak) + 1) + col
+        _, first, inverse = np.unique(code, return_index=True, return_inverse=True)
+        table = []
+        for i in first.tolist():
+            intervals = tuple(int(col[i]) for col in cols)
+            hit = known.get(intervals)
+            if hit is None:
+                hit = known[intervals] = self._computed(tuple(times_s[i]))
+            table.append(hit)
+        return np.array(table, dtype=float)[inverse.reshape(-1)]
 
     def _computed(self, times_s: tuple[float, ...]) -> list[float]:
         e = [w.at_time(t) for w, t in zip(self.stretches, times_s, strict=True)]

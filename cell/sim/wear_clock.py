@@ -223,6 +223,15 @@ class WearExposure:
         self.total = [a + b for a, b in zip(self.total, use)]
         return use
 
+    def cycles(self, legs_s: Sequence[Sequence[float]]) -> np.ndarray:
+        uses = self.wear.of_many(legs_s)
+        # added in the cycles' order, as cycle by cycle (``add.accumulate`` adds in order)
+        self.total = np.add.accumulate(np.vstack([self.total, uses]), axis=0)[-1].tolist()
+        return uses
+
+    def peak_rates(self) -> Sequence[float] | None:
+        return self.wear.peak_rates  # nothing worn at rest
+
 
 def _exposure(table: StepTable, timing: RobotTiming, settings: WearSettingsLike,
                       seed: int | np.random.SeedSequence) -> WearExposure:
@@ -235,6 +244,7 @@ def failures_log(exposure: WearExposure, downtime: Any, failures: Any, end_s: fl
     with cause ``wear`` from its log, the repair time's mean for the expected availability."""
     from cell.scenario.failure_spec import frozen
 
+    downtime.settle()  # the cycles the robot's clock has kept counted in the totals
     log = WearLog(exposure, float(frozen(failures.robot.time_to_repair).mean()))
     robot = [(cause, a, b) for name, cause, a, b, _ in downtime.all_stops(end_s)
              if name == "robot"]

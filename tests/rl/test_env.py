@@ -20,7 +20,7 @@ from cell.rl.actions import FIELDS, PLAN_LIMITS, ActionMap, action_of
 from cell.scenario import catalog
 from cell.scenario.schema import load_scenario
 from cell.sim.policies.adaptive import Adaptive
-from cell.sim.policies.check import check, plan_bounds
+from cell.sim.policies.check import PlanCheck
 from cell.sim.records import PART_COLUMNS
 from cell.sim.simulation import simulate
 
@@ -76,7 +76,7 @@ def test_map_lands_in_the_checked_set_and_fixes_it(k, values, v):
     bit (the map is the identity on the feasible set)."""
     m = ActionMap(k)
     plan = m.to_plan(np.array(values), v)
-    check(plan, plan_bounds(k), "agent", k)  # raises if refused
+    PlanCheck(k, "agent").passes(plan)  # raises if refused
     assert plan.limits & ~PLAN_LIMITS == 0  # no outcome claimed (let go, scrapped...)
     again = m.to_plan(action_of(plan), plan.input_speed)
     assert action_of(again).tobytes() == action_of(plan).tobytes()

@@ -88,8 +88,8 @@ def test_only_the_schedule_ahead_is_kept():
 @given(st.lists(st.tuples(st.floats(0.1, 30.0), st.floats(0.1, 30.0), st.floats(0.1, 30.0),
                           st.floats(0.5, 6.0), st.floats(0.5, 6.0), st.floats(0.5, 6.0)),
                 min_size=1, max_size=12))
-def test_plan_then_is_plan_and_then_to_the_bit(steps):
-    """The output belt's one-call replan (:meth:`Belt.plan_then`, its fast case unrolled) leaves
+def test_plan_of_three_changes_is_plan_and_then_to_the_bit(steps):
+    """The output belt's one-call replan (:meth:`Belt.plan` with a third change) leaves
     the very schedule, travel and settled changes that :meth:`Belt.plan` then :meth:`Belt.then`
     leave, whether the last floor has begun or not (each step replans from ``now``)."""
     told_a: list[tuple[float, float]] = []
@@ -99,9 +99,33 @@ def test_plan_then_is_plan_and_then_to_the_bit(steps):
     now = 0.0
     for gap, to_g, floor, v1, v2, v3 in steps:
         now += gap
-        a.plan_then(now, v1, now + to_g, v2, now + to_g + floor, v3)
+        a.plan(now, v1, now + to_g, v2, now + to_g + floor, v3)
         b.plan(now, v1, now + to_g, v2)
         b.then(now + to_g + floor, v3)
         assert (a._t, a._x, a._v) == (b._t, b._x, b._v)
     assert told_a == told_b
     assert (a.max_speed_in_s, a.min_speed_in_s) == (b.max_speed_in_s, b.min_speed_in_s)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(st.floats(0.1, 30.0), st.floats(0.1, 30.0), st.floats(0.1, 30.0),
+                          st.floats(0.5, 6.0), st.floats(0.5, 6.0), st.floats(0.5, 6.0),
+                          st.floats(0.0, 1.0)),
+                min_size=1, max_size=12))
+def test_a_belt_replayed_from_its_history_travels_as_it_ran(steps):
+    """The belt the animation replays from a run's speed history (:meth:`Belt.of_history`,
+    what ``belts.csv`` holds) is where the running belt was at every instant, to the bit, and
+    reaches each travel when it did: one rule of a belt's travel for both."""
+    told: list[tuple[float, float]] = []
+    b = Belt(2.0, on_change=lambda t, v: told.append((t, v)))
+    seen = []
+    now = 0.0
+    for gap, to_g, floor, v1, v2, v3, later in steps:
+        t = now + later * gap  # an instant before the replan at now + gap: final by then
+        seen.append((t, b.travel(t)))
+        now += gap
+        b.plan(now, v1, now + to_g, v2, now + to_g + floor, v3)
+    b.close()
+    replay = Belt.of_history(told)
+    assert [(t, replay.travel(t)) for t, _ in seen] == seen
+    assert all(replay.time_at(x) == pytest.approx(t, abs=1e-9) for t, x in seen)

@@ -277,7 +277,7 @@ class RIVWear:
     cause = "wear"
 
     def __init__(self, ahead: bool):
-        self.ahead, self.cycles = ahead, 0
+        self.ahead, self.told = ahead, 0
 
     def thresholds(self) -> list[float]:
         return [100.0]
@@ -289,8 +289,14 @@ class RIVWear:
         return (1.0,) if leg == 5 else (0.0,)
 
     def cycle(self, legs_s):  # noqa: ANN001, ANN201
-        self.cycles += 1
+        self.told += 1
         return (legs_s[5],) if self.ahead else None
+
+    def cycles(self, legs_s):  # noqa: ANN001, ANN201 (the cycles the clock kept, in order)
+        return np.array([self.cycle(legs) for legs in legs_s], dtype=float).reshape(-1, 1)
+
+    def peak_rates(self) -> tuple[float, ...] | None:
+        return (1.0,) if self.ahead else None  # 1 a second at most (R IV); None: not known
 
 
 @pytest.mark.parametrize("ahead", [True, False])
@@ -313,7 +319,7 @@ def test_a_wear_exposure_drives_the_robots_failure_clock(monkeypatch, ahead):
     end = parts.at_bot_s + parts.motion_cycle_s
     r4 = (np.minimum(end, first.from_s) - np.minimum(end - parts.r4_s, first.from_s)).clip(0)
     assert r4.sum() == pytest.approx(100.0, abs=1e-6)
-    assert wear.cycles == len(parts)
+    assert wear.told == len(parts)
 
 
 def test_planned_stops_come_back_and_cost_the_parts_they_cover():

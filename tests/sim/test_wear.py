@@ -257,3 +257,77 @@ def test_wear_alone_stops_are_in_the_failures_the_states_and_the_summary(renewal
     assert r.robot_failures == len(stops)
     assert r.mtbf_observed_s == pytest.approx((end - down_s) / len(stops))
     assert r.oee == pytest.approx(r.availability * r.performance * r.quality)
+
+
+@settings(max_examples=20, deadline=None)
+@given(p=st.sampled_from(EXPONENTS),
+       scales=st.lists(st.lists(st.floats(1.0, 3.0), min_size=6, max_size=6), min_size=1,
+                       max_size=30))
+def test_many_cycles_wear_as_each_alone_to_the_bit(cell, p, scales) -> None:
+    """The exposure of many cycles at once is each cycle's own (``of_many`` and ``of_times``),
+    the same floats, whatever the cycles' times and order."""
+    floor = [getattr(cell.timing, name).floor_s for name in STRETCHES]
+    times = [tuple(f * k for f, k in zip(floor, row)) for row in scales]
+    many = CycleWear(cell.table, cell.timing, WearModel(exponent=p)).of_many(times)
+    one = CycleWear(cell.table, cell.timing, WearModel(exponent=p))
+    assert many.tolist() == [one.of_times(t) for t in times]
+
+
+@pytest.mark.parametrize("p", [1.0, 2.0])
+def test_a_wear_clock_that_keeps_cycles_fails_when_one_that_takes_each_does(cell, p) -> None:
+    """A failure clock counting wear takes the cycles' use lazily while no motor is near its
+    end (the exposure's bound a second, :meth:`CycleWear.peak_rates`); its failures come at the
+    very instants, and its motors' totals are the very floats, of a clock told no bound (every
+    cycle's use taken as it starts)."""
+    import simpy
+
+    from cell.sim.failure_clock import MOVING_NOT, FailureClock
+    from cell.sim.wear_clock import WearExposure
+
+    class EachCycle(WearExposure):
+        def peak_rates(self):  # noqa: ANN202
+            return None
+
+    floor = [getattr(cell.timing, name).floor_s for name in STRETCHES]
+    rng = np.random.default_rng(5)
+    legs = [tuple(f * k for f, k in zip(floor, rng.uniform(1.0, 2.5, 6))) for _ in range(4000)]
+    idle = rng.exponential(3.0, len(legs)).tolist()
+
+    def run(kind: type) -> tuple[list[tuple[int, float]], list[float], int]:
+        env = simpy.Environment()
+        exposure = kind(CycleWear(cell.table, cell.timing, WearModel(exponent=p,
+                                                                    rated_life_h=2.0)),
+                        np.random.default_rng(11))
+        failed: list[tuple[int, float]] = []
+
+        def fail(component, cause):  # noqa: ANN001, ANN202
+            failed.append((component, env.now))
+            yield env.timeout(60.0)
+
+        clock = FailureClock(env, exposure, fail, MOVING_NOT)
+        kept = [0]
+
+        def robot():  # noqa: ANN202
+            for cycle, wait in zip(legs, idle):
+                end = env.now + sum(cycle)
+                if clock.cycle(cycle, end):
+                    kept[0] += bool(clock.pending)
+                    yield env.timeout(end - env.now)
+                else:  # near a motor's end: leg by leg
+                    for i, leg in enumerate(cycle):
+                        clock.follow(i)
+                        yield env.timeout(leg)
+                    clock.follow(MOVING_NOT)
+                while clock.failing:
+                    yield env.timeout(1.0)
+                yield env.timeout(wait)
+
+        env.process(robot())
+        env.run()
+        clock.settle()
+        return failed, exposure.total, kept[0]
+
+    lazy, each = run(WearExposure), run(EachCycle)
+    assert len(each[0]) >= 3  # the motors wear out several times
+    assert lazy[:2] == each[:2]
+    assert lazy[2] > len(legs) // 2 and each[2] == 0  # most cycles were kept

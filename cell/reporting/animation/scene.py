@@ -5,7 +5,9 @@ The animation's facts come from one run's records through :func:`frames_input`
 works on the plain arrays of :class:`AnimationInput`:
 
 * a belt is a piecewise-constant speed history, so its travel X(t) is piecewise
-  linear (§6.2 a: speed changes take effect at once), :func:`travel`;
+  linear (§6.2 a: speed changes take effect at once): the simulation's own belt
+  (:class:`cell.sim.conveyors.Belt`) replays the run's history (:func:`schedule`) and
+  answers :func:`travel` and :func:`time_at`, one implementation of the rule;
 * a part on the input belt is ``input_length_in`` upstream of B when the feeder
   drops it, and moves by the belt's travel; one not caught rides on and falls off
   the belt's end at F (§6.3);
@@ -31,6 +33,7 @@ from cell.arm.steptable import StepTable
 from cell.reporting.animation.arm_pose import ArmPose, RobotState, robot_at
 from cell.reporting.animation.stops import OperatingClock
 from cell.scenario.schema import Scenario
+from cell.sim.conveyors import Belt
 
 Floats = NDArray[np.float64]
 
@@ -116,29 +119,32 @@ def frames_input(result: Any, scenario: Scenario) -> AnimationInput:
 
 
 # --------------------------------------------------------------------------- belts
-def travel(history: ArrayLike, t: ArrayLike) -> Floats:
-    """X(t), inches a belt has moved since its first speed change, for any shape of t.
+def schedule(history: ArrayLike) -> Belt:
+    """The simulation's belt replaying a speed history, rows (from_s, speed_in_s) sorted
+    (:meth:`cell.sim.conveyors.Belt.of_history`): its travel is the run's, to the bit."""
+    return Belt.of_history(np.asarray(history, dtype=float).reshape(-1, 2).tolist())
 
-    ``history``: rows (from_s, speed_in_s), sorted, piecewise-constant (§6.2 a);
-    the last speed holds for ever.  Before the first instant the first speed is
-    extrapolated back.
+
+def travel(belt: Belt | ArrayLike, t: ArrayLike) -> Floats:
+    """X(t), inches a belt has moved since its first speed change, for any shape of t
+    (:meth:`cell.sim.conveyors.Belt.travel` at each instant).
+
+    ``belt``: a :func:`schedule`, or its history, rows (from_s, speed_in_s), sorted,
+    piecewise-constant (§6.2 a); the last speed holds for ever.  Before the first instant
+    the first speed is extrapolated back.
     """
-    h = np.asarray(history, dtype=float).reshape(-1, 2)
-    start, speed = h[:, 0], h[:, 1]
-    knots = np.concatenate([[0.0], np.cumsum(speed[:-1] * np.diff(start))])
-    t = np.asarray(t, dtype=float)
-    k = np.clip(np.searchsorted(start, t, side="right") - 1, 0, len(start) - 1)
-    return knots[k] + speed[k] * (t - start[k])
+    b = belt if isinstance(belt, Belt) else schedule(belt)
+    with np.errstate(all="ignore"):  # NaN in (a part never picked): NaN out
+        return np.vectorize(b.travel, otypes=[float])(np.asarray(t, dtype=float))
 
 
-def time_at(history: ArrayLike, x: ArrayLike) -> Floats:
-    """The instant the belt's travel reaches x (the inverse of :func:`travel`; speeds > 0)."""
-    h = np.asarray(history, dtype=float).reshape(-1, 2)
-    start = h[:, 0]
-    knots = travel(h, start)
-    x = np.asarray(x, dtype=float)
-    k = np.clip(np.searchsorted(knots, x, side="right") - 1, 0, len(start) - 1)
-    return start[k] + (x - knots[k]) / h[k, 1]
+def time_at(belt: Belt | ArrayLike, x: ArrayLike) -> Floats:
+    """The instant the belt's travel reaches x (the inverse of :func:`travel`,
+    :meth:`cell.sim.conveyors.Belt.time_at` at each x, in numpy's floats: inf where the belt
+    stands from its last change on)."""
+    b = belt if isinstance(belt, Belt) else schedule(belt)
+    with np.errstate(all="ignore"):
+        return np.vectorize(b.time_at, otypes=[float])(np.asarray(x, dtype=float))
 
 
 # --------------------------------------------------------------------------- the scene
@@ -165,6 +171,16 @@ class Scene:
     stops: tuple[tuple[str, str, float, float], ...] = ()
     """(equipment, cause, from_s, to_s) of every stop of the run: a failure, a worn motor, a
     planned stop (failures.csv's rows)."""
+
+    @cached_property
+    def input_belt(self) -> Belt:
+        """The input belt's schedule (:func:`schedule` of the run's history)."""
+        return schedule(self.data.input_belt)
+
+    @cached_property
+    def output_belt(self) -> Belt:
+        """The output belt's schedule."""
+        return schedule(self.data.output_belt)
 
     @cached_property
     def clock(self) -> OperatingClock:
@@ -224,11 +240,12 @@ def build_scene(data: AnimationInput, table: StepTable, scenario: Scenario,
         seg = record_segments(start[i], pick[i], td[i], data.regime_s[i])
         t_s[row] = clock.wall(start[i] + timeline(table, seg).t_s)
     to_f = data.input_length_in + float(scenario.path.f_in[0] - scenario.path.bot_in[0])
-    x_drop = travel(data.input_belt, data.arrival_s)
-    fall = np.where(data.picked, np.nan, time_at(data.input_belt, x_drop + to_f))
-    y_td = np.where(data.picked, travel(data.output_belt, data.touchdown_s), np.nan)
+    belt_in, belt_out = schedule(data.input_belt), schedule(data.output_belt)
+    x_drop = travel(belt_in, data.arrival_s)
+    fall = np.where(data.picked, np.nan, time_at(belt_in, x_drop + to_f))
+    y_td = np.where(data.picked, travel(belt_out, data.touchdown_s), np.nan)
     to_gone = output_gone_y(scenario, table) - float(table.path.xyz_in[table.path.td, 1])
-    off = np.where(data.picked, time_at(data.output_belt, y_td + to_gone), np.nan)
+    off = np.where(data.picked, time_at(belt_out, y_td + to_gone), np.nan)
     return Scene(data, table, scenario, cycles.astype(np.int64), t_s, fall, x_drop, y_td, off,
                  tuple(stops))
 
@@ -272,7 +289,7 @@ def parts_at(scene: Scene, t: float, robot: tuple[RobotState, ArmPose] | None = 
         falling = on_input & ~d.picked & (t >= scene.fall_s)
         held = d.picked & (d.pick_s <= t) & (t < d.touchdown_s)
         out = d.picked & (t >= d.touchdown_s) & (t < scene.off_output_s)
-    x_in = scene.b_xy[0] - d.input_length_in + (travel(d.input_belt, t) - scene.arrival_travel_in)
+    x_in = scene.b_xy[0] - d.input_length_in + (travel(scene.input_belt, t) - scene.arrival_travel_in)
     xy[on_input] = np.column_stack([x_in, np.full(n, scene.b_xy[1])])[on_input]
     where[on_input] = INPUT
     where[falling] = FALLING
@@ -284,7 +301,7 @@ def parts_at(scene: Scene, t: float, robot: tuple[RobotState, ArmPose] | None = 
         xy[held] = pose.tcp[0, :2]
         angle[held] = state.phi_rad[0]
         where[held] = HAND
-    y_out = scene.td_xy[1] + travel(d.output_belt, t) - scene.touchdown_travel_in
+    y_out = scene.td_xy[1] + travel(scene.output_belt, t) - scene.touchdown_travel_in
     xy[out] = np.column_stack([np.full(n, scene.td_xy[0]), y_out])[out]
     angle[out] = scene.table.path.phi_rad[scene.table.path.td]
     where[out] = OUTPUT

@@ -2,7 +2,7 @@
 
 A policy (built in or a plug-in) answers :meth:`~cell.sim.policies.base.Policy.plan` with the
 regime times and belt speeds of one cycle.  The controller checks each plan the moment it
-gets it (:func:`check`, the one check, whatever the policy), so that each plan must obey the
+gets it (:class:`PlanCheck`, the one check, whatever the policy), so that each plan must obey the
 same physics the built-in policies do before the cell acts on it:
 
 * every regime time finite and no shorter than what a cycle may take
@@ -23,7 +23,7 @@ same physics the built-in policies do before the cell acts on it:
 
 A number is an int or a float (a boolean in a numeric field is read as its 0 or 1, as the
 controller's comparisons read it; an integer beyond the floats' range is an infinity).
-tests/robust/test_plan_check_agrees.py checks that :func:`check`'s comparisons and
+tests/robust/test_plan_check_agrees.py checks that :meth:`PlanCheck.passes`' comparisons and
 :func:`problem`'s wording agree on any plan.
 
 The plan is read by attribute name only (``plan.r1_pre``, ``plan.cycle``...), so any
@@ -197,34 +197,52 @@ def plan_bounds(k: Any) -> tuple[float, ...]:
     return tuple(out)
 
 
-def check(plan: Any, bounds: tuple[float, ...], name: str, k: Any) -> None:
+class PlanCheck:
     """The check every plan passes before the cell acts on it (the controller's, for any
-    policy): returns if ``plan`` obeys the physics above, else raises :class:`PolicyError`
-    naming its first bad value (:func:`problem`).  ``bounds``: :func:`plan_bounds` of ``k``.
+    policy), for constants ``k`` and the policy's ``name``: :meth:`passes`."""
 
-    The fields are read by name and compared once each, the slack baked into ``bounds`` (NaN
-    fails every comparison; with every regime time at or above its floor, a finite cycle below
-    :data:`MAX_S` makes each of them finite); only a plan that fails goes to :func:`problem`
-    for the message."""
-    a1, a2, a3, a4, a5, a6, c1, d1, c2, d2, c3, d3, c4, d4 = bounds
-    try:
-        r1a, r1b, r2, r3a, r3b, r4 = \
-            plan.r1_pre, plan.r1_post, plan.r2, plan.r3_pre, plan.r3_post, plan.r4
-        v, w, w_next, u = plan.input_speed, plan.input_after_lo, plan.input_next, plan.output_to_g
-        to_g, cycle, limits, steers = plan.to_g, plan.cycle, plan.limits, plan.steers_belts
-        off_g, off_b = to_g - (r1a + r1b + r2), cycle - (to_g + r3a + r3b + r4)
-        floor_at = plan.output_floor_at if steers else math.inf  # at or after TD
-        if (a1 <= r1a and a2 <= r1b and a3 <= r2 and a4 <= r3a and a5 <= r3b and a6 <= r4
-                and c1 <= v <= d1 and c2 <= w <= d2 and c3 <= w_next <= d3 and c4 <= u <= d4
-                and -SUM_S <= off_g <= SUM_S and -SUM_S <= off_b <= SUM_S and cycle < MAX_S
-                and limits.__class__ is int and not limits & ~ALL_LIMITS
-                and steers.__class__ is bool and floor_at >= to_g + r3a - SUM_S
-                and (f := tracking_floors(k)(v))[0] - ABS - REL * f[0] <= r1a  # R I at the pace of
-                and f[1] - ABS - REL * f[1] <= r1b):  # the belt it picks from (v checked above)
-            return
-    except Exception:  # noqa: BLE001, S110 - a field missing or not a number: said below
-        pass
-    refuse(plan, name, k)
+    __slots__ = ("k", "name", "bounds", "r1_floors")
+
+    def __init__(self, k: Any, name: str):
+        self.k, self.name = k, name
+        self.bounds = plan_bounds(k)
+        """:func:`plan_bounds` of ``k``."""
+        t = k.timing
+        self.r1_floors = (t.r1_pre.time, t.r1_post.time)
+        """R I's floors (B → LO, LO → F) at an input belt speed, one function each: the two
+        of :meth:`~cell.sim.robot.RobotTiming.r1_time` (:func:`tracking_floors`)."""
+
+    def passes(self, plan: Any) -> None:
+        """Returns if ``plan`` obeys the physics above, else raises :class:`PolicyError`
+        naming its first bad value (:func:`problem`).
+
+        The fields are read by name and compared once each, the slack baked into the bounds
+        (NaN fails every comparison; with every regime time at or above its floor, a finite
+        cycle below :data:`MAX_S` makes each of them finite); only a plan that fails goes to
+        :func:`problem` for the message."""
+        a1, a2, a3, a4, a5, a6, c1, d1, c2, d2, c3, d3, c4, d4 = self.bounds
+        try:
+            r1a, r1b, r2, r3a, r3b, r4 = \
+                plan.r1_pre, plan.r1_post, plan.r2, plan.r3_pre, plan.r3_post, plan.r4
+            v, w, w_next, u = plan.input_speed, plan.input_after_lo, plan.input_next, \
+                plan.output_to_g
+            to_g, cycle, limits, steers = plan.to_g, plan.cycle, plan.limits, plan.steers_belts
+            off_g, off_b = to_g - (r1a + r1b + r2), cycle - (to_g + r3a + r3b + r4)
+            floor_at = plan.output_floor_at if steers else math.inf  # at or after TD
+            if (a1 <= r1a and a2 <= r1b and a3 <= r2 and a4 <= r3a and a5 <= r3b and a6 <= r4
+                    and c1 <= v <= d1 and c2 <= w <= d2 and c3 <= w_next <= d3 and c4 <= u <= d4
+                    and -SUM_S <= off_g <= SUM_S and -SUM_S <= off_b <= SUM_S and cycle < MAX_S
+                    and limits.__class__ is int and not limits & ~ALL_LIMITS
+                    and steers.__class__ is bool and floor_at >= to_g + r3a - SUM_S):
+                pre, post = self.r1_floors  # R I at the pace of the belt it picks from
+                f = pre(v)  # (v checked above)
+                if f - ABS - REL * f <= r1a:
+                    f = post(v)
+                    if f - ABS - REL * f <= r1b:
+                        return
+        except Exception:  # noqa: BLE001, S110 - a field missing or not a number: said below
+            pass
+        refuse(plan, self.name, self.k)
 
 
 def plan_failed(name: str, exc: Exception) -> PolicyError:
@@ -234,7 +252,7 @@ def plan_failed(name: str, exc: Exception) -> PolicyError:
 
 
 def refuse(plan: Any, name: str, k: Any) -> None:
-    """Raise :class:`PolicyError` naming the first bad value of a plan :func:`check`'s
+    """Raise :class:`PolicyError` naming the first bad value of a plan :class:`PlanCheck`'s
     comparisons did not pass (and return if :func:`problem` finds nothing after all)."""
     why = problem(plan, k)
     if why is not None:
