@@ -4,7 +4,6 @@ simulation below the MILP, and a burst where the bound is loose has its optimum 
 
 from __future__ import annotations
 
-import hashlib
 from pathlib import Path
 
 import pytest
@@ -13,18 +12,9 @@ from hypothesis import strategies as st
 
 from cell.experiments.hindsight.milp import check_cycle_s, solve
 from cell.experiments.hindsight.optimum import hindsight
-from cell.scenario.schema import Scenario, load_scenario
 from cell.sim.assembly import assemble
 from cell.sim.simulation import simulate
-
-
-def _scenario(folder: Path, gaps: list[float], policy: str = "adaptive") -> Scenario:
-    """The baseline cell fed ``gaps`` (inter-arrival times, s) as ``arrivals.trace_csv``."""
-    text = "interarrival_s\n" + "".join(f"{g!r}\n" for g in gaps)
-    path = folder / f"{hashlib.sha1(text.encode()).hexdigest()[:16]}.csv"
-    path.write_text(text)
-    return load_scenario("baseline", {"run.parts": len(gaps), "arrivals.trace_csv": str(path),
-                                      "controller.policy": policy})
+from tests.traces import trace_scenario
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +39,7 @@ def test_a_burst_of_ten_parts_has_bound_six_and_optimum_one(folder: Path) -> Non
     is picked.  The next pick is at least 17.566 s later; by then the belt, at 1.5 in/s at
     least, has carried 26.3 in past B, more than the 18 in to part 9: parts 1-9 all reach B
     while the robot is away.  1."""
-    s = _scenario(folder, BURST)
+    s = trace_scenario(folder, BURST)
     out = hindsight(s, budget_s=20.0).summary
     assert out["parts_bound"] == 6
     assert out["parts_upper"] == 1 and out["milp_status"] == "optimal"
@@ -57,7 +47,7 @@ def test_a_burst_of_ten_parts_has_bound_six_and_optimum_one(folder: Path) -> Non
     assert 17.56 < check_cycle_s(assemble(s).k) < 17.57
     # every controller is at or below it, the adaptive and the fixed cycle alike
     for policy in ("adaptive", "non-adaptive"):
-        assert simulate(_scenario(folder, BURST, policy)).summary.parts_delivered <= 1
+        assert simulate(trace_scenario(folder, BURST, policy)).summary.parts_delivered <= 1
 
 
 def test_a_part_of_the_burst_after_a_gap_the_belt_can_make_is_caught(folder: Path) -> None:
@@ -65,7 +55,7 @@ def test_a_part_of_the_burst_after_a_gap_the_belt_can_make_is_caught(folder: Pat
     of each burst, and the belt (1.5 to 12 in/s) can bring the second burst's first part to B
     17.566 s after the first pick: 2.  The MILP proves it and a simulated schedule reaches it."""
     gaps = [5.0, 0.0, 0.0, 60.0, 0.0, 0.0]
-    out = hindsight(_scenario(folder, gaps), budget_s=20.0).summary
+    out = hindsight(trace_scenario(folder, gaps), budget_s=20.0).summary
     assert (out["parts_upper"], out["parts_optimum"], out["exact"]) == (2, 2, True)
 
 
@@ -79,12 +69,12 @@ def test_controllers_sit_below_the_milp_and_the_milp_below_the_bound(folder: Pat
     """On drawn traces of 8-12 parts, bursts among them: every built-in controller's count (the
     real simulation, the same trace) <= the MILP's proved optimum <= parts_bound, and the
     search's simulated schedule <= the MILP's optimum."""
-    s = _scenario(folder, gaps)
+    s = trace_scenario(folder, gaps)
     out = hindsight(s, budget_s=20.0).summary
     assert out["milp_status"] == "optimal"
     upper = out["parts_upper"]
     for policy in ("adaptive", "non-adaptive"):
-        run = simulate(_scenario(folder, gaps, policy)).summary
+        run = simulate(trace_scenario(folder, gaps, policy)).summary
         assert run.parts_delivered <= upper <= run.parts_bound == out["parts_bound"]
         assert run.parts_delivered <= out["parts_optimum"]  # its own run is a schedule too
     assert out["parts_optimum"] <= upper
@@ -97,7 +87,7 @@ def test_a_pick_is_a_cycle_at_its_own_tracking_speed_from_the_next(folder: Path)
     pick is at least the cycle at 3 in/s later, 18.084 s (R I 2.7293 s, docs/model.md's nominal
     cycle with R II and R IV at their peak), not the 17.566 s at the tracking limit; every later
     gap at least 17.566 s."""
-    k = assemble(_scenario(folder, [15.0] * 12)).k
+    k = assemble(trace_scenario(folder, [15.0] * 12)).k
     t = k.timing
     first = sum(t.shortest_parts(k.v_nom, k.u_nom))
     assert abs(first - 18.0841) < 1e-3
@@ -112,7 +102,7 @@ def test_a_pick_is_a_cycle_at_its_own_tracking_speed_from_the_next(folder: Path)
 def test_the_warm_up_is_left_out_of_the_count_as_from_the_bound(folder: Path) -> None:
     """With the first three parts a warm-up, the MILP counts the others only: on parts that
     come a cycle apart, all of them (the bound's count too)."""
-    s = _scenario(folder, [30.0] * 8).with_overrides({"run.warmup_parts": 3})
+    s = trace_scenario(folder, [30.0] * 8).with_overrides({"run.warmup_parts": 3})
     out = hindsight(s, budget_s=20.0).summary
     assert (out["parts_upper"], out["parts_optimum"], out["parts_bound"]) == (5, 5, 5)
     k = assemble(s).k
@@ -167,10 +157,10 @@ def test_a_run_too_long_for_the_milp_gives_the_search_against_the_bound(
     import cell.experiments.hindsight.optimum as hs
 
     monkeypatch.setattr(hs, "MILP_MAX_PARTS", 5)
-    found = hs.hindsight(_scenario(folder, [30.0] * 8), budget_s=20.0)
+    found = hs.hindsight(trace_scenario(folder, [30.0] * 8), budget_s=20.0)
     s = found.summary
     assert (s["milp_status"], s["upper_from"], s["parts_upper"]) == ("too_large", "parts_bound", 8)
     assert s["parts_optimum"] == 8 and s["exact"]
     assert any("too large" in note for note in found.notes)
-    found = hs.hindsight(_scenario(folder, BURST), budget_s=20.0)
+    found = hs.hindsight(trace_scenario(folder, BURST), budget_s=20.0)
     assert (found.summary["parts_optimum"], found.summary["exact"]) == (1, False)

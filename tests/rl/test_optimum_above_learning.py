@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import hashlib
 from pathlib import Path
 
 import pytest
@@ -12,16 +11,8 @@ from hypothesis import strategies as st
 
 from cell.experiments.hindsight.optimum import hindsight
 from cell.rl import CellEnv
-from cell.scenario.schema import Scenario, load_scenario
 from cell.sim.simulation import simulate
-
-
-def trace(folder: Path, gaps: list[float], policy: str) -> Scenario:
-    text = "interarrival_s\n" + "".join(f"{g!r}\n" for g in gaps)
-    path = folder / f"{hashlib.sha1(text.encode()).hexdigest()[:16]}.csv"
-    path.write_text(text)
-    return load_scenario("baseline", {"run.parts": len(gaps), "arrivals.trace_csv": str(path),
-                                      "controller.policy": policy})
+from tests.traces import trace_scenario
 
 
 @pytest.fixture(scope="module")
@@ -37,13 +28,13 @@ gap = st.one_of(st.just(0.0), st.floats(0.0, 40.0, allow_nan=False))
        agent_seed=st.integers(0, 2**16))
 def test_learned_and_any_agent_sit_below_the_milp(folder: Path, gaps: list[float],
                                                   agent_seed: int) -> None:
-    out = hindsight(trace(folder, gaps, "adaptive"), budget_s=20.0).summary
+    out = hindsight(trace_scenario(folder, gaps, "adaptive"), budget_s=20.0).summary
     assert out["milp_status"] == "optimal"
     upper = out["parts_upper"]
     assert upper <= out["parts_bound"]
-    learned = simulate(trace(folder, gaps, "learned")).summary
+    learned = simulate(trace_scenario(folder, gaps, "learned")).summary
     assert learned.parts_delivered <= upper
-    env = CellEnv(trace(folder, gaps, "adaptive"))
+    env = CellEnv(trace_scenario(folder, gaps, "adaptive"))
     env.action_space.seed(agent_seed)
     env.reset()
     done, info = False, {}

@@ -16,6 +16,7 @@ from cell.cli.main import main
 from cell.scenario.arrivals import interarrival_times
 from cell.scenario.rate_profile import Pieces
 from cell.scenario.schema import default_scenario
+from tests.refusals import refused_in_one_line
 
 HOUR = 3600.0
 #: Rates by hour of a 4-hour period: relative, normalised to a mean of 1 over the period.
@@ -132,11 +133,7 @@ def test_a_bad_profile_is_one_line_naming_file_key_and_value(capsys, tmp_path: P
     text = "arrivals:\n  profile: " + str(profile).replace("'", "") + "\n"
     scenario.write_text(text)
     out = tmp_path / "out"
-    assert main(["run", str(scenario), "--out", str(out)]) == 2
-    err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0
-    assert err.startswith(f"cell: error: {scenario}: {key} = {value}")
-    assert not out.exists()
+    refused_in_one_line(capsys, ["run", str(scenario), "--out", str(out)], scenario, key, value, out)
 
 
 def test_a_profile_with_a_trace_is_refused(capsys, tmp_path: Path):

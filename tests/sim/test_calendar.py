@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 from cell.cli.main import main
 from cell.scenario.schema import default_scenario
 from cell.sim.simulation import simulate
+from tests.refusals import refused_in_one_line
 
 DAYS = ("mon", "tue", "wed", "thu", "fri", "sat", "sun")
 START = "2027-01-04T06:00"  # a Monday
@@ -214,11 +215,7 @@ def test_a_bad_calendar_is_one_line_naming_file_key_and_value(capsys, tmp_path: 
     scenario = tmp_path / "s.yaml"
     scenario.write_text(yaml.safe_dump({"calendar": {**TWO_SHIFTS, **change}}))
     out = tmp_path / "out"
-    assert main(["run", str(scenario), "--out", str(out)]) == 2
-    err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0
-    assert err.startswith(f"cell: error: {scenario}: {key} = {value}")
-    assert not out.exists()
+    refused_in_one_line(capsys, ["run", str(scenario), "--out", str(out)], scenario, key, value, out)
 
 
 def test_a_night_shift_crossing_midnight_is_working_time():
