@@ -38,6 +38,7 @@ from cell.sim.bound import parts_bound
 from cell.sim.failures import Downtime
 from cell.sim.horizon import run_arrivals, run_until_done
 from cell.sim.line import build, has_buffer
+from cell.sim.line import measure as line_measure
 from cell.sim.policies.base import Accounting
 from cell.sim.records import (
     LIMIT_BIT,
@@ -340,6 +341,8 @@ class Run:
         result.wear = wear_clock.measures(wear, downtime, env.now)
         line = self.line
         result.station_rows, result.line = (line.rows(env.now), line) if line else (None, None)
+        if line:
+            line_measure(summary, log, env.now)
         return result
 
 
