@@ -121,15 +121,11 @@ def main(args: argparse.Namespace) -> int:
 
 
 def _refuse_a_layout(scenario: Any) -> None:
-    """The animation draws the thesis's one cell: a ``buffer:`` with places or ``stations:``
-    are refused in one line, before anything is simulated (docs/layout.md)."""
+    """The animation draws one cell (and its buffer): ``stations:`` are refused in one line,
+    before anything is simulated (docs/layout.md)."""
     from cell.plumbing.errors import ScenarioError
 
-    given = [(key, value) for key, value in (("stations", scenario.stations),
-                                             ("buffer.places", scenario.buffer and
-                                              scenario.buffer.places)) if value]
-    if given:
-        key, value = given[0]
-        raise ScenarioError(scenario.source, key, [s.name for s in value] if key == "stations"
-                            else value, "cell animate draws one cell without a buffer; a layout "
+    if scenario.stations:
+        raise ScenarioError(scenario.source, "stations", [s.name for s in scenario.stations],
+                            "cell animate draws one cell and its buffer; a line of stations "
                             "is not drawn yet (docs/layout.md)")

@@ -83,8 +83,7 @@ def test_set_addresses_a_station_by_its_name(capsys, tmp_path):
 def test_animate_refuses_a_layout_it_cannot_draw(capsys, tmp_path):
     """cell animate draws the thesis's one cell: a layout is refused in one line, exit 2,
     no file written (docs/layout.md)."""
-    for changes, key in (({}, "stations"), ({"stations": None, "buffer": {"places": 2}},
-                                             "buffer.places")):
+    for changes, key in (({}, "stations"),):
         doc = {k: v for k, v in {**LINE, **changes}.items() if v is not None}
         path = tmp_path / "line.yaml"
         path.write_text(yaml.safe_dump(doc), encoding="utf-8")

@@ -32,6 +32,8 @@ GIF_MEMORY_BYTES = 1.5e9
 #: The fields of a part's record that the frames need (:func:`~cell.reporting.animation.scene.frames_input`).
 FRAME_FIELDS = ("part", "arrival_s", "at_bot_s", "picked", "pick_s", "touchdown_s",
                 "r1_s", "r2_s", "r3_s", "r4_s")
+#: The fields a run with a ``buffer:`` adds (its parts' waits at the gate, docs/layout.md).
+BUFFER_FIELDS = ("buffer_wait_s",)
 #: Runs of at least this many parts show their progress on stderr while they are simulated.
 PROGRESS_FROM_PARTS = 50_000
 
@@ -82,8 +84,9 @@ def simulated(scenario: Scenario, progress: bool = False) -> Any:
     from cell.plumbing.progress import Progress
     from cell.sim.simulation import simulate
 
-    columns = {f: array("d") for f in FRAME_FIELDS}
-    appends, fields = [columns[f].append for f in FRAME_FIELDS], attrgetter(*FRAME_FIELDS)
+    kept = FRAME_FIELDS + (BUFFER_FIELDS if scenario.buffer is not None else ())
+    columns = {f: array("d") for f in kept}
+    appends, fields = [columns[f].append for f in kept], attrgetter(*kept)
     n = scenario.run.parts
     with Progress(n, f"cell animate: simulating ({scenario.controller.policy})", "parts",
                   enabled=progress and n >= PROGRESS_FROM_PARTS) as bar:
@@ -97,7 +100,7 @@ def simulated(scenario: Scenario, progress: bool = False) -> Any:
 
         result = simulate(scenario, keep_parts=False, on_part=keep)
         bar.update(n - bar.n)
-    parts = pd.DataFrame({f: np.frombuffer(columns[f]) for f in FRAME_FIELDS})
+    parts = pd.DataFrame({f: np.frombuffer(columns[f]) for f in kept})
     parts = parts.astype({"part": np.int64, "picked": bool})
     return SimpleNamespace(parts=parts, belts=result.belt_histories(), summary=result.summary,
                            stops=run_stops(result))

@@ -76,6 +76,12 @@ class AnimationInput:
     """Feeder drop point to B."""
     cycle_s: float
     """The cycle the robot plans for: a non-adaptive robot's fixed cycle (the run's ideal_cycle_s)."""
+    buffer_wait_s: Floats | None = None
+    """(n,) how long each part stood at the buffer's gate or behind it (parts.csv's
+    ``buffer_wait_s``; None: no ``buffer:``, every part moving as in the thesis's cell)."""
+    pitch_in: float = 0.0
+    """The buffer's pitch: centre to centre of the parts waiting in it (docs/layout.md; 0:
+    no buffer)."""
 
 
 def belt_history(result: Any, belt: str) -> Floats:
@@ -112,7 +118,18 @@ def frames_input(result: Any, scenario: Scenario) -> AnimationInput:
         input_belt=belt_history(result, "input"),
         output_belt=belt_history(result, "output"),
         input_length_in=float(constants(scenario, robot_timing(scenario)).input_length),
-        cycle_s=float(result.summary.ideal_cycle_s))
+        cycle_s=float(result.summary.ideal_cycle_s),
+        **buffered(d, scenario))
+
+
+def buffered(d: Any, scenario: Scenario) -> dict[str, Any]:
+    """A buffer's :class:`AnimationInput` fields: each part's wait and the pitch (none
+    without a ``buffer:`` with places)."""
+    b = scenario.buffer
+    if b is None or not b.places or "buffer_wait_s" not in d:
+        return {}
+    pitch = b.pitch_in if b.pitch_in is not None else scenario.part.size_in
+    return {"buffer_wait_s": d["buffer_wait_s"].to_numpy(dtype=float), "pitch_in": float(pitch)}
 
 
 # --------------------------------------------------------------------------- belts
@@ -226,11 +243,43 @@ def build_scene(data: AnimationInput, table: StepTable, scenario: Scenario,
     to_f = data.input_length_in + float(scenario.path.f_in[0] - scenario.path.bot_in[0])
     x_drop = travel(data.input_belt, data.arrival_s)
     fall = np.where(data.picked, np.nan, time_at(data.input_belt, x_drop + to_f))
+    waited = waited_parts(data)
+    if waited.any():  # let go at the gate (at_bot_s): from B on with the belt
+        x_b = travel(data.input_belt, data.at_bot_s[waited])
+        to_f_b = float(scenario.path.f_in[0] - scenario.path.bot_in[0])
+        fall[waited] = np.where(data.picked[waited], np.nan,
+                                time_at(data.input_belt, x_b + to_f_b))
     y_td = np.where(data.picked, travel(data.output_belt, data.touchdown_s), np.nan)
     to_gone = output_gone_y(scenario, table) - float(table.path.xyz_in[table.path.td, 1])
     off = np.where(data.picked, time_at(data.output_belt, y_td + to_gone), np.nan)
     return Scene(data, table, scenario, cycles.astype(np.int64), t_s, fall, x_drop, y_td, off,
                  tuple(stops))
+
+
+# --------------------------------------------------------------------------- the buffer
+def waited_parts(data: AnimationInput) -> NDArray[np.bool_]:
+    """(n,) the parts that stood at the buffer's gate (or behind it) before it let them go."""
+    if data.buffer_wait_s is None:
+        return np.zeros(len(data.part), dtype=bool)
+    return data.buffer_wait_s > 0
+
+
+def queue_x(scene: Scene, t: float, x_free: Floats) -> tuple[NDArray[np.bool_], Floats]:
+    """The parts on the input belt before the gate lets them go, and their x at instant t:
+    each moves with the belt (``x_free``, where it would be moving) until it closes up behind
+    the parts still waiting ahead of it, ``pitch_in`` apart, the first at the gate at B
+    (docs/layout.md "The buffer"); let go at its ``at_bot_s``, it moves on from B."""
+    d = scene.data
+    waited = waited_parts(d)
+    queued = waited & (d.arrival_s <= t) & (t < d.at_bot_s)
+    x = np.full(len(d.part), np.nan)
+    if not queued.any():
+        return queued, x
+    idx = np.flatnonzero(queued)
+    release = d.at_bot_s[idx]
+    ahead = (release[None, :] < release[:, None]).sum(axis=1)  # first come, first let go
+    x[idx] = np.minimum(x_free[idx], scene.b_xy[0] - ahead * d.pitch_in)
+    return queued, x
 
 
 # --------------------------------------------------------------------------- the parts
@@ -273,6 +322,13 @@ def parts_at(scene: Scene, t: float, robot: tuple[RobotState, ArmPose] | None = 
         held = d.picked & (d.pick_s <= t) & (t < d.touchdown_s)
         out = d.picked & (t >= d.touchdown_s) & (t < scene.off_output_s)
     x_in = scene.b_xy[0] - d.input_length_in + (travel(d.input_belt, t) - scene.arrival_travel_in)
+    waited = waited_parts(d)
+    if waited.any():  # a buffer: parts queued at the gate, and those it let go
+        queued, x_q = queue_x(scene, t, x_in)
+        x_in = np.where(queued, x_q, x_in)
+        gone = waited & ~queued & (d.at_bot_s <= t)
+        x_in = np.where(gone, scene.b_xy[0] + travel(d.input_belt, t)
+                        - travel(d.input_belt, d.at_bot_s), x_in)
     xy[on_input] = np.column_stack([x_in, np.full(n, scene.b_xy[1])])[on_input]
     where[on_input] = INPUT
     where[falling] = FALLING
