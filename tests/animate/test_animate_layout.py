@@ -1,6 +1,8 @@
 """``cell animate`` draws a layout (docs/layout.md): a buffer's waiting parts stand queued at
 the gate at B at their pitch, read from the scene's data against the run's own record of who
-waited when (parts.csv's ``at_bot_s`` and ``buffer_wait_s``)."""
+waited when (parts.csv's ``at_bot_s`` and ``buffer_wait_s``); a line's second station is drawn
+beside the first with the parts the first set down (series) or let go (downstream), its robot
+carrying them."""
 
 from __future__ import annotations
 
@@ -62,4 +64,70 @@ def test_cell_animate_draws_a_buffer(tmp_path) -> None:  # noqa: ANN001
     out = tmp_path / "buffer.gif"
     assert main(["animate", "baseline", "--set", "buffer.places=2", "--parts", "3",
                  "--speed", "60", "--fps", "2", "--dpi", "20", "--out", str(out)]) == 0
+    assert out.stat().st_size > 0
+
+
+def _line(placement: dict) -> list[Scene]:
+    s = load_scenario("baseline", {
+        "controller.policy": "non-adaptive", "controller.ideal_cycle_s": 24.0,
+        "arrivals": {"distribution": "expon", "params": {"loc": 0.0, "scale": 18.0}},
+        "stations": [{"name": "two", "controller": {"policy": "non-adaptive",
+                                                    "ideal_cycle_s": 20.5}, **placement}]})
+    return simulate_scenes(s, ["non-adaptive"], 1, 16)
+
+
+@pytest.fixture(scope="module")
+def series() -> list[Scene]:
+    return _line({"placement": "series", "transfer_in": 60.0})
+
+
+@pytest.fixture(scope="module")
+def downstream() -> list[Scene]:
+    return _line({"placement": "downstream", "offset_in": 40.0})
+
+
+def _held(scene: Scene, times: np.ndarray) -> set[int]:
+    """The part numbers the scene's robot holds at any of ``times``."""
+    from cell.reporting.animation.scene import HAND
+
+    return {int(scene.data.part[i]) for t in times
+            for i in np.flatnonzero(parts_at(scene, float(t)).where == HAND)}
+
+
+def test_a_series_station_is_drawn_with_the_parts_the_first_set_down(series) -> None:  # noqa: ANN001
+    from cell.reporting.animation.scene import frame_times, window
+
+    first, two = series
+    assert two.data.station == "two, series" and not first.data.station
+    d1, d2 = first.data, two.data
+    set_down = dict(zip(d1.part[d1.picked], d1.touchdown_s[d1.picked]))
+    assert set(d2.part) <= set(set_down)  # it is fed by the first's output belt alone
+    assert d2.arrival_s == pytest.approx([set_down[p] for p in d2.part])  # at the touch-down
+    assert d2.input_length_in == 60.0  # transfer_in from TD to its B
+    times = frame_times(*window(series, 1, 16), 0.5)
+    held = _held(two, times)
+    assert held and held <= set(d2.part[d2.picked])  # its robot carries what came to it
+
+
+def test_a_downstream_robot_takes_what_the_first_let_go(downstream) -> None:  # noqa: ANN001
+    from cell.reporting.animation.scene import frame_times, window
+
+    first, two = downstream
+    assert two.data.station == "two, downstream"
+    d1, d2 = first.data, two.data
+    let_go = set(d1.part[~d1.picked])
+    assert let_go and set(d2.part) <= let_go  # what it let ride past, nothing else
+    assert (d2.arrival_s > d1.at_bot_s[np.searchsorted(d1.part, d2.part)]).all()
+    assert d2.input_length_in == 40.0  # offset_in past the first's F
+    times = frame_times(*window(downstream, 1, 16), 0.5)
+    held = _held(two, times)
+    assert held and held <= let_go  # it catches parts the first let ride past
+
+
+def test_cell_animate_draws_a_line(tmp_path) -> None:  # noqa: ANN001
+    from cell.cli.main import main
+
+    out = tmp_path / "line.gif"
+    assert main(["animate", "two_station_line", "--parts", "3", "--speed", "60", "--fps", "2",
+                 "--dpi", "20", "--out", str(out)]) == 0
     assert out.stat().st_size > 0

@@ -70,6 +70,8 @@ def header(scene: Scene) -> str:
     line = f"{one_line(s.name, 40)} · seed {s.run.seed}"
     if scene.data.policy == "non-adaptive":
         line += f" · fixed cycle {scene.data.cycle_s:.4f} s"
+    if scene.data.station:  # a line's station after the first (docs/layout.md)
+        line += f" · station {scene.data.station}"
     return line
 
 

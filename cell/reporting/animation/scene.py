@@ -82,6 +82,10 @@ class AnimationInput:
     pitch_in: float = 0.0
     """The buffer's pitch: centre to centre of the parts waiting in it (docs/layout.md; 0:
     no buffer)."""
+    station: str = ""
+    """A station of a line after the first: its name and placement (``next, series``; empty:
+    the cell the feeder feeds).  Its parts are those that came to it, in the order they came,
+    ``arrival_s`` the instant each was dropped on its input window (docs/layout.md)."""
 
 
 def belt_history(result: Any, belt: str) -> Floats:
@@ -120,6 +124,30 @@ def frames_input(result: Any, scenario: Scenario) -> AnimationInput:
         input_length_in=float(constants(scenario, robot_timing(scenario)).input_length),
         cycle_s=float(result.summary.ideal_cycle_s),
         **buffered(d, scenario))
+
+
+def station_input(name: str, own: Any, visits: dict[str, np.ndarray],
+                  belts: dict[str, np.ndarray], waited: np.ndarray) -> AnimationInput:
+    """A line's station as the animation needs it (parts.csv's row of a part is its last
+    station's): the parts that came to it and what it did with each
+    (:meth:`cell.sim.line.StationLog.visit_table`), its own belts, its own cell's drop point
+    (``own``: its assembled cell), cycle and buffer (``waited``: each part's wait at it);
+    ``name`` empty for the first station, else ``name, placement``."""
+    picked = visits["picked"] == 1.0
+    b = own.scenario.buffer
+    buffer = {} if b is None or not b.places else {
+        "buffer_wait_s": waited, "pitch_in": float(b.pitch_in if b.pitch_in is not None
+                                                   else own.scenario.part.size_in)}
+    at_bot = visits["at_bot"]
+    return AnimationInput(
+        policy=own.policy.name, part=visits["part"].astype(np.int64) + 1,
+        arrival_s=visits["arrival"], at_bot_s=at_bot, picked=picked,
+        start_s=np.where(picked, at_bot, np.nan), pick_s=visits["pick"],
+        touchdown_s=np.where(picked, visits["touchdown"], np.nan),
+        regime_s=np.column_stack([visits[f"r{r}"] for r in (1, 2, 3, 4)]),
+        input_belt=belts["input"], output_belt=belts["output"],
+        input_length_in=float(own.k.input_length), cycle_s=float(own.policy.ideal_cycle_s),
+        station=name, **buffer)
 
 
 def buffered(d: Any, scenario: Scenario) -> dict[str, Any]:
@@ -380,10 +408,15 @@ def part_done_s(scene: Scene, index: int) -> float:
 
 def window(scenes: list[Scene], first: int, count: int) -> tuple[float, float]:
     """From part ``first``'s arrival (1-based) to the set-down or fall of part
-    ``first + count - 1`` in whichever run is later, plus :data:`TAIL_S`."""
+    ``first + count - 1`` in whichever run is later, plus :data:`TAIL_S`; a line's stations
+    after the first: until each has done with every part up to it that came to it."""
     t0 = float(scenes[0].data.arrival_s[first - 1])
-    t1 = max(part_done_s(s, first + count - 2) for s in scenes) + TAIL_S
-    return t0, t1
+    t1 = max(part_done_s(s, first + count - 2) for s in scenes if not s.data.station)
+    for s in scenes:
+        if s.data.station:
+            came = np.flatnonzero(s.data.part <= first + count - 1)
+            t1 = max([t1, *(part_done_s(s, int(i)) for i in came)])
+    return t0, t1 + TAIL_S
 
 
 def frame_times(t0: float, t1: float, step_s: float) -> Floats:
