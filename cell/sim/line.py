@@ -29,7 +29,6 @@ from cell.sim.failures import Downtime
 from cell.sim.feeder import Feeder
 from cell.sim.mailbox import Mailbox
 from cell.sim.records import BUFFER_FULL, LOST_DOWNTIME, NAN, SCRAPPED, Part
-from cell.sim.sim_result import BeltLog
 from cell.sim.station import Station
 
 if TYPE_CHECKING:
@@ -246,15 +245,17 @@ class Line:
     """The stations of a layout, built and wired; the first fed by the feeder."""
 
     def __init__(self, env: simpy.Environment, cell: AssembledCell, seed: Any, log: Any,
-                 told: Callable[[int], Any], downtime: Downtime | None, keep: bool = False):
+                 told: Callable[[int], Any], downtime: Downtime | None,
+                 keep: Callable[[], Any] | None = None):
         self.env = env
         self.cells: list[tuple[str, str, AssembledCell]] = [(FIRST, "first", cell)] + [
             (st.name, st.placement, own) for st, own in cell.line]
-        self.logs = [StationLog(name, log, keep) for name, _, _ in self.cells]
-        self.belt_logs: list[BeltLog | None] = [None] + [
-            BeltLog(True, None) if keep else None for _ in self.cells[1:]]
-        """The belts of each station after the first, kept only when asked (``keep``: the
-        animation's; the first station's are the run's belts.csv)."""
+        self.logs = [StationLog(name, log, keep is not None) for name, _, _ in self.cells]
+        self.belt_logs: list[Any] = [
+            keep() if keep is not None and i else None for i in range(len(self.cells))]
+        """The belts of each station after the first (a :class:`~cell.sim.sim_result.BeltLog`
+        each), kept only when asked (``keep`` makes one: the animation's; the first station's
+        are the run's belts.csv)."""
         self.downtimes: list[Downtime | None] = [downtime]
         self.stations: list[Station] = []
         none = _no_belts
@@ -322,11 +323,11 @@ def _no_belts(belt: int) -> None:
 
 
 def build(env: simpy.Environment, cell: AssembledCell, seed: Any, log: Any, told: Any,
-          downtime: Downtime | None, t_list: list[float], n: int, keep: bool = False
-          ) -> tuple[Line | None, Station, Feeder]:
+          downtime: Downtime | None, t_list: list[float], n: int,
+          keep: Callable[[], Any] | None = None) -> tuple[Line | None, Station, Feeder]:
     """The station fed by the feeder, and with ``buffer:`` or ``stations:`` the line it is the
-    first of (cell.sim.line; None without); ``keep``: each station's visits and belts kept
-    (:class:`Line`)."""
+    first of (cell.sim.line; None without); ``keep``: each station's visits and belts kept,
+    in belt logs it makes (:class:`Line`)."""
     if not cell.scenario.has_layout:
         station = Station(env, cell, seed, log.delivered_part, told, downtime)
         feeder = Feeder(env, t_list, station.input, n, cell.k.part_size, log.flag)

@@ -295,7 +295,7 @@ class Run:
         downtime = None if not stands else Downtime(env, s.failures or calendar.NO_FAILURES, seed)
         wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
         line, station, feeder = build(env, cell, seed, log, belts.told, downtime, t_list, n,
-                                      keep_stations)
+                                      (lambda: BeltLog(True, None)) if keep_stations else None)
         calendar.keep(env, s, downtime)  # a calendar's shifts, started with the failure clocks
         if downtime is not None:
             downtime.start()

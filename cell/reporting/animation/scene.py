@@ -135,7 +135,7 @@ def station_input(name: str, own: Any, visits: dict[str, np.ndarray],
     ``name`` empty for the first station, else ``name, placement``."""
     picked = visits["picked"] == 1.0
     b = own.scenario.buffer
-    buffer = {} if b is None or not b.places else {
+    buffer: dict[str, Any] = {} if b is None or not b.places else {
         "buffer_wait_s": waited, "pitch_in": float(b.pitch_in if b.pitch_in is not None
                                                    else own.scenario.part.size_in)}
     at_bot = visits["at_bot"]
