@@ -316,6 +316,29 @@ class Line:
                         b.most if b is not None else 0))
         return out
 
+    def measure(self, summary: Any, log: Any, end_s: float) -> None:
+        """The line's throughput and work in process, over the whole run, into the summary
+        (``line_throughput_per_h``, ``line_wip_mean``; docs/layout.md "Measures").
+
+        A part is in the line from its drop on the input belt until it leaves it: set down by a
+        station nothing is fed from (its touch-down), or lost for good (the instant it passed the
+        B of the last station it came to); a part still in the line at the run's end counts until
+        then.  The work in process is the time-average of that count, integrated step by step over
+        the instants parts come and leave."""
+        arrival, td = log.column("arrival"), log.column("touchdown")
+        came = np.isfinite(arrival)
+        left = np.where(np.isfinite(td), td, log.column("at_bot"))[came]
+        left = np.where(np.isfinite(left), np.minimum(left, end_s), end_s)
+        times = np.concatenate((arrival[came], left))
+        steps = np.concatenate((np.ones(left.size), -np.ones(left.size)))
+        order = np.argsort(times, kind="stable")
+        times, count = times[order], np.cumsum(steps[order])  # parts in the line from each instant
+        area = float(np.sum(count[:-1] * np.diff(times))) if times.size else 0.0
+        hours = end_s / 3600.0
+        summary.line_wip_mean = area / end_s if end_s > 0 else math.nan
+        summary.line_throughput_per_h = int(np.count_nonzero(np.isfinite(td))) / hours \
+            if end_s > 0 else math.nan
+
 
 def _no_belts(belt: int) -> None:
     """A station after the first keeps no belt history (belts.csv is the first's)."""
@@ -344,27 +367,3 @@ def has_buffer(cell: AssembledCell) -> bool:
     """Whether any station of the layout has a ``buffer:`` section (parts.csv's
     ``buffer_wait_s``)."""
     return any(c.scenario.buffer is not None for c in (cell, *(own for _, own in cell.line)))
-
-
-def measure(summary: Any, log: Any, end_s: float) -> None:
-    """The line's throughput and work in process, over the whole run, into the summary
-    (``line_throughput_per_h``, ``line_wip_mean``; docs/layout.md "Measures").
-
-    A part is in the line from its drop on the input belt until it leaves it: set down by a
-    station nothing is fed from (its touch-down), or lost for good (the instant it passed the
-    B of the last station it came to); a part still in the line at the run's end counts until
-    then.  The work in process is the time-average of that count, integrated step by step over
-    the instants parts come and leave."""
-    arrival, td = log.column("arrival"), log.column("touchdown")
-    came = np.isfinite(arrival)
-    left = np.where(np.isfinite(td), td, log.column("at_bot"))[came]
-    left = np.where(np.isfinite(left), np.minimum(left, end_s), end_s)
-    times = np.concatenate((arrival[came], left))
-    steps = np.concatenate((np.ones(left.size), -np.ones(left.size)))
-    order = np.argsort(times, kind="stable")
-    times, count = times[order], np.cumsum(steps[order])  # parts in the line from each instant
-    area = float(np.sum(count[:-1] * np.diff(times))) if times.size else 0.0
-    hours = end_s / 3600.0
-    summary.line_wip_mean = area / end_s if end_s > 0 else math.nan
-    summary.line_throughput_per_h = int(np.count_nonzero(np.isfinite(td))) / hours \
-        if end_s > 0 else math.nan

@@ -29,6 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cell.arm.steptable import StepTable
 from cell.reporting.animation.arm_pose import ArmPose, RobotState, robot_at
+from cell.reporting.animation.gate_queue import buffered, queue_x, waited_parts
 from cell.reporting.animation.stops import OperatingClock
 from cell.scenario.schema import Scenario
 
@@ -148,16 +149,6 @@ def station_input(name: str, own: Any, visits: dict[str, np.ndarray],
         input_belt=belts["input"], output_belt=belts["output"],
         input_length_in=float(own.k.input_length), cycle_s=float(own.policy.ideal_cycle_s),
         station=name, **buffer)
-
-
-def buffered(d: Any, scenario: Scenario) -> dict[str, Any]:
-    """A buffer's :class:`AnimationInput` fields: each part's wait and the pitch (none
-    without a ``buffer:`` with places)."""
-    b = scenario.buffer
-    if b is None or not b.places or "buffer_wait_s" not in d:
-        return {}
-    pitch = b.pitch_in if b.pitch_in is not None else scenario.part.size_in
-    return {"buffer_wait_s": d["buffer_wait_s"].to_numpy(dtype=float), "pitch_in": float(pitch)}
 
 
 # --------------------------------------------------------------------------- belts
@@ -282,32 +273,6 @@ def build_scene(data: AnimationInput, table: StepTable, scenario: Scenario,
     off = np.where(data.picked, time_at(data.output_belt, y_td + to_gone), np.nan)
     return Scene(data, table, scenario, cycles.astype(np.int64), t_s, fall, x_drop, y_td, off,
                  tuple(stops))
-
-
-# --------------------------------------------------------------------------- the buffer
-def waited_parts(data: AnimationInput) -> NDArray[np.bool_]:
-    """(n,) the parts that stood at the buffer's gate (or behind it) before it let them go."""
-    if data.buffer_wait_s is None:
-        return np.zeros(len(data.part), dtype=bool)
-    return data.buffer_wait_s > 0
-
-
-def queue_x(scene: Scene, t: float, x_free: Floats) -> tuple[NDArray[np.bool_], Floats]:
-    """The parts on the input belt before the gate lets them go, and their x at instant t:
-    each moves with the belt (``x_free``, where it would be moving) until it closes up behind
-    the parts still waiting ahead of it, ``pitch_in`` apart, the first at the gate at B
-    (docs/layout.md "The buffer"); let go at its ``at_bot_s``, it moves on from B."""
-    d = scene.data
-    waited = waited_parts(d)
-    queued = waited & (d.arrival_s <= t) & (t < d.at_bot_s)
-    x = np.full(len(d.part), np.nan)
-    if not queued.any():
-        return queued, x
-    idx = np.flatnonzero(queued)
-    release = d.at_bot_s[idx]
-    ahead = (release[None, :] < release[:, None]).sum(axis=1)  # first come, first let go
-    x[idx] = np.minimum(x_free[idx], scene.b_xy[0] - ahead * d.pitch_in)
-    return queued, x
 
 
 # --------------------------------------------------------------------------- the parts
