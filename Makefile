@@ -56,7 +56,7 @@ stress: $(STAMP)
 layout: $(STAMP)
 	rm -rf build/layout
 	$(PY) -m cell sweep scenarios/layout_study.yaml --out build/layout --workers $(WORKERS)
-	MPLBACKEND=Agg $(PY) -m cell.reporting.maps.layout_study build/layout/replications.csv reports/layout
+	MPLBACKEND=Agg $(PY) -m cell.reporting.maps.layout_study build/layout/replications.csv reports/layout scenarios/layout_study.yaml
 
 sensor: $(STAMP)
 	rm -rf build/sensor

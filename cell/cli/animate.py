@@ -1,15 +1,16 @@
 """``cell animate SCENARIO [--parts N] [--from-part K] --out FILE.gif|.mp4``: watch the cell.
 
-The cell from above (thesis Fig. 8): both belts with every part where the belts'
-speed history puts it, the arm's links from its joint angles along the path,
-the clock, the counts and the belt speeds (:mod:`cell.reporting.animation.movie`).
+The cell from above (thesis Fig. 8), a buffer's waiting parts at its gate, and each station
+of a line in a column beside it: both belts with every part where the belts' speed history
+puts it, the arm's links from its joint angles along the path, the clock, the counts and the
+belt speeds (:mod:`cell.reporting.animation.movie`).
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from cell.cli.common import scenario_arguments, scenario_of
 
@@ -64,18 +65,20 @@ def check_frame_size(dpi: float, columns: int) -> None:
                         f"use --dpi {int(most)} or less")
 
 
-def check_options(args: argparse.Namespace, cycle_s: float) -> None:
-    """Every option within its bounds, and a frame count that can be drawn, or one line."""
+def check_options(args: argparse.Namespace, cycle_s: float, stations: int = 0) -> None:
+    """Every option within its bounds, and a frame count that can be drawn, or one line
+    (``stations``: a line's stations after the first, each a column beside the first's)."""
     import math
 
     from cell.plumbing.errors import CellError
 
+    columns = 2 if args.policy == "both" else 1 + stations
     for key, (lo, hi) in LIMITS.items():
         value = getattr(args, key)
         if not (math.isfinite(value) and lo <= value <= hi):
             option = "--" + key.replace("_", "-")
             raise CellError(f"{option} {value:g}: must be between {lo:g} and {hi:g}")
-    check_frame_size(args.dpi, 2 if args.policy == "both" else 1)
+    check_frame_size(args.dpi, columns)
     frames = (args.parts + 1) * cycle_s / args.speed * args.fps
     if frames > MAX_FRAMES:
         raise CellError(f"--parts {args.parts} --speed {args.speed:g} --fps {args.fps}: about "
@@ -106,11 +109,11 @@ def main(args: argparse.Namespace) -> int:
     check_output(args.out)  # before anything is simulated
     check_file(args.out)
     scenario = scenario_of(args)
-    _refuse_a_layout(scenario)
     from cell.scenario.arrivals import mean_interarrival
 
     check_options(args, max(scenario.controller.nominal_cycle_s or 0.0,
-                            mean_interarrival(scenario.arrivals, scenario.base_dir)))
+                            mean_interarrival(scenario.arrivals, scenario.base_dir)),
+                  len(scenario.stations or ()))
     for line in notes(scenario, args.from_part, args.parts):
         print(f"cell: {line}", file=sys.stderr)
     done = animate(scenario, args.out, policy=args.policy, parts=args.parts, first=args.from_part,
@@ -118,18 +121,3 @@ def main(args: argparse.Namespace) -> int:
     print(f"wrote {done.path}: {done.frames} frames, simulated {done.t0_s:.1f}-{done.t1_s:.1f} s, "
           f"{done.size_bytes / 1e6:.2f} MB")
     return 0
-
-
-def _refuse_a_layout(scenario: Any) -> None:
-    """The animation draws the thesis's one cell: a ``buffer:`` with places or ``stations:``
-    are refused in one line, before anything is simulated (docs/layout.md)."""
-    from cell.plumbing.errors import ScenarioError
-
-    given = [(key, value) for key, value in (("stations", scenario.stations),
-                                             ("buffer.places", scenario.buffer and
-                                              scenario.buffer.places)) if value]
-    if given:
-        key, value = given[0]
-        raise ScenarioError(scenario.source, key, [s.name for s in value] if key == "stations"
-                            else value, "cell animate draws one cell without a buffer; a layout "
-                            "is not drawn yet (docs/layout.md)")

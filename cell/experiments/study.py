@@ -316,6 +316,8 @@ def _refuse_unset(study: Study, where: str, measure: str) -> None:
 SECTION_MEASURES = {"energy_kwh": "energy", "energy_per_good_part_wh": "energy",
                     "cost_per_good_part": "costs", "cost_per_h": "costs",
                     "arm_energy_per_transfer_j": "energy"}
+#: The line's measures: only a scenario with ``buffer:`` or ``stations:`` reports them.
+LINE_MEASURES = ("line_throughput_per_h", "line_wip_mean")
 
 
 def section_why(measure: str, base: Scenario) -> str | None:
@@ -323,6 +325,8 @@ def section_why(measure: str, base: Scenario) -> str | None:
     section = SECTION_MEASURES.get(measure)
     if section is not None and getattr(base, section, None) is None:
         return f"no run reports it: the base scenario has no {section}: section"
+    if measure in LINE_MEASURES and not base.has_layout:
+        return "no run reports it: the base scenario has no buffer: or stations: section"
     if measure == "arm_energy_per_transfer_j" and base.energy is not None and base.energy.arm != "dynamics":
         return "no run reports it: the base scenario's energy.arm is not dynamics"
     return None

@@ -28,7 +28,7 @@ from cell.sim import oee, wear_clock
 from cell.sim.failures import Downtime
 from cell.sim.feeder import Feeder
 from cell.sim.mailbox import Mailbox
-from cell.sim.records import BUFFER_FULL, LOST_DOWNTIME, SCRAPPED, Part
+from cell.sim.records import BUFFER_FULL, LOST_DOWNTIME, NAN, SCRAPPED, Part
 from cell.sim.station import Station
 
 if TYPE_CHECKING:
@@ -79,6 +79,10 @@ STATION_COLUMNS = StationRow._fields
 #: (set down, or rode on from B).
 COLUMNS = ("arrival", "at_bot", "cycle", "picked", "part", "left")
 _PACK = struct.Struct(f"={len(COLUMNS)}d").pack
+#: What a station's log keeps besides, only when asked (``cell animate``), in the same order:
+#: the part's lift-off and set-down there, its four regimes' times (NaN: not picked), and
+#: its ``buffer_wait_s`` so far (its waits at this station's buffer and those before).
+VISIT_COLUMNS = ("pick", "touchdown", "r1", "r2", "r3", "r4", "waited")
 
 
 def station_seed(seed: Any, i: int) -> Any:
@@ -98,8 +102,10 @@ class StationLog:
     station that takes it (``on_lost``, ``on_delivered``), or, if none does, to the run's log
     with the limits it hit here."""
 
-    def __init__(self, name: str, line: Any):
+    def __init__(self, name: str, line: Any, keep_visits: bool = False):
         self.name, self.line = name, line
+        self.visits: list[tuple[float, ...]] | None = [] if keep_visits else None
+        """Per part done here, :data:`VISIT_COLUMNS` (None: not kept)."""
         self.flags: dict[int, int] = {}
         self.on_lost: Callable[[Part], Any] | None = None
         """The transfer to the station downstream on the input line (None: lost for good)."""
@@ -123,6 +129,12 @@ class StationLog:
 
     def _note(self, part: Part, picked: bool) -> int:
         i, at_bot, td = part.index, part.at_bot_s, part.touchdown_s
+        if self.visits is not None:
+            plan = part.plan if picked else None
+            self.visits.append((part.pick_s, part.touchdown_s) + (
+                (NAN,) * 4 if plan is None else (plan.r1_pre + plan.r1_post, plan.r2,
+                                                 plan.r3_pre + plan.r3_post, plan.r4))
+                + (part.buffer_wait_s,))
         # speed: docs/performance.md#station-log
         self.per_part.extend(_PACK(self.came.pop(i, part.arrival_s), at_bot,
                                    part.plan.cycle if picked else math.nan, picked, i,
@@ -159,6 +171,17 @@ class StationLog:
         if flags:
             self.line.flag(part, flags)
         done(part)
+
+    def visit_table(self) -> dict[str, np.ndarray]:
+        """Every part done here, in the order it came: :data:`COLUMNS` and, if kept,
+        :data:`VISIT_COLUMNS`, each an array."""
+        table = np.frombuffer(self.per_part, dtype=np.float64).reshape(-1, len(COLUMNS))
+        out = {name: table[:, j] for j, name in enumerate(COLUMNS)}
+        if self.visits is not None:
+            more = np.array(self.visits, dtype=np.float64).reshape(-1, len(VISIT_COLUMNS))
+            out.update({name: more[:, j] for j, name in enumerate(VISIT_COLUMNS)})
+        order = np.argsort(out["arrival"], kind="stable")
+        return {name: values[order] for name, values in out.items()}
 
     def column(self, name: str) -> np.ndarray:
         """One of :data:`COLUMNS` in the order the parts began their cycles here."""
@@ -222,11 +245,17 @@ class Line:
     """The stations of a layout, built and wired; the first fed by the feeder."""
 
     def __init__(self, env: simpy.Environment, cell: AssembledCell, seed: Any, log: Any,
-                 told: Callable[[int], Any], downtime: Downtime | None):
+                 told: Callable[[int], Any], downtime: Downtime | None,
+                 keep: Callable[[], Any] | None = None):
         self.env = env
         self.cells: list[tuple[str, str, AssembledCell]] = [(FIRST, "first", cell)] + [
             (st.name, st.placement, own) for st, own in cell.line]
-        self.logs = [StationLog(name, log) for name, _, _ in self.cells]
+        self.logs = [StationLog(name, log, keep is not None) for name, _, _ in self.cells]
+        self.belt_logs: list[Any] = [
+            keep() if keep is not None and i else None for i in range(len(self.cells))]
+        """The belts of each station after the first (a :class:`~cell.sim.sim_result.BeltLog`
+        each), kept only when asked (``keep`` makes one: the animation's; the first station's
+        are the run's belts.csv)."""
         self.downtimes: list[Downtime | None] = [downtime]
         self.stations: list[Station] = []
         none = _no_belts
@@ -237,8 +266,10 @@ class Line:
                     Downtime(env, own.scenario.failures, seed_i)
                 wear_clock.count_on(dt, own, seed_i)
                 self.downtimes.append(dt)
+            belts = self.belt_logs[i]
             self.stations.append(Station(env, own, seed_i, self.logs[i].delivered_part,
-                                         told if i == 0 else none, self.downtimes[i]))
+                                         told if i == 0 else none if belts is None else belts.told,
+                                         self.downtimes[i]))
         self.transfers: list[Transfer] = []
         head = 0  # the last station before that is not downstream: a series station's feeder
         for i, (_, placement, _) in enumerate(self.cells[1:], start=1):
@@ -285,6 +316,29 @@ class Line:
                         b.most if b is not None else 0))
         return out
 
+    def measure(self, summary: Any, log: Any, end_s: float) -> None:
+        """The line's throughput and work in process, over the whole run, into the summary
+        (``line_throughput_per_h``, ``line_wip_mean``; docs/layout.md "Measures").
+
+        A part is in the line from its drop on the input belt until it leaves it: set down by a
+        station nothing is fed from (its touch-down), or lost for good (the instant it passed the
+        B of the last station it came to); a part still in the line at the run's end counts until
+        then.  The work in process is the time-average of that count, integrated step by step over
+        the instants parts come and leave."""
+        arrival, td = log.column("arrival"), log.column("touchdown")
+        came = np.isfinite(arrival)
+        left = np.where(np.isfinite(td), td, log.column("at_bot"))[came]
+        left = np.where(np.isfinite(left), np.minimum(left, end_s), end_s)
+        times = np.concatenate((arrival[came], left))
+        steps = np.concatenate((np.ones(left.size), -np.ones(left.size)))
+        order = np.argsort(times, kind="stable")
+        times, count = times[order], np.cumsum(steps[order])  # parts in the line from each instant
+        area = float(np.sum(count[:-1] * np.diff(times))) if times.size else 0.0
+        hours = end_s / 3600.0
+        summary.line_wip_mean = area / end_s if end_s > 0 else math.nan
+        summary.line_throughput_per_h = int(np.count_nonzero(np.isfinite(td))) / hours \
+            if end_s > 0 else math.nan
+
 
 def _no_belts(belt: int) -> None:
     """A station after the first keeps no belt history (belts.csv is the first's)."""
@@ -292,15 +346,17 @@ def _no_belts(belt: int) -> None:
 
 
 def build(env: simpy.Environment, cell: AssembledCell, seed: Any, log: Any, told: Any,
-          downtime: Downtime | None, t_list: list[float], n: int) -> tuple[Line | None, Station, Feeder]:
+          downtime: Downtime | None, t_list: list[float], n: int,
+          keep: Callable[[], Any] | None = None) -> tuple[Line | None, Station, Feeder]:
     """The station fed by the feeder, and with ``buffer:`` or ``stations:`` the line it is the
-    first of (cell.sim.line; None without)."""
+    first of (cell.sim.line; None without); ``keep``: each station's visits and belts kept,
+    in belt logs it makes (:class:`Line`)."""
     if not cell.scenario.has_layout:
         station = Station(env, cell, seed, log.delivered_part, told, downtime)
         feeder = Feeder(env, t_list, station.input, n, cell.k.part_size, log.flag)
         station.control(feeder.fed_s, n, log)
         return None, station, feeder
-    line = Line(env, cell, seed, log, told, downtime)
+    line = Line(env, cell, seed, log, told, downtime, keep)
     feeder = Feeder(env, t_list, line.first.input, n, cell.k.part_size, log.flag)
     line.control(feeder.fed_s, n)
     line.logs[0].parts_in = n

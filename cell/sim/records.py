@@ -325,6 +325,12 @@ class RunSummary:
     """The run's cost per hour of the run (only with a ``costs:`` section)."""
     arm_energy_per_transfer_j: float | None = None
     """The mean of parts.csv's ``energy_j``, J (only with ``energy.arm: dynamics``)."""
+    line_throughput_per_h: float | None = None
+    """The line's parts set down by a station nothing is fed from, per hour of the run (only
+    with ``buffer:`` or ``stations:``; docs/layout.md)."""
+    line_wip_mean: float | None = None
+    """The line's work in process: the time-average number of parts between their drop on
+    the input belt and leaving the line (set down by its last station, or lost for good)."""
 
     def __getitem__(self, name: str) -> Any:
         return getattr(self, name)

@@ -245,17 +245,17 @@ def _seed_value(seed: Any) -> Any:
 def simulate(scenario: Scenario | AssembledCell,
              seed: int | np.random.SeedSequence | None = None, *, keep_parts: bool = True,
              on_part: PartSink | None = None, on_belt: BeltSink | None = None,
-             keep_belts: bool = True) -> SimResult:
+             keep_belts: bool = True, keep_stations: bool = False) -> SimResult:
     """Run ``run.parts`` parts (or ``run.hours`` of parts) through the cell under its policy.
 
     ``seed``: int or SeedSequence; None means ``run.seed``.  Policies given the
     same seed see the same inter-arrival times (common random numbers).
-    ``keep_parts`` / ``keep_belts``: keep every part's record / belt speed change
-    in the result (off for long runs, which stream them to ``on_part`` /
-    ``on_belt`` instead, as each becomes final: memory then stays flat).
+    ``keep_parts`` / ``keep_belts``: keep every part's record / belt speed change in the result
+    (off for long runs, which stream them to ``on_part`` / ``on_belt`` instead, as each becomes
+    final: memory then stays flat); ``keep_stations``: a layout's stations' visits and belts.
     """
     run = Run(scenario, seed, keep_parts=keep_parts, on_part=on_part, on_belt=on_belt,
-              keep_belts=keep_belts)
+              keep_belts=keep_belts, keep_stations=keep_stations)
     run.go()
     return run.result()
 
@@ -269,16 +269,15 @@ class Run:
     def __init__(self, scenario: Scenario | AssembledCell,
                  seed: int | np.random.SeedSequence | None = None, *, keep_parts: bool = True,
                  on_part: PartSink | None = None, on_belt: BeltSink | None = None,
-                 keep_belts: bool = True):
+                 keep_belts: bool = True, keep_stations: bool = False):
         cell = scenario if isinstance(scenario, AssembledCell) else assemble(scenario)
         s, k, policy = cell.scenario, cell.k, cell.policy
         seed = s.run.seed if seed is None else seed
         # T_1 .. T_{n+1}: the last is only the last part's "next arrival".
         t_all, n, horizon = run_arrivals(s, seed)
         t_list: list[float] = t_all.tolist()
-
         rows: list[tuple[Any, ...]] | None = [] if keep_parts else None
-        belts = BeltLog(keep_belts, on_belt)
+        belts, keep = BeltLog(keep_belts, on_belt), (lambda: BeltLog(True, None)) if keep_stations else None
 
         acct = policy.accounting()
         env = simpy.Environment()
@@ -292,7 +291,7 @@ class Run:
                      (s.stations is not None, has_buffer(cell)))
         downtime = None if not stands else Downtime(env, s.failures or calendar.NO_FAILURES, seed)
         wear_clock.count_on(downtime, cell, seed)  # wear counted by the robot's failure clock
-        line, station, feeder = build(env, cell, seed, log, belts.told, downtime, t_list, n)
+        line, station, feeder = build(env, cell, seed, log, belts.told, downtime, t_list, n, keep)
         calendar.keep(env, s, downtime)  # a calendar's shifts, started with the failure clocks
         if downtime is not None:
             downtime.start()
@@ -338,8 +337,9 @@ class Run:
         result = SimResult(summary, self.rows, self.belts if self.keep_belts else None)
         result.downtime, result.timelines, result.stop_rows = downtime, lines, stops
         result.wear = wear_clock.measures(wear, downtime, env.now)
-        line = self.line
-        result.station_rows, result.line = (line.rows(env.now), line) if line else (None, None)
+        if line := self.line:  # stations.csv's rows, the line's measures (cell.sim.line)
+            result.station_rows, result.line = line.rows(env.now), line
+            line.measure(summary, log, env.now)
         return result
 
 

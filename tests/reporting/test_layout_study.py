@@ -38,3 +38,39 @@ def test_the_committed_report_is_its_replications_reading():
     m = layout.matches(t.assign(layout=t["layout"].astype(str)))
     assert layout.headline(m) in (REPORT / "README.md").read_text(encoding="utf-8")
     assert set(t["replications"]) == {20}
+
+
+def test_the_committed_money_follows_from_its_own_csv():
+    """layout.csv's money is its own counts at scenarios/layout_study.yaml's prices: the parts
+    lost, and the hours at the options each layout has (each robot with its sensor, a place
+    of buffer each, the adaptive controller for the adaptive robot); the README names the
+    cheapest layout per arrival point and loss target."""
+    import yaml
+
+    prices = yaml.safe_load((REPORT.parents[1] / "scenarios" / "layout_study.yaml")
+                            .read_text(encoding="utf-8"))["set"]
+    t = pd.read_csv(REPORT / "layout.csv")
+    name = t["layout"].astype(str)
+    robots = np.where(name == "two fixed robots", 2, 1)
+    places = name.str.extract(r"(\d+) places")[0].fillna("0").astype(int)
+    options = (robots * (prices["costs.options_per_h.robot"]
+                         + prices["costs.options_per_h.sensor"])
+               + places * prices["costs.options_per_h.buffer_place"]
+               + name.str.startswith("adaptive") * prices["costs.options_per_h.adaptive_controller"])
+    assert np.allclose(t["options_per_h"], options, rtol=1e-12)
+    hand = (t["lost"] * prices["costs.part_value"] + t["down_h"] * prices["costs.downtime_per_h"]
+            + t["repairs"] * prices["costs.repair"] + options * t["hours"])
+    assert (t["down_h"] == 0).all() and (t["repairs"] == 0).all()  # the study has no failures
+    assert np.allclose(hand, t["cost"], rtol=1e-9)
+    assert np.allclose(t["cost"] / t["good"], t["cost_per_good_part"], rtol=1e-9)
+    assert np.allclose(t["good"] + t["lost"], 500)  # every part delivered or lost
+    text = (REPORT / "README.md").read_text(encoding="utf-8")
+    for (cv, mean), point in t.groupby(["cv", "mean_s"]):
+        at = text.index(f"**cv {cv:g}, load {mean / layout.FASTEST_S:.2f}.**")
+        paragraph = text[at:text.index("\n", at)]
+        for target in layout.LOSS_TARGETS:
+            meets = point[point["lost"] <= target]
+            if len(meets):
+                best = meets.loc[meets["cost_per_good_part"].idxmin()]
+                assert f"cheapest with {best['layout']}, {best['cost_per_good_part']:.4f}" \
+                    in paragraph

@@ -80,16 +80,13 @@ def test_set_addresses_a_station_by_its_name(capsys, tmp_path):
     assert not out.exists() or not any(out.iterdir())
 
 
-def test_animate_refuses_a_layout_it_cannot_draw(capsys, tmp_path):
-    """cell animate draws the thesis's one cell: a layout is refused in one line, exit 2,
-    no file written (docs/layout.md)."""
-    for changes, key in (({}, "stations"), ({"stations": None, "buffer": {"places": 2}},
-                                             "buffer.places")):
-        doc = {k: v for k, v in {**LINE, **changes}.items() if v is not None}
-        path = tmp_path / "line.yaml"
-        path.write_text(yaml.safe_dump(doc), encoding="utf-8")
-        out = tmp_path / "line.gif"
-        assert main(["animate", str(path), "--out", str(out)]) == 2
-        err = capsys.readouterr().err.strip()
-        assert len(err.splitlines()) == 1 and f"{key} = " in err and str(path) in err
-        assert not out.exists()
+def test_animate_refuses_both_policies_for_a_line(capsys, tmp_path):
+    """cell animate draws a line's stations beside the first under one policy: --policy both
+    with stations is refused in one line, exit 2, no file written (docs/layout.md)."""
+    path = tmp_path / "line.yaml"
+    path.write_text(yaml.safe_dump(LINE), encoding="utf-8")
+    out = tmp_path / "line.gif"
+    assert main(["animate", str(path), "--policy", "both", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--policy both" in err
+    assert not out.exists()

@@ -32,6 +32,8 @@ GIF_MEMORY_BYTES = 1.5e9
 #: The fields of a part's record that the frames need (:func:`~cell.reporting.animation.scene.frames_input`).
 FRAME_FIELDS = ("part", "arrival_s", "at_bot_s", "picked", "pick_s", "touchdown_s",
                 "r1_s", "r2_s", "r3_s", "r4_s")
+#: The fields a run with a ``buffer:`` adds (its parts' waits at the gate, docs/layout.md).
+BUFFER_FIELDS = ("buffer_wait_s",)
 #: Runs of at least this many parts show their progress on stderr while they are simulated.
 PROGRESS_FROM_PARTS = 50_000
 
@@ -82,8 +84,9 @@ def simulated(scenario: Scenario, progress: bool = False) -> Any:
     from cell.plumbing.progress import Progress
     from cell.sim.simulation import simulate
 
-    columns = {f: array("d") for f in FRAME_FIELDS}
-    appends, fields = [columns[f].append for f in FRAME_FIELDS], attrgetter(*FRAME_FIELDS)
+    kept = FRAME_FIELDS + (BUFFER_FIELDS if scenario.buffer is not None else ())
+    columns = {f: array("d") for f in kept}
+    appends, fields = [columns[f].append for f in kept], attrgetter(*kept)
     n = scenario.run.parts
     with Progress(n, f"cell animate: simulating ({scenario.controller.policy})", "parts",
                   enabled=progress and n >= PROGRESS_FROM_PARTS) as bar:
@@ -95,12 +98,39 @@ def simulated(scenario: Scenario, progress: bool = False) -> Any:
             if bar.enabled and record.part % step == 0:
                 bar.update(step)
 
-        result = simulate(scenario, keep_parts=False, on_part=keep)
+        result = simulate(scenario, keep_parts=False, on_part=keep,
+                          keep_stations=bool(scenario.stations))
         bar.update(n - bar.n)
-    parts = pd.DataFrame({f: np.frombuffer(columns[f]) for f in FRAME_FIELDS})
+    parts = pd.DataFrame({f: np.frombuffer(columns[f]) for f in kept})
     parts = parts.astype({"part": np.int64, "picked": bool})
     return SimpleNamespace(parts=parts, belts=result.belt_histories(), summary=result.summary,
-                           stops=run_stops(result))
+                           stops=run_stops(result), stations=station_inputs(result))
+
+
+def station_inputs(result: Any) -> list[Any]:
+    """The frames' input of each station of a line of ``stations:``, the first's first (none
+    without one): each from its own log, a part's wait at each station the growth of its
+    ``buffer_wait_s`` since the station before."""
+    import numpy as np
+
+    from cell.reporting.animation.scene import station_input
+
+    line = result.line
+    if line is None or len(line.cells) == 1:
+        return []
+    so_far: dict[int, float] = {}  # each part's buffer_wait_s after the stations before
+    out = []
+    for i, ((name, placement, own), log, belts) in enumerate(zip(line.cells, line.logs,
+                                                                  line.belt_logs)):
+        visits = log.visit_table()
+        parts = visits["part"].astype(np.int64)
+        before = np.array([so_far.get(int(p), 0.0) for p in parts])
+        so_far.update(zip(parts.tolist(), visits["waited"].tolist()))
+        out.append(station_input(f"{name}, {placement}" if i else "", own, visits,
+                                 result.belt_histories() if belts is None else
+                                 type(result)(None, None, belts).belt_histories(),
+                                 visits["waited"] - before))
+    return out
 
 
 def run_stops(result: Any) -> tuple[tuple[str, str, float, float], ...]:
@@ -142,14 +172,26 @@ def simulate_scenes(scenario: Scenario, policies: list[str], first: int, count: 
             s = scenario.with_overrides({"controller.policy": policy, "run.parts": n,
                                          "run.hours": None, **own})  # a run of parts, hours or not
             run = simulated(s, progress)
-            runs.append((frames_input(run, s), s, run.stops))
+            line = run.stations  # a line's stations, the first's first (one policy: its run's)
+            runs.append((line[0] if line else frames_input(run, s), s, run.stops))
         from_s = min(float(data.arrival_s[first - 1]) for data, _, _ in runs)
         scenes = [build_scene(data, table, s, from_s=from_s, stops=stops)
                   for data, s, stops in runs]
+        scenes += [build_scene(data, step_table(own.scenario), own.scenario, from_s=from_s)
+                   for data, own in station_cells(s, line[1:])]
         _, t1 = window(scenes, first, count)
-        if all(sc.data.arrival_s[-1] > t1 for sc in scenes):
+        if all(sc.data.arrival_s[-1] > t1 for sc in scenes if not sc.data.station):
             return scenes
         extra *= 2
+
+
+def station_cells(scenario: Scenario, line: list[Any]) -> list[Any]:
+    """(frames' input, assembled cell) of each station after the first of ``scenario``."""
+    if not line:
+        return []
+    from cell.sim.assembly import assemble
+
+    return list(zip(line, [own for _, own in assemble(scenario).line]))
 
 
 def animate(scenario: Scenario, out: str | Path, *, policy: str | None = None, parts: int = 12,
@@ -171,6 +213,9 @@ def animate(scenario: Scenario, out: str | Path, *, policy: str | None = None, p
     if chosen not in POLICIES:
         raise CellError(f"--policy {chosen!r}: one of {', '.join(POLICIES)}")
     policies = ["adaptive", "non-adaptive"] if chosen == "both" else [chosen]
+    if scenario.stations and len(policies) > 1:
+        raise CellError("--policy both: a line of stations is drawn under one policy, its "
+                        "own stations' beside it")
     scenes = simulate_scenes(scenario, policies, first, parts, progress)
     t0, t1 = window(scenes, first, parts)
     times = frame_times(t0, t1, speed / fps)

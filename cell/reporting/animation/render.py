@@ -68,9 +68,8 @@ def header(scene: Scene) -> str:
     """What a panel shows, under its title: the scenario, the seed, a fixed robot's cycle."""
     s = scene.scenario
     line = f"{one_line(s.name, 40)} · seed {s.run.seed}"
-    if scene.data.policy == "non-adaptive":
-        line += f" · fixed cycle {scene.data.cycle_s:.4f} s"
-    return line
+    line += f" · fixed cycle {scene.data.cycle_s:.4f} s" if scene.data.policy == "non-adaptive" else ""
+    return line + (f" · station {scene.data.station}" if scene.data.station else "")  # a line's
 
 
 def clock(t: float) -> str:

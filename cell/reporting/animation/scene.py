@@ -1,8 +1,8 @@
 """Where everything in the cell is at an instant: pure functions, no drawing.
 
-The animation's facts come from one run's records through :func:`frames_input`
-(the only function that reads a :class:`~cell.sim.simulation.SimResult`); the rest
-works on the plain arrays of :class:`AnimationInput`:
+The animation's facts come from one run's records through :func:`frames_input` (the only
+function that reads a :class:`~cell.sim.simulation.SimResult`); the rest works on the plain
+arrays of :class:`AnimationInput`:
 
 * a belt is a piecewise-constant speed history, so its travel X(t) is piecewise
   linear (§6.2 a: speed changes take effect at once): the simulation's own belt
@@ -31,6 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cell.arm.steptable import StepTable
 from cell.reporting.animation.arm_pose import ArmPose, RobotState, robot_at
+from cell.reporting.animation.gate_queue import buffered, queue_x, waited_parts
 from cell.reporting.animation.stops import OperatingClock
 from cell.scenario.schema import Scenario
 from cell.sim.conveyors import Belt
@@ -79,6 +80,16 @@ class AnimationInput:
     """Feeder drop point to B."""
     cycle_s: float
     """The cycle the robot plans for: a non-adaptive robot's fixed cycle (the run's ideal_cycle_s)."""
+    buffer_wait_s: Floats | None = None
+    """(n,) how long each part stood at the buffer's gate or behind it (parts.csv's
+    ``buffer_wait_s``; None: no ``buffer:``, every part moving as in the thesis's cell)."""
+    pitch_in: float = 0.0
+    """The buffer's pitch: centre to centre of the parts waiting in it (docs/layout.md; 0:
+    no buffer)."""
+    station: str = ""
+    """A station of a line after the first: its name and placement (``next, series``; empty:
+    the cell the feeder feeds).  Its parts are those that came to it, in the order they came,
+    ``arrival_s`` the instant each was dropped on its input window (docs/layout.md)."""
 
 
 def belt_history(result: Any, belt: str) -> Floats:
@@ -115,33 +126,52 @@ def frames_input(result: Any, scenario: Scenario) -> AnimationInput:
         input_belt=belt_history(result, "input"),
         output_belt=belt_history(result, "output"),
         input_length_in=float(constants(scenario, robot_timing(scenario)).input_length),
-        cycle_s=float(result.summary.ideal_cycle_s))
+        cycle_s=float(result.summary.ideal_cycle_s),
+        **buffered(d, scenario))
+
+
+def station_input(name: str, own: Any, visits: dict[str, np.ndarray],
+                  belts: dict[str, np.ndarray], waited: np.ndarray) -> AnimationInput:
+    """A line's station as the animation needs it (parts.csv's row of a part is its last
+    station's): the parts that came to it and what it did with each
+    (:meth:`cell.sim.line.StationLog.visit_table`), its own belts, its own cell's drop point
+    (``own``: its assembled cell), cycle and buffer (``waited``: each part's wait at it);
+    ``name`` empty for the first station, else ``name, placement``."""
+    picked = visits["picked"] == 1.0
+    b = own.scenario.buffer
+    buffer: dict[str, Any] = {} if b is None or not b.places else {
+        "buffer_wait_s": waited, "pitch_in": float(b.pitch_in if b.pitch_in is not None
+                                                   else own.scenario.part.size_in)}
+    at_bot = visits["at_bot"]
+    return AnimationInput(
+        policy=own.policy.name, part=visits["part"].astype(np.int64) + 1,
+        arrival_s=visits["arrival"], at_bot_s=at_bot, picked=picked,
+        start_s=np.where(picked, at_bot, np.nan), pick_s=visits["pick"],
+        touchdown_s=np.where(picked, visits["touchdown"], np.nan),
+        regime_s=np.column_stack([visits[f"r{r}"] for r in (1, 2, 3, 4)]),
+        input_belt=belts["input"], output_belt=belts["output"],
+        input_length_in=float(own.k.input_length), cycle_s=float(own.policy.ideal_cycle_s),
+        station=name, **buffer)
 
 
 # --------------------------------------------------------------------------- belts
 def schedule(history: ArrayLike) -> Belt:
-    """The simulation's belt replaying a speed history, rows (from_s, speed_in_s) sorted
-    (:meth:`cell.sim.conveyors.Belt.of_history`): its travel is the run's, to the bit."""
+    """The simulation's belt replaying a sorted speed history (:meth:`Belt.of_history`)."""
     return Belt.of_history(np.asarray(history, dtype=float).reshape(-1, 2).tolist())
 
 
 def travel(belt: Belt | ArrayLike, t: ArrayLike) -> Floats:
-    """X(t), inches a belt has moved since its first speed change, for any shape of t
-    (:meth:`cell.sim.conveyors.Belt.travel` at each instant).
-
-    ``belt``: a :func:`schedule`, or its history, rows (from_s, speed_in_s), sorted,
-    piecewise-constant (§6.2 a); the last speed holds for ever.  Before the first instant
-    the first speed is extrapolated back.
-    """
+    """X(t), inches ``belt`` (a :func:`schedule`, or its history: rows (from_s, speed_in_s),
+    sorted; the last speed holds for ever, the first is extrapolated back) has moved since its
+    first change, at each t of any shape (:meth:`cell.sim.conveyors.Belt.travel`)."""
     b = belt if isinstance(belt, Belt) else schedule(belt)
     with np.errstate(all="ignore"):  # NaN in (a part never picked): NaN out
         return np.vectorize(b.travel, otypes=[float])(np.asarray(t, dtype=float))
 
 
 def time_at(belt: Belt | ArrayLike, x: ArrayLike) -> Floats:
-    """The instant the belt's travel reaches x (the inverse of :func:`travel`,
-    :meth:`cell.sim.conveyors.Belt.time_at` at each x, in numpy's floats: inf where the belt
-    stands from its last change on)."""
+    """The instant the belt's travel reaches each x (:meth:`cell.sim.conveyors.Belt.time_at`,
+    the inverse of :func:`travel`; inf where the belt stands from its last change on)."""
     b = belt if isinstance(belt, Belt) else schedule(belt)
     with np.errstate(all="ignore"):
         return np.vectorize(b.time_at, otypes=[float])(np.asarray(x, dtype=float))
@@ -243,6 +273,11 @@ def build_scene(data: AnimationInput, table: StepTable, scenario: Scenario,
     belt_in, belt_out = schedule(data.input_belt), schedule(data.output_belt)
     x_drop = travel(belt_in, data.arrival_s)
     fall = np.where(data.picked, np.nan, time_at(belt_in, x_drop + to_f))
+    waited = waited_parts(data)
+    if waited.any():  # let go at the gate (at_bot_s): from B on with the belt
+        x_b = travel(belt_in, data.at_bot_s[waited])
+        to_f_b = float(scenario.path.f_in[0] - scenario.path.bot_in[0])
+        fall[waited] = np.where(data.picked[waited], np.nan, time_at(belt_in, x_b + to_f_b))
     y_td = np.where(data.picked, travel(belt_out, data.touchdown_s), np.nan)
     to_gone = output_gone_y(scenario, table) - float(table.path.xyz_in[table.path.td, 1])
     off = np.where(data.picked, time_at(belt_out, y_td + to_gone), np.nan)
@@ -290,6 +325,13 @@ def parts_at(scene: Scene, t: float, robot: tuple[RobotState, ArmPose] | None = 
         held = d.picked & (d.pick_s <= t) & (t < d.touchdown_s)
         out = d.picked & (t >= d.touchdown_s) & (t < scene.off_output_s)
     x_in = scene.b_xy[0] - d.input_length_in + (travel(scene.input_belt, t) - scene.arrival_travel_in)
+    waited = waited_parts(d)
+    if waited.any():  # a buffer: parts queued at the gate, and those it let go
+        queued, x_q = queue_x(scene, t, x_in)
+        x_in = np.where(queued, x_q, x_in)
+        gone = waited & ~queued & (d.at_bot_s <= t)
+        x_in = np.where(gone, scene.b_xy[0] + travel(scene.input_belt, t)
+                        - travel(scene.input_belt, d.at_bot_s), x_in)
     xy[on_input] = np.column_stack([x_in, np.full(n, scene.b_xy[1])])[on_input]
     where[on_input] = INPUT
     where[falling] = FALLING
@@ -341,10 +383,15 @@ def part_done_s(scene: Scene, index: int) -> float:
 
 def window(scenes: list[Scene], first: int, count: int) -> tuple[float, float]:
     """From part ``first``'s arrival (1-based) to the set-down or fall of part
-    ``first + count - 1`` in whichever run is later, plus :data:`TAIL_S`."""
+    ``first + count - 1`` in whichever run is later, plus :data:`TAIL_S`; a line's stations
+    after the first: until each has done with every part up to it that came to it."""
     t0 = float(scenes[0].data.arrival_s[first - 1])
-    t1 = max(part_done_s(s, first + count - 2) for s in scenes) + TAIL_S
-    return t0, t1
+    t1 = max(part_done_s(s, first + count - 2) for s in scenes if not s.data.station)
+    for s in scenes:
+        if s.data.station:
+            came = np.flatnonzero(s.data.part <= first + count - 1)
+            t1 = max([t1, *(part_done_s(s, int(i)) for i in came)])
+    return t0, t1 + TAIL_S
 
 
 def frame_times(t0: float, t1: float, step_s: float) -> Floats:

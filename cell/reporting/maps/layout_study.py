@@ -12,18 +12,26 @@ the other, on the same parts, across arrival means and spreads) this writes, as 
 - ``README.md``: a reading generated from the numbers: how many places of buffer buy what the
   adaptive controller buys, and where a second robot pays.
 
-``python -m cell.reporting.maps.layout_study REPLICATIONS.csv DIR``.
+With the sweep file as a third argument and a ``costs:`` section in its scenarios, the table
+gains each layout's money (:mod:`cell.reporting.money_reading`: per 500-part run, the good
+parts, hours, downtime, the options per hour, a robot and a buffer place counted per station as
+:mod:`cell.sim.run_cost` counts them, and the cost) and the README a money reading: per arrival
+point, the cheapest layout to each of :data:`LOSS_TARGETS`.  Without it, nothing changes.
+
+``python -m cell.reporting.maps.layout_study REPLICATIONS.csv DIR [SWEEP.yaml]``.
 """
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
-from typing import cast
+from typing import Any, cast
 
 import numpy as np
 import pandas as pd
 
 from cell.experiments.stats import summarise
+from cell.reporting import money_reading
 from cell.reporting.maps import map_report
 
 KEYS = ("arrivals.cv", "arrivals.mean_s")
@@ -34,6 +42,10 @@ PLACES = (0, 1, 2, 3, 5)
 #: The layouts of the study, as the table names them.
 FIXED = tuple(f"fixed, {n} places" for n in PLACES)
 LAYOUTS = (*FIXED, "adaptive, 0 places", "adaptive, 1 places", "two fixed robots")
+#: The money reading's loss targets, parts lost per 500-part run (``math.inf``: none).
+LOSS_TARGETS = (5.0, 25.0, 50.0, math.inf)
+#: The money's columns layout.csv gains with ``costs:`` (``lost`` is the table's own).
+MONEY_COLUMNS = tuple(c for c in (*money_reading.INPUTS, *money_reading.OUTPUTS) if c != "lost")
 
 
 def _layout(row: pd.Series) -> str | None:
@@ -165,11 +177,62 @@ def markdown(t: pd.DataFrame, source: str) -> str:
     return "\n".join(lines)
 
 
-def write(replications: str | Path, out_dir: str | Path) -> Path:
+def money(t: pd.DataFrame, reps: pd.DataFrame, sweep: Any) -> pd.DataFrame:
+    """``t`` with each layout's money at each arrival point (:data:`MONEY_COLUMNS`;
+    :func:`cell.reporting.money_reading.priced`, per 500-part run), from its runs and its
+    point's scenario (a second robot's options counted as a station's)."""
+    if reps["parts_scrapped"].sum() > 0:  # the table's lost counts ridden-off parts only
+        raise ValueError("the layout study's money needs runs without scrapped parts")
+    scenarios = {(p.policy, p.index): p.scenario for p in sweep.points}
+    reps = reps.assign(layout=reps.apply(_layout, axis=1)).dropna(subset=["layout"])
+    rows = []
+    for key, runs in reps.groupby([*KEYS, "layout"], sort=True):
+        cv, mean, name = cast(tuple[float, float, str], key)
+        policy, point = str(runs["policy"].iloc[0]), int(runs["point"].iloc[0])
+        rows.append({"cv": float(cv), "mean_s": float(mean), "layout": name,
+                     **money_reading.run_inputs(runs, scenarios[(policy, point)])})
+    priced = money_reading.priced(pd.DataFrame(rows), sweep.points[0].scenario.costs)
+    out = t.assign(layout=t["layout"].astype(str)).merge(
+        priced[["cv", "mean_s", "layout", *MONEY_COLUMNS]], on=["cv", "mean_s", "layout"],
+        how="left", validate="one_to_one")
+    out["layout"] = pd.Categorical(out["layout"], LAYOUTS, ordered=True)
+    return out
+
+
+def money_lines(t: pd.DataFrame, costs: Any) -> list[str]:
+    """The money reading: per arrival point, the cheapest layout to each loss target."""
+    o = costs.options_per_h
+    lines = ["## Money", "",
+             f"With the study's `costs:` (a part lost {costs.part_value:g}, a robot "
+             f"{o.robot:g} an hour, its sensor {o.sensor:g}, a place of buffer "
+             f"{o.buffer_place:g}, the adaptive controller {o.adaptive_controller:g}; "
+             "docs/usage.md, \"Energy and cost\"), each layout's cost per 500-part run is its "
+             "parts lost × their value + its hours × the options it has (two robots: two "
+             "robots and two sensors); `layout.csv` has each term.", ""]
+    for key, point in t.groupby(["cv", "mean_s"], sort=True):
+        cv, mean = cast(tuple[float, float], key)
+        options = point.assign(layout=point["layout"].astype(str)).reset_index(drop=True)
+        lines += [f"**cv {cv:g}, load {mean / FASTEST_S:.2f}.** " + " ".join(
+            money_reading.sentences(options, LOSS_TARGETS, "layout", "per 500 parts")), ""]
+    return lines
+
+
+def write(replications: str | Path, out_dir: str | Path, sweep_file: str | Path | None = None
+          ) -> Path:
     map_report.check(out_dir, "layout")
-    t = table(pd.read_csv(replications))
-    return map_report.write_set(out_dir, "layout", t, figure(t), markdown(t, str(replications)))
+    reps = pd.read_csv(replications)
+    t = table(reps)
+    text = markdown(t, str(replications))
+    if sweep_file is not None:
+        from cell.experiments.sweep.spec import load_sweep
+
+        sweep = load_sweep(sweep_file)
+        costs = sweep.points[0].scenario.costs
+        if costs is not None:
+            t = money(t, reps, sweep)
+            text = text + "\n" + "\n".join(money_lines(t, costs)).rstrip() + "\n"
+    return map_report.write_set(out_dir, "layout", t, figure(t), text)
 
 
 if __name__ == "__main__":  # pragma: no cover
-    map_report.command_line("cell.reporting.maps.layout_study", write, 2)
+    map_report.command_line("cell.reporting.maps.layout_study", write, 2, optional=1)
