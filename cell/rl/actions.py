@@ -7,9 +7,9 @@ hit).  :func:`to_plan` maps any vector (NaN and infinities included) to a plan t
 :class:`cell.sim.policies.check.PlanCheck` passes: each value clipped to the check's own bounds
 (R I's at the pace of the input belt the part reached B on), ``to_g`` and ``cycle`` kept where
 they are within the check's tolerance of their regimes' sums and replaced by those sums
-otherwise, the limits kept to :data:`PLAN_LIMITS`.  A value the check accepts (with limits
-among those) is left as it is, to the bit: the map is the identity on
-the feasible set, so a decision passed through the environment is the decision.
+otherwise, the limits kept to the check's :data:`~cell.sim.policies.check.PLAN_LIMITS`.  A
+value the check accepts (with limits among those) is left as it is, to the bit: the map is the
+identity on the feasible set, so a decision passed through the environment is the decision.
 """
 
 from __future__ import annotations
@@ -23,34 +23,18 @@ from cell.sim.policies.base import CellConstants, Plan
 from cell.sim.policies.check import (
     ABS,
     MAX_S,
+    PLAN_LIMITS,
     REL,
     SUM_S,
     plan_bounds,
     tracking_floors,
 )
 from cell.sim.policies.fixed import fixed_plan
-from cell.sim.records import (
-    INPUT_CEILING,
-    INPUT_FLOOR,
-    INPUT_TRACKING,
-    OUTPUT_CEILING,
-    OUTPUT_FLOOR,
-    R2_PEAK,
-    R4_PEAK,
-    SPACING_UNFORESEEN,
-    SPACING_WAIT,
-)
 
 #: The action's components, in order: the fields of :class:`~cell.sim.policies.base.Plan`.
 FIELDS = ("r1_pre", "r1_post", "r2", "r3_pre", "r3_post", "r4", "input_after_lo", "input_next",
           "output_to_g", "output_floor_at", "to_g", "cycle", "limits")
 TIMES = FIELDS[:6]
-#: The limits a plan may say it hit: the belts' and motors' (what the adaptive controller
-#: flags).  The others are what happened to the part (let go, set down off spacing, held at the
-#: feeder, lost or scrapped in a failure): the cell's to record, not a plan's to claim (the check
-#: would pass a plan claiming them, and the run would count its part lost).
-PLAN_LIMITS = (INPUT_FLOOR | INPUT_CEILING | INPUT_TRACKING | OUTPUT_FLOOR | OUTPUT_CEILING
-               | R2_PEAK | R4_PEAK | SPACING_WAIT | SPACING_UNFORESEEN)
 SPEEDS = ("input_after_lo", "input_next", "output_to_g")
 
 

@@ -81,3 +81,21 @@ def test_a_run_stops_exactly_when_problem_finds_something(scenario, k, data):
     else:
         with pytest.raises(PolicyError, match=f"policy '{NAME}' planned "):
             simulate(scenario, keep_parts=False, keep_belts=False)
+
+
+@pytest.mark.parametrize("outcome", ["let_go", "spacing_off", "held_at_feeder", "lost_downtime",
+                                     "scrapped", "buffer_full"])
+def test_a_plan_claiming_what_became_of_its_part_is_refused(scenario, k, outcome):
+    """What became of a part is the cell's to record: a plan claiming it (which would count a
+    part set down as lost or scrapped) is refused, naming its limits; its own bits pass."""
+    from cell.sim.records import LIMIT_BIT
+
+    base = fixed_plan(k, k.cycle_nom)
+    fields = {f: getattr(base, f) for f in FIELDS}
+    _Planned.planned = SimpleNamespace(**{**fields, "limits": base.limits | LIMIT_BIT["r4_peak"]})
+    simulate(scenario, keep_parts=False, keep_belts=False)  # a plan's own bit: passes
+    claimed = SimpleNamespace(**{**fields, "limits": base.limits | LIMIT_BIT[outcome]})
+    assert (problem(claimed, k) or "").startswith("limits = ")
+    _Planned.planned = claimed
+    with pytest.raises(PolicyError, match=f"policy '{NAME}' planned limits = "):
+        simulate(scenario, keep_parts=False, keep_belts=False)

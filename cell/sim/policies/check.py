@@ -52,9 +52,13 @@ SUM_S = 1e-6
 #: No regime time is this long (a year): a finite time is below it.
 MAX_S = 3.2e7
 
-ALL_LIMITS = 0
-for _bit in LIMIT_BIT.values():
-    ALL_LIMITS |= _bit
+#: The limit bits a plan may carry: what held its belts and motors (and its spacing wait).  What
+#: became of the part (let go, off spacing, held at the feeder, lost, scrapped, the buffer full)
+#: is the cell's to record, not a plan's to claim: a plan claiming it would miscount the run.
+PLAN_LIMITS = 0
+for _name in ("input_floor", "input_ceiling", "input_tracking", "output_floor", "output_ceiling",
+              "r2_peak", "r4_peak", "spacing_wait", "spacing_unforeseen"):
+    PLAN_LIMITS |= LIMIT_BIT[_name]
 
 #: The plan's regime-time fields, in order.
 TIMES = ("r1_pre", "r1_post", "r2", "r3_pre", "r3_post", "r4")
@@ -163,8 +167,8 @@ def problem(plan: Any, k: Any) -> str | None:
         return f"cycle = {cycle:.6g} s: not its regimes' sum, {whole:.6g} s"
     limits = plan.limits
     if isinstance(limits, bool) or not isinstance(limits, int) or limits < 0 \
-            or limits & ~ALL_LIMITS:
-        return f"limits = {one_line(repr(limits), 60)}: not a set of the known limit bits"
+            or limits & ~PLAN_LIMITS:
+        return f"limits = {one_line(repr(limits), 60)}: not a set of a plan's limit bits"
     if not isinstance(plan.steers_belts, bool):
         return f"steers_belts = {one_line(repr(plan.steers_belts), 60)}: not true or false"
     return _floor_problem(plan, to_g + values["r3_pre"]) if plan.steers_belts else None
@@ -232,7 +236,7 @@ class PlanCheck:
             if (a1 <= r1a and a2 <= r1b and a3 <= r2 and a4 <= r3a and a5 <= r3b and a6 <= r4
                     and c1 <= v <= d1 and c2 <= w <= d2 and c3 <= w_next <= d3 and c4 <= u <= d4
                     and -SUM_S <= off_g <= SUM_S and -SUM_S <= off_b <= SUM_S and cycle < MAX_S
-                    and limits.__class__ is int and not limits & ~ALL_LIMITS
+                    and limits.__class__ is int and not limits & ~PLAN_LIMITS
                     and steers.__class__ is bool and floor_at >= to_g + r3a - SUM_S):
                 pre, post = self.r1_floors  # R I at the pace of the belt it picks from
                 f = pre(v)  # (v checked above)
