@@ -152,17 +152,27 @@ def off_spans(s: Any, end_s: float) -> tuple[np.ndarray, np.ndarray] | None:
 
 
 
-class Stamped:
-    """A part's record with its arrival's timestamp on the calendar (parts.csv's
-    ``arrival_time``), every other column the record's."""
+class Dated:
+    """A row with some of its instants as calendar timestamps (``times``: parts.csv's
+    ``arrival_time``, states.csv's and failures.csv's ``from_time`` and ``to_time``), every
+    other column the record's."""
 
-    __slots__ = ("arrival_time", "record")
+    __slots__ = ("record", "times")
 
-    def __init__(self, record: Any, arrival_time: str):
-        self.record, self.arrival_time = record, arrival_time
+    def __init__(self, record: Any, **times: str):
+        self.record, self.times = record, times
 
     def __getattr__(self, name: str) -> Any:
-        return getattr(self.record, name)
+        times = self.times
+        return times[name] if name in times else getattr(self.record, name)
+
+
+def clock(s: Any) -> Callable[[float], str]:
+    """Seconds from the run's start -> the calendar's ISO timestamp (to the millisecond)."""
+    import datetime as dt
+
+    start = s.calendar.start_at
+    return lambda seconds: (start + dt.timedelta(seconds=seconds)).isoformat(timespec="milliseconds")
 
 
 def stamped(s: Any, sink: Callable[[Any], Any]) -> Callable[[Any], Any]:
@@ -170,27 +180,8 @@ def stamped(s: Any, sink: Callable[[Any], Any]) -> Callable[[Any], Any]:
     calendar; ``sink`` itself without one."""
     if s.calendar is None:
         return sink
-    import datetime as dt
-
-    start = s.calendar.start_at
-
-    def told(record: Any) -> Any:
-        when = start + dt.timedelta(seconds=record.arrival_s)
-        return sink(Stamped(record, when.isoformat(timespec="milliseconds")))
-    return told
-
-
-class Dated:
-    """A state span's or a stop's row with its ends as calendar timestamps (states.csv's and
-    failures.csv's ``from_time`` and ``to_time``), every other column the record's."""
-
-    __slots__ = ("from_time", "record", "to_time")
-
-    def __init__(self, record: Any, from_time: str, to_time: str):
-        self.record, self.from_time, self.to_time = record, from_time, to_time
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self.record, name)
+    at = clock(s)
+    return lambda record: sink(Dated(record, arrival_time=at(record.arrival_s)))
 
 
 def dated(s: Any, rows: Any) -> tuple[list[str], Any]:
@@ -198,11 +189,6 @@ def dated(s: Any, rows: Any) -> tuple[list[str], Any]:
     row's ``from_s`` and ``to_s`` also as ISO timestamps; without one, no column and the rows."""
     if s.calendar is None:
         return [], rows
-    import datetime as dt
-
-    start = s.calendar.start_at
-
-    def at(seconds: float) -> str:
-        return (start + dt.timedelta(seconds=seconds)).isoformat(timespec="milliseconds")
-
-    return ["from_time", "to_time"], (Dated(r, at(r.from_s), at(r.to_s)) for r in rows)
+    at = clock(s)
+    return ["from_time", "to_time"], (Dated(r, from_time=at(r.from_s), to_time=at(r.to_s))
+                                      for r in rows)
