@@ -159,13 +159,14 @@ class WeekPattern:
 
 def _weekly(days: Sequence[str], spans: Sequence[tuple[float, float]]
             ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Clock spans (start, length) on each of ``days``, as sorted intervals in one week from
-    Monday 00:00 (one crossing Sunday midnight split at the week's end)."""
+    """Spans (start from the day's midnight, length) on each of ``days``, as sorted intervals
+    in one week from Monday 00:00 (one crossing Sunday midnight split at the week's end)."""
     s: list[float] = []
     e: list[float] = []
     for day in sorted({DAYS.index(d) for d in days}):
         for a, length in spans:
-            lo, hi = day * DAY_S + a, day * DAY_S + a + length
+            lo = (day * DAY_S + a) % WEEK_S
+            hi = lo + length
             s.append(lo)
             e.append(min(hi, WEEK_S))
             if hi > WEEK_S:
@@ -241,8 +242,12 @@ def working_week(cal: CalendarSettings, file: object = "<calendar>",
         if not any((a - s) % DAY_S + n <= length for s, length in shifts):
             raise ScenarioError(file, f"calendar.breaks[{i}]", list(cal.breaks[i]),
                                 "lies outside every shift: a break is taken inside one")
+    # A break is taken in the shift it lies in, on that shift's day: one after midnight in a
+    # night shift falls on the next morning, whether or not that day is a working day.
+    taken = [(s + (a - s) % DAY_S, n) for s, length in shifts for a, n in breaks
+             if (a - s) % DAY_S + n <= length]
     own = shifts if hours is None else _spans(hours, file, hours_key)
-    s, e = _minus(*_weekly(cal.days, own), *_weekly(cal.days, breaks))
+    s, e = _minus(*_weekly(cal.days, own), *_weekly(cal.days, taken))
     start = cal.start_at
     phase = start.weekday() * DAY_S + start.hour * 3600.0 + start.minute * 60.0 + \
         start.second + start.microsecond * 1e-6

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from cell.cli.main import main
@@ -102,6 +102,8 @@ def calendars(draw) -> dict:
 
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(cal=calendars())
+@example(cal={"start": "2027-01-04T00:00", "days": ["mon"], "shifts": [["23:45", "00:30"]],
+              "breaks": [["00:00", "00:15"]]})  # a night shift's break after midnight, on a day off
 def test_nothing_comes_or_moves_off_shift_and_the_states_tile_the_run(cal):
     """No part comes (is due from the feeder) and no part is picked or set down outside
     working time; every equipment's states tile [0, end] and are ``off_shift`` exactly where
