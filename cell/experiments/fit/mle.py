@@ -92,10 +92,39 @@ def _loglik(dist: Any, x: NDArray[np.float64], theta: Sequence[float]) -> float:
     return ll if math.isfinite(ll) else -math.inf
 
 
+def weibull_at(x: NDArray[np.float64], loc: float) -> list[float]:
+    """The Weibull's shape c and scale by maximum likelihood with the threshold held at ``loc``:
+    the root of the profile equation sum(y^c ln y) / sum(y^c) - 1/c = mean(ln y), y = x - loc
+    (increasing in c, from -inf at 0 to max(ln y) - mean(ln y) > 0), found by Brent's method,
+    and scale = mean(y^c)^(1/c).  The exact maximum, where scipy's ``fit(x, floc=loc)`` runs
+    Nelder-Mead over both parameters to its tolerance, some 25 times slower; ValueError for
+    data at or below ``loc`` or all equal."""
+    y = x - loc
+    if not np.all(y > 0.0):
+        raise ValueError("data at or below the threshold")
+    ly = np.log(y)
+    top, mean_ly = float(ly.max()), float(ly.mean())
+    if top == float(ly.min()):
+        raise ValueError("all values equal")
+
+    def excess(c: float) -> float:
+        w = np.exp(c * (ly - top))  # y^c / max(y)^c: no overflow
+        return float(np.dot(w, ly) / w.sum()) - 1.0 / c - mean_ly
+
+    lo = hi = 1.0
+    while excess(lo) > 0.0:
+        lo /= 2.0
+    while excess(hi) < 0.0:
+        hi *= 2.0
+    c = float(optimize.brentq(excess, lo, hi, xtol=1e-14, rtol=4.0 * np.finfo(float).eps))
+    return [c, loc, math.exp(top) * float(np.mean(np.exp(c * (ly - top)))) ** (1.0 / c)]
+
+
 def _fit_fixed_loc(dist: Any, x: NDArray[np.float64], loc: float) -> tuple[list[float], float]:
     """Shapes and scale by MLE with the location held at ``loc``; and the log-likelihood."""
     try:
-        theta = [float(v) for v in dist.fit(x, floc=loc)]
+        theta = weibull_at(x, loc) if dist.name == "weibull_min" else \
+            [float(v) for v in dist.fit(x, floc=loc)]
     except (ValueError, RuntimeError, FloatingPointError):
         return [], -math.inf
     return theta, _loglik(dist, x, theta)
