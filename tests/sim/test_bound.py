@@ -98,3 +98,21 @@ def test_the_bound_covers_the_parts_measured(thesis_cell: Scenario, warmup: int)
     r = simulate(thesis_cell.with_overrides({"run.parts": 100, "run.warmup_parts": warmup}),
                  seed=3).summary
     assert r.parts_bound == r.parts_arrived == 100 - warmup
+
+
+def test_where_the_input_belt_stood_the_bound_counts_the_windows_alone(thesis_cell: Scenario) -> None:
+    """The one-belt fact needs the belt's floor: a run in which the input belt stood (a failure
+    every 20 s of its running on average, repaired in 5 s) gets the windows' count (six for the
+    ten at once, test_the_bound_counts_a_burst_by_hand), one whose robot alone fails keeps the
+    one belt's (one)."""
+    s = thesis_cell.with_overrides({"run.parts": 10})
+    k = assemble(s).k
+    come = [5.0] * 10
+    often = {"time_to_failure": {"distribution": "expon", "mean_s": 20.0},
+             "time_to_repair": {"distribution": "expon", "mean_s": 5.0}}
+    stood = run_trace(s.with_overrides({"failures": {"input_belt": often}}), [5.0] + [0.0] * 10)
+    assert stood.summary.input_speed_min_in_s == 0.0
+    assert stood.summary.parts_bound == parts_bound(k, come, one_belt=False) == 6
+    robot = run_trace(s.with_overrides({"failures": {"robot": often}}), [5.0] + [0.0] * 10)
+    assert robot.summary.input_speed_min_in_s > 0.0
+    assert robot.summary.parts_bound == parts_bound(k, come) == 1
