@@ -29,7 +29,7 @@ o_{k+1}'s; the pass takes the first candidate, whose earliest time is no later).
 controller whose plans pass the check delivers more; it may not reach the bound (the belt's
 speed during a pick and the output belt are left out).  The coupling is only as good as the
 belt's floor: where the belt stood (a failure, a shift calendar) the pass leaves it out
-(``one_belt=False``, the windows alone).
+(``one_belt=False``: the windows alone).
 """
 
 from __future__ import annotations
@@ -41,6 +41,7 @@ import numpy as np
 
 if TYPE_CHECKING:
     from cell.plumbing.types import Array
+    from cell.sim.conveyors import Belt
     from cell.sim.policies.base import CellConstants
 
 #: A part reaching B this close before the robot is back is taken (the controller's
@@ -93,8 +94,12 @@ def greedy_picks(come_s: Sequence[float] | Array, length_in: float, v_min: float
     return count
 
 
-def parts_bound(k: CellConstants, come_s: Sequence[float] | Array, one_belt: bool = True) -> int:
-    """The bound for a run of the cell ``k`` whose parts come at ``come_s``; ``one_belt``
-    False where the input belt stood in the run (the windows alone)."""
+def parts_bound(k: CellConstants, come_s: Sequence[float] | Array, belt: Belt | None = None,
+                one_belt: bool = True) -> int:
+    """The bound for a run of the cell ``k`` whose parts come at ``come_s``.  ``belt``: the
+    run's input belt once closed; if it stood (its slowest speed 0), or ``one_belt`` is
+    False, the windows alone."""
+    if belt is not None and not belt.min_speed_in_s > 0.0:
+        one_belt = False
     return greedy_picks(come_s, k.input_length, k.input_min, k.input_max, k.part_size,
                         fastest_possible_cycle(k), one_belt)
