@@ -7,8 +7,8 @@ policy asks to them), so the part reaches B no earlier than r_i = a_i + L / v_ma
 drops it at a_i, or later if the belt has not cleared a part's size since the last drop, and
 never later than D_i = max(a_i, D_{i-1} + size / v_min), so it reaches B no later than
 d_i = D_i + L / v_min.  The robot picks a part as it reaches B, and two picks are at least its
-fastest possible cycle c apart (less :data:`EPS_S`: a part that comes that close to the
-robot's return is taken).
+fastest possible cycle c apart (less :data:`~cell.sim.conveyors.EPS_S`: a part that comes
+that close to the robot's return is taken).
 
 **One belt.**  The parts ride one belt and keep their distances on it.  Part k is dropped a
 part's size behind part k - 1 if the feeder held it, else at a_k, when the belt has carried
@@ -39,14 +39,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from cell.sim.conveyors import EPS_S  # a part this close before the robot is back is taken
+
 if TYPE_CHECKING:
     from cell.plumbing.types import Array
     from cell.sim.conveyors import Belt
     from cell.sim.policies.base import CellConstants
 
-#: A part reaching B this close before the robot is back is taken (the controller's
-#: :data:`cell.sim.conveyors.EPS_S`), so picks may be this much closer than a cycle.
-EPS_S = 1e-6
 #: Room on the belt's distance between two drops (in) for the feeder's roundings (it drops a
 #: held part up to EPS_S of belt travel past a part's size clear) and the MILP's slack
 #: (:data:`cell.experiments.hindsight.milp.HOLD_IN`).
