@@ -1,18 +1,35 @@
 """The bound on any controller: the most parts that could be delivered from given arrivals
 with the same robot and belts (SPEC §11; docs/model.md, "The bound").
 
-Part i comes at a_i, ``length`` inches before B.  Whatever the controller does, the
-input belt runs between its floor v_min and its ceiling v_max, so the part reaches
-B no earlier than a_i + L / v_max; the feeder drops it at a_i, or later if the belt
-has not cleared a part's size since the last drop, and never later than
-D_i = max(a_i, D_{i-1} + size / v_min), so it reaches B no later than D_i + L / v_min.
-The robot picks a part at B, and two picks are at least its fastest possible cycle
-c_min apart.  Each part then has a window [r_i, d_i]; both ends grow with i, so the
-greedy pass in order of arrival (pick i at max(r_i, last pick + c_min) if that is no
-later than d_i) fits the most picks into the windows (an exchange argument: any
-feasible choice can be turned, pick by pick, into the greedy one).  The windows
-ignore that the parts share one belt, so no controller can deliver more; it may not
-reach the bound.
+Part i comes at a_i, ``length`` inches before B.  Whatever the controller does, the input
+belt runs between its floor v_min and its ceiling v_max (the plan check holds every speed a
+policy asks to them), so the part reaches B no earlier than r_i = a_i + L / v_max; the feeder
+drops it at a_i, or later if the belt has not cleared a part's size since the last drop, and
+never later than D_i = max(a_i, D_{i-1} + size / v_min), so it reaches B no later than
+d_i = D_i + L / v_min.  The robot picks a part as it reaches B, and two picks are at least its
+fastest possible cycle c apart (less :data:`~cell.sim.conveyors.EPS_S`: a part that comes
+that close to the robot's return is taken).
+
+**One belt.**  The parts ride one belt and keep their distances on it.  Part k is dropped a
+part's size behind part k - 1 if the feeder held it, else at a_k, when the belt has carried
+part k - 1 at most v_max (a_k - a_{k-1}) since its drop (no earlier than a_{k-1}); so the
+belt's distance between them is at most g_k = max(size, v_max (a_k - a_{k-1})) (plus
+:data:`SLACK_IN` for the feeder's roundings).  Two parts i < j both picked reach B the time
+the belt takes to carry that distance apart, at the floor at most: with s_i the sum of
+g_k / v_min up to i, t_j - t_i <= s_j - s_i.  Two picks in a row are at least c apart in time,
+so s_j - s_i >= c too: a burst of m parts the feeder drops a part's size apart yields at most
+1 + (m - 1) size / v_min / c of them.
+
+**The pass.**  Both ends of the windows and s grow with i, so the greedy pass in order of
+arrival (pick i at max(r_i, last pick + c) if that is no later than d_i and s_i is at least
+the last pick's s plus c) fits the most picks: if any run picks o_1 < o_2 < ..., the pass's
+k-th pick g_k is at or before o_k, in index and in time (by induction: o_{k+1} is a candidate
+after g_k, as its s is at least s(o_k) + c >= s(g_k) + c and its earliest time no later than
+o_{k+1}'s; the pass takes the first candidate, whose earliest time is no later).  So no
+controller whose plans pass the check delivers more; it may not reach the bound (the belt's
+speed during a pick and the output belt are left out).  The coupling is only as good as the
+belt's floor: where the belt stood (a failure, a shift calendar) the pass leaves it out
+(``one_belt=False``: the windows alone).
 """
 
 from __future__ import annotations
@@ -22,9 +39,17 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from cell.sim.conveyors import EPS_S  # a part this close before the robot is back is taken
+
 if TYPE_CHECKING:
     from cell.plumbing.types import Array
+    from cell.sim.conveyors import Belt
     from cell.sim.policies.base import CellConstants
+
+#: Room on the belt's distance between two drops (in) for the feeder's roundings (it drops a
+#: held part up to EPS_S of belt travel past a part's size clear) and the MILP's slack
+#: (:data:`cell.experiments.hindsight.milp.HOLD_IN`).
+SLACK_IN = 1e-3
 
 
 def fastest_possible_cycle(k: CellConstants) -> float:
@@ -38,25 +63,42 @@ def fastest_possible_cycle(k: CellConstants) -> float:
 
 
 def greedy_picks(come_s: Sequence[float] | Array, length_in: float, v_min: float, v_max: float,
-                 part_size_in: float, cycle_min_s: float) -> int:
+                 part_size_in: float, cycle_min_s: float, one_belt: bool = True) -> int:
     """The most parts, coming at ``come_s`` (in order), that fit their windows at B with
-    picks ``cycle_min_s`` apart: the greedy pass of the module's text, a part at a time."""
+    picks ``cycle_min_s`` apart and, with ``one_belt``, their belt's distance between them
+    at least a cycle at the floor: the greedy pass of the module's text, a part at a time."""
     early, late, clear = length_in / v_max, length_in / v_min, part_size_in / v_min
-    next_drop = next_pick = -float("inf")  # the latest drop plus clear; the last pick plus c_min
+    cycle = cycle_min_s - EPS_S
+    gap_min = (part_size_in + SLACK_IN) / v_min  # the belt's distance to the last part, at
+    per_s = v_max / v_min                        # the floor: its size, or v_max per second
+    next_drop = next_pick = -float("inf")  # the latest drop plus clear; the last pick plus c
+    at, next_at = 0.0, -float("inf")  # the part's s; the last pick's s plus c (one belt)
+    last = None
     count = 0
     for come in np.asarray(come_s, dtype=float).tolist():
+        if last is not None:
+            gap = per_s * (come - last) + SLACK_IN / v_min
+            at += gap if gap > gap_min else gap_min
+        last = come
         latest_drop = come if come > next_drop else next_drop
         next_drop = latest_drop + clear
         pick = come + early
         if pick < next_pick:
             pick = next_pick
-        if pick <= latest_drop + late:
+        if pick <= latest_drop + late and at >= next_at:
             count += 1
-            next_pick = pick + cycle_min_s
+            next_pick = pick + cycle
+            if one_belt:
+                next_at = at + cycle
     return count
 
 
-def parts_bound(k: CellConstants, come_s: Sequence[float] | Array) -> int:
-    """The bound for a run of the cell ``k`` whose parts come at ``come_s``."""
+def parts_bound(k: CellConstants, come_s: Sequence[float] | Array, belt: Belt | None = None,
+                one_belt: bool = True) -> int:
+    """The bound for a run of the cell ``k`` whose parts come at ``come_s``.  ``belt``: the
+    run's input belt once closed; if it stood (its slowest speed 0), or ``one_belt`` is
+    False, the windows alone."""
+    if belt is not None and not belt.min_speed_in_s > 0.0:
+        one_belt = False
     return greedy_picks(come_s, k.input_length, k.input_min, k.input_max, k.part_size,
-                        fastest_possible_cycle(k))
+                        fastest_possible_cycle(k), one_belt)

@@ -333,7 +333,7 @@ class Run:
         summary.seed = _seed_value(seed)
         summary.input_speed_max_in_s = station.input.belt.max_speed_in_s
         summary.input_speed_min_in_s = station.input.belt.min_speed_in_s
-        summary.parts_bound = parts_bound(k, self.feeder.fed_s[summary.warmup_parts:n])
+        summary.parts_bound = parts_bound(k, self.feeder.fed_s[summary.warmup_parts:n], station.input.belt)
         result = SimResult(summary, self.rows, self.belts if self.keep_belts else None)
         result.downtime, result.timelines, result.stop_rows = downtime, lines, stops
         result.wear = wear_clock.measures(wear, downtime, env.now)

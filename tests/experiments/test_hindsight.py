@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -13,6 +14,7 @@ from hypothesis import strategies as st
 from cell.experiments.hindsight.milp import check_cycle_s, solve
 from cell.experiments.hindsight.optimum import hindsight
 from cell.sim.assembly import assemble
+from cell.sim.bound import parts_bound
 from cell.sim.simulation import simulate
 from tests.traces import trace_scenario
 
@@ -26,22 +28,24 @@ def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
 BURST = [5.0] + [0.0] * 9
 
 
-def test_a_burst_of_ten_parts_has_bound_six_and_optimum_one(folder: Path) -> None:
+def test_a_burst_of_ten_parts_has_optimum_one_and_the_one_belt_bound_one(folder: Path) -> None:
     """By hand, in the baseline cell (input belt 1.5 to 12 in/s, 3.0 nominal; L = 135.516 in
     from the feeder to B; parts 2 in; the shortest cycle a plan may have 17.566 s, the bound's
     16.63 s).  The feeder drops the ten parts a part's size apart, each as the belt has carried
     the last 2 in clear: part i is 2 i in behind part 0, whatever the belt does.
-    parts_bound: every window opens at 5 + L / 12 = 16.29 s; part i's closes at
+    The windows alone: every window opens at 5 + L / 12 = 16.29 s; part i's closes at
     5 + 2 i / 1.5 + L / 1.5 = 95.34 + 1.33 i s.  Picks 16.63 s apart from 16.29: 16.29, 32.92,
     49.55, 66.18, 82.81 (parts 0-4) and 99.44 <= 95.34 + 6.67 (part 5); part 6 at 116.07 is past
-    every later window's end (at most 95.34 + 12.0): 6.
+    every later window's end (at most 95.34 + 12.0): 6.  parts_bound counts the one belt: part 9
+    is 18 in behind part 0, 12 s at the floor, less than a cycle: 1.
     Optimum: part 0 reaches B with the robot free (at 5 + L / 3, the belt untouched so far) and
     is picked.  The next pick is at least 17.566 s later; by then the belt, at 1.5 in/s at
     least, has carried 26.3 in past B, more than the 18 in to part 9: parts 1-9 all reach B
     while the robot is away.  1."""
     s = trace_scenario(folder, BURST)
     out = hindsight(s, budget_s=20.0).summary
-    assert out["parts_bound"] == 6
+    assert out["parts_bound"] == 1
+    assert parts_bound(assemble(s).k, np.cumsum(BURST), one_belt=False) == 6
     assert out["parts_upper"] == 1 and out["milp_status"] == "optimal"
     assert out["parts_optimum"] == 1 and out["exact"]
     assert 17.56 < check_cycle_s(assemble(s).k) < 17.57
@@ -67,12 +71,14 @@ gap = st.one_of(st.just(0.0), st.floats(0.5, 45.0), st.floats(15.0, 30.0))
 def test_controllers_sit_below_the_milp_and_the_milp_below_the_bound(folder: Path,
                                                                      gaps: list[float]) -> None:
     """On drawn traces of 8-12 parts, bursts among them: every built-in controller's count (the
-    real simulation, the same trace) <= the MILP's proved optimum <= parts_bound, and the
-    search's simulated schedule <= the MILP's optimum."""
+    real simulation, the same trace) <= the MILP's proved optimum <= parts_bound <= the windows
+    alone (the bound before it counted the one belt), and the search's simulated schedule <= the
+    MILP's optimum."""
     s = trace_scenario(folder, gaps)
     out = hindsight(s, budget_s=20.0).summary
     assert out["milp_status"] == "optimal"
     upper = out["parts_upper"]
+    assert out["parts_bound"] <= parts_bound(assemble(s).k, np.cumsum(gaps), one_belt=False)
     for policy in ("adaptive", "non-adaptive"):
         run = simulate(trace_scenario(folder, gaps, policy)).summary
         assert run.parts_delivered <= upper <= run.parts_bound == out["parts_bound"]
@@ -126,7 +132,7 @@ def test_the_command_writes_the_schedule_and_the_summary(folder: Path, tmp_path:
     summary = pd.read_csv(tmp_path / "a" / "summary.csv")
     schedule = pd.read_csv(tmp_path / "a" / "schedule.csv")
     row = summary.iloc[0]
-    assert (row["parts_optimum"], bool(row["exact"]), row["parts_bound"]) == (1, True, 6)
+    assert (row["parts_optimum"], bool(row["exact"]), row["parts_bound"]) == (1, True, 1)
     assert row["budget_s"] == 20.0 and "solve_s" not in summary.columns  # times told, not written
     assert list(schedule["part"]) == list(range(1, 11))
     assert int(schedule["picked"].sum()) == 1 and int(schedule["milp_picked"].sum()) == 1
@@ -153,7 +159,8 @@ def test_bad_input_is_one_line_exit_2_and_nothing_written(tmp_path: Path, extra:
 def test_a_run_too_long_for_the_milp_gives_the_search_against_the_bound(
         folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Past the MILP's size the search's schedule is given, exact only where it reaches the
-    bound (here, parts a cycle apart: all of them)."""
+    bound (here, parts a cycle apart: all of them; the burst: one, the bound counting the one
+    belt)."""
     import cell.experiments.hindsight.optimum as hs
 
     monkeypatch.setattr(hs, "MILP_MAX_PARTS", 5)
@@ -162,5 +169,5 @@ def test_a_run_too_long_for_the_milp_gives_the_search_against_the_bound(
     assert (s["milp_status"], s["upper_from"], s["parts_upper"]) == ("too_large", "parts_bound", 8)
     assert s["parts_optimum"] == 8 and s["exact"]
     assert any("too large" in note for note in found.notes)
-    found = hs.hindsight(trace_scenario(folder, BURST), budget_s=20.0)
-    assert (found.summary["parts_optimum"], found.summary["exact"]) == (1, False)
+    found = hs.hindsight(trace_scenario(folder, BURST), budget_s=20.0)  # the bound counts the
+    assert (found.summary["parts_optimum"], found.summary["exact"]) == (1, True)  # one belt

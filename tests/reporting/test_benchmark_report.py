@@ -56,3 +56,13 @@ def test_the_readme_quotes_the_headline(runs: pd.DataFrame) -> None:
     assert pct in line
     readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
     assert line in readme
+
+
+def test_the_reading_gives_how_far_parts_bound_sits_above_the_optimum(runs: pd.DataFrame) -> None:
+    """The reading's figures for parts_bound, worked from runs.csv: its pooled excess over the
+    optimum and the runs where it meets the MILP's bound."""
+    text = " ".join((DIR / "report.md").read_text(encoding="utf-8").split())
+    above = 100 * (runs["parts_bound"].sum() / runs["optimum"].sum() - 1)
+    met = int((runs["parts_bound"] == runs["milp_upper"]).sum())
+    assert f"is {above:.1f} % above the optimum" in text
+    assert f"meets the MILP's bound in {met} of the {len(runs)}" in text

@@ -186,3 +186,33 @@ def test_no_plug_in_the_check_lets_run_delivers_more_than_the_bound(
         delivered, bound = got
         event("bound reached" if delivered == bound else "below the bound")
         assert delivered <= bound
+
+
+#: Gaps between parts in bursts: at once, closer than a part's size at the ceiling, a few
+#: parts' sizes at the floor, about a cycle.
+_BURST_GAP = st.sampled_from([0.0, 0.0, 0.1]) | st.floats(0.0, 3.0) | st.floats(14.0, 24.0)
+
+
+@settings(max_examples=40, deadline=None)
+@example(length=135.52, nominal=4.3692, gaps=[5.0] + [0.0] * PARTS, seed=0,
+         how=["floor"] * 6, extra=[0.0] * 6, honest=True, aim=True, next_fast=True)
+@example(length=8.0, nominal=3.0, gaps=[5.0, 0.0, 0.0, 2.9, 0.0, 1.4, 0.0, 0.0, 2.7, 0.0, 0.0],
+         seed=0, how=["belt"] * 6, extra=[0.0] * 6, honest=True, aim=True, next_fast=True)
+@given(length=st.sampled_from(LENGTHS), nominal=st.sampled_from(NOMINALS),
+       gaps=st.lists(_BURST_GAP, min_size=PARTS + 1, max_size=PARTS + 1),
+       seed=st.integers(0, 2**32 - 1), how=st.lists(_HOW, min_size=6, max_size=6),
+       extra=st.lists(_EXTRA, min_size=6, max_size=6), honest=st.booleans(),
+       aim=st.booleans(), next_fast=st.booleans())
+def test_on_bursts_no_plug_in_delivers_more_than_the_one_belt_bound(
+        cells: dict, length: float, nominal: float, gaps: list[float], seed: int,
+        how: list[str], extra: list[float], honest: bool, aim: bool, next_fast: bool) -> None:
+    """Parts in bursts, where the bound counts that they share one belt (cell/sim/bound.py):
+    still no drawn plug-in the check lets run delivers more."""
+    Drawn.style = {"rng": np.random.default_rng(seed), "how": how, "extra": extra,
+                   "honest": honest, "aim": aim, "next_fast": next_fast}
+    got = _delivered_and_bound(cells[(Drawn.name, length, nominal)], gaps)
+    event("refused" if got is None else "ran")
+    if got is not None:
+        delivered, bound = got
+        event("bound reached" if delivered == bound else "below the bound")
+        assert delivered <= bound

@@ -21,8 +21,9 @@ event within a pick's 4 in from B to LO is held to the McCormick envelope of tra
 slowness, not to one speed exactly.  So its optimum is at least every controller's count; a
 schedule run through the simulation that reaches it proves it the optimum
 (:mod:`cell.experiments.hindsight.search`).  Every run of a controller is one of its points,
-and every point keeps the windows and the cycle of :mod:`cell.sim.bound`, so its optimum is at
-most ``parts_bound``.
+and every point keeps the windows, the cycle and the one belt's distances of
+:mod:`cell.sim.bound` (its SLACK and HOLD_IN within the bound's allowances), so its optimum is
+at most ``parts_bound``.
 """
 
 from __future__ import annotations

@@ -228,9 +228,10 @@ def markdown(t: pd.DataFrame, source: str) -> str:
     for sentence in reading(t):
         lines += [sentence, ""]
     lines += ["The bound (`parts_bound`, docs/model.md) counts the parts any controller could "
-              "deliver from the same arrivals, ignoring that the parts share one belt: with a "
-              "79 s window at B for each part it is nearly every part here, so it bounds both "
-              "robots loosely.", ""]
+              "deliver from the same arrivals: each part's window at B (79 s long), picks a "
+              "fastest cycle apart and far enough apart on the one belt. It takes each of these "
+              "on its own, so on the spread arrivals it bounds both robots loosely "
+              "(reports/benchmark: how far above the optimum it sits).", ""]
     return "\n".join(lines).rstrip() + "\n"
 
 
