@@ -328,8 +328,8 @@ class Run:
             wear_clock.stop_rows(wear, env.now)  # failures.csv's rows
         lines = oee.measure(summary, column, downtime, k.cycle_nom, env.now, stops,
                             s.quality.rule, calendar.off_spans(s, env.now))
-        lines = state_energy.measure(summary, s, lines, log, downtime, env.now, stops)
-        run_cost.measure(summary, s, stops, log.column)
+        lines = state_energy.measure(summary, s, lines, log, downtime, env.now, stops, line)
+        run_cost.measure(summary, s, stops, log.column, line)
         summary.seed = _seed_value(seed)
         summary.input_speed_max_in_s = station.input.belt.max_speed_in_s
         summary.input_speed_min_in_s = station.input.belt.min_speed_in_s

@@ -23,6 +23,8 @@ from cell.sim.simulation import simulate
 SECOND_FAILS = """\
 name: second_fails
 run: {hours: 3, seed: 7}
+costs: {repair: 100, downtime_per_h: 60}   # nothing else costs
+energy: {arm: none}                         # every state's default power
 arrivals: {distribution: expon, params: {loc: 0.0, scale: 21.0}}
 stations:
   - name: next
@@ -95,6 +97,24 @@ def test_the_summarys_time_shares_are_the_first_stations_robots(second_fails):
     assert summary.robot_down_fraction == 0 and summary.loss_downtime == 0  # the first never fails
     assert summary.robot_busy_fraction == pytest.approx(first.busy_fraction, abs=1e-9)
     assert summary.availability == pytest.approx(first.busy_fraction, abs=1e-9)
+
+
+def test_the_lines_cost_counts_every_stations_repairs_and_robot_downtime(second_fails):
+    summary, stops = second_fails["summary"].iloc[0], second_fails["failures"]
+    states = second_fails["states"]
+    robots_down = states[(states.equipment == "robot") & (states.state == "down")]
+    down_h = (robots_down.to_s - robots_down.from_s).sum() / 3600.0
+    hours = summary.sim_end_s / 3600.0
+    assert summary.cost_per_h * hours == pytest.approx(100 * len(stops) + 60 * down_h, rel=1e-8)
+
+
+def test_the_lines_energy_is_the_sum_over_every_stations_states(second_fails):
+    from cell.scenario.energy_sections import EnergySettings
+
+    power, states = EnergySettings().power, second_fails["states"]
+    joules = sum(power(e, state) * (b - a)
+                 for e, state, a, b in zip(states.equipment, states.state, states.from_s, states.to_s))
+    assert second_fails["summary"].energy_kwh.iloc[0] * 3.6e6 == pytest.approx(joules, rel=1e-9)
 
 
 FAILS = {"robot": {"time_to_failure": {"distribution": "expon", "params": {"scale": 600.0}},
