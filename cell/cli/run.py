@@ -54,7 +54,7 @@ def main(args: argparse.Namespace) -> int:
     from cell.scenario.schema import inert_settings
     from cell.sim.assembly import assemble
     from cell.sim.records import BELT_COLUMNS
-    from cell.sim.sim_result import part_columns, stops_anything, writes_states
+    from cell.sim.sim_result import part_columns, station_columns, stops_anything, writes_states
     from cell.sim.simulation import simulate
 
     names = RUN_FILES + FAILURE_FILES + PARQUET_FILES + ("stations.csv",)
@@ -83,10 +83,8 @@ def main(args: argparse.Namespace) -> int:
         with out.open("summary.csv", newline="") as sf:
             RowWriter(sf, list(result.summary.as_dict())).record(result.summary)
         if result.station_rows is not None:  # buffer: or stations: (docs/layout.md)
-            from cell.sim.line import STATION_COLUMNS
-
             with out.open("stations.csv", newline="") as f:
-                write = RowWriter(f, STATION_COLUMNS).record
+                write = RowWriter(f, station_columns(scenario)).record
                 for row in result.station_rows:
                     write(row)
         if writes_states(scenario):
@@ -140,15 +138,18 @@ def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) ->
         print(f"wrote {shown}/{written[0]}, {written[1]}{also} and {written[2]}")
         return
     print(stops_line(r, scenario.failures))
-    print(f"wrote {shown}/{written[0]}, {written[1]}, {written[2]}, states.csv and failures.csv")
+    also = ", stations.csv" if result.station_rows is not None else ""
+    print(f"wrote {shown}/{written[0]}, {written[1]}, {written[2]}{also}, states.csv and failures.csv")
 
 
 def _write_failures(out: Any, result: Any, stops: bool, scenario: Any) -> None:
-    """states.csv, and failures.csv of a run with failures or wear (``stops``); under a
-    calendar each row's ends also as timestamps."""
+    """states.csv, and failures.csv of a run with failures or wear (``stops``) at any station
+    (each row naming its station in a layout); under a calendar each row's ends also as
+    timestamps."""
     from cell.plumbing.csvfile import RowWriter
     from cell.sim.calendar import dated
     from cell.sim.records import STATE_COLUMNS, STOP_COLUMNS
+    from cell.sim.sim_result import named_columns
 
     for name, columns, rows in (("states.csv", STATE_COLUMNS, result.state_spans()),
                                 ("failures.csv", STOP_COLUMNS, result.stops() if stops else None)):
@@ -156,7 +157,7 @@ def _write_failures(out: Any, result: Any, stops: bool, scenario: Any) -> None:
             continue
         times, rows = dated(scenario, rows)
         with out.open(name, newline="") as f:
-            write = RowWriter(f, columns + times).record
+            write = RowWriter(f, named_columns(result, columns) + times).record
             for row in rows:
                 write(row)
 

@@ -22,10 +22,6 @@ def check_calendar(s: Any, file: object) -> None:
         if s.wear.enabled and (f is None or f.robot is None):
             raise ScenarioError(file, "wear.enabled", True, "with a calendar, wear is counted "
                                 "by the robot's failure clock: give failures.robot")
-        if s.has_layout:  # only the first station would stand off shift
-            key = "buffer" if s.stations is None else "stations"
-            raise ScenarioError(file, key, "given", "a calendar with a buffer or more stations is "
-                                "not modelled yet: run the layout without calendar:")
         return
     why = "needs a calendar: section (the working time it counts)"
     if f is None:

@@ -24,7 +24,7 @@ import simpy
 
 from cell.scenario.arrivals import root_seed
 from cell.scenario.layout_sections import FIRST_STATION
-from cell.sim import oee, wear_clock
+from cell.sim import calendar, oee, state_energy, wear_clock
 from cell.sim.failures import Downtime
 from cell.sim.feeder import Feeder
 from cell.sim.mailbox import Mailbox
@@ -68,10 +68,15 @@ class StationRow(NamedTuple):
     """Mean number of parts waiting in its buffer (0: none)."""
     buffer_max: int
     """The most parts that waited in it at once."""
+    down_fraction: float = math.nan
+    """Share its robot was down (failed or worn, a crew's wait included); a column only when
+    a station can stop (``failures:`` at any station, or ``wear:``)."""
 
 
-#: stations.csv's columns, in order.
-STATION_COLUMNS = StationRow._fields
+#: stations.csv's columns, in order (then ``down_fraction``: sim_result.station_columns).
+STATION_COLUMNS = StationRow._fields[:-1]
+#: The per-part values a station logs of its own visits (the first's: :meth:`Line.first_column`).
+STATION_VALUES = ("arrival", "at_bot", "cycle", "picked")
 
 
 #: What a station's log keeps of each part done there: when it came, its B (its cycle's
@@ -261,9 +266,10 @@ class Line:
         none = _no_belts
         for i, (_, _, own) in enumerate(self.cells):
             seed_i = station_seed(seed, i)
-            if i:
-                dt = None if own.scenario.failures is None else \
-                    Downtime(env, own.scenario.failures, seed_i)
+            if i:  # its own failures, and a calendar's stands (with or without failures)
+                f, cal = own.scenario.failures, own.scenario.calendar
+                dt = None if f is None and cal is None else \
+                    Downtime(env, f or calendar.NO_FAILURES, seed_i)
                 wear_clock.count_on(dt, own, seed_i)
                 self.downtimes.append(dt)
             belts = self.belt_logs[i]
@@ -287,25 +293,50 @@ class Line:
 
     def control(self, fed_s: list[float], n_parts: int) -> None:
         """Start every station's controller (the first's look-ahead reads ``fed_s``) and
-        their failure clocks."""
+        their failure clocks, a calendar's shifts with them (the first's: the run's)."""
         for i, station in enumerate(self.stations):
             station.control(fed_s if i == 0 else None, n_parts, self.logs[i])
-            if i:
-                dt = self.downtimes[i]
-                if dt is not None:
-                    dt.start()
+            dt = self.downtimes[i]
+            if i and dt is not None:
+                calendar.keep(self.env, self.cells[i][2].scenario, dt)
+                dt.start()
 
     def close(self, end_s: float) -> None:
         for station in self.stations:
             station.close(end_s)
 
-    def rows(self, end_s: float) -> list[StationRow]:
-        """stations.csv's rows (:data:`STATION_COLUMNS`), over the whole run."""
+    def stops(self, end_s: float) -> list[list[tuple[str, str, float, float, Any]]]:
+        """Each station's stops (its ``Downtime.all_stops``, or its worn motors' alone)."""
+        return [dt.all_stops(end_s) if dt is not None else
+                wear_clock.stop_rows(None if st.wear is None else st.wear.log, end_s)
+                for dt, st in zip(self.downtimes, self.stations)]
+
+    def timelines(self, end_s: float) -> list[tuple[str, state_energy.Timelines]]:
+        """Each station's name and its equipment's states over [0, end_s] (states.csv), from its
+        own log and stops; with ``energy:``, its sensor's as :func:`state_energy.timelines` adds."""
         out = []
-        for (name, _, _), log, station, dt in zip(self.cells, self.logs, self.stations,
-                                                  self.downtimes):
-            stops = dt.all_stops(end_s) if dt is not None else []
-            sec = oee.unit_seconds(log.column, dt, end_s, stops)
+        for (name, _, own), log, dt, stops in zip(self.cells, self.logs, self.downtimes,
+                                                  self.stops(end_s)):
+            lines = oee.timelines(log.column, dt, end_s, stops, calendar.off_spans(own.scenario, end_s))
+            if own.scenario.energy is not None:
+                lines = state_energy.timelines(own.scenario, lines, log.column, dt, end_s, stops)
+            out.append((name, lines))
+        return out
+
+    def first_column(self, column: Callable[[str], np.ndarray]) -> Callable[[str], np.ndarray]:
+        """The run log's ``column`` with :data:`STATION_VALUES` the first station's own: the
+        summary's time shares and OEE's times then describe the first station's robot (a part
+        another station took has there its B and cycle), as states.csv's first rows do."""
+        own = self.logs[0].column
+        return lambda name: own(name) if name in STATION_VALUES else column(name)
+
+    def rows(self, end_s: float) -> list[StationRow]:
+        """stations.csv's rows (:data:`STATION_COLUMNS`, ``down_fraction``), over the whole run."""
+        out = []
+        for (name, _, own), log, station, dt, stops in zip(self.cells, self.logs, self.stations,
+                                                           self.downtimes, self.stops(end_s)):
+            off = calendar.off_spans(own.scenario, end_s)
+            sec = oee.unit_seconds(log.column, dt, end_s, stops, () if off is None else (off,))
             share = (lambda x: x / end_s) if end_s > 0 else (lambda x: math.nan)
             b = station.buffer
             out.append(StationRow(name, log.parts_in, log.delivered,
@@ -313,7 +344,7 @@ class Line:
                         log.lost_full, log.lost_down, share(sec["busy"]),
                         share(sec["starved"]), share(sec["blocked"]),
                         b.occupancy_mean(end_s) if b is not None else 0.0,
-                        b.most if b is not None else 0))
+                        b.most if b is not None else 0, share(sec["down"])))
         return out
 
     def measure(self, summary: Any, log: Any, end_s: float) -> None:

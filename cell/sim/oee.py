@@ -89,9 +89,11 @@ def timelines(column: Callable[[str], np.ndarray], downtime: Any, end_s: float,
     return out
 
 
-def state_spans(lines: dict[str, list[tuple[str, float, float]]]) -> list[StateSpan]:
-    """states.csv's rows, equipment by equipment."""
-    return [StateSpan(name, state, a, b) for name, rows in lines.items() for state, a, b in rows]
+def state_spans(lines: dict[str, list[tuple[str, float, float]]], station: str | None = None
+                ) -> list[StateSpan]:
+    """states.csv's rows, equipment by equipment (``station``: whose, in a layout)."""
+    return [StateSpan(name, state, a, b, station) for name, rows in lines.items()
+            for state, a, b in rows]
 
 
 def _covered(starts: np.ndarray, ends: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:

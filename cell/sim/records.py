@@ -90,8 +90,7 @@ def limit_names(flags: int) -> str:
     return names
 
 
-LIMIT_NAMES: dict[int, str] = {}
-""":func:`limit_names`' answers so far, by flag word."""
+LIMIT_NAMES: dict[int, str] = {}  # :func:`limit_names`' answers so far, by flag word
 
 
 class PartRecord(NamedTuple):
@@ -314,7 +313,6 @@ class RunSummary:
     parts_bound: int = 0
     """The most parts any controller could deliver from the same arrivals with the same robot
     and belts (a bound: each part's window at B, picks a fastest cycle apart; cell.sim.bound)."""
-
     energy_kwh: float | None = None
     """The run's energy, kWh (only with an ``energy:`` section; docs/usage.md)."""
     energy_per_good_part_wh: float | None = None
@@ -364,6 +362,8 @@ class StateSpan:
     """When the state began."""
     to_s: float
     """When it ended (the run's end for the last)."""
+    station: str | None = None
+    """The station's name, with ``stations:`` or ``buffer:`` (stations.csv's ``station``)."""
 
 
 @dataclass(slots=True, frozen=True)
@@ -380,6 +380,8 @@ class Stop:
     """When it ran again (repair done, crew wait included); the run's end if still down."""
     part: Any
     """The part the robot held or was picking when it failed (empty otherwise)."""
+    station: str | None = None
+    """The station's name, with ``stations:`` or ``buffer:`` (stations.csv's ``station``)."""
 
 
 def columns(record_type: type) -> list[str]:
@@ -394,5 +396,5 @@ OPTIONAL_PART_COLUMNS = ("energy_j", "station", "buffer_wait_s")
 OPTIONAL_COLUMNS = tuple(columns(RunSummary)[columns(RunSummary).index("energy_kwh"):])  # the sections' own
 SUMMARY_COLUMNS = [c for c in columns(RunSummary) if c not in OPTIONAL_COLUMNS]  # those: with sections
 BELT_COLUMNS = columns(BeltChange)
-STATE_COLUMNS = columns(StateSpan)
-STOP_COLUMNS = columns(Stop)
+STATE_COLUMNS = columns(StateSpan)[:-1]  # station: with a layout (docs/layout.md)
+STOP_COLUMNS = columns(Stop)[:-1]

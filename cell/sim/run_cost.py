@@ -8,7 +8,8 @@ sensor``, the adaptive controller under the ``adaptive`` policy, a robot per rob
 place per place, for each station of a layout: docs/layout.md).  Lost parts: those ridden off
 and those scrapped from the hand (the summary's
 ``parts_missed`` and ``parts_scrapped``); repairs: every failure in failures.csv, of any piece
-of equipment (a worn motor's included); good parts: by ``quality.rule``, as OEE counts them.
+of equipment (a worn motor's included); the downtime and the repairs of a layout are every
+station's; good parts: by ``quality.rule``, as OEE counts them.
 """
 
 from __future__ import annotations
@@ -45,23 +46,30 @@ def cost(c: Any, lost: Any, energy_kwh: Any, down_h: Any, repairs: Any, maintena
             + repairs * c.repair + maintenance * c.maintenance + options_per_h * hours)
 
 
-def run_cost(r: RunSummary, scenario: Any, stops: Sequence[tuple[str, str, float, float, Any]]
-             ) -> float:
-    """The run's cost (see the module's text) from its summary and failures.csv's rows."""
+def run_cost(r: RunSummary, scenario: Any, stops: Sequence[tuple[str, str, float, float, Any]],
+             down_fraction: float | None = None) -> float:
+    """The run's cost (see the module's text) from its summary and failures.csv's rows;
+    ``down_fraction``: the robots' downtime over the run (None: the summary's robot's)."""
     hours = r.sim_end_s / 3600.0
     maintenance = sum(1 for _, cause, *_ in stops if cause == "maintenance")
     energy_kwh = r.energy_kwh if r.energy_kwh is not None else 0.0
+    down = r.robot_down_fraction if down_fraction is None else down_fraction
     return float(cost(scenario.costs, r.parts_missed + r.parts_scrapped, energy_kwh,
-                      r.robot_down_fraction * hours, len(stops) - maintenance, maintenance,
+                      down * hours, len(stops) - maintenance, maintenance,
                       options_per_h(scenario), hours))
 
 
 def measure(r: RunSummary, scenario: Any, stops: Sequence[tuple[str, str, float, float, Any]],
-            column: Callable[[str], np.ndarray]) -> None:
-    """With a ``costs:`` section, fill the summary's cost columns."""
+            column: Callable[[str], np.ndarray], line: Any = None) -> None:
+    """With a ``costs:`` section, fill the summary's cost columns (``line``: a layout's
+    :class:`~cell.sim.line.Line`, whose every station's stops and downtime count)."""
     if scenario.costs is None:
         return
-    total = run_cost(r, scenario, stops)
+    if line is None:
+        total = run_cost(r, scenario, stops)
+    else:
+        total = run_cost(r, scenario, [row for rows in line.stops(r.sim_end_s) for row in rows],
+                         sum(row.down_fraction for row in line.rows(r.sim_end_s)))
     _, good = oee.produced_and_good(column, scenario.quality.rule)
     r.cost_per_good_part = total / good if good else math.nan
     r.cost_per_h = total / (r.sim_end_s / 3600.0) if r.sim_end_s > 0 else math.nan

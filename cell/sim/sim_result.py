@@ -45,8 +45,22 @@ def part_columns(cell: Any) -> list[str]:
 
 
 def stops_anything(scenario: Any) -> bool:
-    """Whether the scenario can stop the cell (``failures:``, or ``wear:`` on): failures.csv."""
-    return scenario.failures is not None or scenario.wear.enabled
+    """Whether the scenario can stop the cell, any station of its layout (``failures:``, or
+    ``wear:`` on): failures.csv."""
+    return any(s.failures is not None or s.wear.enabled
+               for s in (scenario, *(own for _, own in scenario.line)))
+
+
+def station_columns(scenario: Any) -> list[str]:
+    """stations.csv's columns (docs/layout.md): ``down_fraction`` last when a station can stop."""
+    from cell.sim.line import STATION_COLUMNS
+
+    return [*STATION_COLUMNS, *["down_fraction"] * stops_anything(scenario)]
+
+
+def named_columns(result: Any, columns: list[str]) -> list[str]:
+    """states.csv's or failures.csv's columns: with a layout, ``station`` after the others."""
+    return columns + ["station"] * (result.line is not None)
 
 
 def writes_states(scenario: Any) -> bool:
@@ -83,12 +97,22 @@ class SimResult:
         """Every failure and planned stop (wear's included), in order of start."""
 
     def state_spans(self) -> list[StateSpan]:
-        """states.csv's rows."""
-        return oee.state_spans(self.timelines)
+        """states.csv's rows; a layout's station by station, each naming its station."""
+        if self.line is None:
+            return oee.state_spans(self.timelines)
+        return [span for name, lines in self.line.timelines(self.summary.sim_end_s)
+                for span in oee.state_spans(lines, name)]
 
     def stops(self) -> list[Stop]:
-        """failures.csv's rows: every failure and planned stop, in order of start."""
-        return [Stop(*row) for row in self.stop_rows]
+        """failures.csv's rows: every failure and planned stop, in order of start (a layout's
+        every station's, each naming its station; at one instant, in station order)."""
+        if self.line is None:
+            return [Stop(*row) for row in self.stop_rows]
+        names = [name for name, _, _ in self.line.cells]
+        rows = [Stop(e, cause, a, b, part, name)
+                for name, stops in zip(names, self.line.stops(self.summary.sim_end_s))
+                for e, cause, a, b, part in stops]
+        return sorted(rows, key=attrgetter("from_s"))  # stable: station order kept
 
     @functools.cached_property
     def records(self) -> list[PartRecord] | None:

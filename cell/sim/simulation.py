@@ -317,19 +317,19 @@ class Run:
 
     def result(self) -> SimResult:
         """The run's result once it is over: its summary, rows and belts."""
-        cell, log, acct, env, station, downtime = \
-            self.cell, self.log, self.acct, self.env, self.station, self.downtime
+        cell, log, acct, env, station, downtime, line = \
+            self.cell, self.log, self.acct, self.env, self.station, self.downtime, self.line
         s, k, n, seed = cell.scenario, cell.k, self.n, self.seed
-        (self.line or station).close(env.now)
-
+        (line or station).close(env.now)
+        column = log.column if line is None else line.first_column(log.column)  # its robot's
         summary = _summary(cell, log, acct, self.t_all, n, env.now)
         wear = None if station.wear is None else station.wear.log  # wear: without failures
         stops = downtime.all_stops(env.now) if downtime is not None else \
             wear_clock.stop_rows(wear, env.now)  # failures.csv's rows
-        lines = oee.measure(summary, log.column, downtime, k.cycle_nom, env.now, stops,
+        lines = oee.measure(summary, column, downtime, k.cycle_nom, env.now, stops,
                             s.quality.rule, calendar.off_spans(s, env.now))
-        lines = state_energy.measure(summary, s, lines, log, downtime, env.now, stops)
-        run_cost.measure(summary, s, stops, log.column)
+        lines = state_energy.measure(summary, s, lines, log, downtime, env.now, stops, line)
+        run_cost.measure(summary, s, stops, log.column, line)
         summary.seed = _seed_value(seed)
         summary.input_speed_max_in_s = station.input.belt.max_speed_in_s
         summary.input_speed_min_in_s = station.input.belt.min_speed_in_s
@@ -337,7 +337,7 @@ class Run:
         result = SimResult(summary, self.rows, self.belts if self.keep_belts else None)
         result.downtime, result.timelines, result.stop_rows = downtime, lines, stops
         result.wear = wear_clock.measures(wear, downtime, env.now)
-        if line := self.line:  # stations.csv's rows, the line's measures (cell.sim.line)
+        if line:  # stations.csv's rows, the line's measures (cell.sim.line)
             result.station_rows, result.line = line.rows(env.now), line
             line.measure(summary, log, env.now)
         return result

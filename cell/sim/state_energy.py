@@ -88,17 +88,20 @@ def timelines(scenario: Any, lines: Timelines, column: Callable[[str], np.ndarra
 
 
 def measure(r: RunSummary, scenario: Any, lines: Timelines, log: Any, downtime: Any,
-            end_s: float, stops: Sequence[tuple[str, str, float, float, Any]]) -> Timelines:
+            end_s: float, stops: Sequence[tuple[str, str, float, float, Any]],
+            line: Any = None) -> Timelines:
     """With an ``energy:`` section, fill the summary's energy columns and return the
     timelines states.csv shows; without one, ``lines`` as they are.  ``log``: the run's
     :class:`~cell.sim.simulation.RunLog` (its ``column`` and, with ``arm: dynamics``, its
-    :class:`ArmTransfers`)."""
+    :class:`ArmTransfers`); ``line``: a layout's :class:`~cell.sim.line.Line`, whose every
+    station's states count (states.csv's rows, station by station)."""
     energy, column = scenario.energy, log.column
     if energy is None:
         return lines
     lines = timelines(scenario, lines, column, downtime, end_s, stops)
     arm = log.energy_of
-    joules = state_energy_j(lines, energy, busy=arm is None)
+    joules = sum(state_energy_j(own, energy, busy=arm is None)
+                 for own in ([lines] if line is None else [o for _, o in line.timelines(end_s)]))
     if arm is not None:
         joules += arm.total_j
         r.arm_energy_per_transfer_j = arm.total_j / arm.transfers if arm.transfers else float("nan")

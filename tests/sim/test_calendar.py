@@ -326,21 +326,6 @@ def test_two_run_lengths_are_refused(capsys, tmp_path: Path):
     assert not (tmp_path / "out").exists()
 
 
-@pytest.mark.parametrize("layout, key", [
-    ({"buffer": {"places": 2}}, "buffer"),
-    ({"stations": [{"name": "catcher", "placement": "downstream", "offset_in": 40}]}, "stations"),
-])
-def test_a_calendar_with_a_layout_is_refused_until_every_station_keeps_it(capsys, tmp_path: Path,
-                                                                          layout, key):
-    scenario = tmp_path / "s.yaml"
-    scenario.write_text(yaml.safe_dump({"calendar": TWO_SHIFTS, **layout}))
-    out = tmp_path / "out"
-    assert main(["run", str(scenario), "--out", str(out)]) == 2
-    err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0 and err.startswith(f"cell: error: {scenario}: {key} = ")
-    assert not out.exists()
-
-
 def test_states_and_failures_carry_the_calendars_timestamps(tmp_path: Path):
     """Under a calendar states.csv and failures.csv give each row's ends as timestamps too:
     ``from_time`` / ``to_time`` are the start plus ``from_s`` / ``to_s``; without one, neither."""

@@ -136,8 +136,8 @@ def station_inputs(result: Any) -> list[Any]:
 def run_stops(result: Any) -> tuple[tuple[str, str, float, float], ...]:
     """(equipment, cause, from_s, to_s) of every stop of a run: its failures and planned
     stops (``failures:``), and the robot's stops for a worn motor (``wear:``)."""
-    if getattr(result, "downtime", None) is not None:  # failures.csv's rows, wear's included
-        rows = [(s.equipment, s.cause, s.from_s, s.to_s) for s in result.stops()]
+    if getattr(result, "downtime", None) is not None:  # the first station's failures.csv rows
+        rows = [(e, cause, a, b) for e, cause, a, b, _ in result.stop_rows]
     else:
         wear = getattr(result, "wear", None)
         rows = [("robot", "wear", a, b) for a, b, _ in (wear.stops if wear else [])]
