@@ -343,7 +343,7 @@ def test_an_interrupted_sweep_says_how_to_go_on(tmp_path):
 
     # a few seconds of work in small tasks (Table 7.1's sweep did the same in a minute)
     sweep = tmp_path / "s.yaml"
-    sweep.write_text("base: baseline\nset: {run.parts: 300}\npolicies: [non-adaptive, adaptive]\n"
+    sweep.write_text("base: baseline\nset: {run.parts: 100}\npolicies: [non-adaptive, adaptive]\n"
                      "replications: 100\nbatch: 5\nseed: 7\n")
     command = [sys.executable, "-m", "cell", "sweep", str(sweep), "--out", str(tmp_path / "out"),
                "--workers", "1"]
