@@ -177,10 +177,15 @@ _EXTRA = st.sampled_from([0.0, 0.0, 0.05, 1.0])
 def test_no_plug_in_the_check_lets_run_delivers_more_than_the_bound(
         cells: dict, length: float, nominal: float, gap: float, jitter: list[float], seed: int,
         how: list[str], extra: list[float], honest: bool, aim: bool, next_fast: bool) -> None:
-    Drawn.style = {"rng": np.random.default_rng(seed), "how": how, "extra": extra,
-                   "honest": honest, "aim": aim, "next_fast": next_fast}
-    gaps = [max(gap + j, 0.0) for j in jitter]
-    got = _delivered_and_bound(cells[(Drawn.name, length, nominal)], gaps)
+    _holds(cells[(Drawn.name, length, nominal)], [max(gap + j, 0.0) for j in jitter],
+           {"rng": np.random.default_rng(seed), "how": how, "extra": extra, "honest": honest,
+            "aim": aim, "next_fast": next_fast})
+
+
+def _holds(cell, gaps: list[float], style: dict) -> None:
+    """The drawn plug-in (``style``) on ``gaps``: refused, or no more parts than the bound."""
+    Drawn.style = style
+    got = _delivered_and_bound(cell, gaps)
     event("refused" if got is None else "ran")
     if got is not None:
         delivered, bound = got
@@ -208,11 +213,6 @@ def test_on_bursts_no_plug_in_delivers_more_than_the_one_belt_bound(
         how: list[str], extra: list[float], honest: bool, aim: bool, next_fast: bool) -> None:
     """Parts in bursts, where the bound counts that they share one belt (cell/sim/bound.py):
     still no drawn plug-in the check lets run delivers more."""
-    Drawn.style = {"rng": np.random.default_rng(seed), "how": how, "extra": extra,
-                   "honest": honest, "aim": aim, "next_fast": next_fast}
-    got = _delivered_and_bound(cells[(Drawn.name, length, nominal)], gaps)
-    event("refused" if got is None else "ran")
-    if got is not None:
-        delivered, bound = got
-        event("bound reached" if delivered == bound else "below the bound")
-        assert delivered <= bound
+    _holds(cells[(Drawn.name, length, nominal)], gaps,
+           {"rng": np.random.default_rng(seed), "how": how, "extra": extra, "honest": honest,
+            "aim": aim, "next_fast": next_fast})
