@@ -138,6 +138,9 @@ def _report(args: argparse.Namespace, scenario: Any, result: Any, shown: str) ->
         print(f"wrote {shown}/{written[0]}, {written[1]}{also} and {written[2]}")
         return
     print(stops_line(r, scenario.failures))
+    if result.station_rows is not None:  # the line above is the first station's
+        print("down, share of the run: " + ", ".join(
+            f"{row.station} {row.down_fraction:.3f}" for row in result.station_rows))
     also = ", stations.csv" if result.station_rows is not None else ""
     print(f"wrote {shown}/{written[0]}, {written[1]}, {written[2]}{also}, states.csv and failures.csv")
 

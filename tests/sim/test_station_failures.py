@@ -45,10 +45,22 @@ def second_fails(tmp_path_factory: pytest.TempPathFactory) -> dict[str, pd.DataF
     second: its output files, read back."""
     where = tmp_path_factory.mktemp("second_fails")
     (where / "line.yaml").write_text(SECOND_FAILS)
-    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+    said = io.StringIO()
+    with contextlib.redirect_stdout(said), contextlib.redirect_stderr(io.StringIO()):
         assert main(["run", str(where / "line.yaml"), "--out", str(where / "out")]) == 0
-    return {name: pd.read_csv(where / "out" / f"{name}.csv")
-            for name in ("failures", "states", "stations", "summary")}
+    return {"stdout": said.getvalue(), **{name: pd.read_csv(where / "out" / f"{name}.csv")
+                                          for name in ("failures", "states", "stations", "summary")}}
+
+
+def test_cell_run_prints_each_stations_downtime(second_fails):
+    """The printed stops line is the first station's; the next line gives every station's
+    share of the run down, as stations.csv has it."""
+    line = next(x for x in second_fails["stdout"].splitlines() if x.startswith("down, share"))
+    shown = dict(part.rsplit(" ", 1) for part in line.split(": ", 1)[1].split(", "))
+    stations = second_fails["stations"]
+    assert list(shown) == list(stations.station)
+    np.testing.assert_allclose([float(v) for v in shown.values()], stations.down_fraction, atol=5e-4)
+    assert float(shown["next"]) > 0 == float(shown["first"])
 
 
 def test_the_second_stations_failures_are_in_failures_csv_named_as_in_stations_csv(second_fails):
