@@ -320,9 +320,9 @@ class InputConveyor:
         while True:
             part, dropped = yield get()
             i = part.index
-            # the clock: the drop, or the last hand-off if the part was dropped while the one
-            # before it was still on its way (speed: docs/performance.md#input-clock)
-            now = dropped if dropped > self.due_s else self.due_s
+            # the clock: the drop, or the last hand-off if the part came while the one before
+            # it was still on its way to B
+            now = dropped if dropped > self.due_s else self.due_s  # speed: docs/performance.md#input-clock
             target = x_fed[i] + length
             if stops is None or not belt.stopped:
                 delay = belt.time_at(target) - now
