@@ -269,8 +269,7 @@ class InputConveyor:
         self.process = env.process(self.run())
 
     def drop(self, part: Part, x: float, now: float) -> None:
-        """The feeder puts a part on the belt now (the clock's ``now``), the belt's travel
-        being x."""
+        """The feeder puts a part on the belt now (the clock's ``now``), its travel being x."""
         self.x_fed[part.index] = x
         self.loaded.put((part, now))
 
@@ -320,8 +319,7 @@ class InputConveyor:
         while True:
             part, dropped = yield get()
             i = part.index
-            # the clock: the drop, or the last hand-off if the part came while the one before
-            # it was still on its way to B
+            # the clock: the drop, or the last hand-off if the part came while one was on its way
             now = dropped if dropped > self.due_s else self.due_s  # speed: docs/performance.md#input-clock
             target = x_fed[i] + length
             if stops is None or not belt.stopped:
