@@ -156,6 +156,7 @@ class Controller:
         robot, view, k, log = self.robot, self.view, self.k, self.log
         conveyor, output, plan_for, name = self.conveyor, self.output, self.policy.plan, self.name
         aim = k.lookahead_margin_s  # step 6.3 from when the next part is aimed at B
+        u_nom, u_min = k.u_nom, k.output_min  # the output belt's nominal speed and floor
         floor_after_td = math.nan  # the last planned TD (the spacing contract; nan: none)
         passes, passed = self.check.passes, None  # the last plan that passed the check
         get, steers_input = self.source.get, self.steers_input
@@ -182,11 +183,11 @@ class Controller:
                                     plan.input_next)
                 at_g = now + to_g
                 if plan.output_floor_at < INF:  # the spacing contract: the belt's floor after TD
-                    output.replan(now, plan.output_to_g, at_g, k.u_nom,
-                                  now + plan.output_floor_at, k.output_min)
+                    output.replan(now, plan.output_to_g, at_g, u_nom,
+                                  now + plan.output_floor_at, u_min)
                     floor_after_td = at_g + r3a
                 else:
-                    output.replan(now, plan.output_to_g, at_g, k.u_nom)
+                    output.replan(now, plan.output_to_g, at_g, u_nom)
             part.plan = plan  # the part's regime times and belt speeds (read as its row is made)
             if plan.limits:
                 log.flag(part, plan.limits)

@@ -268,10 +268,10 @@ class InputConveyor:
         """True while a part's way to B is waited for in steps a stop can interrupt."""
         self.process = env.process(self.run())
 
-    def drop(self, part: Part, x: float) -> None:
-        """The feeder puts a part on the belt now, the belt's travel being x."""
+    def drop(self, part: Part, x: float, now: float) -> None:
+        """The feeder puts a part on the belt now (the clock's ``now``), its travel being x."""
         self.x_fed[part.index] = x
-        self.loaded.put(part)
+        self.loaded.put((part, now))
 
     def changed(self) -> simpy.Event:
         """An event that succeeds when the belt's plan next changes (a replan, a stop or a
@@ -317,9 +317,10 @@ class InputConveyor:
         env, get, hand_over, belt = self.env, self.loaded.get, self.at_bot.put_after, self.belt
         x_fed, length, stops = self.x_fed, self.length_in, self.stops
         while True:
-            part = yield get()
+            part, dropped = yield get()
             i = part.index
-            now = env.now
+            # the clock: the drop, or the last hand-off if the part came while one was on its way
+            now = dropped if dropped > self.due_s else self.due_s  # speed: docs/performance.md#input-clock
             target = x_fed[i] + length
             if stops is None or not belt.stopped:
                 delay = belt.time_at(target) - now

@@ -30,7 +30,7 @@ class Loadable(Protocol):
 
     belt: Any
 
-    def drop(self, part: Part, x: float) -> None: ...
+    def drop(self, part: Part, x: float, now: float) -> None: ...
 
     def changed(self) -> simpy.Event: ...
 
@@ -80,5 +80,5 @@ class Feeder:
                     flag(part, HELD_AT_FEEDER)
             else:
                 part = Part(i, f)
-            drop(part, x)
+            drop(part, x, now)
             clear_at = x + size

@@ -228,7 +228,7 @@ class Transfer:
                 yield env.timeout(at_f - env.now)
             now = env.now
             log.arrive(part, now)
-            conveyor.drop(part, conveyor.belt.travel(now))
+            conveyor.drop(part, conveyor.belt.travel(now), now)
 
 
 def series_feed(env: simpy.Environment, downstream: Station, log: StationLog
@@ -242,7 +242,7 @@ def series_feed(env: simpy.Environment, downstream: Station, log: StationLog
         now = env.now
         part.begin_visit()
         log.arrive(part, now)
-        conveyor.drop(part, conveyor.belt.travel(now))
+        conveyor.drop(part, conveyor.belt.travel(now), now)
     return feed
 
 
