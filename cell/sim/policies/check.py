@@ -205,7 +205,7 @@ class PlanCheck:
     """The check every plan passes before the cell acts on it (the controller's, for any
     policy), for constants ``k`` and the policy's ``name``: :meth:`passes`."""
 
-    __slots__ = ("k", "name", "bounds", "r1_floors", "floors_speed", "floors")
+    __slots__ = ("k", "name", "bounds", "r1_floors")
 
     def __init__(self, k: Any, name: str):
         self.k, self.name = k, name
@@ -215,10 +215,6 @@ class PlanCheck:
         self.r1_floors = (t.r1_pre.time, t.r1_post.time)
         """R I's floors (B → LO, LO → F) at an input belt speed, one function each: the two
         of :meth:`~cell.sim.robot.RobotTiming.r1_time` (:func:`tracking_floors`)."""
-        self.floors_speed, self.floors = math.nan, (math.nan, math.nan)
-        """The input belt speed of the last plan checked and R I's two floors there, the slack
-        baked in (``f - ABS - REL * f``, as :func:`plan_bounds`): a plan at the same speed
-        (the tracking limit, at which most adaptive plans pick) reuses them."""
 
     def passes(self, plan: Any) -> None:
         """Returns if ``plan`` obeys the physics above, else raises :class:`PolicyError`
@@ -243,14 +239,12 @@ class PlanCheck:
                     and off_g <= SUM_S and -SUM_S <= off_b and off_b <= SUM_S and cycle < MAX_S
                     and limits.__class__ is int and not limits & ~PLAN_LIMITS
                     and steers.__class__ is bool and floor_at >= to_g + r3a - SUM_S):
-                # R I at the pace of the belt it picks from (v checked above)
-                if v != self.floors_speed:  # speed: docs/performance.md#r-i-floors
-                    pre, post = self.r1_floors
-                    f, g = pre(v), post(v)
-                    self.floors_speed, self.floors = v, (f - ABS - REL * f, g - ABS - REL * g)
-                f, g = self.floors
-                if f <= r1a and g <= r1b:
-                    return
+                pre, post = self.r1_floors  # R I at the pace of the belt it picks from
+                f = pre(v)  # (v checked above)
+                if f - ABS - REL * f <= r1a:
+                    f = post(v)
+                    if f - ABS - REL * f <= r1b:
+                        return
         except Exception:  # noqa: BLE001, S110 - a field missing or not a number: said below
             pass
         refuse(plan, self.name, self.k)
