@@ -18,11 +18,13 @@ all: test
 # uv installs what pip would (the same releases: constraints.txt pins every library to the one
 # the committed reports were made with) in half the time: 34 s against 70 s on a machine with no
 # download cache. Like pip with --no-compile, it leaves byte-code to the first import.
+# Where uv cannot be had or cannot reach the index, pip installs the same pins.
 INSTALL := $(VENV)/bin/uv pip install -q --python $(PY) -c constraints.txt
+PIP_INSTALL := $(PY) -m pip install -qq --no-compile -c constraints.txt
 $(STAMP): pyproject.toml constraints.txt
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install -qq uv==0.13.9
-	$(INSTALL) -e ".[dev,dist]"
+	($(PY) -m pip install -qq uv==0.13.9 && $(INSTALL) -e ".[dev,dist]") || \
+		$(PIP_INSTALL) -e ".[dev,dist]"
 	@touch $(STAMP)
 
 venv: $(STAMP)
@@ -109,7 +111,7 @@ year: $(STAMP)
 # The learned controller's network retrained (issue 36 item 3): CMA-ES, the optional extra [rl],
 # seeded, about 6 minutes on one core of this 2-core machine; writes cell/rl/weights/learned.json.
 learn: $(STAMP)
-	$(INSTALL) -e ".[rl]"
+	$(INSTALL) -e ".[rl]" || $(PIP_INSTALL) -e ".[rl]"
 	$(PY) -m cell.rl.train
 
 # The benchmark (issue 36 item 4): every controller's parts against the hindsight optimum.
