@@ -302,21 +302,19 @@ class Line:
                 dt.start()
 
     def close(self, end_s: float) -> None:
+        """The run is over: each station closed, and its stops (its ``Downtime.all_stops``, or
+        its worn motors' alone) taken once, as ``stopped``."""
         for station in self.stations:
             station.close(end_s)
-
-    def stops(self, end_s: float) -> list[list[tuple[str, str, float, float, Any]]]:
-        """Each station's stops (its ``Downtime.all_stops``, or its worn motors' alone)."""
-        return [dt.all_stops(end_s) if dt is not None else
-                wear_clock.stop_rows(None if st.wear is None else st.wear.log, end_s)
-                for dt, st in zip(self.downtimes, self.stations)]
+        self.stopped = [dt.all_stops(end_s) if dt is not None else wear_clock.stop_rows(
+            None if st.wear is None else st.wear.log, end_s) for dt, st in zip(self.downtimes, self.stations)]
 
     def timelines(self, end_s: float) -> list[tuple[str, state_energy.Timelines]]:
         """Each station's name and its equipment's states over [0, end_s] (states.csv), from its
         own log and stops; with ``energy:``, its sensor's as :func:`state_energy.timelines` adds."""
         out = []
         for (name, _, own), log, dt, stops in zip(self.cells, self.logs, self.downtimes,
-                                                  self.stops(end_s)):
+                                                  self.stopped):
             lines = oee.timelines(log.column, dt, end_s, stops, calendar.off_spans(own.scenario, end_s))
             if own.scenario.energy is not None:
                 lines = state_energy.timelines(own.scenario, lines, log.column, dt, end_s, stops)
@@ -334,7 +332,7 @@ class Line:
         """stations.csv's rows (:data:`STATION_COLUMNS`, ``down_fraction``), over the whole run."""
         out = []
         for (name, _, own), log, station, dt, stops in zip(self.cells, self.logs, self.stations,
-                                                           self.downtimes, self.stops(end_s)):
+                                                           self.downtimes, self.stopped):
             off = calendar.off_spans(own.scenario, end_s)
             sec = oee.unit_seconds(log.column, dt, end_s, stops, () if off is None else (off,))
             share = (lambda x: x / end_s) if end_s > 0 else (lambda x: math.nan)

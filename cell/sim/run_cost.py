@@ -68,7 +68,7 @@ def measure(r: RunSummary, scenario: Any, stops: Sequence[tuple[str, str, float,
     if line is None:
         total = run_cost(r, scenario, stops)
     else:
-        total = run_cost(r, scenario, [row for rows in line.stops(r.sim_end_s) for row in rows],
+        total = run_cost(r, scenario, [row for rows in line.stopped for row in rows],
                          sum(row.down_fraction for row in line.rows(r.sim_end_s)))
     _, good = oee.produced_and_good(column, scenario.quality.rule)
     r.cost_per_good_part = total / good if good else math.nan

@@ -110,7 +110,7 @@ class SimResult:
             return [Stop(*row) for row in self.stop_rows]
         names = [name for name, _, _ in self.line.cells]
         rows = [Stop(e, cause, a, b, part, name)
-                for name, stops in zip(names, self.line.stops(self.summary.sim_end_s))
+                for name, stops in zip(names, self.line.stopped)
                 for e, cause, a, b, part in stops]
         return sorted(rows, key=attrgetter("from_s"))  # stable: station order kept
 
