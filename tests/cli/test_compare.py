@@ -14,8 +14,8 @@ from cell.experiments.sweep import load_sweep, run_sweep
 from cell.reporting.experiment.report import difference_table
 from tests.prose import in_order
 
-# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
-pytestmark = pytest.mark.usefixtures("unrendered")
+# Figures built, not laid out: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unlaid")
 
 
 def scenario(tmp_path: Path, name: str, **settings) -> Path:
