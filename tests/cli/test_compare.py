@@ -267,7 +267,7 @@ def test_compare_warns_when_both_warmups_are_auto(tmp_path, capsys):
     a = scenario(tmp_path, "one", run__parts=30, run__warmup_parts="auto")
     b = scenario(tmp_path, "other", run__parts=30, run__warmup_parts="auto",
                  controller__policy="non-adaptive")
-    out, warned = compare_run(capsys, a, b)
+    out, warned = compare_run(capsys, a, b, "--out", str(tmp_path / "cmp"))
     assert len(warned) == 1, warned
     assert in_order(warned[0], "one has run.warmup_parts auto,", "other auto", "MSER-5",
                     "(--set run.warmup_parts=N,")
@@ -275,7 +275,6 @@ def test_compare_warns_when_both_warmups_are_auto(tmp_path, capsys):
     assert "not compared" in rows["Parts delivered"] and "auto against auto" in rows[
         "Parts delivered"]
     assert "not compared" not in rows["Parts per hour (wall clock)"]
-    compare_run(capsys, a, b, "--out", str(tmp_path / "cmp"))
     measures = set(pd.read_csv(tmp_path / "cmp" / "differences.csv")["measure"])
     assert "parts_per_hr_wallclock" in measures and "parts_delivered" not in measures
     out, warned = compare_run(capsys, a, b, "--set", "run.warmup_parts=5")
