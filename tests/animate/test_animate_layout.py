@@ -14,6 +14,9 @@ from cell.reporting.animation.scene import INPUT, Scene, parts_at
 from cell.scenario.schema import load_scenario
 
 PITCH = 3.0
+#: The instants the queue is checked at, 2.1 s apart (a default frame is 20/12 s of the run):
+#: over 200 of them find two parts or more queued.
+STEP_S = 2.1
 
 
 @pytest.fixture(scope="module")
@@ -31,7 +34,7 @@ def test_the_parts_that_wait_stand_at_the_gate_at_their_pitch(buffered: Scene) -
     reached = d.at_bot_s - d.buffer_wait_s  # when each came to B (docs/layout.md)
     b, size = buffered.b_xy[0], buffered.scenario.part.size_in
     seen = 0
-    for t in np.arange(reached[0], d.at_bot_s[-10], 0.7):
+    for t in np.arange(reached[0], d.at_bot_s[-10], STEP_S):
         waiting = np.flatnonzero((d.buffer_wait_s > 0) & (reached <= t) & (t < d.at_bot_s))
         at = parts_at(buffered, float(t))
         order = waiting[np.argsort(d.at_bot_s[waiting])]  # the gate lets them go in order

@@ -48,10 +48,13 @@ def test_an_overloaded_cell_is_warned_of_as_cell_run_warns(
 
 def test_parts_past_the_run_get_a_note(tmp_path: Path,
                                        capsys: pytest.CaptureFixture[str]) -> None:
+    from cell.cli.animate import notes
+    from cell.scenario.schema import load_scenario
+
+    # parts 4-5: within the run, nothing to say (the lines the command prints are notes')
+    assert notes(load_scenario("baseline", {"run.parts": 5}), 4, 2) == []
     common = ["animate", "baseline", "--set", "run.parts=5", "--out", str(tmp_path / "a.gif"),
               "--speed", "200", "--dpi", "20", "--parts", "2"]
-    assert cli([*common, "--from-part", "4"]) == 0  # parts 4-5: within the run
-    assert said(capsys) == []
     assert cli([*common, "--from-part", "5"]) == 0
     (note,) = said(capsys)
     assert in_order(note, "cell: note: --from-part 5 --parts 2", "up to 6", "run.parts = 5",
@@ -62,10 +65,12 @@ def test_a_run_of_hours_is_animated_and_its_parts_counted_from_its_hours(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """A scenario with run.hours animates (the window's run is of parts: it was refused as
     giving both), and the note counts the parts the hours bring, 0.1 h / 22.586 s: about 16."""
+    from cell.cli.animate import notes
+    from cell.scenario.schema import load_scenario
+
+    assert notes(load_scenario("baseline", {"run.hours": 0.1}), 15, 2) == []  # parts 15-16
     common = ["animate", "baseline", "--set", "run.hours=0.1", "--out", str(tmp_path / "a.gif"),
               "--speed", "200", "--dpi", "20", "--parts", "2"]
-    assert cli([*common, "--from-part", "15"]) == 0
-    assert said(capsys) == []
     assert cli([*common, "--from-part", "16"]) == 0
     (note,) = said(capsys)
     assert in_order(note, "cell: note: --from-part 16 --parts 2", "up to 17",

@@ -2,20 +2,24 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
 from pathlib import Path
+from types import SimpleNamespace
 
 import pandas as pd
 import pytest
 import scipy.stats
 import yaml
+from matplotlib.figure import Figure
 
 from cell.cli.main import main
 from cell.experiments.sweep import load_sweep, run_sweep
 from cell.reporting.experiment.report import difference_table
 from tests.prose import in_order
 
-# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
-pytestmark = pytest.mark.usefixtures("unrendered")
+# Figures built, not laid out: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unlaid")
 
 
 def scenario(tmp_path: Path, name: str, **settings) -> Path:
@@ -178,11 +182,33 @@ def verdict_rows(out: str) -> dict[str, str]:
             if line.startswith("  ")}  # not the overall line (issue 24)
 
 
-def test_compare_warns_once_when_run_lengths_differ_and_leaves_counts_uncompared(
-        tmp_path, capsys):
-    a = scenario(tmp_path, "short", run__parts=30)
-    b = scenario(tmp_path, "long", run__parts=45, controller__policy="non-adaptive")
-    out, warned = compare_run(capsys, a, b)
+@pytest.fixture(scope="module")
+def run_lengths(tmp_path_factory) -> SimpleNamespace:
+    """``cell compare --out`` of runs of 30 and 45 parts (``differ``), and again with the
+    ``--set run.parts=45`` its warning suggests (``same``): each one's stdout, warning lines and
+    folder."""
+    from tests.reporting.conftest import unlaid_savefig
+
+    tmp = tmp_path_factory.mktemp("run_lengths")
+    a = scenario(tmp, "short", run__parts=30)
+    b = scenario(tmp, "long", run__parts=45, controller__policy="non-adaptive")
+    said = {}
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(Figure, "savefig", unlaid_savefig)
+        for name, more in (("differ", []), ("same", ["--set", "run.parts=45"])):
+            out, err = io.StringIO(), io.StringIO()
+            with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+                code = main(["compare", str(a), str(b), "--replications", "3", "--workers", "1",
+                             "--out", str(tmp / name), *more])
+            assert code == 0, err.getvalue()
+            said[name] = SimpleNamespace(
+                out=out.getvalue(), folder=tmp / name,
+                warned=[line for line in err.getvalue().splitlines() if "warning" in line])
+    return SimpleNamespace(**said)
+
+
+def test_compare_warns_once_when_run_lengths_differ_and_leaves_counts_uncompared(run_lengths):
+    out, warned = run_lengths.differ.out, run_lengths.differ.warned
     assert len(warned) == 1, warned
     assert "short runs 30 parts, long 45" in warned[0] and "not comparable" in warned[0]
     assert "--set run.parts=45" in warned[0]
@@ -194,9 +220,8 @@ def test_compare_warns_once_when_run_lengths_differ_and_leaves_counts_uncompared
         assert "not compared" not in rows[rate] and "±" in rows[rate]
     assert "3 replications of 30 and 45 parts" in out.splitlines()[0]
     # the suggested --set makes the windows equal: no warning, counts compared per run
-    out, warned = compare_run(capsys, a, b, "--set", "run.parts=45")
-    assert warned == []
-    assert "per 45-part run" in verdict_rows(out)["Parts delivered"]
+    assert run_lengths.same.warned == []
+    assert "per 45-part run" in verdict_rows(run_lengths.same.out)["Parts delivered"]
 
 
 def test_compare_does_not_warn_when_windows_are_equal(tmp_path, capsys):
@@ -221,20 +246,16 @@ def test_compare_warns_when_warmups_differ(tmp_path, capsys):
     assert warned == [] and "not compared" not in out
 
 
-def test_compare_report_carries_the_window_caveat(tmp_path, capsys):
+def test_compare_report_carries_the_window_caveat(run_lengths):
     """``--out``'s report.md says what the warning said, before its tables; not otherwise."""
-    a = scenario(tmp_path, "short", run__parts=30)
-    b = scenario(tmp_path, "long", run__parts=45, controller__policy="non-adaptive")
-    _, warned = compare_run(capsys, a, b, "--out", str(tmp_path / "differ"))
-    report = (tmp_path / "differ" / "report.md").read_text()
-    said = warned[0].split("warning: ", 1)[1]
+    report = (run_lengths.differ.folder / "report.md").read_text()
+    said = run_lengths.differ.warned[0].split("warning: ", 1)[1]
     assert f"**Caveat:** {said}." in report
     assert report.index("**Caveat:**") < report.index("## ")
-    compare_run(capsys, a, b, "--out", str(tmp_path / "same"), "--set", "run.parts=45")
-    assert "Caveat" not in (tmp_path / "same" / "report.md").read_text()
+    assert "Caveat" not in (run_lengths.same.folder / "report.md").read_text()
     # differences.csv: the counts only over the same window, the rates either way
-    differ, same = (set(pd.read_csv(tmp_path / d / "differences.csv")["measure"])
-                    for d in ("differ", "same"))
+    differ, same = (set(pd.read_csv(run.folder / "differences.csv")["measure"])
+                    for run in (run_lengths.differ, run_lengths.same))
     counts = {"parts_delivered", "parts_missed", "spacing_outside_tol"}
     assert counts <= same and not counts & differ
     assert "parts_per_hr_wallclock" in differ & same
@@ -246,7 +267,7 @@ def test_compare_warns_when_both_warmups_are_auto(tmp_path, capsys):
     a = scenario(tmp_path, "one", run__parts=30, run__warmup_parts="auto")
     b = scenario(tmp_path, "other", run__parts=30, run__warmup_parts="auto",
                  controller__policy="non-adaptive")
-    out, warned = compare_run(capsys, a, b)
+    out, warned = compare_run(capsys, a, b, "--out", str(tmp_path / "cmp"))
     assert len(warned) == 1, warned
     assert in_order(warned[0], "one has run.warmup_parts auto,", "other auto", "MSER-5",
                     "(--set run.warmup_parts=N,")
@@ -254,7 +275,6 @@ def test_compare_warns_when_both_warmups_are_auto(tmp_path, capsys):
     assert "not compared" in rows["Parts delivered"] and "auto against auto" in rows[
         "Parts delivered"]
     assert "not compared" not in rows["Parts per hour (wall clock)"]
-    compare_run(capsys, a, b, "--out", str(tmp_path / "cmp"))
     measures = set(pd.read_csv(tmp_path / "cmp" / "differences.csv")["measure"])
     assert "parts_per_hr_wallclock" in measures and "parts_delivered" not in measures
     out, warned = compare_run(capsys, a, b, "--set", "run.warmup_parts=5")

@@ -14,8 +14,8 @@ import pytest
 from cell.cli.main import main
 from cell.experiments.stats import paired_difference
 
-# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
-pytestmark = pytest.mark.usefixtures("unrendered")
+# Figures built, not laid out: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unlaid")
 
 
 def test_compare_gives_each_sides_share_of_the_bound(tmp_path, capsys):

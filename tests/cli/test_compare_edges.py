@@ -13,8 +13,8 @@ from cell.cli.main import main
 from cell.reporting.formatting import too_few
 from tests.prose import in_order
 
-# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
-pytestmark = pytest.mark.usefixtures("unrendered")
+# Figures built, not laid out: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unlaid")
 
 
 def test_a_rate_no_run_has_is_not_compared_rather_than_nan(tmp_path, capsys):

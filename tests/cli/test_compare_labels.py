@@ -13,8 +13,8 @@ from cell.cli.compare import labels
 from cell.cli.main import main
 from cell.scenario.schema import load_scenario
 
-# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
-pytestmark = pytest.mark.usefixtures("unrendered")
+# Figures built, not laid out: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unlaid")
 
 
 def write(path: Path, name: str | None, **run: object) -> Path:

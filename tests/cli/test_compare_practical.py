@@ -21,7 +21,7 @@ from cell.reporting.compare_rates import rate_error_s, rates_differ
 from cell.reporting.compare_verdict import Judged, decide
 from cell.scenario.schema import load_scenario
 
-pytestmark = pytest.mark.usefixtures("unrendered")
+pytestmark = pytest.mark.usefixtures("unlaid")
 
 A, B = "good-sensor", "cheap-sensor"
 #: Both sides' means: A delivers 177 parts more of 500 arrived; B leaves 0.125 fewer spacings

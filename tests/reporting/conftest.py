@@ -1,11 +1,13 @@
 """Figures laid out but not rasterised, for tests of what a figure says or which are drawn
-(the ``unrendered`` fixture, in tests/conftest.py, puts :func:`unrendered_savefig` in place)."""
+(the ``unrendered`` fixture, in tests/conftest.py, puts :func:`unrendered_savefig` in place);
+figures built but neither laid out nor rasterised (``unlaid``), for tests that read none."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Any
 
+import pytest
 from matplotlib.figure import Figure
 
 #: A PNG signature: what an unrendered figure's file holds (tests/reporting/test_figures.py reads
@@ -13,11 +15,32 @@ from matplotlib.figure import Figure
 STUB = b"\x89PNG\r\n\x1a\n"
 
 
-def unrendered_savefig(fig: Figure, fname: Any, *args: Any, **kwargs: Any) -> None:
-    """Everything a save does but the pixels: the layout, the texts and ticks, and any warning
-    they raise are met; the file holds :data:`STUB`."""
-    fig.draw_without_rendering()
+def stub_file(fname: Any) -> None:
+    """Write :data:`STUB` where a save would write its PNG."""
     if hasattr(fname, "write"):
         fname.write(STUB)
     else:
         Path(fname).write_bytes(STUB)
+
+
+def unrendered_savefig(fig: Figure, fname: Any, *args: Any, **kwargs: Any) -> None:
+    """Everything a save does but the pixels: the layout, the texts and ticks, and any warning
+    they raise are met; the file holds :data:`STUB`."""
+    fig.draw_without_rendering()
+    stub_file(fname)
+
+
+def unlaid_savefig(fig: Figure, fname: Any, *args: Any, **kwargs: Any) -> None:
+    """The file a save writes, holding :data:`STUB`; the figure, built with all its artists,
+    is not laid out (its layout is most of a save's time when nothing is rasterised)."""
+    stub_file(fname)
+
+
+@pytest.fixture
+def unlaid(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Figures built but not laid out: for tests of where a report's files go and of what its
+    tables, markdown and messages say, which read no figure and turn no warning into an error.
+    A figure's layout and pixels are checked where a test reads them: tests/reporting/
+    test_figures.py (every thesis figure a real PNG), test_experiment_plots.py (a report's),
+    and the ``unrendered`` tests that read a figure's texts."""
+    monkeypatch.setattr(Figure, "savefig", unlaid_savefig)

@@ -23,7 +23,7 @@ def runs() -> pd.DataFrame:
 
 
 def test_the_report_is_what_the_code_makes_of_its_runs(runs: pd.DataFrame, tmp_path: Path,
-                                                       unrendered: None) -> None:
+                                                       unlaid: None) -> None:
     out = report.write(tmp_path / "b", runs.to_dict("records"))
     for name in ("report.md", "benchmark.csv", "runs.csv"):
         assert (out / name).read_bytes() == (DIR / name).read_bytes(), name

@@ -6,6 +6,7 @@ contract written by folder."""
 from __future__ import annotations
 
 import ast
+import functools
 import re
 from pathlib import Path
 
@@ -21,6 +22,17 @@ FOLDERS = ("cli", "reporting", "bench", "experiments", "rl", "sim", "scenario", 
 def modules() -> list[Path]:
     return [p.relative_to(PACKAGE) for p in sorted(PACKAGE.rglob("*.py"))
             if p.name != "__init__.py"]
+
+
+@functools.cache
+def sources() -> dict[Path, tuple[str, ast.Module]]:
+    """Every module of the package, its text and its tree, read and parsed once for the tests
+    that walk them all."""
+    out = {}
+    for p in sorted(PACKAGE.rglob("*.py")):
+        src = p.read_text(encoding="utf-8")
+        out[p] = (src, ast.parse(src))
+    return out
 
 
 def test_architecture_lists_every_module() -> None:
@@ -90,11 +102,10 @@ def test_init_files_only_re_export() -> None:
 
 def test_modules_and_functions_are_small() -> None:
     big = []
-    for p in sorted(PACKAGE.rglob("*.py")):
-        src = p.read_text(encoding="utf-8")
+    for p, (src, tree) in sources().items():
         if src.count("\n") > 400:
             big.append(f"{p.relative_to(ROOT)}: {src.count(chr(10))} lines")
-        for node in ast.walk(ast.parse(src)):
+        for node in ast.walk(tree):
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 n = (node.end_lineno or node.lineno) - node.lineno + 1
                 if n > 60:
@@ -132,8 +143,7 @@ def test_the_private_import_check_sees_one() -> None:
 
 def test_no_module_imports_a_private_name() -> None:
     private = []
-    for p in sorted(PACKAGE.rglob("*.py")):
-        tree = ast.parse(p.read_text(encoding="utf-8"))
+    for p, (_, tree) in sources().items():
         private += [f"{p.relative_to(ROOT)}:{line} {name}" for line, name in private_imports(tree)]
     assert private == []
 

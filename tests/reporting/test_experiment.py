@@ -29,10 +29,10 @@ from cell.reporting.experiment.report import (
 from cell.scenario import catalog
 from tests.prose import in_order
 
-# Figures laid out, not rasterised, in the tests that make their own reports (they read the
+# Figures built, not laid out, in the tests that make their own reports (they read the
 # tables, markdown and file names); known_report, module-scoped and so set up before any
 # function fixture, draws real PNGs.
-pytestmark = pytest.mark.usefixtures("unrendered")
+pytestmark = pytest.mark.usefixtures("unlaid")
 
 ROOT = Path(__file__).resolve().parents[2]
 WHATIF = ROOT / "reports" / "whatif"

@@ -8,6 +8,7 @@ from __future__ import annotations
 import re
 import struct
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -38,33 +39,59 @@ def png_size(path: Path) -> tuple[int, int]:
     return struct.unpack(">II", head[16:24])
 
 
+#: The committed figures' scenario (``cell figures``'s default), at 60 parts a run.
+SCENARIO = load_scenario("baseline").with_overrides({"run.parts": 60})
+#: The figures drawn to pixels: one of each drawing function.  Fig. 18-21 are Fig. 17's
+#: function for another joint, Fig. 24 Fig. 23's for running means, Fig. 26-30 Fig. 25's for
+#: another cycle: those are laid out (their texts read here), not rasterised.
+RASTERISED = (8, 9, 12, 13, 14, 15, 16, 17, 22, 23, 25)
+
+
 @pytest.fixture(scope="module")
-def captured(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, list[str]]]:
-    """Every figure drawn (60 parts a run), and the texts of each as it was saved."""
+def captured(tmp_path_factory: pytest.TempPathFactory) -> SimpleNamespace:
+    """Every figure drawn once (:data:`RASTERISED`'s to pixels), for every test here: the
+    folder (``out``), the texts of each as it was saved (``texts``), each figure as saved
+    (``figures``), by file stem, and the runs Fig. 22-30 were drawn from (``runs``)."""
+    from cell.reporting.figures import runs as run_figures
+    from tests.reporting.conftest import unrendered_savefig
+
     out = tmp_path_factory.mktemp("figures")
     texts: dict[str, list[str]] = {}
-    original = Figure.savefig
+    figures: dict[str, Figure] = {}
+    simulated: list[Any] = []
+    original, simulate_runs = Figure.savefig, run_figures.simulate_runs
 
     def savefig(fig: Figure, fname: Any, *args: Any, **kwargs: Any) -> None:
-        texts[Path(fname).name.lstrip(".").split(".png")[0]] = [
-            t.get_text() for t in fig.findobj(Text) if t.get_visible() and t.get_text()]
-        original(fig, fname, *args, **kwargs)
+        stem = Path(fname).name.lstrip(".").split(".png")[0]
+        texts[stem] = [t.get_text() for t in fig.findobj(Text) if t.get_visible() and t.get_text()]
+        figures[stem] = fig
+        save = original if stem in {FILES[n] for n in RASTERISED} else unrendered_savefig
+        save(fig, fname, *args, **kwargs)
+
+    def kept(*args: Any, **kwargs: Any) -> Any:
+        simulated.append(simulate_runs(*args, **kwargs))
+        return simulated[-1]
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(Figure, "savefig", savefig)
-        make_figures(default_scenario(), out, parts=60)
-    return out, texts
+        mp.setattr(run_figures, "simulate_runs", kept)
+        make_figures(SCENARIO, out)
+    (runs,) = simulated
+    return SimpleNamespace(out=out, texts=texts, figures=figures, runs=runs)
 
 
 @pytest.fixture(scope="module")
-def drawn(captured: tuple[Path, dict[str, list[str]]]) -> Path:
-    return captured[0]
+def drawn(captured: SimpleNamespace) -> Path:
+    return captured.out
 
 
-@pytest.mark.parametrize("number", sorted(FILES))
+def test_every_figure_is_written(drawn: Path) -> None:
+    assert sorted(p.name for p in drawn.iterdir()) == sorted(f"{stem}.png" for stem in FILES.values())
+
+
+@pytest.mark.parametrize("number", RASTERISED)
 def test_every_figure_is_a_readable_png(drawn: Path, number: int) -> None:
     path = drawn / f"{FILES[number]}.png"
-    assert path.exists(), f"Fig. {number} missing"
     width, height = png_size(path)
     assert width >= 600 and height >= 400          # readable on screen
     assert width <= 1400 and height <= 1200        # modest (dpi ~110)
@@ -175,7 +202,7 @@ REPO = Path(__file__).resolve().parents[2]
 def test_no_figure_cites_what_a_reader_cannot_open(captured) -> None:
     """No SPEC, no files outside the repository, no issue numbers; every docs/ link
     names a page and a section that exist."""
-    _, texts = captured
+    texts = captured.texts
     assert set(texts) == set(FILES.values())
     links = 0
     for name, words in texts.items():
@@ -195,9 +222,8 @@ def test_fig23_24_say_which_non_adaptive_mean_they_draw(captured) -> None:
     the summary's actual cycle is the same Σ D over the parts delivered (docs/accounting.md)."""
     from cell.sim.simulation import simulate
 
-    _, texts = captured
-    s = default_scenario().with_overrides({"run.parts": 60, "controller.policy": "non-adaptive"})
-    r = simulate(s)
+    texts = captured.texts
+    r = simulate(SCENARIO.with_overrides({"controller.policy": "non-adaptive"}))
     d, summary = r.parts, r.summary.as_dict()
     total = d["thesis_interval_s"].sum()
     delivered = len(d) - int(d["missed_thesis"].sum())
@@ -215,17 +241,12 @@ def test_fig23_24_say_which_non_adaptive_mean_they_draw(captured) -> None:
 
 # --------------------------------------------------------------------------- Fig. 22
 @pytest.fixture(scope="module")
-def fig22() -> tuple[Figure, Any, Any]:
-    from cell.reporting.figures.runs import simulate_runs
-    from cell.reporting.figures.style import style
-    from cell.reporting.figures.tip import fig22_figure, pick_transfer
+def fig22(captured: SimpleNamespace) -> tuple[Figure, Any, Any]:
+    """Fig. 22 as saved, the record of the transfer it draws, and its scenario."""
+    from cell.reporting.figures.tip import pick_transfer
 
-    s = load_scenario("baseline")             # the committed figure's run
-    runs = simulate_runs(s, cycles=(22.5872,))
-    with style():
-        fig = fig22_figure(runs, step_table(s), s)
-    fig.canvas.draw()
-    return fig, runs.adaptive.parts.iloc[pick_transfer(runs.adaptive)], s
+    adaptive = captured.runs.adaptive
+    return captured.figures[FILES[22]], adaptive.parts.iloc[pick_transfer(adaptive)], SCENARIO
 
 
 def tip_curve(fig: Figure) -> tuple[np.ndarray, np.ndarray]:
@@ -352,14 +373,8 @@ def test_fig22_no_label_is_drawn_over(fig22) -> None:
     assert covered(fig, [*steps, *ax.collections, *ax.lines]) == []
 
 
-def test_fig09_no_name_is_drawn_over() -> None:
-    from cell.reporting.figures.layout import fig09_figure
-    from cell.reporting.figures.style import style
-
-    s = default_scenario()
-    with style():
-        fig = fig09_figure(s, step_table(s))
-    fig.canvas.draw()
+def test_fig09_no_name_is_drawn_over(captured: SimpleNamespace) -> None:
+    fig = captured.figures[FILES[9]]
     ax = fig.axes[0]
     names = {t.get_text() for t in ax.texts}
     assert {"B", "F", "G", "K", "LO", "TD"} <= names

@@ -1,7 +1,7 @@
 """``cell figures`` of a scenario whose non-adaptive robot cannot make some of Table 7.1's cycles:
 every other figure is drawn, the Fig. 25-30 it cannot make are left out with one warning line
 naming them, the cycles, the scenario's shortest fixed cycle and the way out when the nominal
-cycle is why (laid out, not rasterised: tests/reporting/test_figures.py reads real PNGs)."""
+cycle is why (built, not laid out: tests/reporting/test_figures.py reads real PNGs)."""
 
 from __future__ import annotations
 
@@ -40,7 +40,7 @@ def test_the_scenario_cannot_make_the_two_shortest_cycles():
         fixed_plan(k, cycle)
 
 
-def test_the_others_are_drawn_and_one_line_says_which_are_not(tmp_path: Path, unrendered):
+def test_the_others_are_drawn_and_one_line_says_which_are_not(tmp_path: Path, unlaid):
     s = default_scenario().with_overrides(SLOWER)
     said: list[str] = []
     drawn = make_figures(s, tmp_path, only=[8, 25, 28, 29, 30], warn=said.append)
@@ -59,7 +59,7 @@ def test_the_others_are_drawn_and_one_line_says_which_are_not(tmp_path: Path, un
     assert said == []
 
 
-def test_no_way_out_is_offered_when_the_robot_is_why(tmp_path: Path, unrendered):
+def test_no_way_out_is_offered_when_the_robot_is_why(tmp_path: Path, unlaid):
     """Slower motors under the thesis's own nominal: no nominal cycle would help."""
     s = default_scenario().with_overrides({
         "robot.motors.max_rate_no_load_rad_s": [0.3356, 0.288, 0.656, 1.616, 1.616],
@@ -74,7 +74,7 @@ def test_no_way_out_is_offered_when_the_robot_is_why(tmp_path: Path, unrendered)
 
 
 def test_the_command_draws_the_rest_and_warns_once(tmp_path: Path, capsys: pytest.CaptureFixture[str],
-                                                   unrendered):
+                                                   unlaid):
     scenario = tmp_path / "slower arrivals.yaml"
     scenario.write_text("arrivals: {distribution: gamma, mean_s: 23.3, cv: 0.3}\nrun: {parts: 30}\n")
     out = tmp_path / "figs"

@@ -67,7 +67,7 @@ def test_fig13_marks_too_few_draws_on_the_axis_and_says_so(tmp_path: Path):
      "fig14_gengamma_cdf"),
     ("{trace_csv: gaps.csv}", "fig13_trace_pdf", "fig14_trace_cdf")])
 def test_fig13_14_files_are_named_after_the_arrivals(tmp_path: Path, arrivals: str | None,
-                                                     pdf: str, cdf: str, unrendered):
+                                                     pdf: str, cdf: str, unlaid):
     """Fig. 13/14 are written under the family's name, the thesis's for a Weibull, and a
     figure folder holding either is one `cell figures` may replace."""
     from cell.plumbing.output.atomic import OutputDir

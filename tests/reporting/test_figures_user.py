@@ -79,10 +79,13 @@ def test_the_thesis_captions_stay_for_the_thesis_cell(tmp_path: Path):
     assert "non-adaptive at" not in got[23] and "non-adaptive's cycle" not in got[23]
 
 
-@pytest.mark.parametrize("parts", [1, 5, 13])
-def test_a_short_run_says_no_nan_and_no_numpy_warning(tmp_path: Path, parts: int):
-    got = texts(default_scenario().with_overrides({"run.parts": parts}), tmp_path,
-                [13, 14, 22, 23, 24, 25])
+@pytest.mark.parametrize(("parts", "numbers"), [
+    (1, [13, 14, 22, 23, 24, 25]),  # one draw, one part: no time between two deliveries
+    (5, [13, 14, 22, 23, 24, 25]),  # fewer parts than a lot: dots on the curves, one short lot
+    (13, [23, 24]),  # a whole lot and a short one; Fig. 13, 14, 22, 25 draw 13 parts as they do 5
+])
+def test_a_short_run_says_no_nan_and_no_numpy_warning(tmp_path: Path, parts: int, numbers: list[int]):
+    got = texts(default_scenario().with_overrides({"run.parts": parts}), tmp_path, numbers)
     for number, text in got.items():
         assert not re.search(r"\bnan\b", text, re.IGNORECASE), (number, text)
     short = parts % LOT
@@ -116,7 +119,7 @@ def test_no_part_delivered_says_so(tmp_path: Path):
 
 
 def test_the_command_warns_of_an_overload_as_cell_run_does(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                                                          capsys: pytest.CaptureFixture[str], unrendered):
+                                                          capsys: pytest.CaptureFixture[str], unlaid):
     import functools
 
     import cell.reporting.figures.thesis_figures

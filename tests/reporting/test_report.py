@@ -178,7 +178,7 @@ def test_reading_follows_the_direction_of_the_numbers():
     assert "+66.7%" in more  # actual cycle 50 s against 30 s
 
 
-def test_the_report_writes_both_table_7_1_files(sweeps, tmp_path, unrendered):
+def test_the_report_writes_both_table_7_1_files(sweeps, tmp_path, unlaid):
     """A Table 7.1 sweep's report holds table_7_1.csv (the long form, read back whole) and
     table_7_1.md, as :func:`table_7_1_files` makes them."""
     from cell.reporting.experiment.report import plan_report, write_report

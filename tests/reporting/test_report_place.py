@@ -11,15 +11,22 @@ from cell.cli.main import main
 from cell.experiments.sweep import load_sweep
 from cell.scenario import catalog
 
-# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
-pytestmark = pytest.mark.usefixtures("unrendered")
+# Figures built, not laid out: these tests read which files are written where.
+pytestmark = pytest.mark.usefixtures("unlaid")
 
 ROOT = Path(__file__).resolve().parents[2]
 WHATIF = ROOT / "reports" / "whatif"
 
 
 # --------------------------------------------------------------------------- where the report goes
-def test_a_shared_report_folder_gets_a_subfolder_and_keeps_its_files(sweeps, tmp_path):
+@pytest.fixture
+def stand_in(sweeps, monkeypatch):
+    """The stand-in replication (tests/conftest.py) in place of the cell's runs: where a report
+    goes does not hang on its numbers."""
+    monkeypatch.setattr("cell.experiments.sweep.simulate_summary", sweeps.bookkeeping)
+
+
+def test_a_shared_report_folder_gets_a_subfolder_and_keeps_its_files(sweeps, tmp_path, stand_in):
     shared = tmp_path / "reports"
     shared.mkdir()
     (shared / "README.md").write_text("mine\n")
@@ -34,7 +41,8 @@ def test_a_shared_report_folder_gets_a_subfolder_and_keeps_its_files(sweeps, tmp
         p.name for p in (shared / "sweep").iterdir()}
 
 
-def test_a_report_into_the_results_folder_keeps_table_7_1_with_the_report(sweeps, tmp_path):
+def test_a_report_into_the_results_folder_keeps_table_7_1_with_the_report(sweeps, tmp_path,
+                                                                          stand_in):
     path = sweeps.write(tmp_path, replications=2, batch=2, set={"run.parts": 500})
     out = tmp_path / "o"
     assert main(["sweep", str(path), "--out", str(out), "--workers", "1"]) == 0
@@ -45,7 +53,7 @@ def test_a_report_into_the_results_folder_keeps_table_7_1_with_the_report(sweeps
         p.name for p in (out / "sweep").iterdir()}
 
 
-def test_a_report_folder_of_its_own_holds_table_7_1_beside_the_rest(sweeps, tmp_path):
+def test_a_report_folder_of_its_own_holds_table_7_1_beside_the_rest(sweeps, tmp_path, stand_in):
     path = sweeps.write(tmp_path, replications=2, batch=2, set={"run.parts": 500})
     assert main(["sweep", str(path), "--out", str(tmp_path / "o"), "--workers", "1",
                  "--report", str(tmp_path / "rep")]) == 0
