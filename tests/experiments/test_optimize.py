@@ -33,17 +33,30 @@ def _study(tmp_path: Path, text: str, name: str = "study.yaml") -> Path:
     return path
 
 
-def test_the_optimiser_finds_the_grid_optimum_of_the_fixed_cycle_robot(tmp_path: Path,
-                                                                        unrendered) -> None:
+@pytest.fixture(scope="module")
+def whole(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """FIXED's 8 trials run unbroken (one worker), once for the module: the grid test reads its
+    best, the killed-and-resumed run must equal its trials."""
+    from matplotlib.figure import Figure
+
+    from tests.reporting.conftest import unrendered_savefig
+
+    folder = tmp_path_factory.mktemp("whole")
+    path = _study(folder, FIXED.replace("TRIALS", "8"))
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(Figure, "savefig", unrendered_savefig)  # as the ``unrendered`` fixture
+        assert main(["optimize", str(path), "--out", str(folder / "out")]) == 0
+    return folder
+
+
+def test_the_optimiser_finds_the_grid_optimum_of_the_fixed_cycle_robot(whole: Path) -> None:
     """The fixed-cycle robot's ideal cycle that loses fewest parts, on the same streams: the
     exhaustive grid (9 cycles) is the independent answer; 8 trials of TPE must reach its
     best within one part."""
-    path = _study(tmp_path, FIXED.replace("TRIALS", "8"))
-    study = load_study(path)
+    study = load_study(whole / "study.yaml")
     grid = {round(20.1 + 0.3 * i, 1): sum(r["parts_missed"] for r in replicate(
         study, {"controller.ideal_cycle_s": 20.1 + 0.3 * i}, range(2))) / 2 for i in range(9)}
-    assert main(["optimize", str(path), "--out", str(tmp_path / "out")]) == 0
-    best = pd.read_csv(tmp_path / "out" / "best.csv")
+    best = pd.read_csv(whole / "out" / "best.csv")
     assert best["parts_missed"].min() <= min(grid.values()) + 1.0
     assert grid[round(float(best["controller.ideal_cycle_s"].iloc[0]), 1)] <= min(grid.values()) + 1.0
     # the losses fall as the cycle shortens (Table 7.1): the optimum is near the shortest cycle
@@ -80,7 +93,7 @@ sys.exit(main(sys.argv[1:]))
 """
 
 
-def test_a_killed_optimize_resumes_without_losing_or_repeating_a_trial(tmp_path: Path,
+def test_a_killed_optimize_resumes_without_losing_or_repeating_a_trial(tmp_path: Path, whole: Path,
                                                                         unrendered) -> None:
     path = _study(tmp_path, FIXED.replace("TRIALS", "8"))
     out = tmp_path / "out"
@@ -94,10 +107,9 @@ def test_a_killed_optimize_resumes_without_losing_or_repeating_a_trial(tmp_path:
     resumed = pd.read_csv(out / "trials.csv")
     assert len(resumed) == 8 and resumed["trial"].is_unique
     # the same as an unbroken run with the same seed (one worker): no trial lost or repeated
-    assert main(["optimize", str(path), "--out", str(tmp_path / "whole")]) == 0
-    whole = pd.read_csv(tmp_path / "whole" / "trials.csv")
+    unbroken = pd.read_csv(whole / "out" / "trials.csv")
     cols = ["controller.ideal_cycle_s", "parts_missed"]
-    assert resumed[cols].reset_index(drop=True).equals(whole[cols].reset_index(drop=True))
+    assert resumed[cols].reset_index(drop=True).equals(unbroken[cols].reset_index(drop=True))
 
 
 BAD = {
