@@ -13,6 +13,7 @@ import pytest
 
 from cell.cli.main import main
 from cell.experiments.study import load_study, replicate
+from tests.experiments.unlaid import unlaid, unlaid_savefig  # noqa: F401 (unlaid: the fixture)
 
 BASE = Path(__file__).resolve().parents[2] / "scenarios" / "baseline.yaml"
 
@@ -39,12 +40,10 @@ def whole(tmp_path_factory: pytest.TempPathFactory) -> Path:
     best, the killed-and-resumed run must equal its trials."""
     from matplotlib.figure import Figure
 
-    from tests.reporting.conftest import unrendered_savefig
-
     folder = tmp_path_factory.mktemp("whole")
     path = _study(folder, FIXED.replace("TRIALS", "8"))
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(Figure, "savefig", unrendered_savefig)  # as the ``unrendered`` fixture
+        mp.setattr(Figure, "savefig", unlaid_savefig)  # as the ``unlaid`` fixture
         assert main(["optimize", str(path), "--out", str(folder / "out")]) == 0
     return folder
 
@@ -93,8 +92,9 @@ sys.exit(main(sys.argv[1:]))
 """
 
 
-def test_a_killed_optimize_resumes_without_losing_or_repeating_a_trial(tmp_path: Path, whole: Path,
-                                                                        unrendered) -> None:
+@pytest.mark.usefixtures("unlaid")
+def test_a_killed_optimize_resumes_without_losing_or_repeating_a_trial(tmp_path: Path,
+                                                                        whole: Path) -> None:
     path = _study(tmp_path, FIXED.replace("TRIALS", "8"))
     out = tmp_path / "out"
     cmd = [sys.executable, "-c", KILLED_AT_THE_4TH_TRIAL, "optimize", str(path), "--out", str(out)]
@@ -141,7 +141,8 @@ def test_bad_study_files_get_one_line_and_exit_2(tmp_path: Path, capsys, case: s
 
 
 
-def test_a_killed_optimize_ends_as_every_command_does(tmp_path: Path, unrendered, monkeypatch,
+@pytest.mark.usefixtures("unlaid")
+def test_a_killed_optimize_ends_as_every_command_does(tmp_path: Path, monkeypatch,
                                                       capsys) -> None:
     """kill (SIGTERM) during the trials: 143 and ``cell: terminated`` last (it said 130 and
     ``cell: interrupted``, its own handler's), the finished trial kept for --resume."""
