@@ -268,6 +268,7 @@ def test_money_and_energy_are_objectives_where_the_base_gives_their_section(tmp_
     assert ("costs" if measure.startswith("cost") else "energy") in refused.value.why
 
 
+@pytest.mark.usefixtures("unlaid")
 def test_an_optimisation_over_places_and_a_station_s_key(tmp_path: Path) -> None:
     """A buffer's places and a station's keys (by its name) are varied like any other key
     (docs/layout.md): each trial's row holds the values it ran, whole places whole, and the
