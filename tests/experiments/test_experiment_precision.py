@@ -9,9 +9,10 @@ import pytest
 
 from cell.experiments.sweep import load_sweep, run_sweep
 from cell.reporting.experiment.report import plan_report, write_report
+from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 
-# Figures laid out, not rasterised: these tests read the tables and markdown.
-pytestmark = pytest.mark.usefixtures("unrendered")
+# Figures drawn, neither laid out nor rasterised: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unlaid")
 
 
 def gaps(scenario, seed) -> dict:

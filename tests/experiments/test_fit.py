@@ -18,6 +18,7 @@ from cell.experiments.fit.budget import subsample
 from cell.experiments.fit.mle import Fit, fit_trace
 from cell.experiments.fit.output import arrivals_yaml, format_table
 from cell.plumbing.errors import ScenarioError
+from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 
 # Thesis eq. 6.9: T = 17.6019 + 5.4342 (-ln(1 - u))^0.2038.
 THESIS = {"c": 1 / 0.2038, "loc": 17.6019, "scale": 5.4342}
@@ -281,6 +282,7 @@ def test_arrival_times_are_refused_without_times(tmp_path: Path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["times.csv"]
 
 
+@pytest.mark.usefixtures("unlaid")  # its figure is not what it tests
 def test_times_fits_the_differenced_column(tmp_path: Path, capsys):
     times = _write(tmp_path / "times.csv", "arrival_s", _arrival_times())
     gaps = np.diff(np.array(_arrival_times(), dtype=float))

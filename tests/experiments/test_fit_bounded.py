@@ -24,6 +24,7 @@ from cell.experiments.fit.mle import fit_trace
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.schema import load_scenario
 from cell.scenario.trace_file import cells_of, find_column, records
+from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 from tests.prose import in_order
 
 
@@ -92,6 +93,7 @@ def test_a_budget_or_max_gap_that_is_no_time_is_refused(small: Path, value: str)
 
 
 # --------------------------------------------------------------------------- long traces
+@pytest.mark.usefixtures("unlaid")  # its figure is not what it tests
 def test_a_long_trace_is_fitted_on_a_seeded_subsample(tmp_path: Path, capsys):
     x = stats.gamma(a=9.0, loc=10.0, scale=1.5).rvs(MAX_FIT_VALUES * 4, random_state=np.random.default_rng(2))
     part = subsample(x)

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from matplotlib.figure import Figure
 from scipy import stats
 
 from cell.cli.fit import add_arguments
@@ -20,6 +21,7 @@ from cell.experiments.fit.pattern import LEVEL, MAX_TESTED, WORK, find_pattern, 
 from cell.experiments.sweep.runner import simulate_summary
 from cell.scenario.schema import load_scenario
 from cell.sim.simulation import simulate
+from tests.experiments.unlaid import unlaid_savefig
 
 HOUR = 3600.0
 #: Eq. 6.9's Weibull, the thesis's gaps: T = 17.6019 + 5.4342 (-ln(1 - u))^0.2038.
@@ -133,11 +135,13 @@ def shift_log(tmp_path_factory) -> dict:
     gaps = np.diff(np.concatenate([[0], ms])) / 1000.0
     (folder / "gaps.csv").write_text("interarrival_s\n" + "".join(f"{g}\n" for g in gaps))
     blocks = {}
-    for name, extra in (("profile", []), ("iid", ["--iid"])):
-        out = folder / f"{name}.yaml"
-        assert cmd_fit(parse(str(folder / "log.csv"), "--column", "time", "--times",
-                             "--families", "weibull_min", "--out", str(out), *extra)) == 0
-        blocks[name] = out.read_text()
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(Figure, "savefig", unlaid_savefig)  # the blocks are read, not the figures
+        for name, extra in (("profile", []), ("iid", ["--iid"])):
+            out = folder / f"{name}.yaml"
+            assert cmd_fit(parse(str(folder / "log.csv"), "--column", "time", "--times",
+                                 "--families", "weibull_min", "--out", str(out), *extra)) == 0
+            blocks[name] = out.read_text()
     return {"folder": folder, "blocks": blocks, "gaps": gaps}
 
 

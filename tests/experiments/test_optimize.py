@@ -13,6 +13,7 @@ import pytest
 
 from cell.cli.main import main
 from cell.experiments.study import load_study, replicate
+from tests.experiments.unlaid import unlaid, unlaid_savefig  # noqa: F401 (unlaid: the fixture)
 
 BASE = Path(__file__).resolve().parents[2] / "scenarios" / "baseline.yaml"
 
@@ -33,17 +34,28 @@ def _study(tmp_path: Path, text: str, name: str = "study.yaml") -> Path:
     return path
 
 
-def test_the_optimiser_finds_the_grid_optimum_of_the_fixed_cycle_robot(tmp_path: Path,
-                                                                        unrendered) -> None:
+@pytest.fixture(scope="module")
+def whole(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """FIXED's 8 trials run unbroken (one worker), once for the module: the grid test reads its
+    best, the killed-and-resumed run must equal its trials."""
+    from matplotlib.figure import Figure
+
+    folder = tmp_path_factory.mktemp("whole")
+    path = _study(folder, FIXED.replace("TRIALS", "8"))
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(Figure, "savefig", unlaid_savefig)  # as the ``unlaid`` fixture
+        assert main(["optimize", str(path), "--out", str(folder / "out")]) == 0
+    return folder
+
+
+def test_the_optimiser_finds_the_grid_optimum_of_the_fixed_cycle_robot(whole: Path) -> None:
     """The fixed-cycle robot's ideal cycle that loses fewest parts, on the same streams: the
     exhaustive grid (9 cycles) is the independent answer; 8 trials of TPE must reach its
     best within one part."""
-    path = _study(tmp_path, FIXED.replace("TRIALS", "8"))
-    study = load_study(path)
+    study = load_study(whole / "study.yaml")
     grid = {round(20.1 + 0.3 * i, 1): sum(r["parts_missed"] for r in replicate(
         study, {"controller.ideal_cycle_s": 20.1 + 0.3 * i}, range(2))) / 2 for i in range(9)}
-    assert main(["optimize", str(path), "--out", str(tmp_path / "out")]) == 0
-    best = pd.read_csv(tmp_path / "out" / "best.csv")
+    best = pd.read_csv(whole / "out" / "best.csv")
     assert best["parts_missed"].min() <= min(grid.values()) + 1.0
     assert grid[round(float(best["controller.ideal_cycle_s"].iloc[0]), 1)] <= min(grid.values()) + 1.0
     # the losses fall as the cycle shortens (Table 7.1): the optimum is near the shortest cycle
@@ -80,8 +92,9 @@ sys.exit(main(sys.argv[1:]))
 """
 
 
+@pytest.mark.usefixtures("unlaid")
 def test_a_killed_optimize_resumes_without_losing_or_repeating_a_trial(tmp_path: Path,
-                                                                        unrendered) -> None:
+                                                                        whole: Path) -> None:
     path = _study(tmp_path, FIXED.replace("TRIALS", "8"))
     out = tmp_path / "out"
     cmd = [sys.executable, "-c", KILLED_AT_THE_4TH_TRIAL, "optimize", str(path), "--out", str(out)]
@@ -94,10 +107,9 @@ def test_a_killed_optimize_resumes_without_losing_or_repeating_a_trial(tmp_path:
     resumed = pd.read_csv(out / "trials.csv")
     assert len(resumed) == 8 and resumed["trial"].is_unique
     # the same as an unbroken run with the same seed (one worker): no trial lost or repeated
-    assert main(["optimize", str(path), "--out", str(tmp_path / "whole")]) == 0
-    whole = pd.read_csv(tmp_path / "whole" / "trials.csv")
+    unbroken = pd.read_csv(whole / "out" / "trials.csv")
     cols = ["controller.ideal_cycle_s", "parts_missed"]
-    assert resumed[cols].reset_index(drop=True).equals(whole[cols].reset_index(drop=True))
+    assert resumed[cols].reset_index(drop=True).equals(unbroken[cols].reset_index(drop=True))
 
 
 BAD = {
@@ -129,7 +141,8 @@ def test_bad_study_files_get_one_line_and_exit_2(tmp_path: Path, capsys, case: s
 
 
 
-def test_a_killed_optimize_ends_as_every_command_does(tmp_path: Path, unrendered, monkeypatch,
+@pytest.mark.usefixtures("unlaid")
+def test_a_killed_optimize_ends_as_every_command_does(tmp_path: Path, monkeypatch,
                                                       capsys) -> None:
     """kill (SIGTERM) during the trials: 143 and ``cell: terminated`` last (it said 130 and
     ``cell: interrupted``, its own handler's), the finished trial kept for --resume."""
@@ -255,6 +268,7 @@ def test_money_and_energy_are_objectives_where_the_base_gives_their_section(tmp_
     assert ("costs" if measure.startswith("cost") else "energy") in refused.value.why
 
 
+@pytest.mark.usefixtures("unlaid")
 def test_an_optimisation_over_places_and_a_station_s_key(tmp_path: Path) -> None:
     """A buffer's places and a station's keys (by its name) are varied like any other key
     (docs/layout.md): each trial's row holds the values it ran, whole places whole, and the

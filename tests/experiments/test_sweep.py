@@ -17,9 +17,10 @@ from cell.experiments.sweep import load_sweep, run_sweep
 from cell.plumbing.errors import CellError, ScenarioError
 from cell.scenario import catalog
 from cell.scenario.schema import load_scenario
+from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 
-# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
-pytestmark = pytest.mark.usefixtures("unrendered")
+# Figures drawn, neither laid out nor rasterised: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unlaid")
 
 TABLE_7_1_CYCLES = [22.5872, 22.0, 21.5, 21.0, 20.5, 20.0907]
 
@@ -334,9 +335,10 @@ def test_a_grid_over_a_distribution_parameter(sweeps, tmp_path):
     assert all(p.scenario.arrivals.params["scale"] == 5.4342 for p in sweep.points)
 
 
-def test_an_interrupted_sweep_says_how_to_go_on(tmp_path):
+def test_an_interrupted_sweep_says_how_to_go_on(tmp_path, capsys):
     """Ctrl-C in the middle of ``cell sweep``: exit 130, one line naming what is kept and
-    --resume; the same command with --resume then reuses those tasks."""
+    --resume; the same command with --resume then reuses those tasks (run in this process:
+    the resume is not about a process, the Ctrl-C is)."""
     import signal
     import subprocess
     import sys
@@ -359,8 +361,8 @@ def test_an_interrupted_sweep_says_how_to_go_on(tmp_path):
     hint = next(line for line in err.splitlines() if line.startswith("cell sweep: stopped"))
     kept = int(hint.split("; ")[1].split()[0])
     assert kept > 0 and "--resume" in hint
-    done = subprocess.run([*command, "--resume"], capture_output=True, text=True, check=True)
-    assert f"{kept} reused)" in done.stdout
+    assert main([*command[3:], "--resume"]) == 0
+    assert f"{kept} reused)" in capsys.readouterr().out
 
 
 def test_a_grid_over_buffer_places_runs_each_layout(tmp_path):

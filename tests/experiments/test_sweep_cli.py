@@ -9,10 +9,11 @@ import pytest
 from cell.cli.main import main
 from cell.experiments.sweep import load_sweep, run_sweep
 from cell.plumbing.errors import CellError
+from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 from tests.prose import in_order
 
-# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
-pytestmark = pytest.mark.usefixtures("unrendered")
+# Figures drawn, neither laid out nor rasterised: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unlaid")
 
 TABLE_7_1_CYCLES = [22.5872, 22.0, 21.5, 21.0, 20.5, 20.0907]
 

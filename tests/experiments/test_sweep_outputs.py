@@ -6,10 +6,11 @@ from __future__ import annotations
 import pytest
 
 from cell.cli.main import main
+from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 from tests.prose import in_order
 
-# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
-pytestmark = pytest.mark.usefixtures("unrendered")
+# Figures drawn, neither laid out nor rasterised: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unlaid")
 
 
 def test_a_folder_with_a_users_replications_csv_is_refused_and_left_alone(sweeps, tmp_path,

@@ -10,9 +10,10 @@ import pytest
 import yaml
 
 from cell.cli.main import main
+from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 
-# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
-pytestmark = pytest.mark.usefixtures("unrendered")
+# Figures drawn, neither laid out nor rasterised: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unlaid")
 
 
 def _trace(path: Path, gap: float) -> None:

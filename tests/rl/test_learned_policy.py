@@ -17,6 +17,7 @@ from cell.rl.learned import Learned, load_weights, size
 from cell.scenario.schema import load_scenario
 from cell.sim.assembly import AssembledCell, assemble
 from cell.sim.simulation import simulate
+from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 
 STRESSED = {"arrivals.distribution": "gamma", "arrivals.cv": 1.0, "arrivals.mean_s": 17.1799,
             "controller.nominal_cycle_s": None, "sensor.lookahead": "sensor", "run.parts": 80}
@@ -49,6 +50,7 @@ def test_cell_run_takes_it_without_a_training_library(tmp_path: Path,
         assert next(csv.DictReader(f))["policy"] == "learned"
 
 
+@pytest.mark.usefixtures("unlaid")
 def test_cell_compare_takes_it(tmp_path: Path) -> None:
     a, b = tmp_path / "learned.yaml", tmp_path / "adaptive.yaml"
     for path, policy in ((a, "learned"), (b, "adaptive")):
@@ -59,7 +61,8 @@ def test_cell_compare_takes_it(tmp_path: Path) -> None:
     assert set(reps["policy"]) == {"learned", "adaptive"}
 
 
-def test_a_sweep_and_the_stress_map_take_it(tmp_path: Path, unrendered: None) -> None:
+@pytest.mark.usefixtures("unlaid")
+def test_a_sweep_and_the_stress_map_take_it(tmp_path: Path) -> None:
     from cell.reporting.maps import stress
 
     sweep = tmp_path / "sweep.yaml"

@@ -16,6 +16,7 @@ from cell.cli.main import main
 from cell.scenario.arrivals import interarrival_times
 from cell.scenario.rate_profile import Pieces
 from cell.scenario.schema import default_scenario
+from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 from tests.refusals import refused_in_one_line
 
 HOUR = 3600.0
@@ -165,6 +166,7 @@ def test_cell_run_says_the_arrivals_are_not_stationary(capsys, tmp_path: Path):
     assert "arrivals.profile" not in capsys.readouterr().out
 
 
+@pytest.mark.usefixtures("unlaid")
 def test_a_sweep_report_says_the_arrivals_are_not_stationary(sweeps, tmp_path: Path):
     profile = {"period_h": 8, "rates": [2, 1]}
     path = sweeps.write(tmp_path, set={"run.parts": 20, "arrivals.profile": profile},

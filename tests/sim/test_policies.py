@@ -18,6 +18,7 @@ from cell.sim.policies.adaptive import adaptive_plan
 from cell.sim.policies.fixed import fixed_plan
 from cell.sim.records import INPUT_FLOOR, OUTPUT_CEILING, OUTPUT_FLOOR, R2_PEAK, R4_PEAK
 from cell.sim.simulation import simulate
+from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 
 #: Table 7.1: ideal cycle -> Vavg R IV (in/s).
 VAVG_R4 = {22.5872: 3.5594, 22.0: 3.7818, 21.5: 3.9943, 21.0: 4.2321, 20.5: 4.5000,
@@ -188,7 +189,8 @@ def test_a_policy_from_outside_the_package_runs_like_the_fixed_cycle_it_is(plug_
     assert ours.belt_changes == [c for c in fixed.belt_changes]   # never steered
 
 
-def test_a_plug_in_policy_runs_through_a_sweep(plug_in, tmp_path, capsys, unrendered):
+@pytest.mark.usefixtures("unlaid")
+def test_a_plug_in_policy_runs_through_a_sweep(plug_in, tmp_path, capsys):
     sweep = tmp_path / "sweep.yaml"
     sweep.write_text(f"base: {catalog.path('baseline')}\nset: {{run.parts: 60}}\n"
                      f"policies: [{plug_in}, non-adaptive]\nreplications: 3\nseed: 7\n")

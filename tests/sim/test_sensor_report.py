@@ -10,6 +10,7 @@ import pytest
 from cell.experiments.sweep import load_sweep
 from cell.reporting.maps.sensor_map import headline, reading, table, write
 from cell.scenario import catalog
+from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 from tests.prose import in_order
 
 ROOT = catalog.BUILT_IN.parent.parent
@@ -76,6 +77,7 @@ def test_the_readme_quotes_the_headline():
     assert headline(t) in readme
 
 
+@pytest.mark.usefixtures("unlaid")  # the map drawn, rendered in the byte-for-byte test below
 def test_written_as_a_set(tmp_path):
     path = tmp_path / "reps.csv"
     synthetic().to_csv(path, index=False)
@@ -98,6 +100,7 @@ def costed() -> pd.DataFrame:
                        robot_failures=0)
 
 
+@pytest.mark.usefixtures("unlaid")  # reads the CSV and the text, not the map
 def test_the_money_reading_is_each_options_cost_by_hand(tmp_path, costed):
     """With the sweep file, each option's cost per run is its lost parts at 12 and its hours at
     the options it has (robot 6, adaptive controller 0.5, sensor 0.4 an hour); the reading

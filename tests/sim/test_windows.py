@@ -13,10 +13,11 @@ from cell.cli.main import main
 from cell.experiments.sweep.windows import count_measures, extreme_measures, window_measures
 from cell.reporting.formatting import HEADLINES
 from cell.sim.records import RunSummary
+from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 from tests.prose import in_order
 
-# Figures laid out, not rasterised: these tests read the tables, markdown and CSVs.
-pytestmark = pytest.mark.usefixtures("unrendered")
+# Figures drawn, neither laid out nor rasterised: these tests read the tables, markdown and CSVs.
+pytestmark = pytest.mark.usefixtures("unlaid")
 
 RATES = ("parts_per_hr_wallclock", "actual_cycle_wallclock_s", "ip_wallclock")
 
