@@ -73,6 +73,20 @@ def unrendered(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(Figure, "savefig", unrendered_savefig)
 
 
+@pytest.fixture
+def unlaid(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Figures built but neither laid out nor rasterised (a figure's layout is most of a save's
+    time): for tests of where a report's files go and of what its tables, markdown and messages
+    say, which read no figure and turn no warning into an error.  A figure's layout and pixels
+    are checked where a test reads them: tests/reporting/test_figures.py (every thesis figure),
+    test_experiment_plots.py (a report's), and the ``unrendered`` tests that read its texts."""
+    from matplotlib.figure import Figure
+
+    from tests.reporting.conftest import unlaid_savefig
+
+    monkeypatch.setattr(Figure, "savefig", unlaid_savefig)
+
+
 # --------------------------------------------------------------------------- sweep stand-ins
 # The sweep runner takes the replication as a function; these small deterministic stand-ins
 # draw from the stream they are given (module-level, so worker processes can run them).

@@ -9,7 +9,6 @@ import pytest
 
 from cell.experiments.sweep import load_sweep, run_sweep
 from cell.reporting.experiment.report import plan_report, write_report
-from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 
 # Figures drawn, neither laid out nor rasterised: these tests read the tables, markdown and CSVs.
 pytestmark = pytest.mark.usefixtures("unlaid")

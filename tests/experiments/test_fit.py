@@ -18,7 +18,6 @@ from cell.experiments.fit.budget import subsample
 from cell.experiments.fit.mle import Fit, fit_trace
 from cell.experiments.fit.output import arrivals_yaml, format_table
 from cell.plumbing.errors import ScenarioError
-from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 
 # Thesis eq. 6.9: T = 17.6019 + 5.4342 (-ln(1 - u))^0.2038.
 THESIS = {"c": 1 / 0.2038, "loc": 17.6019, "scale": 5.4342}

@@ -24,7 +24,6 @@ from cell.experiments.fit.mle import fit_trace
 from cell.plumbing.errors import ScenarioError
 from cell.scenario.schema import load_scenario
 from cell.scenario.trace_file import cells_of, find_column, records
-from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 from tests.prose import in_order
 
 

@@ -21,7 +21,7 @@ from cell.experiments.fit.pattern import LEVEL, MAX_TESTED, WORK, find_pattern, 
 from cell.experiments.sweep.runner import simulate_summary
 from cell.scenario.schema import load_scenario
 from cell.sim.simulation import simulate
-from tests.experiments.unlaid import unlaid_savefig
+from tests.reporting.conftest import unlaid_savefig
 
 HOUR = 3600.0
 #: Eq. 6.9's Weibull, the thesis's gaps: T = 17.6019 + 5.4342 (-ln(1 - u))^0.2038.

@@ -13,7 +13,7 @@ import pytest
 
 from cell.cli.main import main
 from cell.experiments.study import load_study, replicate
-from tests.experiments.unlaid import unlaid, unlaid_savefig  # noqa: F401 (unlaid: the fixture)
+from tests.reporting.conftest import unlaid_savefig
 
 BASE = Path(__file__).resolve().parents[2] / "scenarios" / "baseline.yaml"
 

@@ -17,7 +17,6 @@ from cell.experiments.sweep import load_sweep, run_sweep
 from cell.plumbing.errors import CellError, ScenarioError
 from cell.scenario import catalog
 from cell.scenario.schema import load_scenario
-from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 
 # Figures drawn, neither laid out nor rasterised: these tests read the tables, markdown and CSVs.
 pytestmark = pytest.mark.usefixtures("unlaid")

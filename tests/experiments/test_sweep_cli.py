@@ -9,7 +9,6 @@ import pytest
 from cell.cli.main import main
 from cell.experiments.sweep import load_sweep, run_sweep
 from cell.plumbing.errors import CellError
-from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 from tests.prose import in_order
 
 # Figures drawn, neither laid out nor rasterised: these tests read the tables, markdown and CSVs.

@@ -6,7 +6,6 @@ from __future__ import annotations
 import pytest
 
 from cell.cli.main import main
-from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 from tests.prose import in_order
 
 # Figures drawn, neither laid out nor rasterised: these tests read the tables, markdown and CSVs.

@@ -10,7 +10,6 @@ import pytest
 import yaml
 
 from cell.cli.main import main
-from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 
 # Figures drawn, neither laid out nor rasterised: these tests read the tables, markdown and CSVs.
 pytestmark = pytest.mark.usefixtures("unlaid")

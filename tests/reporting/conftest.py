@@ -1,13 +1,12 @@
 """Figures laid out but not rasterised, for tests of what a figure says or which are drawn
 (the ``unrendered`` fixture, in tests/conftest.py, puts :func:`unrendered_savefig` in place);
-figures built but neither laid out nor rasterised (``unlaid``), for tests that read none."""
+figures built but neither laid out nor rasterised (``unlaid``, likewise), for tests that read none."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Any
 
-import pytest
 from matplotlib.figure import Figure
 
 #: A PNG signature: what an unrendered figure's file holds (tests/reporting/test_figures.py reads
@@ -34,13 +33,3 @@ def unlaid_savefig(fig: Figure, fname: Any, *args: Any, **kwargs: Any) -> None:
     """The file a save writes, holding :data:`STUB`; the figure, built with all its artists,
     is not laid out (its layout is most of a save's time when nothing is rasterised)."""
     stub_file(fname)
-
-
-@pytest.fixture
-def unlaid(monkeypatch: pytest.MonkeyPatch) -> None:
-    """Figures built but not laid out: for tests of where a report's files go and of what its
-    tables, markdown and messages say, which read no figure and turn no warning into an error.
-    A figure's layout and pixels are checked where a test reads them: tests/reporting/
-    test_figures.py (every thesis figure a real PNG), test_experiment_plots.py (a report's),
-    and the ``unrendered`` tests that read a figure's texts."""
-    monkeypatch.setattr(Figure, "savefig", unlaid_savefig)

@@ -17,7 +17,6 @@ from cell.rl.learned import Learned, load_weights, size
 from cell.scenario.schema import load_scenario
 from cell.sim.assembly import AssembledCell, assemble
 from cell.sim.simulation import simulate
-from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 
 STRESSED = {"arrivals.distribution": "gamma", "arrivals.cv": 1.0, "arrivals.mean_s": 17.1799,
             "controller.nominal_cycle_s": None, "sensor.lookahead": "sensor", "run.parts": 80}

@@ -16,7 +16,6 @@ from cell.cli.main import main
 from cell.scenario.arrivals import interarrival_times
 from cell.scenario.rate_profile import Pieces
 from cell.scenario.schema import default_scenario
-from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 from tests.refusals import refused_in_one_line
 
 HOUR = 3600.0

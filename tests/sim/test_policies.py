@@ -18,7 +18,6 @@ from cell.sim.policies.adaptive import adaptive_plan
 from cell.sim.policies.fixed import fixed_plan
 from cell.sim.records import INPUT_FLOOR, OUTPUT_CEILING, OUTPUT_FLOOR, R2_PEAK, R4_PEAK
 from cell.sim.simulation import simulate
-from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 
 #: Table 7.1: ideal cycle -> Vavg R IV (in/s).
 VAVG_R4 = {22.5872: 3.5594, 22.0: 3.7818, 21.5: 3.9943, 21.0: 4.2321, 20.5: 4.5000,

@@ -10,7 +10,6 @@ import pytest
 from cell.experiments.sweep import load_sweep
 from cell.reporting.maps.sensor_map import headline, reading, table, write
 from cell.scenario import catalog
-from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 from tests.prose import in_order
 
 ROOT = catalog.BUILT_IN.parent.parent

@@ -13,7 +13,6 @@ from cell.cli.main import main
 from cell.experiments.sweep.windows import count_measures, extreme_measures, window_measures
 from cell.reporting.formatting import HEADLINES
 from cell.sim.records import RunSummary
-from tests.experiments.unlaid import unlaid  # noqa: F401 (the fixture)
 from tests.prose import in_order
 
 # Figures drawn, neither laid out nor rasterised: these tests read the tables, markdown and CSVs.
