@@ -63,6 +63,8 @@ def buffered(tmp_path_factory):
         "fit": _stdout_closed("fit", tmp / "trace.csv"),
     }
     if FULL:
+        commands["run full"] = _stdout_closed("run", "baseline", "--set", "run.parts=20", "--out",
+                                              tmp / "run-full", device="full")
         commands["fit full"] = _stdout_closed("fit", tmp / "trace.csv", device="full")
         commands["compare full"] = _stdout_closed(
             "compare", "baseline", "non_adaptive", "--replications", "2", "--set", "run.parts=10",
@@ -169,6 +171,15 @@ def test_every_command_outlives_its_reader(buffered, unbuffered):
     tmp, res = buffered
     assert (res["compare"]["code"], res["compare"]["other"].count("Exception ignored")) == (0, 0)
     assert (tmp / "cmp" / "report.md").is_file()
+
+
+@pytest.mark.skipif(not FULL, reason="needs /dev/full")
+def test_a_full_stdout_loses_only_the_commentary(buffered):
+    """Beside the files a run writes, what it prints is commentary: its loss is no error."""
+    tmp, res = buffered
+    assert res["run full"]["code"] == 0, res["run full"]
+    assert sorted(p.name for p in (tmp / "run-full").iterdir()) == ["belts.csv", "parts.csv",
+                                                                    "summary.csv"]
 
 
 @pytest.mark.skipif(not FULL, reason="needs /dev/full")
