@@ -17,9 +17,11 @@ SUBCOMMANDS = ["path", "run", "sweep", "compare", "figures", "mintime", "bench",
                "hindsight"]
 
 
-def test_help_lists_the_subcommands():
-    out = subprocess.run([sys.executable, "-m", "cell", "--help"], capture_output=True,
-                         text=True, check=True).stdout
+def test_help_lists_the_subcommands(capsys):
+    """In-process (``python -m cell`` in a real process: test_installed_cell_command's console
+    script, and tests/plumbing, tests/robust)."""
+    assert main(["--help"]) == 0
+    out = capsys.readouterr().out
     for name in SUBCOMMANDS:
         assert name in out
 
@@ -63,24 +65,20 @@ def test_cell_path_writes_the_thesis_table(tmp_path):
     assert set(df.event) == {"", "LO", "TD"}
 
 
-def _run(args, tmp_path):
-    return subprocess.run([sys.executable, "-m", "cell", *args], capture_output=True, text=True,
-                          cwd=Path.cwd())
-
-
 @pytest.mark.parametrize("yaml_text,needle", [
     ("robot:\n  motrs: {}\n", "robot.motrs"),
     ("run:\n  parts: ten\n", "run.parts"),
     ("path:\n  bot_in: [-26.0, 0.0, 3.0]\n", "path.bot_in"),
     ("belts:\n  input_nominal_in_s: -1\n", "belts.input_nominal_in_s"),
 ])
-def test_hostile_scenario_one_line_exit_2_no_file(tmp_path, yaml_text, needle):
+def test_hostile_scenario_one_line_exit_2_no_file(tmp_path, capsys, yaml_text, needle):
+    """In-process: the refusal is the command's (a real process's exit 2 and one line:
+    tests/plumbing/test_output_streams.py, tests/hostile/test_hostile_commands.py)."""
     bad = tmp_path / "bad.yaml"
     bad.write_text(yaml_text)
     out = tmp_path / "out" / "steps.csv"
-    res = _run(["path", str(bad), "--out", str(out)], tmp_path)
-    assert res.returncode == 2
-    lines = res.stderr.strip().splitlines()
+    assert main(["path", str(bad), "--out", str(out)]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and str(bad) in lines[0] and needle in lines[0]
     assert not out.exists()
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())

@@ -6,9 +6,6 @@ from __future__ import annotations
 import os
 import signal
 import stat
-import subprocess
-import sys
-import textwrap
 from pathlib import Path
 
 import pandas as pd
@@ -17,9 +14,9 @@ import pytest
 import cell.plumbing.output.atomic as output
 from cell.plumbing.errors import CellError
 from cell.plumbing.output.atomic import OutputDir, atomic_path, check_file, write_csv, write_text
+from tests.killing import die_at_step
 from tests.outputs import (
     NAMES,
-    ROOT,
     current_umask,
     dead_pid,
     full_disk_open,
@@ -97,27 +94,33 @@ def test_stale_temporary_files_of_killed_writes_are_removed(tmp_path):
 
 # --- killed at every step -------------------------------------------------------------------
 
-CHILD = textwrap.dedent("""
-    import sys
-    import cell.plumbing.output.atomic as out
-    from tests.killing import die_at_step
+def _run_child(target: Path, k: int, fallback: bool, names: list[str]) -> int:
+    """Fork; the child writes the new set (``names == ["--single"]``: the one file) and SIGKILLs
+    itself at its ``k``-th file-system step (tests/killing.py).  The child's wait status: exit 0
+    once it finished the write, 1 if it raised, or killed."""
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - the child never returns
+        code = 1
+        try:
+            die_at_step(k, fallback)
+            if names == ["--single"]:
+                write_text("new\n", target)
+            else:
+                with OutputDir(target, names) as d:
+                    for name in names:
+                        d.write_text(name, f"{name} new\n" * 50)
+            code = 0
+        finally:
+            os._exit(code)
+    _, status = os.waitpid(pid, 0)
+    return status
 
-    target, k, fallback, names = sys.argv[1], int(sys.argv[2]), sys.argv[3] == "1", sys.argv[4:]
-    die_at_step(k, fallback)
-    if names == ["--single"]:
-        out.write_text("new\\n", target)
-    else:
-        with out.OutputDir(target, names) as d:
-            for name in names:
-                d.write_text(name, f"{name} new\\n" * 50)
-    print("finished")
-""")
 
-
-def _run_child(target: Path, k: int, fallback: bool, names: list[str]) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    return subprocess.run([sys.executable, "-c", CHILD, str(target), str(k), str(int(fallback)), *names],
-                          capture_output=True, text=True, timeout=60, env=env)
+def _ended(status: int) -> bool:
+    """Whether the child finished (exit 0); else it must have been killed, not raised."""
+    assert os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0 or \
+        os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGKILL, status
+    return os.WIFEXITED(status)
 
 
 @pytest.mark.parametrize("fallback", [False, True], ids=["exchange", "fallback"])
@@ -128,15 +131,14 @@ def test_killed_at_any_step_leaves_the_old_set_or_the_new(tmp_path, fallback):
     write_set(target, "old")
     seen = set()
     for k in range(1, 100):
-        child = _run_child(target, k, fallback, NAMES)
-        assert child.returncode in (0, -signal.SIGKILL), child.stderr
+        finished = _ended(_run_child(target, k, fallback, NAMES))
         state = set_state(target)
         seen.add(state)
         assert state in (("old", "new", None) if fallback else ("old", "new"))
         OutputDir(target, NAMES).discard()  # the next run cleans up (and puts an old set back)
         assert set_state(target) in ("old", "new") and siblings(target) == ["run"]
-        if child.returncode == 0:
-            assert "finished" in child.stdout and state == "new"
+        if finished:
+            assert state == "new"
             break
         if state == "new":
             write_set(target, "old")
@@ -149,12 +151,11 @@ def test_single_file_killed_at_any_step_is_old_or_new(tmp_path):
     target = tmp_path / "a.txt"
     target.write_text("old\n")
     for k in range(1, 50):
-        child = _run_child(target, k, False, ["--single"])
-        assert child.returncode in (0, -signal.SIGKILL), child.stderr
+        finished = _ended(_run_child(target, k, False, ["--single"]))
         assert target.read_text() in ("old\n", "new\n")
         write_text(target.read_text(), target)  # cleans the temporary files of killed writes
         assert siblings(target) == ["a.txt"]
-        if child.returncode == 0:
+        if finished:
             assert target.read_text() == "new\n"
             break
         target.write_text("old\n")

@@ -44,14 +44,6 @@ def test_a_closed_stderr_on_a_refusal_is_exit_2_and_nothing_written(tmp_path):
     assert p.returncode == 2 and os.listdir(tmp_path) == []
 
 
-def test_a_full_stdout_loses_only_the_commentary(tmp_path):
-    out = tmp_path / "o"
-    with open("/dev/full", "w") as full:
-        p = _cell([*RUN, "--out", str(out)], tmp_path, stdout=full, stderr=subprocess.PIPE)
-    assert p.returncode == 0, p.stderr
-    assert _files(out) == ["belts.csv", "parts.csv", "summary.csv"]
-
-
 def test_a_deleted_working_directory_is_one_line(tmp_path):
     gone = tmp_path / "gone"
     gone.mkdir()

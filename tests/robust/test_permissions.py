@@ -10,6 +10,7 @@ own folders); as another user, as it is.  Skipped where neither can be had.
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import subprocess
@@ -44,14 +45,13 @@ def _unprivileged_prefix(probe: Path) -> list[str] | None:
     return SETPRIV if p.returncode != 0 and with_rights else None
 
 
-@pytest.fixture
-def held(tmp_path):
-    """Run ``python -m cell ARGS`` held to permission bits, with ``umask``, in ``tmp_path/w``,
-    its HOME ``tmp_path/w/home`` and TMPDIR ``tmp_path/w/tmp`` unless ``env`` says otherwise."""
-    prefix = _unprivileged_prefix(tmp_path / "probe")
+def _held(base: Path):
+    """Run ``python -m cell ARGS`` held to permission bits, with ``umask``, in ``base/w``, its
+    HOME ``base/w/home`` and TMPDIR ``base/w/tmp`` unless ``env`` says otherwise."""
+    prefix = _unprivileged_prefix(base / "probe")
     if prefix is None:
         pytest.skip("no way to run without root's permission override (setpriv)")
-    work = tmp_path / "w"
+    work = base / "w"
     (work / "home").mkdir(parents=True)
     (work / "tmp").mkdir()
 
@@ -66,6 +66,25 @@ def held(tmp_path):
     return run
 
 
+@pytest.fixture
+def held(tmp_path):
+    return _held(tmp_path)
+
+
+#: Several commands in one process (one interpreter start-up), each through cell.cli.main as
+#: ``python -m cell`` runs it: its exit code, stdout and stderr, as JSON on stdout at the end.
+SEVERAL = """
+import contextlib, io, json, sys
+from cell.cli.main import main
+said = []
+for argv in json.loads(sys.argv[1]):
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        said.append((main(argv), out.getvalue(), err.getvalue()))
+print(json.dumps(said))
+"""
+
+
 def _tree(folder: Path) -> list[str]:
     return sorted(str(p.relative_to(folder)) for p in folder.rglob("*"))
 
@@ -74,29 +93,45 @@ def _lines(err: str) -> list[str]:
     return [x for x in err.splitlines() if "%)" not in x]  # progress lines aside
 
 
-@pytest.mark.parametrize(("args", "names"), [
-    (["run", BASELINE, "--set", "run.parts=20", "--out", "o"], "o"),
-    (["sweep", "SWEEP", "--out", "s", "--workers", "1"], "s"),
-    (["compare", BASELINE, "non_adaptive", "--set", "run.parts=20", "--replications", "2",
-      "--workers", "1"], "cell compare's temporary folder"),
-    (["fit", "TRACE", "--out", "fit.yaml"], "fit.yaml"),
-    (["path", BASELINE, "--out", "p/path.csv"], "p/path.csv"),
-], ids=["run", "sweep", "compare", "fit", "path"])
-def test_umask_0777_is_one_line_and_leaves_nothing(held, args, names):
+UMASK_CASES = {
+    "run": (["run", BASELINE, "--set", "run.parts=20", "--out", "o"], "o"),
+    "sweep": (["sweep", "SWEEP", "--out", "s", "--workers", "1"], "s"),
+    "compare": (["compare", BASELINE, "non_adaptive", "--set", "run.parts=20", "--replications",
+                 "2", "--workers", "1"], "cell compare's temporary folder"),
+    "fit": (["fit", "TRACE", "--out", "fit.yaml"], "fit.yaml"),
+    "path": (["path", BASELINE, "--out", "p/path.csv"], "p/path.csv"),
+}
+
+
+@pytest.fixture(scope="module")
+def umask_0777(tmp_path_factory):
+    """Every command of UMASK_CASES under umask 0777, in one process held to permission bits:
+    each one's (exit code, stdout, stderr), and the folder's tree before and after them all."""
+    held = _held(tmp_path_factory.mktemp("umask"))
     w = held.work
     (w / "sweep.yaml").write_text(f"base: {BASELINE}\ngrid: {{run.parts: [20, 21]}}\n"
                                   "replications: 2\n")
     (w / "trace.csv").write_text("interarrival_s\n" + "\n".join(
         str(20 + i % 5) for i in range(30)) + "\n")
-    args = [str(w / "sweep.yaml") if a == "SWEEP" else str(w / "trace.csv") if a == "TRACE"
-            else a for a in args]
+    argvs = [[str(w / "sweep.yaml") if a == "SWEEP" else str(w / "trace.csv") if a == "TRACE"
+              else a for a in args] for args, _ in UMASK_CASES.values()]
     before = _tree(w)
-    p = held(args, umask=0o777)
-    assert p.returncode == 2, p.stderr
-    (line,) = _lines(p.stderr)
+    p = held([], umask=0o777, code=SEVERAL.replace("json.loads(sys.argv[1])", repr(argvs)))
+    assert (p.returncode, p.stderr) == (0, ""), p.stderr
+    said = json.loads(p.stdout.splitlines()[-1])
+    return dict(zip(UMASK_CASES, said)), before, _tree(w)
+
+
+@pytest.mark.parametrize("name", list(UMASK_CASES))
+def test_umask_0777_is_one_line_and_leaves_nothing(umask_0777, name):
+    said, before, after = umask_0777
+    code, _, err = said[name]
+    assert code == 2, err
+    (line,) = _lines(err)
+    names = UMASK_CASES[name][1]
     what = "a file" if "." in names.rsplit("/", 1)[-1] else "a folder"  # the thing it could not use
-    assert in_order(line, f"cell: error: {names}: ", "umask 0777", what, "umask 022"), p.stderr
-    assert _tree(w) == before  # no output, no staging, no cache or matplotlib folder
+    assert in_order(line, f"cell: error: {names}: ", "umask 0777", what, "umask 022"), err
+    assert after == before  # no output, no staging, no cache or matplotlib folder, of any of them
 
 
 def test_umask_0777_still_runs_a_command_that_writes_nothing(held):

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import math
 import os
-import subprocess
 import sys
 from pathlib import Path
 from types import SimpleNamespace
@@ -159,17 +158,23 @@ def _plugin_dir(tmp_path: Path, module_text: str | None) -> Path:
      "could not be loaded: RuntimeError: broken at import"),
     ("Policy = 42\n", "is not a policy class: TypeError: int object is not callable"),
 ])
-def test_a_plug_in_that_cannot_be_imported_is_one_line(tmp_path, module, message):
+def test_a_plug_in_that_cannot_be_imported_is_one_line(tmp_path, monkeypatch, capsys, module,
+                                                       message):
+    """In-process: the folder on sys.path as PYTHONPATH would put it, the registry's entry
+    points read anew (and again after the test)."""
     site = _plugin_dir(tmp_path, module)
+    monkeypatch.syspath_prepend(str(site))
+    monkeypatch.setattr(registry, "_entry_points", None)
+    monkeypatch.delitem(sys.modules, "robustplug", raising=False)
     out = tmp_path / "out"
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
-        [str(site), *filter(None, [os.environ.get("PYTHONPATH")])])}
-    p = subprocess.run([sys.executable, "-m", "cell", "run", str(catalog.path("baseline")),
-                        "--set", "run.parts=5", "--set", "controller.policy=broken-plugin",
-                        "--out", str(out)], capture_output=True, text=True, env=env,
-                       cwd=tmp_path, timeout=120)
-    assert p.returncode == 2, p.stderr
-    assert p.stderr.splitlines() == [f"cell: error: policy 'broken-plugin' {message}"]
+    try:
+        code = main(["run", str(catalog.path("baseline")), "--set", "run.parts=5",
+                     "--set", "controller.policy=broken-plugin", "--out", str(out)])
+    finally:
+        sys.modules.pop("robustplug", None)
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert err.splitlines() == [f"cell: error: policy 'broken-plugin' {message}"]
     assert not out.exists()
 
 

@@ -85,8 +85,10 @@ def test_run_terminated_leaves_no_output_and_no_staging(tmp_path):
 
 def test_sweep_terminated_keeps_its_finished_tasks_for_resume(tmp_path):
     sweep = tmp_path / "sweep.yaml"
-    sweep.write_text(f"base: {BASELINE}\ngrid: {{run.parts: [2000, 2001, 2002, 2003, 2004, "
-                     "2005, 2006, 2007]}\nreplications: 3\nseed: 1\n")
+    # 8 tasks of 3 x 500 parts: the 7 left after the first outlast the few ms the test takes
+    # to see it and send the signal, on a loaded machine too
+    sweep.write_text(f"base: {BASELINE}\ngrid: {{run.parts: [500, 501, 502, 503, 504, "
+                     "505, 506, 507]}\nreplications: 3\nseed: 1\n")
     out = tmp_path / "out"
     proc = _start(["sweep", str(sweep), "--out", str(out), "--workers", "1"], tmp_path)
     _wait_for(proc, lambda: _glob(out, "tasks/task-*.csv"), "a finished task")
