@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import re
+import signal
 from collections import Counter
 from pathlib import Path
 from types import SimpleNamespace
@@ -30,6 +31,17 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 # ~/.cache is left alone.  Subprocesses inherit it; tests of the cache set their own.
 os.environ["XDG_CACHE_HOME"] = str(Path(__file__).resolve().parent.parent / ".pytest_cache"
                                    / "xdg")
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """Commands are started as a terminal starts them, with SIGINT at its default, even when
+    pytest itself was started ignoring it (in a shell script's background job): cell keeps a
+    SIGINT it was started ignoring ignored, and the signal tests send theirs to a command."""
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        try:
+            signal.signal(signal.SIGINT, signal.default_int_handler)
+        except ValueError:  # not the main thread: left as it is
+            pass
 
 
 @pytest.fixture(scope="session")

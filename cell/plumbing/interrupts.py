@@ -62,7 +62,8 @@ class Stops:
     after :meth:`disarm`.  A stop raised where Python drops what is raised (a destructor, a
     weakref callback: "Exception ignored in") is raised again (:meth:`lost`).
 
-    Installed only in the main thread; :meth:`restore` puts the previous handlers back."""
+    Installed only in the main thread, and not for a signal the process was started ignoring
+    (cell/plumbing/startup.py); :meth:`restore` puts the previous handlers back."""
 
     SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
@@ -77,7 +78,8 @@ class Stops:
     def install(self) -> Stops:
         with contextlib.suppress(ValueError, OSError):  # not the main thread: left as it is
             for number in self.SIGNALS:
-                self.previous[number] = signal.signal(number, self)
+                if signal.getsignal(number) is not signal.SIG_IGN:  # started ignoring it: kept
+                    self.previous[number] = signal.signal(number, self)
             self.hook, sys.unraisablehook = sys.unraisablehook, self.unraisable
         return self
 

@@ -73,12 +73,15 @@ def stop_now(signum: int, frame: object) -> None:
 
 def install() -> bool:
     """:func:`stop_now` for SIGINT and SIGTERM, if this process is the command; whether it
-    was installed."""
+    was installed.  A signal the process was started ignoring (SIGINT in a shell script's
+    background job, as the shell does so that the script's Ctrl-C spares it) stays ignored,
+    as Python itself leaves it."""
     if not is_the_command(sys.argv, getattr(sys, "orig_argv", [])):
         return False
     try:
         for number in LINES:
-            signal.signal(number, stop_now)
+            if signal.getsignal(number) is not signal.SIG_IGN:  # ignored by who started us: kept
+                signal.signal(number, stop_now)
     except (ValueError, OSError):  # not the main thread, or not allowed
         return False
     return True

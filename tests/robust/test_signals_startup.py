@@ -13,6 +13,7 @@ moment the handlers are seen.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -59,13 +60,32 @@ def _lost_by_python(number: int, code: int, err: str) -> bool:
             and "KeyboardInterrupt" in err)
 
 
+@contextlib.contextmanager
+def sigint_at_start(handler: object):
+    """The SIGINT a child is started with: one this process catches is the default in the
+    child, one it ignores stays ignored (as pytest's own, when it runs in a script's
+    background job: the child would then never see the test's SIGINT)."""
+    before = signal.signal(signal.SIGINT, handler)  # type: ignore[arg-type]
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
+def _start(command: list[str], where: Path, handler: object) -> subprocess.Popen[str]:
+    """``cell run`` of 100,000 parts in ``where`` (its TMPDIR and cache there too)."""
+    env = {**os.environ, "TMPDIR": str(where / "tmp"), "XDG_CACHE_HOME": str(where / ".cache")}
+    with sigint_at_start(handler):
+        return subprocess.Popen([*command, "run", str(catalog.path("baseline")), "--set",
+                                 "run.parts=100000", "--out", str(where / "out")], cwd=where,
+                                env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                text=True)
+
+
 def _one(command: list[str], number: int, delay: float | None, where: Path) -> None:
     where.mkdir()
     (where / "tmp").mkdir()
-    env = {**os.environ, "TMPDIR": str(where / "tmp"), "XDG_CACHE_HOME": str(where / ".cache")}
-    proc = subprocess.Popen([*command, "run", str(catalog.path("baseline")), "--set",
-                             "run.parts=100000", "--out", str(where / "out")], cwd=where, env=env,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    proc = _start(command, where, signal.default_int_handler)
     if delay is None:  # the moment the handlers are in place
         end = time.monotonic() + 60
         while not _caught_term(proc.pid) and time.monotonic() < end and proc.poll() is None:
@@ -92,6 +112,25 @@ def test_a_signal_from_the_first_millisecond_on(tmp_path, number, how):
         pytest.skip(f"no console script beside {sys.executable}")
     for i, delay in enumerate([*DELAYS_S, None, None]):
         _one(COMMANDS[how], number, delay, tmp_path / f"r{i}")
+
+
+def test_a_sigint_the_command_was_started_ignoring_stays_ignored(tmp_path):
+    """As a shell script's background job is started (SIGINT ignored, so that the script's
+    Ctrl-C spares it): cell keeps it ignored, as Python does, and still ends on SIGTERM."""
+    (tmp_path / "tmp").mkdir()
+    proc = _start(COMMANDS["python -m cell"], tmp_path, signal.SIG_IGN)
+    end = time.monotonic() + 60
+    while not _caught_term(proc.pid) and time.monotonic() < end and proc.poll() is None:
+        time.sleep(0.0005)
+    time.sleep(0.05)  # into the run
+    proc.send_signal(signal.SIGINT)
+    time.sleep(0.3)
+    running = proc.poll() is None
+    proc.send_signal(signal.SIGTERM)
+    err = proc.communicate()[1]
+    assert running
+    assert (proc.returncode, err) == (LINES[signal.SIGTERM][0], LINES[signal.SIGTERM][1] + "\n")
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name != ".cache") == ["tmp"]
 
 
 #: A ``sitecustomize`` (run by the interpreter before any code of cell) that holds the import
