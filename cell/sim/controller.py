@@ -147,14 +147,15 @@ class Controller:
         self.log.flag(part, self.robot.loss(now))
         self.log.missed(part)
         if floor_after_td == floor_after_td:
-            self.output.replan(max(now, floor_after_td), self.k.output_min)
+            self.output.belt.plan(max(now, floor_after_td), self.k.output_min)
 
     def run(self):  # noqa: ANN201 (SimPy generator)
         """Once per part: the part at B taken the instant it gets there (its ``at_bot_s``),
         the policy asked for its plan (checked, :meth:`.PlanCheck.passes`), the
         belts set and the robot told its order."""
         robot, view, k, log = self.robot, self.view, self.k, self.log
-        conveyor, output, plan_for, name = self.conveyor, self.output, self.policy.plan, self.name
+        conveyor, plan_for, name = self.conveyor, self.policy.plan, self.name
+        output = self.output.belt  # the output belt's plan set directly (nothing else to tell)
         aim = k.lookahead_margin_s  # step 6.3 from when the next part is aimed at B
         u_nom, u_min = k.u_nom, k.output_min  # the output belt's nominal speed and floor
         floor_after_td = math.nan  # the last planned TD (the spacing contract; nan: none)
@@ -183,11 +184,11 @@ class Controller:
                                     plan.input_next)
                 at_g = now + to_g
                 if plan.output_floor_at < INF:  # the spacing contract: the belt's floor after TD
-                    output.replan(now, plan.output_to_g, at_g, u_nom,
-                                  now + plan.output_floor_at, u_min)
+                    output.plan(now, plan.output_to_g, at_g, u_nom, now + plan.output_floor_at,
+                                u_min)
                     floor_after_td = at_g + r3a
                 else:
-                    output.replan(now, plan.output_to_g, at_g, u_nom)
+                    output.plan(now, plan.output_to_g, at_g, u_nom)
             part.plan = plan  # the part's regime times and belt speeds (read as its row is made)
             if plan.limits:
                 log.flag(part, plan.limits)

@@ -373,11 +373,6 @@ class OutputConveyor:
         """Instant of the last touch-down (read once ``last_td_x`` is set)."""
         self.process = env.process(self.run())
 
-    def replan(self, t1: float, v1: float, t2: float | None = None, v2: float = 0.0,
-               t3: float | None = None, v3: float = 0.0) -> None:
-        """New speed plan from the controller (:meth:`Belt.plan`)."""
-        self.belt.plan(t1, v1, t2, v2, t3, v3)
-
     def stop(self, now: float) -> None:
         """A failure stops the belt now (a part the robot sets down stays where it is put)."""
         self.belt.stop(now)
