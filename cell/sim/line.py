@@ -262,6 +262,8 @@ class Line:
         each), kept only when asked (``keep`` makes one: the animation's; the first station's
         are the run's belts.csv)."""
         self.downtimes: list[Downtime | None] = [downtime]
+        self.stopped: list[list[tuple[str, str, float, float, Any]]] = []
+        """Each station's stops (failures.csv's rows), taken when the run closes (:meth:`close`)."""
         self.stations: list[Station] = []
         none = _no_belts
         for i, (_, _, own) in enumerate(self.cells):
@@ -302,12 +304,11 @@ class Line:
                 dt.start()
 
     def close(self, end_s: float) -> None:
-        """The run is over: each station closed, and its stops (its ``Downtime.all_stops``, or
-        its worn motors' alone) taken once, as ``stopped``."""
+        """The run is over: each station closed, and its stops taken once, as ``stopped``."""
         for station in self.stations:
             station.close(end_s)
-        self.stopped = [dt.all_stops(end_s) if dt is not None else wear_clock.stop_rows(
-            None if st.wear is None else st.wear.log, end_s) for dt, st in zip(self.downtimes, self.stations)]
+        self.stopped = [wear_clock.station_stops(dt, None if st.wear is None else st.wear.log, end_s)
+                        for dt, st in zip(self.downtimes, self.stations)]
 
     def timelines(self, end_s: float) -> list[tuple[str, state_energy.Timelines]]:
         """Each station's name and its equipment's states over [0, end_s] (states.csv), from its

@@ -324,8 +324,7 @@ class Run:
         column = log.column if line is None else line.first_column(log.column)  # its robot's
         summary = _summary(cell, log, acct, self.t_all, n, env.now)
         wear = None if station.wear is None else station.wear.log  # wear: without failures
-        stops = downtime.all_stops(env.now) if downtime is not None else \
-            wear_clock.stop_rows(wear, env.now)  # failures.csv's rows
+        stops = line.stopped[0] if line else wear_clock.station_stops(downtime, wear, env.now)
         lines = oee.measure(summary, column, downtime, k.cycle_nom, env.now, stops,
                             s.quality.rule, calendar.off_spans(s, env.now))
         lines = state_energy.measure(summary, s, lines, log, downtime, env.now, stops, line)

@@ -103,6 +103,13 @@ def stop_rows(wear: WearLog | None, end_s: float) -> list[tuple[str, str, float,
     return [("robot", "wear", a, min(b, end_s), "") for a, b, _ in wear.stops if a < end_s]
 
 
+def station_stops(downtime: Any, wear: WearLog | None, end_s: float
+                  ) -> list[tuple[str, str, float, float, Any]]:
+    """failures.csv's rows of a station's stops: its :class:`~cell.sim.failures.Downtime`'s
+    (``all_stops``), or, with nothing that can fail, its worn motors' alone."""
+    return downtime.all_stops(end_s) if downtime is not None else stop_rows(wear, end_s)
+
+
 class WearStops:
     """Wear without failures, handed to the robot (:class:`cell.sim.robot.Robot`): each cycle
     it is ordered to run wears its motors (the stretch times read from the part's record and
