@@ -234,9 +234,8 @@ class PlanCheck:
             off_g, off_b = to_g - (r1a + r1b + r2), cycle - (to_g + r3a + r3b + r4)
             floor_at = plan.output_floor_at if steers else math.inf  # at or after TD
             if (a1 <= r1a and a2 <= r1b and a3 <= r2 and a4 <= r3a and a5 <= r3b and a6 <= r4
-                    and c1 <= v and v <= d1 and c2 <= w and w <= d2 and c3 <= w_next
-                    and w_next <= d3 and c4 <= u and u <= d4 and -SUM_S <= off_g
-                    and off_g <= SUM_S and -SUM_S <= off_b and off_b <= SUM_S and cycle < MAX_S
+                    and c1 <= v <= d1 and c2 <= w <= d2 and c3 <= w_next <= d3 and c4 <= u <= d4
+                    and -SUM_S <= off_g <= SUM_S and -SUM_S <= off_b <= SUM_S and cycle < MAX_S
                     and limits.__class__ is int and not limits & ~PLAN_LIMITS
                     and steers.__class__ is bool and floor_at >= to_g + r3a - SUM_S):
                 pre, post = self.r1_floors  # R I at the pace of the belt it picks from
