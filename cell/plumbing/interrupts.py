@@ -14,6 +14,8 @@ import threading
 import time
 from typing import Any
 
+from cell.plumbing.startup import kept_ignored
+
 
 def exit_now(code: int) -> None:
     """End the process now with ``code`` (a command stopped by Ctrl-C or kill, its files
@@ -78,7 +80,7 @@ class Stops:
     def install(self) -> Stops:
         with contextlib.suppress(ValueError, OSError):  # not the main thread: left as it is
             for number in self.SIGNALS:
-                if signal.getsignal(number) is not signal.SIG_IGN:  # started ignoring it: kept
+                if not kept_ignored(number):
                     self.previous[number] = signal.signal(number, self)
             self.hook, sys.unraisablehook = sys.unraisablehook, self.unraisable
         return self

@@ -71,16 +71,21 @@ def stop_now(signum: int, frame: object) -> None:
     os._exit(code)
 
 
+def kept_ignored(number: int) -> bool:
+    """Whether signal ``number`` is ignored, as the process may have been started (SIGINT in a
+    shell script's background job, so that the script's Ctrl-C spares it): cell then leaves
+    it ignored, as Python itself does."""
+    return signal.getsignal(number) is signal.SIG_IGN
+
+
 def install() -> bool:
     """:func:`stop_now` for SIGINT and SIGTERM, if this process is the command; whether it
-    was installed.  A signal the process was started ignoring (SIGINT in a shell script's
-    background job, as the shell does so that the script's Ctrl-C spares it) stays ignored,
-    as Python itself leaves it."""
+    was installed; not for a signal the process was started ignoring (:func:`kept_ignored`)."""
     if not is_the_command(sys.argv, getattr(sys, "orig_argv", [])):
         return False
     try:
         for number in LINES:
-            if signal.getsignal(number) is not signal.SIG_IGN:  # ignored by who started us: kept
+            if not kept_ignored(number):
                 signal.signal(number, stop_now)
     except (ValueError, OSError):  # not the main thread, or not allowed
         return False
