@@ -13,6 +13,7 @@ from typing import Any
 
 from cell.cli.common import check_workers, set_argument, workers_argument
 from cell.plumbing.interrupts import exit_now
+from cell.plumbing.startup import kept_ignored
 
 HELP = "replicated sweep over scenario keys, with its report"
 DESCRIPTION = ("Run a grid of scenarios with replications (common random numbers); write "
@@ -75,7 +76,8 @@ def main(args: argparse.Namespace) -> int:
     if threading.current_thread() is not threading.main_thread():
         return _sweep(args, _Stop())
     stop = _Stop()
-    previous = {number: signal.signal(number, stop) for number in stop.SIGNALS}
+    previous = {number: signal.signal(number, stop) for number in stop.SIGNALS
+                if not kept_ignored(number)}
     try:
         code = _sweep(args, stop)
     except BaseException:

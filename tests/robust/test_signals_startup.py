@@ -133,6 +133,23 @@ def test_a_sigint_the_command_was_started_ignoring_stays_ignored(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir() if p.name != ".cache") == ["tmp"]
 
 
+def test_a_sweep_started_ignoring_sigint_keeps_it_ignored(tmp_path):
+    """``cell sweep``, which installs its own stop, keeps an ignored SIGINT ignored too."""
+    with sigint_at_start(signal.SIG_IGN):
+        proc = subprocess.Popen([*COMMANDS["python -m cell"], "sweep",
+                                 str(catalog.path("table_7_1")), "--workers", "1", "--out",
+                                 str(tmp_path / "out")], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.PIPE, text=True)
+    time.sleep(2.0)  # into the sweep, its own handlers in place
+    proc.send_signal(signal.SIGINT)
+    time.sleep(0.3)
+    running = proc.poll() is None
+    proc.send_signal(signal.SIGTERM)
+    proc.communicate()
+    assert running
+    assert proc.returncode == LINES[signal.SIGTERM][0]
+
+
 #: A ``sitecustomize`` (run by the interpreter before any code of cell) that holds the import
 #: of one module: it marks that it got there, then waits, so the signal lands in that import,
 #: until the test says the signal is sent (HOLD_GO, made after ``send_signal``: the kernel
