@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from cell.cli.common import check_workers, set_argument, workers_argument
-from cell.plumbing.interrupts import exit_now
+from cell.plumbing.interrupts import exit_now, stopped_by
 from cell.plumbing.startup import kept_ignored
 
 HELP = "replicated sweep over scenario keys, with its report"
@@ -83,7 +83,7 @@ def main(args: argparse.Namespace) -> int:
     except BaseException:
         if stop.signum is None:
             raise
-        print("cell: interrupted", file=sys.stderr)  # loading, or writing the report
+        print(stopped_by(None, stop.signum)[1], file=sys.stderr)  # loading, or writing the report
         code = stop.code
     finally:
         if stop.signum is None:
