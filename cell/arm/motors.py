@@ -13,8 +13,10 @@ regime's time for a velocity is one numpy sum.
 
 from __future__ import annotations
 
+import math
 from bisect import bisect_left, bisect_right
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -83,7 +85,9 @@ class Segment:
     a scalar bisection (microseconds), as the simulation needs.
     """
 
-    __slots__ = ("length_in", "floor_s", "_ub", "_lfree", "_tfix", "_tbreak")
+    __slots__ = ("length_in", "floor_s", "_ub", "_lfree", "_tfix", "_tbreak", "_seen")
+    #: What a segment is rebuilt from (:meth:`saved`, :meth:`of_saved`: the timing's disk cache).
+    SAVED = ("length_in", "floor_s", "_ub", "_lfree", "_tfix", "_tbreak")
 
     def __init__(self, lengths_in: ArrayLike, min_times_s: ArrayLike):
         ell = np.asarray(lengths_in, dtype=float)
@@ -110,12 +114,32 @@ class Segment:
         # t at each breakpoint, increasing: inverts t(u) by bisection.
         self._tbreak: list[float] = [self._tfix[j] + self._lfree[j] * u
                                      for j, u in enumerate(self._ub)]
+        self._seen = (math.nan, math.nan)
+        """The last velocity asked and its time (:meth:`time`)."""
+
+    def saved(self) -> dict[str, Any]:
+        """What the segment is rebuilt from (:data:`SAVED`), by name."""
+        return {name: getattr(self, name) for name in self.SAVED}
+
+    @classmethod
+    def of_saved(cls, saved: dict[str, Any]) -> Segment:
+        """The segment :meth:`saved` gave ``saved``."""
+        segment = cls.__new__(cls)
+        for name in cls.SAVED:
+            setattr(segment, name, saved[name])
+        segment._seen = (math.nan, math.nan)
+        return segment
 
     def time(self, velocity: float) -> float:
         """Σ max(ℓ/v, t_min): the moves' time at tip (or belt) velocity v > 0."""
+        seen = self._seen  # speed: docs/performance.md#last-time
+        if seen[0] == velocity:
+            return seen[1]
         u = 1.0 / velocity
         j = bisect_right(self._ub, u)
-        return self._tfix[j] + self._lfree[j] * u
+        t = self._tfix[j] + self._lfree[j] * u
+        self._seen = (velocity, t)
+        return t
 
     def velocity(self, time_s: float) -> float:
         """The velocity v whose moves take exactly ``time_s`` (inverse of :meth:`time`)."""

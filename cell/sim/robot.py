@@ -140,8 +140,7 @@ def timing_to_plain(t: RobotTiming) -> dict[str, Any]:
     for f in fields(t):
         value = getattr(t, f.name)
         if isinstance(value, Segment):
-            out[f.name] = {"segment": {slot: plain(getattr(value, slot))
-                                       for slot in Segment.__slots__}}
+            out[f.name] = {"segment": {name: plain(v) for name, v in value.saved().items()}}
         else:
             out[f.name] = plain(value)
     return out
@@ -153,10 +152,7 @@ def timing_from_plain(data: dict[str, Any]) -> RobotTiming:
     for f in fields(RobotTiming):
         value = data[f.name]
         if isinstance(value, dict):
-            segment = Segment.__new__(Segment)
-            for slot in Segment.__slots__:
-                setattr(segment, slot, value["segment"][slot])
-            value = segment
+            value = Segment.of_saved(value["segment"])
         elif type(value) is not float:
             raise TypeError(f"{f.name}: not a float")
         values[f.name] = value

@@ -23,6 +23,21 @@ def test_segment_time_is_the_sum_of_move_times(ms, v):
     assert seg.floor_s == pytest.approx(tmin.sum())
 
 
+@settings(max_examples=60, deadline=None)
+@given(moves, st.lists(st.sampled_from([0.3, 1.0, 4.3693, 7.0, 2, float("nan")]), max_size=12))
+def test_a_segment_that_keeps_its_last_time_answers_as_a_fresh_one(ms, speeds):
+    """Asked a run of speeds with repeats (an int among them, and a NaN, which equals nothing),
+    the segment gives each the very float a segment never asked before gives (its last answer
+    kept: docs/performance.md#last-time); rebuilt from what it saves, it answers the same."""
+    ell, tmin = np.array(ms).T
+    seg = Segment(ell, tmin)
+    again = Segment.of_saved(seg.saved())
+    for v in speeds:
+        fresh = Segment(ell, tmin).time(v)
+        for got in (seg.time(v), again.time(v)):
+            assert got == fresh or (np.isnan(got) and np.isnan(fresh))
+
+
 @settings(max_examples=80, deadline=None)
 @given(moves, st.floats(1.0001, 5.0))
 def test_segment_velocity_inverts_time(ms, factor):
