@@ -66,7 +66,19 @@ def greedy_picks(come_s: Sequence[float] | Array, length_in: float, v_min: float
                  part_size_in: float, cycle_min_s: float, one_belt: bool = True) -> int:
     """The most parts, coming at ``come_s`` (in order), that fit their windows at B with
     picks ``cycle_min_s`` apart and, with ``one_belt``, their belt's distance between them
-    at least a cycle at the floor: the greedy pass of the module's text, a part at a time."""
+    at least a cycle at the floor: :func:`greedy_pass`, or all of them where
+    :func:`all_picked` finds from the whole array at once that the pass picks every one."""
+    come = np.asarray(come_s, dtype=float)
+    if all_picked(come, length_in / v_max, length_in / v_min, cycle_min_s - EPS_S,
+                  v_max / v_min, SLACK_IN / v_min, (part_size_in + SLACK_IN) / v_min, one_belt):
+        return int(come.size)  # speed: docs/performance.md#bound-at-once
+    return greedy_pass(come, length_in, v_min, v_max, part_size_in, cycle_min_s, one_belt)
+
+
+def greedy_pass(come_s: Sequence[float] | Array, length_in: float, v_min: float, v_max: float,
+                part_size_in: float, cycle_min_s: float, one_belt: bool = True) -> int:
+    """:func:`greedy_picks` worked out by the greedy pass of the module's text, a part at a
+    time."""
     early, late, clear = length_in / v_max, length_in / v_min, part_size_in / v_min
     cycle = cycle_min_s - EPS_S
     gap_min = (part_size_in + SLACK_IN) / v_min  # the belt's distance to the last part, at
@@ -91,6 +103,27 @@ def greedy_picks(come_s: Sequence[float] | Array, length_in: float, v_min: float
             if one_belt:
                 next_at = at + cycle
     return count
+
+
+def all_picked(come: Array, early: float, late: float, cycle: float, per_s: float,
+               slack_s: float, gap_min: float, one_belt: bool) -> bool:
+    """Whether :func:`greedy_pass` picks every part coming at ``come``, each at its earliest
+    (the pass's ``early``, ``late``, ``cycle``, ``per_s`` and ``gap_min``; ``slack_s`` =
+    SLACK_IN / v_min), found without the pass: the earliest picks r_i = a_i + early are each a
+    cycle after the one before (the same floats as the pass's r_i and last pick plus c); a
+    part's window ends no earlier than it starts (early <= late, so r_i <= D_i + late, as
+    D_i >= a_i); and with ``one_belt`` each part's belt gap at the floor, the pass's
+    g_i = max(per_s (a_i - a_(i-1)) + slack_s, gap_min), is a cycle at least, so
+    s_i >= s_(i-1) + c.  Arrivals not all finite are left to the pass."""
+    if not come.size or not early <= late:
+        return False
+    first = come + early
+    if not np.isfinite(first).all() or not (first[1:] >= first[:-1] + cycle).all():
+        return False
+    if not one_belt:
+        return True
+    gap = np.maximum(per_s * np.diff(come) + slack_s, gap_min)
+    return bool((gap >= cycle).all())
 
 
 def parts_bound(k: CellConstants, come_s: Sequence[float] | Array, belt: Belt | None = None,

@@ -3,13 +3,22 @@ window at B, worked by hand here, and never below what either policy delivers.""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cell.scenario.schema import Scenario
 from cell.sim.assembly import assemble
-from cell.sim.bound import fastest_possible_cycle, greedy_picks, parts_bound
+from cell.sim.bound import (
+    SLACK_IN,
+    all_picked,
+    fastest_possible_cycle,
+    greedy_pass,
+    greedy_picks,
+    parts_bound,
+)
+from cell.sim.conveyors import EPS_S
 from cell.sim.simulation import simulate
 from tests.sim.test_sensor import run_trace
 
@@ -116,3 +125,22 @@ def test_where_the_input_belt_stood_the_bound_counts_the_windows_alone(thesis_ce
     robot = run_trace(s.with_overrides({"failures": {"robot": often}}), [5.0] + [0.0] * 10)
     assert robot.summary.input_speed_min_in_s > 0.0
     assert robot.summary.parts_bound == parts_bound(k, come) == 1
+
+
+@settings(max_examples=60, deadline=None)
+@given(gaps=st.lists(st.floats(0.0, 30.0), max_size=40), slack=st.floats(-1e-9, 1e-9),
+       one_belt=st.booleans(), v=st.sampled_from([(1.0, 4.0), (2.0, 2.0), (3.0, 1.0)]))
+def test_all_picked_read_at_once_is_the_pass(gaps: list[float], slack: float, one_belt: bool,
+                                             v: tuple[float, float]) -> None:
+    """Where :func:`all_picked` reads from the whole array that every part is picked, the
+    part-at-a-time pass picks every part too; whatever it reads, greedy_picks is the pass's
+    count.  Arrivals drawn about a cycle apart (10 s, some exactly, some a rounding less),
+    so that both answers come up; belts slower than, as fast as and faster than the floor."""
+    come = np.cumsum([g if g < 9.0 else 10.0 - EPS_S + slack for g in gaps]).tolist()
+    args = (come, 12.0, v[0], v[1], 1.0, 10.0, one_belt)
+    counted = greedy_pass(*args)
+    assert greedy_picks(*args) == counted
+    early, late = 12.0 / v[1], 12.0 / v[0]
+    if all_picked(np.asarray(come, dtype=float), early, late, 10.0 - EPS_S, v[1] / v[0],
+                  SLACK_IN / v[0], (1.0 + SLACK_IN) / v[0], one_belt):
+        assert counted == len(come)
