@@ -46,9 +46,10 @@ class Belt:
     """
 
     __slots__ = ("_t", "_x", "_v", "on_change", "max_speed_in_s", "min_speed_in_s", "_halted",
-                 "_at_t", "_at_x", "_at_v")
+                 "stoppable", "_at_t", "_at_x", "_at_v")
 
-    def __init__(self, speed_in_s: float, on_change: Callable[[float, float], Any] | None = None):
+    def __init__(self, speed_in_s: float, on_change: Callable[[float, float], Any] | None = None,
+                 stoppable: bool = False):
         self._t, self._x, self._v = [0.0], [0.0], [speed_in_s]
         """Instants at which a speed starts, the travel then, and the speed from then on (the last
         holds for ever)."""
@@ -58,9 +59,10 @@ class Belt:
         """The fastest and the slowest of the settled speeds (of all of them once closed)."""
         self._halted: tuple[float, list[tuple[float, float]]] | None = None
         """While stopped by a failure: the speed it ran at and the changes planned after."""
+        self.stoppable = stoppable  # by a failure or the calendar: only then is the below kept
         self._at_t, self._at_x, self._at_v = 0.0, 0.0, speed_in_s
         """The last settled change (instant, travel, speed), in force when a replan from a later
-        instant has settled past the present (a stop starts from it)."""
+        instant has settled past the present (a stop starts from it; kept if ``stoppable``)."""
 
     @classmethod
     def of_history(cls, history: Sequence[Sequence[float]]) -> Belt:
@@ -163,7 +165,7 @@ class Belt:
     def _settle(self, n: int) -> None:
         """The first ``n`` changes are final: note their speeds and tell ``on_change`` (the
         last of them kept as the anchor a stop starts from)."""
-        if n:
+        if n and self.stoppable:
             self._at_t, self._at_x, self._at_v = self._t[n - 1], self._x[n - 1], self._v[n - 1]
         vs = self._v
         hi, lo = self.max_speed_in_s, self.min_speed_in_s
@@ -210,7 +212,10 @@ class Belt:
 
     def stop(self, t: float) -> None:
         """Stand from instant t (now) on: speed 0, parts stay where they are; what was
-        planned after t is kept for :meth:`restart` (docs/model.md, "When equipment fails")."""
+        planned after t is kept for :meth:`restart` (docs/model.md, "When equipment fails");
+        only a belt built ``stoppable``."""
+        if not self.stoppable:
+            raise RuntimeError("a belt built as one nothing can stop was stopped")
         ts, vs = self._t, self._v
         if ts[0] > t:  # a replan from a later instant settled the change in force now: stop
             t0, x0, v0 = self._at_t, self._at_x, self._at_v  # from it, every held change kept for the restart
@@ -250,7 +255,7 @@ class InputConveyor:
     def __init__(self, env: simpy.Environment, speed_in_s: float, length_in: float,
                  on_change: Callable[[float, float], Any] | None = None, stops: Any = None):
         self.env = env
-        self.belt = Belt(speed_in_s, on_change)
+        self.belt = Belt(speed_in_s, on_change, stoppable=stops is not None)
         self.length_in = length_in
         """Feeder drop point to B (in)."""
         self.stops = stops
@@ -361,9 +366,9 @@ class OutputConveyor:
 
     def __init__(self, env: simpy.Environment, speed_in_s: float,
                  delivered: Callable[[Part], Any],
-                 on_change: Callable[[float, float], Any] | None = None):
+                 on_change: Callable[[float, float], Any] | None = None, stoppable: bool = False):
         self.env = env
-        self.belt = Belt(speed_in_s, on_change)
+        self.belt = Belt(speed_in_s, on_change, stoppable)  # stoppable: by a failure, a calendar
         self.placed: Mailbox = Mailbox(env)
         """Parts set down by the robot, each due at its touch-down, with that instant."""
         self.delivered = delivered

@@ -49,7 +49,7 @@ class Station:
         self.input = InputConveyor(env, k.v_nom, k.input_length, told(0),
                                    None if downtime is None else BeltStops(downtime, "input_belt"))
         """The window on the input belt: parts from the drop point to B (and on to F)."""
-        self.output = OutputConveyor(env, k.u_nom, delivered, told(1))
+        self.output = OutputConveyor(env, k.u_nom, delivered, told(1), downtime is not None)
         """The window on the output belt: parts set down at TD, their spacing measured."""
         self.wear: WearStops | None = wear_clock.alone(cell, seed, downtime)
         """The motors' wear without failures (None: none, or counted by the failure clock)."""

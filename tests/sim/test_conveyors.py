@@ -129,3 +129,20 @@ def test_a_belt_replayed_from_its_history_travels_as_it_ran(steps):
     replay = Belt.of_history(told)
     assert [(t, replay.travel(t)) for t, _ in seen] == seen
     assert all(replay.time_at(x) == pytest.approx(t, abs=1e-9) for t, x in seen)
+
+
+def test_only_a_belt_built_stoppable_stops_and_it_stops_where_it_was():
+    """Both belts run the same plans alike; only the one built ``stoppable`` (a failure or the
+    calendar can stop it) stops.  A replan from 25 s settles the change at 10 s; a stop at 15 s,
+    before the first change still held (20 s), starts from the change at 10 s: 30 in + 6 in/s x
+    5 s = 60 in, where the belt then stands."""
+    plain, stoppable = Belt(3.0), Belt(3.0, stoppable=True)
+    for b in (plain, stoppable):
+        b.plan(10.0, 6.0, 20.0, 1.5)
+        b.plan(25.0, 2.0, 30.0, 3.0)
+    assert [plain.travel(t) for t in (20.0, 26.0, 50.0)] == \
+        [stoppable.travel(t) for t in (20.0, 26.0, 50.0)] == [90.0, 99.5, 167.5]
+    with pytest.raises(RuntimeError):
+        plain.stop(15.0)
+    stoppable.stop(15.0)
+    assert stoppable.travel(15.0) == stoppable.travel(100.0) == 60.0
