@@ -49,6 +49,8 @@ ABS = 1e-9
 #: How far a sum may be off its parts (s): far above the rounding of any sum of times below
 #: :data:`MAX_S` (a few ns), far below anything the cell could tell.
 SUM_S = 1e-6
+#: The sums' lowest allowed offset.
+SUM_LO = -SUM_S  # speed: docs/performance.md#plan-check
 #: No regime time is this long (a year): a finite time is below it.
 MAX_S = 3.2e7
 
@@ -235,14 +237,14 @@ class PlanCheck:
             floor_at = plan.output_floor_at if steers else math.inf  # at or after TD
             if (a1 <= r1a and a2 <= r1b and a3 <= r2 and a4 <= r3a and a5 <= r3b and a6 <= r4
                     and c1 <= v <= d1 and c2 <= w <= d2 and c3 <= w_next <= d3 and c4 <= u <= d4
-                    and -SUM_S <= off_g <= SUM_S and -SUM_S <= off_b <= SUM_S and cycle < MAX_S
+                    and SUM_LO <= off_g <= SUM_S and SUM_LO <= off_b <= SUM_S and cycle < MAX_S
                     and limits.__class__ is int and not limits & ~PLAN_LIMITS
                     and steers.__class__ is bool and floor_at >= to_g + r3a - SUM_S):
                 pre, post = self.r1_floors  # R I at the pace of the belt it picks from
-                f = pre(v)  # (v checked above)
-                if f - ABS - REL * f <= r1a:
+                f = pre(v)  # (v checked above): at the floor, or within its slack
+                if f <= r1a or f - ABS - REL * f <= r1a:  # speed: docs/performance.md#plan-check
                     f = post(v)
-                    if f - ABS - REL * f <= r1b:
+                    if f <= r1b or f - ABS - REL * f <= r1b:
                         return
         except Exception:  # noqa: BLE001, S110 - a field missing or not a number: said below
             pass
