@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 import struct
 from collections.abc import Callable
+from functools import cached_property
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
@@ -264,6 +265,8 @@ class Line:
         self.downtimes: list[Downtime | None] = [downtime]
         self.stopped: list[list[tuple[str, str, float, float, Any]]] = []
         """Each station's stops (failures.csv's rows), taken when the run closes (:meth:`close`)."""
+        self.rows: list[StationRow] = []  # stations.csv's, taken at close (station_rows)
+        self.end_s = math.nan  # when it closed
         self.stations: list[Station] = []
         none = _no_belts
         for i, (_, _, own) in enumerate(self.cells):
@@ -304,16 +307,18 @@ class Line:
                 dt.start()
 
     def close(self, end_s: float) -> None:
-        """The run is over: each station closed, and its stops taken once, as ``stopped``."""
+        """The run is over: each station closed; its stops and stations.csv's rows taken once."""
         for station in self.stations:
             station.close(end_s)
         self.stopped = [wear_clock.station_stops(dt, None if st.wear is None else st.wear.log, end_s)
                         for dt, st in zip(self.downtimes, self.stations)]
+        self.end_s, self.rows = end_s, self.station_rows(end_s)
 
-    def timelines(self, end_s: float) -> list[tuple[str, state_energy.Timelines]]:
-        """Each station's name and its equipment's states over [0, end_s] (states.csv), from its
-        own log and stops; with ``energy:``, its sensor's as :func:`state_energy.timelines` adds."""
-        out = []
+    @cached_property
+    def timelines(self) -> list[tuple[str, state_energy.Timelines]]:
+        """Each station's name and its equipment's states over the run (states.csv; once, after
+        :meth:`close`); with ``energy:``, its sensor's as :func:`state_energy.timelines` adds."""
+        out, end_s = [], self.end_s
         for (name, _, own), log, dt, stops in zip(self.cells, self.logs, self.downtimes,
                                                   self.stopped):
             lines = oee.timelines(log.column, dt, end_s, stops, calendar.off_spans(own.scenario, end_s))
@@ -329,7 +334,7 @@ class Line:
         own = self.logs[0].column
         return lambda name: own(name) if name in STATION_VALUES else column(name)
 
-    def rows(self, end_s: float) -> list[StationRow]:
+    def station_rows(self, end_s: float) -> list[StationRow]:
         """stations.csv's rows (:data:`STATION_COLUMNS`, ``down_fraction``), over the whole run."""
         out = []
         for (name, _, own), log, station, dt, stops in zip(self.cells, self.logs, self.stations,

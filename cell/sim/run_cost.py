@@ -69,7 +69,7 @@ def measure(r: RunSummary, scenario: Any, stops: Sequence[tuple[str, str, float,
         total = run_cost(r, scenario, stops)
     else:
         total = run_cost(r, scenario, [row for rows in line.stopped for row in rows],
-                         sum(row.down_fraction for row in line.rows(r.sim_end_s)))
+                         sum(row.down_fraction for row in line.rows))
     _, good = oee.produced_and_good(column, scenario.quality.rule)
     r.cost_per_good_part = total / good if good else math.nan
     r.cost_per_h = total / (r.sim_end_s / 3600.0) if r.sim_end_s > 0 else math.nan

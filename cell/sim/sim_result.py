@@ -100,7 +100,7 @@ class SimResult:
         """states.csv's rows; a layout's station by station, each naming its station."""
         if self.line is None:
             return oee.state_spans(self.timelines)
-        return [span for name, lines in self.line.timelines(self.summary.sim_end_s)
+        return [span for name, lines in self.line.timelines
                 for span in oee.state_spans(lines, name)]
 
     def stops(self) -> list[Stop]:

@@ -337,7 +337,7 @@ class Run:
         result.downtime, result.timelines, result.stop_rows = downtime, lines, stops
         result.wear = wear_clock.measures(wear, downtime, env.now)
         if line:  # stations.csv's rows, the line's measures (cell.sim.line)
-            result.station_rows, result.line = line.rows(env.now), line
+            result.station_rows, result.line = line.rows, line
             line.measure(summary, log, env.now)
         return result
 

@@ -101,7 +101,7 @@ def measure(r: RunSummary, scenario: Any, lines: Timelines, log: Any, downtime: 
     lines = timelines(scenario, lines, column, downtime, end_s, stops)
     arm = log.energy_of
     joules = sum(state_energy_j(own, energy, busy=arm is None)
-                 for own in ([lines] if line is None else [o for _, o in line.timelines(end_s)]))
+                 for own in ([lines] if line is None else [o for _, o in line.timelines]))
     if arm is not None:
         joules += arm.total_j
         r.arm_energy_per_transfer_j = arm.total_j / arm.transfers if arm.transfers else float("nan")
