@@ -369,23 +369,20 @@ class Line:
         order = np.argsort(times, kind="stable")
         times, count = times[order], np.cumsum(steps[order])  # parts in the line from each instant
         area = float(np.sum(count[:-1] * np.diff(times))) if times.size else 0.0
-        hours = end_s / 3600.0
+        done = int(np.count_nonzero(np.isfinite(td)))
         summary.line_wip_mean = area / end_s if end_s > 0 else math.nan
-        summary.line_throughput_per_h = int(np.count_nonzero(np.isfinite(td))) / hours \
-            if end_s > 0 else math.nan
+        summary.line_throughput_per_h = done / (end_s / 3600.0) if end_s > 0 else math.nan
 
 
 def _no_belts(belt: int) -> None:
     """A station after the first keeps no belt history (belts.csv is the first's)."""
-    return None
 
 
 def build(env: simpy.Environment, cell: AssembledCell, seed: Any, log: Any, told: Any,
           downtime: Downtime | None, t_list: list[float], n: int,
           keep: Callable[[], Any] | None = None) -> tuple[Line | None, Station, Feeder]:
     """The station fed by the feeder, and with ``buffer:`` or ``stations:`` the line it is the
-    first of (cell.sim.line; None without); ``keep``: each station's visits and belts kept,
-    in belt logs it makes (:class:`Line`)."""
+    first of (None without); ``keep``: each station's visits and belts kept (:class:`Line`)."""
     if not cell.scenario.has_layout:
         station = Station(env, cell, seed, log.delivered_part, told, downtime)
         feeder = Feeder(env, t_list, station.input, n, cell.k.part_size, log.flag)
@@ -399,6 +396,5 @@ def build(env: simpy.Environment, cell: AssembledCell, seed: Any, log: Any, told
 
 
 def has_buffer(cell: AssembledCell) -> bool:
-    """Whether any station of the layout has a ``buffer:`` section (parts.csv's
-    ``buffer_wait_s``)."""
+    """Whether any station of the layout has a ``buffer:`` (parts.csv's ``buffer_wait_s``)."""
     return any(c.scenario.buffer is not None for c in (cell, *(own for _, own in cell.line)))
