@@ -35,7 +35,7 @@ belt's floor: where the belt stood (a failure, a shift calendar) the pass leaves
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -69,27 +69,53 @@ def greedy_picks(come_s: Sequence[float] | Array, length_in: float, v_min: float
     at least a cycle at the floor: :func:`greedy_pass`, or all of them where
     :func:`all_picked` finds from the whole array at once that the pass picks every one."""
     come = np.asarray(come_s, dtype=float)
-    if all_picked(come, length_in / v_max, length_in / v_min, cycle_min_s - EPS_S,
-                  v_max / v_min, SLACK_IN / v_min, (part_size_in + SLACK_IN) / v_min, one_belt):
+    args = (length_in, v_min, v_max, part_size_in, cycle_min_s, one_belt)
+    if all_picked(come, *args):
         return int(come.size)  # speed: docs/performance.md#bound-at-once
-    return greedy_pass(come, length_in, v_min, v_max, part_size_in, cycle_min_s, one_belt)
+    return greedy_pass(come, *args)
+
+
+class PassConstants(NamedTuple):
+    """What the greedy pass works with, from the cell's figures (:func:`pass_constants`)."""
+
+    early: float
+    """B reached at the belt's ceiling after the drop (s)."""
+    late: float
+    """B reached at the belt's floor after the drop (s)."""
+    clear: float
+    """The floor's time to carry a part's size (s): the feeder's next drop at the earliest."""
+    cycle: float
+    """Two picks at least this far apart (the fastest cycle less EPS_S)."""
+    per_s: float
+    """v_max / v_min: a second between arrivals, in seconds of the floor."""
+    slack_s: float
+    """SLACK_IN at the floor (s)."""
+    gap_min: float
+    """The belt's shortest distance to the last part, at the floor: its size and SLACK_IN (s)."""
+
+
+def pass_constants(length_in: float, v_min: float, v_max: float, part_size_in: float,
+                   cycle_min_s: float) -> PassConstants:
+    """The pass's constants for a belt of ``length_in`` between ``v_min`` and ``v_max``,
+    parts ``part_size_in`` long and the fastest cycle ``cycle_min_s``."""
+    return PassConstants(length_in / v_max, length_in / v_min, part_size_in / v_min,
+                         cycle_min_s - EPS_S, v_max / v_min, SLACK_IN / v_min,
+                         (part_size_in + SLACK_IN) / v_min)
 
 
 def greedy_pass(come_s: Sequence[float] | Array, length_in: float, v_min: float, v_max: float,
                 part_size_in: float, cycle_min_s: float, one_belt: bool = True) -> int:
     """:func:`greedy_picks` worked out by the greedy pass of the module's text, a part at a
     time."""
-    early, late, clear = length_in / v_max, length_in / v_min, part_size_in / v_min
-    cycle = cycle_min_s - EPS_S
-    gap_min = (part_size_in + SLACK_IN) / v_min  # the belt's distance to the last part, at
-    per_s = v_max / v_min                        # the floor: its size, or v_max per second
+    early, late, clear, cycle, per_s, slack_s, gap_min = pass_constants(
+        length_in, v_min, v_max, part_size_in, cycle_min_s)
     next_drop = next_pick = -float("inf")  # the latest drop plus clear; the last pick plus c
     at, next_at = 0.0, -float("inf")  # the part's s; the last pick's s plus c (one belt)
     last = None
     count = 0
     for come in np.asarray(come_s, dtype=float).tolist():
         if last is not None:
-            gap = per_s * (come - last) + SLACK_IN / v_min
+            gap = per_s * (come - last) + slack_s
             at += gap if gap > gap_min else gap_min
         last = come
         latest_drop = come if come > next_drop else next_drop
@@ -105,25 +131,25 @@ def greedy_pass(come_s: Sequence[float] | Array, length_in: float, v_min: float,
     return count
 
 
-def all_picked(come: Array, early: float, late: float, cycle: float, per_s: float,
-               slack_s: float, gap_min: float, one_belt: bool) -> bool:
-    """Whether :func:`greedy_pass` picks every part coming at ``come``, each at its earliest
-    (the pass's ``early``, ``late``, ``cycle``, ``per_s`` and ``gap_min``; ``slack_s`` =
-    SLACK_IN / v_min), found without the pass: the earliest picks r_i = a_i + early are each a
-    cycle after the one before (the same floats as the pass's r_i and last pick plus c); a
-    part's window ends no earlier than it starts (early <= late, so r_i <= D_i + late, as
-    D_i >= a_i); and with ``one_belt`` each part's belt gap at the floor, the pass's
-    g_i = max(per_s (a_i - a_(i-1)) + slack_s, gap_min), is a cycle at least, so
-    s_i >= s_(i-1) + c.  Arrivals not all finite are left to the pass."""
-    if not come.size or not early <= late:
+def all_picked(come: Array, length_in: float, v_min: float, v_max: float, part_size_in: float,
+               cycle_min_s: float, one_belt: bool = True) -> bool:
+    """Whether :func:`greedy_pass` picks every part coming at ``come``, each at its earliest,
+    found without the pass (in its constants, :func:`pass_constants`): the earliest picks
+    r_i = a_i + early are each a cycle after the one before (the same floats as the pass's r_i
+    and last pick plus c); a part's window ends no earlier than it starts (early <= late, so
+    r_i <= D_i + late, as D_i >= a_i); and with ``one_belt`` each part's belt gap at the
+    floor, the pass's g_i = max(per_s (a_i - a_(i-1)) + slack_s, gap_min), is a cycle at
+    least, so s_i >= s_(i-1) + c.  Arrivals not all finite are left to the pass."""
+    c = pass_constants(length_in, v_min, v_max, part_size_in, cycle_min_s)
+    if not come.size or not c.early <= c.late:
         return False
-    first = come + early
-    if not np.isfinite(first).all() or not (first[1:] >= first[:-1] + cycle).all():
+    first = come + c.early
+    if not np.isfinite(first).all() or not (first[1:] >= first[:-1] + c.cycle).all():
         return False
     if not one_belt:
         return True
-    gap = np.maximum(per_s * np.diff(come) + slack_s, gap_min)
-    return bool((gap >= cycle).all())
+    gap = np.maximum(c.per_s * np.diff(come) + c.slack_s, c.gap_min)
+    return bool((gap >= c.cycle).all())
 
 
 def parts_bound(k: CellConstants, come_s: Sequence[float] | Array, belt: Belt | None = None,

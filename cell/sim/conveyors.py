@@ -164,7 +164,7 @@ class Belt:
 
     def _settle(self, n: int) -> None:
         """The first ``n`` changes are final: note their speeds and tell ``on_change`` (the
-        last of them kept as the anchor a stop starts from)."""
+        last of them kept as the anchor a stop starts from, if the belt is ``stoppable``)."""
         if n and self.stoppable:
             self._at_t, self._at_x, self._at_v = self._t[n - 1], self._x[n - 1], self._v[n - 1]
         vs = self._v

@@ -11,7 +11,6 @@ from hypothesis import strategies as st
 from cell.scenario.schema import Scenario
 from cell.sim.assembly import assemble
 from cell.sim.bound import (
-    SLACK_IN,
     all_picked,
     fastest_possible_cycle,
     greedy_pass,
@@ -140,7 +139,5 @@ def test_all_picked_read_at_once_is_the_pass(gaps: list[float], slack: float, on
     args = (come, 12.0, v[0], v[1], 1.0, 10.0, one_belt)
     counted = greedy_pass(*args)
     assert greedy_picks(*args) == counted
-    early, late = 12.0 / v[1], 12.0 / v[0]
-    if all_picked(np.asarray(come, dtype=float), early, late, 10.0 - EPS_S, v[1] / v[0],
-                  SLACK_IN / v[0], (1.0 + SLACK_IN) / v[0], one_belt):
+    if all_picked(np.asarray(come, dtype=float), *args[1:]):
         assert counted == len(come)
